@@ -1,0 +1,111 @@
+"""The in-memory trial record every reader returns and every analysis consumes.
+
+A :class:`TrialRecord` holds time series in SI units (seconds, metres, radians,
+metres per second, revolutions per second).  Channels a source does not carry
+are ``None``.  Heading is always unwrapped (continuous), so analyses never have
+to care whether the source wrapped it to (-pi, pi] or [0, 2 pi).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Optional
+
+import numpy as np
+
+CHANNELS = ("x", "y", "psi", "U", "u", "v", "r", "delta", "n")
+"""Optional channels of a record, besides time ``t``.
+
+x, y   position of midship, earth-fixed, x north and y east [m]
+psi    heading, unwrapped [rad]
+U      speed over ground [m/s]
+u, v   surge and sway velocity at midship [m/s]
+r      yaw rate [rad/s]
+delta  rudder angle, positive to starboard [rad]
+n      propeller revolutions [rps]
+"""
+
+
+@dataclass(frozen=True)
+class TrialRecord:
+    """A manoeuvre as recorded: time plus whichever channels the source had.
+
+    Parameters
+    ----------
+    t : ndarray
+        Time [s], strictly increasing.
+    name : str
+        Trial name (e.g. ``"zz10"`` or the source file's stem).
+    ship : str
+        Ship name.
+    source : str
+        Where it came from (file path, or ``"simulation"``).
+    x, y, psi, U, u, v, r, delta, n : ndarray or None
+        Channels, see :data:`CHANNELS`.
+    meta : dict
+        Free-form metadata (seed, start position, trial kind, ...).
+    """
+
+    t: np.ndarray
+    name: str = ""
+    ship: str = ""
+    source: str = ""
+    x: Optional[np.ndarray] = None
+    y: Optional[np.ndarray] = None
+    psi: Optional[np.ndarray] = None
+    U: Optional[np.ndarray] = None
+    u: Optional[np.ndarray] = None
+    v: Optional[np.ndarray] = None
+    r: Optional[np.ndarray] = None
+    delta: Optional[np.ndarray] = None
+    n: Optional[np.ndarray] = None
+    meta: dict = field(default_factory=dict)
+
+    def channels(self) -> tuple[str, ...]:
+        """Names of the channels present in this record."""
+        return tuple(c for c in CHANNELS if getattr(self, c) is not None)
+
+    def speed(self) -> np.ndarray:
+        """Speed [m/s]: ``U`` if recorded, else sqrt(u^2 + v^2), else from the track."""
+        if self.U is not None:
+            return self.U
+        if self.u is not None and self.v is not None:
+            return np.hypot(self.u, self.v)
+        if self.u is not None:
+            return np.abs(self.u)
+        if self.x is not None and self.y is not None:
+            return np.hypot(np.gradient(self.x, self.t), np.gradient(self.y, self.t))
+        raise ValueError(f"record {self.name!r} has no channel to compute speed from")
+
+    def yaw_rate(self) -> np.ndarray:
+        """Yaw rate [rad/s]: ``r`` if recorded, else a central difference of ``psi``."""
+        if self.r is not None:
+            return self.r
+        if self.psi is None:
+            raise ValueError(f"record {self.name!r} has neither r nor psi")
+        return np.gradient(self.psi, self.t)
+
+    def to_pandas(self):
+        """The channels as a DataFrame indexed by time [s] (SI units)."""
+        import pandas as pd
+
+        data = {c: getattr(self, c) for c in self.channels()}
+        return pd.DataFrame(data, index=pd.Index(self.t, name="t"))
+
+    def slice_time(self, t0: float, t1: float) -> "TrialRecord":
+        """The part of the record with t0 <= t <= t1."""
+        m = (self.t >= t0) & (self.t <= t1)
+        kw = {f.name: getattr(self, f.name) for f in fields(self)}
+        for c in ("t",) + CHANNELS:
+            if kw[c] is not None:
+                kw[c] = kw[c][m]
+        return TrialRecord(**kw)
+
+    def equals(self, other: "TrialRecord", rtol: float = 0.0, atol: float = 0.0) -> bool:
+        """Channel-by-channel equality (within tolerances) plus same names and metadata."""
+        if self.channels() != other.channels() or (self.name, self.ship) != (other.name, other.ship):
+            return False
+        for c in ("t",) + self.channels():
+            a, b = getattr(self, c), getattr(other, c)
+            if a.shape != b.shape or not np.allclose(a, b, rtol=rtol, atol=atol):
+                return False
+        return True
