@@ -1,0 +1,114 @@
+"""Steady straight run: the rpm, trim rudder and drift that hold a given speed.
+
+Rhee & Kim (1999) start every trial from 10 kn straight ahead with the rpm that
+zeroes the surge equation (their n_0 = 54.12 rpm).  Y_0 and N_0 make delta = 0
+non-straight, so we also solve the small trim rudder angle and sway velocity
+that make Y = N = 0 with r = 0.  For a constant-power engine the delivered power
+is P_0 = watts_per_hp * SHP_0(u_0) (eqs. 18-19); since no Esso Osaka K_Q(J) is
+published, the K_Q curve is scaled so that the shaft is in torque balance at the
+solved point (the fact sheet's recommendation), which makes the straight run a
+true equilibrium of all eight states.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import fsolve
+
+from .model import POLY_KQ, N_, PackedShip, forces, pack, polyval, rhs
+from .ship import Ship
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """A steady straight run.
+
+    u [m/s], v [m/s], delta [rad] (trim rudder), n [rps], engine power P_0 [W],
+    K_Q_scale (factor applied to K_Q so the shaft balances; 1 for constant rpm),
+    residual: max |du/dt|, |dv/dt|, |dr/dt|, |dn/dt| at the solution.
+    """
+
+    u: float
+    v: float
+    delta: float
+    n: float
+    power_W: float
+    K_Q_scale: float
+    residual: float
+
+    def state(self) -> np.ndarray:
+        """Initial state vector [u, v, r, x, y, psi, delta, n] at the origin heading north."""
+        return np.array([self.u, self.v, 0.0, 0.0, 0.0, 0.0, self.delta, self.n])
+
+
+def engine_power(ship: Ship, u0: float) -> float:
+    """Constant engine power P_0 [W] = watts_per_hp * SHP_0(u0), eq. (18)-(19)."""
+    return ship.engine.watts_per_hp * float(np.polyval(ship.engine.SHP_0[::-1], u0))
+
+
+def _accels(pk: PackedShip, u, v, delta, n):
+    x = np.array([u, v, 0.0, 0.0, 0.0, 0.0, delta, n])
+    out = np.zeros(8)
+    rhs(x, delta, *pk.args(), out)
+    return out
+
+
+def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = True,
+                 disturbance_slots: dict | None = None) -> Equilibrium:
+    """Solve the steady straight run at surge speed ``u0`` [m/s].
+
+    Parameters
+    ----------
+    ship : Ship
+    u0 : float
+        Approach speed [m/s].
+    n : float, optional
+        Propeller revolutions [rps]; solved from the surge balance when None.
+    trim : bool
+        Solve the trim rudder and sway velocity that cancel Y_0, N_0 (else delta = v = 0).
+    disturbance_slots : dict, optional
+        Packed disturbance values (see :mod:`mmg.disturbances`).
+    """
+    power = engine_power(ship, u0) if ship.engine.mode == "constant_power" else 0.0
+    pk = pack(ship, power, disturbance_slots)
+    n_guess = n if n is not None else u0 / (0.6 * ship.propeller.D)
+
+    def unpack(z):
+        nn = z[0] if n is None else n
+        vv, dd = (z[-2], z[-1]) if trim else (0.0, 0.0)
+        return nn, vv, dd
+
+    def resid(z):
+        nn, vv, dd = unpack(z)
+        a = _accels(pk, u0, vv, dd, nn)
+        out = []
+        if n is None:
+            out.append(a[0])
+        if trim:
+            out += [a[1], a[2]]
+        return out
+
+    z0 = ([n_guess] if n is None else []) + ([0.0, 0.0] if trim else [])
+    if z0:
+        z = fsolve(resid, z0, xtol=1e-13, full_output=False)
+    else:
+        z = []
+    nn, vv, dd = unpack(z)
+    scale = 1.0
+    if ship.engine.mode == "constant_power":
+        x = np.array([u0, vv, 0.0, 0.0, 0.0, 0.0, dd, nn])
+        J = forces(x, *pk.args())[3]
+        kq = polyval(pk.poly[POLY_KQ], J)
+        D, rho = ship.propeller.D, ship.particulars.rho
+        scale = power / (2 * np.pi * nn) / (rho * nn**2 * D**5 * kq)
+    pk2 = pack(with_kq_scale(ship, scale), power, disturbance_slots)
+    a = _accels(pk2, u0, vv, dd, nn)
+    res = float(np.max(np.abs(a[[0, 1, 2, N_]])))
+    return Equilibrium(u=u0, v=float(vv), delta=float(dd), n=float(nn), power_W=power,
+                       K_Q_scale=float(scale), residual=res)
+
+
+def with_kq_scale(ship: Ship, scale: float) -> Ship:
+    """The ship with its K_Q curve scaled (see module docstring)."""
+    return replace(ship, propeller=replace(ship.propeller, K_Q_scale=scale))

@@ -1,0 +1,264 @@
+"""The 3-DOF MMG model: forces and equations of motion as small compiled functions.
+
+State vector (SI), index constants below::
+
+    x = [u, v, r, x0, y0, psi, delta, n]
+
+u, v    surge and sway velocity of midship through the water [m/s]
+r       yaw rate [rad/s]
+x0, y0  position of midship over ground, north and east [m]
+psi     heading [rad], delta rudder angle [rad] (+ to starboard), n propeller revolutions [rps]
+
+Forces follow Rhee & Kim (1999) eqs. (1)-(20) with the MMG rudder and propeller
+model of Yasukawa & Yoshimura (2015); the equations of motion are written about
+midship with the centre of gravity at x_G (x_G = 0 gives Rhee & Kim eqs. 1-3).
+
+The ship is packed once into a flat parameter vector ``p`` (layout below), a
+polynomial table ``poly`` and the hull's term tables, so every function here
+compiles with numba and runs on real or complex numbers (complex-step
+derivatives for the estimator use the same code).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from .nondim import force_scale, inertia_scale, mass_scale, moment_scale, r_prime
+from .ship import Ship
+from .terms import AXES, TERMS, sabs, term_value
+
+# state indices
+U_, V_, R_, X_, Y_, PSI_, DELTA_, N_ = range(8)
+STATE_NAMES = ("u", "v", "r", "x", "y", "psi", "delta", "n")
+STATE_UNITS = ("m/s", "m/s", "rad/s", "m", "m", "rad", "rad", "rps")
+
+# parameter-vector layout
+(
+    P_RHO, P_L, P_T, P_XG, P_M, P_MX, P_MY, P_IZ, P_JZ,
+    P_D, P_XP, P_WAKE, P_CWAKE, P_C1, P_C2POS, P_C2NEG, P_KQSCALE,
+    P_AR, P_FALPHA, P_EPS, P_KAPPA, P_ETA, P_TR, P_AH, P_XH, P_XR, P_GPOS, P_GNEG, P_LR,
+    P_TE, P_RATE, P_DMAX,
+    P_ENGINE, P_POWER, P_SHAFT_I,
+    P_CUR_SPEED, P_CUR_DIR, P_RUDDER_OFFSET, P_EXT_X, P_EXT_Y, P_EXT_N,
+    N_PARAMS,
+) = range(42)
+
+# polynomial table rows
+POLY_KT, POLY_KQ, POLY_TP, POLY_WP0 = range(4)
+POLY_WIDTH = 6
+
+ENGINE_CONSTANT_POWER, ENGINE_CONSTANT_RPM = 0, 1
+WAKE_KIJIMA, WAKE_MMG2015 = 0, 1
+
+
+@dataclass(frozen=True)
+class PackedShip:
+    """A ship in the arrays the compiled code reads (see module docstring)."""
+
+    p: np.ndarray
+    poly: np.ndarray
+    hull_axis: np.ndarray
+    hull_term: np.ndarray
+    hull_coef: np.ndarray
+
+    def args(self):
+        """Positional arguments of the compiled functions after the state."""
+        return self.p, self.poly, self.hull_axis, self.hull_term, self.hull_coef
+
+
+def _poly_row(c) -> np.ndarray:
+    row = np.zeros(POLY_WIDTH)
+    row[: len(c)] = c
+    return row
+
+
+def pack(ship: Ship, engine_power_W: float = 0.0, disturbance_slots: dict | None = None) -> PackedShip:
+    """Pack a :class:`~mmg.ship.Ship` into arrays.
+
+    Parameters
+    ----------
+    ship : Ship
+    engine_power_W : float
+        Delivered power P_0 [W] for a constant-power engine (from the approach
+        condition, see :func:`mmg.equilibrium.engine_power`).
+    disturbance_slots : dict, optional
+        Parameter-vector index -> value, as written by :mod:`mmg.disturbances`.
+    """
+    pa, ms, pr, ru, st, en = ship.particulars, ship.mass, ship.propeller, ship.rudder, ship.steering, ship.engine
+    p = np.zeros(N_PARAMS)
+    p[P_RHO], p[P_L], p[P_T], p[P_XG] = pa.rho, pa.L, pa.T, pa.x_G
+    ms_ = mass_scale(pa.rho, pa.L, pa.T)
+    is_ = inertia_scale(pa.rho, pa.L, pa.T)
+    p[P_M], p[P_MX], p[P_MY] = ms.m_prime * ms_, ms.m_x_prime * ms_, ms.m_y_prime * ms_
+    p[P_IZ], p[P_JZ] = ms.I_zG_prime * is_, ms.J_z_prime * is_
+    p[P_D], p[P_XP] = pr.D, pr.x_P_prime
+    p[P_WAKE] = WAKE_KIJIMA if pr.wake_model == "kijima" else WAKE_MMG2015
+    p[P_CWAKE], p[P_C1], p[P_C2POS], p[P_C2NEG], p[P_KQSCALE] = pr.C_wake, pr.C_1, pr.C_2_pos, pr.C_2_neg, pr.K_Q_scale
+    p[P_AR], p[P_FALPHA], p[P_EPS], p[P_KAPPA], p[P_ETA] = ru.A_R, ru.f_alpha, ru.epsilon, ru.kappa, ru.eta
+    p[P_TR], p[P_AH], p[P_XH], p[P_XR] = ru.t_R, ru.a_H, ru.x_H_prime * pa.L, ru.x_R_prime * pa.L
+    p[P_GPOS], p[P_GNEG], p[P_LR] = ru.gamma_R_pos, ru.gamma_R_neg, ru.l_R_prime
+    p[P_TE], p[P_RATE], p[P_DMAX] = st.T_E, st.rate_max, st.delta_max
+    p[P_ENGINE] = ENGINE_CONSTANT_POWER if en.mode == "constant_power" else ENGINE_CONSTANT_RPM
+    p[P_POWER] = engine_power_W
+    p[P_SHAFT_I] = en.shaft_inertia_coefficient * pr.D**5
+    for k, v in (disturbance_slots or {}).items():
+        p[k] = v
+    poly = np.vstack([_poly_row(pr.K_T), _poly_row(pr.K_Q), _poly_row(pr.t_P), _poly_row(pr.w_P0)])
+    h = ship.hull
+    return PackedShip(
+        p=p,
+        poly=poly,
+        hull_axis=np.array([AXES[a] for a in h.axes], dtype=np.int64),
+        hull_term=np.array([TERMS[t] for t in h.terms], dtype=np.int64),
+        hull_coef=np.array(h.values, dtype=np.float64),
+    )
+
+
+# --------------------------------------------------------------------------- force components
+
+
+@njit(cache=True, inline="always")
+def polyval(c, x):
+    """Polynomial with coefficients ``c`` (lowest power first) at ``x`` (Horner)."""
+    acc = c[c.shape[0] - 1] + 0.0 * x
+    for i in range(c.shape[0] - 2, -1, -1):
+        acc = acc * x + c[i]
+    return acc
+
+
+@njit(cache=True)
+def kinematics(u, v, r, L):
+    """Speed U [m/s], drift angle beta = atan(-v/u) [rad], v' and r' at midship."""
+    U = np.sqrt(u * u + v * v)
+    beta = np.arctan(-v / u)
+    return U, beta, v / U, r_prime(r, L, U)
+
+
+@njit(cache=True)
+def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
+    """Primed hull forces (X_H', Y_H', N_H') = sum of coefficient x term per axis."""
+    X = 0.0 * beta
+    Y = 0.0 * beta
+    N = 0.0 * beta
+    for i in range(hull_coef.shape[0]):
+        val = hull_coef[i] * term_value(hull_term[i], beta, vp, rp)
+        a = hull_axis[i]
+        if a == 0:
+            X += val
+        elif a == 1:
+            Y += val
+        else:
+            N += val
+    return X, Y, N
+
+
+@njit(cache=True)
+def one_minus_wake(u, beta, rp, p, poly):
+    """(1 - w_P) in manoeuvring: Kijima exp(-C beta_P^2) or MMG 2015 form, beta_P = beta - x_P' r'."""
+    w0 = polyval(poly[POLY_WP0], u)
+    bp = beta - p[P_XP] * rp
+    if p[P_WAKE] == WAKE_KIJIMA:
+        return 1.0 - w0 * np.exp(-p[P_CWAKE] * bp * bp)
+    c2 = p[P_C2POS] if bp.real > 0.0 else p[P_C2NEG]
+    return (1.0 - w0) * (1.0 + (1.0 - np.exp(-p[P_C1] * sabs(bp))) * (c2 - 1.0))
+
+
+@njit(cache=True)
+def propeller(u, n, one_minus_wP, p, poly):
+    """Advance ratio J_P, thrust coefficient K_T and surge force X_P [N] (eq. 12)."""
+    D = p[P_D]
+    J = u * one_minus_wP / (n * D)
+    KT = polyval(poly[POLY_KT], J)
+    tP = polyval(poly[POLY_TP], u)
+    XP = (1.0 - tP) * p[P_RHO] * n * n * D ** 4 * KT
+    return J, KT, XP
+
+
+@njit(cache=True)
+def rudder(u, U, beta, rp, delta, one_minus_wP, J, KT, p):
+    """MMG rudder forces (X_R, Y_R, N_R) [N, N, N m] and the normal force F_N [N]."""
+    d = delta + p[P_RUDDER_OFFSET]
+    uP = u * one_minus_wP
+    s = 1.0 + p[P_KAPPA] * (np.sqrt(1.0 + 8.0 * KT / (np.pi * J * J)) - 1.0)
+    uR = p[P_EPS] * uP * np.sqrt(p[P_ETA] * s * s + (1.0 - p[P_ETA]))
+    bR = beta - p[P_LR] * rp
+    g = p[P_GPOS] if bR.real >= 0.0 else p[P_GNEG]
+    vR = U * g * bR
+    alpha = d - np.arctan(vR / uR)
+    FN = 0.5 * p[P_RHO] * p[P_AR] * (uR * uR + vR * vR) * p[P_FALPHA] * np.sin(alpha)
+    cd = np.cos(d)
+    XR = -(1.0 - p[P_TR]) * FN * np.sin(d)
+    YR = -(1.0 + p[P_AH]) * FN * cd
+    NR = -(p[P_XR] + p[P_AH] * p[P_XH]) * FN * cd
+    return XR, YR, NR, FN
+
+
+@njit(cache=True)
+def steering_rate(delta_cmd, delta, p):
+    """Steering gear, Rhee & Kim eq. (20): rudder rate [rad/s] towards the clipped order."""
+    dmax = p[P_DMAX]
+    c = min(max(delta_cmd, -dmax), dmax)
+    err = c - delta
+    if abs(err.real) <= p[P_TE] * p[P_RATE]:
+        return err / p[P_TE]
+    return (p[P_RATE] if err.real > 0.0 else -p[P_RATE]) + 0.0 * err
+
+
+@njit(cache=True)
+def shaft_acceleration(u, n, J, p, poly):
+    """dn/dt [rps/s] of the shaft, eq. (15): 2 pi (I+J) dn/dt = Q_P + Q_E (constant power)."""
+    if p[P_ENGINE] != ENGINE_CONSTANT_POWER:
+        return 0.0 * n
+    D = p[P_D]
+    KQ = p[P_KQSCALE] * polyval(poly[POLY_KQ], J)
+    QP = -p[P_RHO] * n * n * D ** 5 * KQ
+    QE = p[P_POWER] / (2.0 * np.pi * n)
+    return (QP + QE) / (2.0 * np.pi * p[P_SHAFT_I])
+
+
+@njit(cache=True)
+def forces(x, p, poly, hull_axis, hull_term, hull_coef):
+    """Total surge and sway force [N] and yaw moment [N m] about midship, and J_P."""
+    u, v, r, delta, n = x[U_], x[V_], x[R_], x[DELTA_], x[N_]
+    L = p[P_L]
+    U, beta, vp, rp = kinematics(u, v, r, L)
+    XHp, YHp, NHp = hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef)
+    fs = force_scale(p[P_RHO], L, p[P_T], U)
+    ms = moment_scale(p[P_RHO], L, p[P_T], U)
+    owp = one_minus_wake(u, beta, rp, p, poly)
+    J, KT, XP = propeller(u, n, owp, p, poly)
+    XR, YR, NR, FN = rudder(u, U, beta, rp, delta, owp, J, KT, p)
+    X = XHp * fs + XP + XR + p[P_EXT_X]
+    Y = YHp * fs + YR + p[P_EXT_Y]
+    N = NHp * ms + NR + p[P_EXT_N]
+    return X, Y, N, J
+
+
+@njit(cache=True)
+def rhs(x, delta_cmd, p, poly, hull_axis, hull_term, hull_coef, out):
+    """Time derivative of the state, written into ``out`` (MMG equations of motion).
+
+    (m+m_x) du/dt - (m+m_y) v r - x_G m r^2 = X
+    (m+m_y) dv/dt + x_G m dr/dt + (m+m_x) u r = Y
+    (I_zG + x_G^2 m + J_z) dr/dt + x_G m (dv/dt + u r) = N
+    """
+    u, v, r, psi = x[U_], x[V_], x[R_], x[PSI_]
+    X, Y, N, J = forces(x, p, poly, hull_axis, hull_term, hull_coef)
+    m, mx, my, xG = p[P_M], p[P_MX], p[P_MY], p[P_XG]
+    a11 = m + my
+    a12 = xG * m
+    a22 = p[P_IZ] + xG * xG * m + p[P_JZ]
+    b1 = Y - (m + mx) * u * r
+    b2 = N - xG * m * u * r
+    det = a11 * a22 - a12 * a12
+    out[V_] = (b1 * a22 - a12 * b2) / det
+    out[R_] = (a11 * b2 - a12 * b1) / det
+    out[U_] = (X + (m + my) * v * r + xG * m * r * r) / (m + mx)
+    c, s = np.cos(psi), np.sin(psi)
+    out[X_] = u * c - v * s + p[P_CUR_SPEED] * np.cos(p[P_CUR_DIR])
+    out[Y_] = u * s + v * c + p[P_CUR_SPEED] * np.sin(p[P_CUR_DIR])
+    out[PSI_] = r
+    out[DELTA_] = steering_rate(delta_cmd, x[DELTA_], p)
+    out[N_] = shaft_acceleration(u, x[N_], J, p, poly)

@@ -1,0 +1,109 @@
+"""Named hull-force terms: the hull model is a sum of coefficients times these terms.
+
+A hull force component (X_H', Y_H' or N_H', all primed, see :mod:`mmg.nondim`)
+is ``sum_i c_i * term_i(beta, v', r')``.  The Kijima (1990) form used for the
+Esso Osaka writes its terms in the drift angle beta = atan(-v/u) and r' = rL/U;
+the MMG standard method (Yasukawa & Yoshimura 2015) used for KVLCC2 writes them
+in v' = v/U and r'.  Both draw from the one registry below, so the simulator,
+the estimator (whose Jacobian with respect to a coefficient *is* the term's
+value) and later model extensions share the same definitions.
+
+Each term is a key (the expression as written in the configs) and an integer id
+used inside compiled code.  ``|x|`` is the absolute value: ``beta|beta|`` is the
+odd quadratic Kijima uses.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+TERMS: dict[str, int] = {
+    "1": 0,
+    "beta": 1,
+    "r": 2,
+    "beta|beta|": 3,
+    "r|r|": 4,
+    "beta^2*r": 5,
+    "beta*r^2": 6,
+    "r*sin(beta)": 7,
+    "cos(beta)^2": 8,
+    "v": 9,
+    "v^2": 10,
+    "v*r": 11,
+    "r^2": 12,
+    "v^4": 13,
+    "v^3": 14,
+    "v^2*r": 15,
+    "v*r^2": 16,
+    "r^3": 17,
+    "v|v|": 18,
+}
+"""Term expression -> integer id (beta [rad], v = v', r = r', all dimensionless)."""
+
+TERM_NAMES = {i: k for k, i in TERMS.items()}
+
+AXES = {"X": 0, "Y": 1, "N": 2}
+
+
+@njit(cache=True)
+def sabs(x):
+    """|x| written so that complex-step differentiation stays analytic (sign from the real part)."""
+    return x if x.real >= 0.0 else -x
+
+
+@njit(cache=True)
+def term_value(tid, beta, vp, rp):
+    """Value of term ``tid`` at drift angle beta [rad], v' and r' (dimensionless)."""
+    if tid == 0:
+        return 1.0 + 0.0 * beta
+    if tid == 1:
+        return beta
+    if tid == 2:
+        return rp
+    if tid == 3:
+        return beta * sabs(beta)
+    if tid == 4:
+        return rp * sabs(rp)
+    if tid == 5:
+        return beta * beta * rp
+    if tid == 6:
+        return beta * rp * rp
+    if tid == 7:
+        return rp * np.sin(beta)
+    if tid == 8:
+        c = np.cos(beta)
+        return c * c
+    if tid == 9:
+        return vp
+    if tid == 10:
+        return vp * vp
+    if tid == 11:
+        return vp * rp
+    if tid == 12:
+        return rp * rp
+    if tid == 13:
+        return vp * vp * vp * vp
+    if tid == 14:
+        return vp * vp * vp
+    if tid == 15:
+        return vp * vp * rp
+    if tid == 16:
+        return vp * rp * rp
+    if tid == 17:
+        return rp * rp * rp
+    if tid == 18:
+        return vp * sabs(vp)
+    return 0.0 * beta
+
+
+def term_id(key: str) -> int:
+    """Integer id of a term expression; KeyError lists the known ones."""
+    try:
+        return TERMS[key]
+    except KeyError:
+        raise KeyError(f"unknown hull term {key!r}; known terms: {', '.join(TERMS)}") from None
+
+
+def evaluate_terms(term_ids, beta, vp, rp) -> np.ndarray:
+    """Values of several terms at one point, as an array (Python convenience)."""
+    return np.array([term_value(int(t), beta, vp, rp) for t in term_ids])
