@@ -102,7 +102,8 @@ def write_trial_outputs(run, stage: StagedOutput, show: bool = False) -> dict:
     return m
 
 
-def print_metrics(m: dict, out=sys.stdout) -> None:
+def print_metrics(m: dict, out=None) -> None:
+    out = out or sys.stdout
     keys = ["trial", "kind", "approach_speed_kn", "approach_rpm", "trim_rudder_deg", "advance_L", "transfer_L",
             "tactical_diameter_L", "steady_diameter_L", "speed_loss", "overshoots_deg", "initial_turning_time_s",
             "period_s", "final_heading_change_deg"]

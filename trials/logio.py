@@ -83,7 +83,7 @@ def write_csv(path: Path, df: pd.DataFrame, meta: dict) -> None:
     """Write a DataFrame with a ``# key: value`` metadata header."""
     with open(path, "w") as fh:
         fh.write(_header(meta))
-        df.to_csv(fh, index=False, float_format="%.10g")
+        df.to_csv(fh, index=False, float_format="%.12g")
 
 
 def truth_frame(t, states, orders) -> pd.DataFrame:
@@ -135,6 +135,12 @@ def _check(df: pd.DataFrame, cols, source: str, time_col: str, max_gap: float | 
         raise InputError(source, time_col, f"gap of {dt[gap[0]]:g} s at t = {t[gap[0]]:g} s (sampling {med:g} s)")
 
 
+def unwrap_heading(psi_wrapped: np.ndarray) -> np.ndarray:
+    """Continuous heading [rad] from a wrapped one, starting on the branch (-pi, pi]."""
+    psi = np.unwrap(psi_wrapped)
+    return psi - 2 * np.pi * np.round(psi[0] / (2 * np.pi))
+
+
 def read_record(path: str | Path) -> TrialRecord:
     """Read a project log, a project truth file or an FRT-DS-ESSO CSV into a TrialRecord."""
     path = Path(path)
@@ -179,7 +185,7 @@ def read_record(path: str | Path) -> TrialRecord:
             extra["delta"] = df["rudder_deg"].to_numpy(dtype=float) * DEG
         return TrialRecord(t=a["time_s"], name=name, ship=ship, source=src,
                            x=(a["lat_deg"] - lat0) * mlat, y=(a["lon_deg"] - lon0) * mlon,
-                           psi=np.unwrap(np.radians(a["heading_deg"])), U=a["speed_kn"] * KNOT,
+                           psi=unwrap_heading(np.radians(a["heading_deg"])), U=a["speed_kn"] * KNOT,
                            n=a["rpm"] / 60.0, meta={**meta, "format": "log"}, **extra)
     missing = sorted(set(LOG_COLUMNS) - cols)
     raise InputError(src, missing[0] if missing else "", "missing column (not a project log, truth file or FRT-DS-ESSO CSV)")
@@ -189,7 +195,7 @@ def _read_frt(df: pd.DataFrame, src: str, path: Path) -> TrialRecord:
     present = [c for c in FRT_COLUMNS if c in df.columns]
     _check(df, list(FRT_REQUIRED) + [c for c in present if c not in FRT_REQUIRED], src, "t [s]")
     a = {FRT_COLUMNS[c]: df[c].to_numpy(dtype=float) for c in present}
-    psi = np.unwrap(a.pop("psi"))
+    psi = unwrap_heading(a.pop("psi"))
     u, v = a.get("u"), a.get("v")
     U = np.hypot(u, v) if u is not None and v is not None else None
     meta = {"format": "frt-ds-esso", "ship": "Esso Osaka 3 m model", "length_m": 3.0}
