@@ -73,13 +73,13 @@ def dump_json(obj, path: Path) -> None:
         json.dump(obj, fh, indent=2, default=_json_default)
 
 
-def fmt(v, nd=3):
+def fmt(v, nd=4):
     if v is None:
         return "-"
     if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(fmt(x, nd) for x in v) + "]"
+        return "[" + ", ".join(f"{x:.{min(nd, 2)}f}" for x in v) + "]"
     if isinstance(v, (float, np.floating)):
-        return f"{v:.{nd}f}"
+        return f"{v:.{nd}g}"
     return str(v)
 
 
@@ -146,8 +146,8 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
         if rec.x is None:
             raise InputError(rec.source, "lat_deg", "turning metrics need the track (positions)")
         out.update(MET.turning_metrics(rec.t, rec.x, rec.y, rec.psi, U, L,
-                                       t_execute=rec.meta.get("execute_s", None) if rec.delta is None else None,
-                                       delta=rec.delta))
+                                       t_execute=rec.meta.get("execute_s"), delta=rec.delta,
+                                       order=rec.meta.get("delta_order")))
     else:
         order = rec.meta.get("delta_order", rec.delta)
         ang = angle

@@ -41,15 +41,30 @@ def fit_circle(x, y):
     return xc, yc, float(np.sqrt(c[2] + xc * xc + yc * yc))
 
 
-def execute_time(t, delta=None, threshold=0.5 * DEG):
-    """Rudder execute: first time the rudder has moved ``threshold`` from its initial angle (0 without rudder)."""
+def execute_time(t, delta=None, order=None):
+    """Rudder execute time [s].
+
+    From the rudder order when known (the instant it departs from its initial value by
+    more than 0.5 deg: the IMO execute); else from the measured rudder angle, as the
+    instant it first reaches half of its final (held) value, which is robust to the
+    small rudder motions of an approach; else the start of the record.
+    """
+    t = np.asarray(t, dtype=float)
+    if order is not None:
+        o = np.asarray(order, dtype=float)
+        moved = np.flatnonzero(np.abs(o - o[0]) > 0.5 * DEG)
+        return float(t[moved[0]]) if moved.size else float(t[0])
     if delta is None:
         return float(t[0])
-    moved = np.flatnonzero(np.abs(delta - delta[0]) > threshold)
-    return float(t[moved[0]]) if moved.size else float(t[0])
+    d = np.asarray(delta, dtype=float)
+    final = float(np.median(d[len(d) // 2:]))
+    if abs(final) < 1 * DEG:
+        return float(t[0])
+    reached = np.flatnonzero(np.sign(final) * d >= 0.5 * abs(final))
+    return float(t[reached[0]]) if reached.size else float(t[0])
 
 
-def turning_metrics(t, x, y, psi, U, L, t_execute=None, delta=None) -> dict:
+def turning_metrics(t, x, y, psi, U, L, t_execute=None, delta=None, order=None) -> dict:
     """Turning-circle metrics; lengths divided by L.
 
     Parameters
@@ -60,8 +75,8 @@ def turning_metrics(t, x, y, psi, U, L, t_execute=None, delta=None) -> dict:
         Ship length [m].
     t_execute : float, optional
         Rudder execute time [s]; from ``delta`` (see :func:`execute_time`) when omitted.
-    delta : array, optional
-        Rudder angle [rad].
+    delta, order : array, optional
+        Rudder angle and rudder order [rad] (for the execute time).
 
     Returns
     -------
@@ -71,7 +86,7 @@ def turning_metrics(t, x, y, psi, U, L, t_execute=None, delta=None) -> dict:
     when the record does not reach the heading change they need.
     """
     t, x, y, psi, U = (np.asarray(a, dtype=float) for a in (t, x, y, psi, U))
-    te = execute_time(t, delta) if t_execute is None else float(t_execute)
+    te = execute_time(t, delta, order) if t_execute is None else float(t_execute)
     i0 = int(np.searchsorted(t, te))
     i0 = min(i0, len(t) - 1)
     psi0, x0, y0, U0 = psi[i0], x[i0], y[i0], U[i0]
