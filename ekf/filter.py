@@ -223,11 +223,11 @@ def _check(z, P):
 
 
 @njit(cache=True)
-def filter_kernel(z0, P0, meas, delta, dt, R, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag):
+def filter_kernel(z0, P0, meas, delta, dt, R, q, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag):
     """The whole pass: predict (RK4 + complex-step F), P = F P F^T, Joseph update, checks.
 
     meas (N, 4) u, v, r, n at times k*dt; delta (N,); zs (N, 16) and pdiag (N, 16) are filled
-    (row 0 the initial values). Returns (status, step index, final P).
+    (row 0 the initial values); q: Q = q I (0 in the paper). Returns (status, step index, final P).
     """
     nz = z0.shape[0]
     N = meas.shape[0]
@@ -242,6 +242,9 @@ def filter_kernel(z0, P0, meas, delta, dt, R, p, poly, hull_axis, hull_term, hul
         propagate_jacobian(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, hull_coef, idx, zn, F)
         z[:] = zn
         P = F @ P @ F.T
+        if q > 0.0:
+            for i in range(nz):
+                P[i, i] += q
         st = _check(z, P)
         if st != OK:
             return st, k, P
@@ -317,11 +320,11 @@ class FilterResult:
         return {n: float(self.z[-1, NS + i]) for i, n in enumerate(DERIVATIVES)}
 
 
-def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str = "") -> FilterResult:
+def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str = "", q: float = 0.0) -> FilterResult:
     """Run the compiled EKF over a whole record; raises FilterDivergence on failure.
 
     t (N,) equally spaced [s]; meas (N, 4) u, v, r, n; delta (N,) rudder [rad];
-    z0 (16,), P0 (16, 16), R (4, 4).
+    z0 (16,), P0 (16, 16), R (4, 4); q: Q = q I per step (0 = the paper's Q = 0).
     """
     t = np.asarray(t, float)
     dt = float(t[1] - t[0])
@@ -330,7 +333,7 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     zs = np.full((N, NZ), np.nan)
     pd_ = np.full((N, NZ), np.nan)
     st, k, P = filter_kernel(np.asarray(z0, float), np.asarray(P0, float), meas, np.asarray(delta, float), dt,
-                             np.asarray(R, float), *packed.args(), np.asarray(slots, np.int64), zs, pd_)
+                             np.asarray(R, float), float(q), *packed.args(), np.asarray(slots, np.int64), zs, pd_)
     if st != OK:
         raise FilterDivergence(trial, t[k], _REASON[st])
     return FilterResult(t, zs, pd_, P)

@@ -1,0 +1,397 @@
+"""From a sea-trial log (or a trial YAML, simulated first) to derivative estimates and reports.
+
+:func:`load_config` reads ``configs/estimation/rhee_kim.yaml`` (overridable);
+:func:`data_from_log` / :func:`data_from_trial` give a :class:`TrialData` (the recovered
+0.1 s measurements, the packed ship, the truth if known); :func:`estimate` runs the
+filter; :func:`write_reports` writes the estimates, the Table-10-style error table and
+the convergence figures (Rhee & Kim Figs 15-26, all trials on one figure per derivative).
+"""
+from __future__ import annotations
+
+import copy
+import json
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from mmg.errors import InputError
+from mmg.simulation import prepare
+from mmg.ship import Ship, load_ship
+from mmg.units import KNOT, to_si
+
+from .filter import DERIVATIVES, NS, NZ, STATES, FilterResult, derivative_slots, run_filter
+from .preprocess import Measurements, compare_with_truth, plot_comparison, recover
+
+REPO = Path(__file__).resolve().parents[1]
+DEFAULT_CONFIG = REPO / "configs" / "estimation" / "rhee_kim.yaml"
+DEFAULT_SHIP = REPO / "configs" / "ships" / "esso_osaka.yaml"
+G = 9.80665
+
+
+# --------------------------------------------------------------------------- configuration
+
+
+def _merge(base: dict, over: dict) -> dict:
+    out = copy.deepcopy(base)
+    for k, v in (over or {}).items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = _merge(out[k], v)
+        else:
+            out[k] = v
+    return out
+
+
+def _set(cfg: dict, assignment: str) -> None:
+    if "=" not in assignment:
+        raise InputError("--set", assignment, "expected key.path=value")
+    key, val = assignment.split("=", 1)
+    parts = key.strip().split(".")
+    d = cfg
+    for p in parts[:-1]:
+        if not isinstance(d.get(p), dict):
+            d[p] = {}
+        d = d[p]
+    d[parts[-1]] = yaml.safe_load(val)
+
+
+def load_config(path: str | Path | None = None, sets=()) -> dict:
+    """The estimation config: the default file, merged with ``path`` and ``--set`` assignments; validated."""
+    with open(DEFAULT_CONFIG) as fh:
+        cfg = yaml.safe_load(fh)
+    src = str(DEFAULT_CONFIG)
+    if path is not None:
+        src = str(path)
+        try:
+            with open(path) as fh:
+                over = yaml.safe_load(fh) or {}
+        except FileNotFoundError:
+            raise InputError(src, "", "file not found") from None
+        except yaml.YAMLError as e:
+            raise InputError(src, "", f"not valid YAML ({str(e).splitlines()[0]})") from None
+        if not isinstance(over, dict):
+            raise InputError(src, "", "expected a mapping")
+        cfg = _merge(cfg, over)
+    for s in sets:
+        _set(cfg, s)
+    _validate(cfg, src)
+    return cfg
+
+
+def _validate(cfg: dict, src: str) -> None:
+    try:
+        cfg["dt_s"] = to_si(str(cfg["dt"]), "time")
+    except Exception as e:  # noqa: BLE001 - any bad dt is an input error
+        raise InputError(src, "dt", f"bad time step ({e})") from None
+    if not cfg["dt_s"] > 0:
+        raise InputError(src, "dt", "must be positive")
+    if cfg.get("P0_is") not in ("variance", "std"):
+        raise InputError(src, "P0_is", "must be 'variance' or 'std'")
+    for name in STATES + DERIVATIVES:
+        v = cfg.get("P0", {}).get(name)
+        if not isinstance(v, (int, float)) or not np.isfinite(v) or v <= 0:
+            raise InputError(src, f"P0.{name}", f"must be a positive number, got {v!r}")
+    q = cfg.get("Q", 0.0)
+    if not isinstance(q, (int, float)) or q < 0:
+        raise InputError(src, "Q", "must be a non-negative number")
+    sc = cfg.get("initial", {}).get("scale", 1.2)
+    if not isinstance(sc, (int, float)) or not np.isfinite(sc):
+        raise InputError(src, "initial.scale", "must be a number")
+    for k, v in (cfg.get("initial", {}).get("values") or {}).items():
+        if k not in DERIVATIVES:
+            raise InputError(src, f"initial.values.{k}", f"unknown derivative; known: {', '.join(DERIVATIVES)}")
+        if not isinstance(v, (int, float)) or not np.isfinite(v):
+            raise InputError(src, f"initial.values.{k}", "must be a finite number")
+    if "default" not in cfg.get("R", {}):
+        raise InputError(src, "R.default", "missing")
+    for trial, row in cfg["R"].items():
+        for ch in STATES:
+            v = (row or {}).get(ch)
+            if not isinstance(v, (int, float)) or not np.isfinite(v) or v <= 0:
+                raise InputError(src, f"R.{trial}.{ch}", f"must be a positive number, got {v!r}")
+
+
+def R_for(cfg: dict, trial: str) -> np.ndarray:
+    """Diagonal R (4x4) for a trial name (Table 8; ``default`` otherwise)."""
+    row = cfg["R"].get(trial, cfg["R"]["default"])
+    return np.diag([float(row[c]) for c in STATES])
+
+
+def P0_for(cfg: dict) -> np.ndarray:
+    v = np.array([float(cfg["P0"][n]) for n in STATES + DERIVATIVES])
+    return np.diag(v if cfg["P0_is"] == "variance" else v * v)
+
+
+# --------------------------------------------------------------------------- data
+
+
+@dataclass
+class TrialData:
+    """What the filter needs for one trial, and the truth when it is known."""
+
+    name: str
+    meas: Measurements
+    ship: Ship
+    packed: object
+    slots: np.ndarray
+    reference: dict          # the ship file's derivatives (initial guess = scale x these)
+    truth: object = None     # TrialRecord of the truth file, when known
+    true_values: dict | None = None
+    source: str = ""
+
+
+def _fit_checks(rec, ship: Ship, n_eq: float, cfg: dict, src: str) -> None:
+    fc = cfg.get("fit_checks", {})
+    L = ship.particulars.L
+    if "length_m" in rec.meta:
+        lm = float(rec.meta["length_m"])
+        if abs(lm / L - 1) > fc.get("length_mismatch", 0.05):
+            raise InputError(src, "length_m", f"log is for a {lm:g} m ship but {ship.name} is {L:g} m long")
+    if rec.U is not None:
+        Fn = np.asarray(rec.U) / np.sqrt(G * L)
+        lo, hi = fc.get("froude_min", 0.01), fc.get("froude_max", 0.35)
+        if np.nanmax(Fn) > hi or np.nanmedian(Fn) < lo:
+            raise InputError(src, "speed_kn", f"logged speeds {np.nanmin(rec.U) / KNOT:.3g}-{np.nanmax(rec.U) / KNOT:.3g} kn "
+                                              f"(Froude {np.nanmin(Fn):.3g}-{np.nanmax(Fn):.3g}) are outside the range "
+                                              f"{lo:g}-{hi:g} the {ship.name} model covers")
+    n0 = float(rec.n[0])
+    if not n0 > 0 or abs(n0 / n_eq - 1) > fc.get("rpm_mismatch", 0.25):
+        raise InputError(src, "rpm", f"first logged rpm {n0 * 60:.4g} does not fit {ship.name}: its straight run at "
+                                     f"the logged speed needs {n_eq * 60:.4g} rpm")
+
+
+def data_from_log(path: str | Path, cfg: dict, ship_path: str | Path | None = None,
+                  truth_path: str | Path | None = None) -> TrialData:
+    """Read a project log, check it fits the ship, recover the 0.1 s measurements."""
+    from trials.logio import read_record
+
+    rec = read_record(path)
+    src = str(path)
+    if rec.meta.get("format") != "log":
+        raise InputError(src, "", f"expected a project sea-trial log (time_s, lat_deg, lon_deg, heading_deg, speed_kn, "
+                                  f"rpm), got a {rec.meta.get('format')} file")
+    if len(rec.t) < 10:
+        raise InputError(src, "time_s", f"only {len(rec.t)} samples; too short to estimate from")
+    ship = load_ship(ship_path or DEFAULT_SHIP)
+    u0 = float(rec.meta.get("approach_speed_kn", rec.U[0] / KNOT)) * KNOT
+    if not (u0 > 0 and np.isfinite(u0)):
+        raise InputError(src, "speed_kn", "the approach speed must be positive")
+    if u0 / np.sqrt(G * ship.particulars.L) > cfg.get("fit_checks", {}).get("froude_max", 0.35):
+        raise InputError(src, "speed_kn", f"approach speed {u0 / KNOT:.3g} kn is far beyond what the {ship.name} model covers")
+    try:
+        pk, eq = prepare(ship, u0)
+    except Exception as e:  # noqa: BLE001 - a failed equilibrium means the log doesn't fit
+        raise InputError(src, "speed_kn", f"no straight run of {ship.name} at {u0 / KNOT:.3g} kn ({e})") from None
+    _fit_checks(rec, ship, eq.n, cfg, src)
+    meas = recover(rec, pk.p, dt=cfg["dt_s"])
+    truth = None
+    tv = None
+    if truth_path is not None:
+        truth = read_record(truth_path)
+        tv = ship.hull.as_dict()
+    ref = ship.hull.as_dict()
+    return TrialData(rec.name, meas, ship, pk, derivative_slots(pk, DERIVATIVES, ship), ref, truth, tv, src)
+
+
+def data_from_trial(path: str | Path, cfg: dict, seed: int | None = None, workdir: str | Path | None = None) -> TrialData:
+    """Simulate a trial YAML (with noise seed ``seed``), write its log and truth, recover the measurements."""
+    import tempfile
+
+    from trials.logio import write_csv
+    from trials.run import run_trial
+    from trials.trial import load_trial
+
+    tr = load_trial(path)
+    if tr.kind not in ("turning", "zigzag", "stype"):
+        raise InputError(str(path), "manoeuvre.kind", f"the estimator rebuilds the rudder of turning, zigzag and S-type "
+                                                      f"trials only, not {tr.kind}")
+    if seed is not None:
+        tr = replace(tr, log=replace(tr.log, seed=int(seed)))
+    run = run_trial(tr)
+    wd = Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="ekf-"))
+    wd.mkdir(parents=True, exist_ok=True)
+    meta = run.log_meta()
+    log_path, truth_path = wd / "log.csv", wd / "truth.csv"
+    write_csv(log_path, run.log(), meta)
+    write_csv(truth_path, run.truth(), meta)
+    ship_path = tr.ship_path
+    return data_from_log(log_path, cfg, ship_path=ship_path, truth_path=truth_path)
+
+
+# --------------------------------------------------------------------------- estimation
+
+
+@dataclass
+class Estimate:
+    data: TrialData
+    result: FilterResult
+    initial: dict
+    R: np.ndarray
+
+    @property
+    def name(self) -> str:
+        return self.data.name
+
+    @property
+    def final(self) -> dict:
+        return self.result.final
+
+    def errors_pct(self) -> dict | None:
+        tv = self.data.true_values
+        if tv is None:
+            return None
+        return {n: 100.0 * abs(self.final[n] - tv[n]) / abs(tv[n]) for n in DERIVATIVES}
+
+
+def initial_state(data: TrialData, cfg: dict) -> np.ndarray:
+    m = data.meas
+    ini = cfg.get("initial", {})
+    sc = float(ini.get("scale", 1.2))
+    vals = ini.get("values") or {}
+    der = [float(vals[n]) if n in vals else sc * data.reference[n] for n in DERIVATIVES]
+    return np.r_[m.u[0], m.v[0], m.r[0], m.n[0], der]
+
+
+def estimate(data: TrialData, cfg: dict) -> Estimate:
+    """Run the augmented EKF on one trial (raises FilterDivergence naming the trial and time)."""
+    z0 = initial_state(data, cfg)
+    R = R_for(cfg, data.name)
+    P0 = P0_for(cfg)
+    q = float(cfg.get("Q", 0.0))
+    res = run_filter(data.packed, data.slots, data.meas.t, data.meas.z(), data.meas.delta, z0, P0, R,
+                     trial=data.name, q=q)
+    return Estimate(data, res, dict(zip(DERIVATIVES, z0[NS:])), R)
+
+
+# --------------------------------------------------------------------------- reports
+
+
+def estimates_json(ests: list[Estimate]) -> dict:
+    """{derivative: {"estimate", "true", "error_pct"}} (true/error_pct when the truth is known).
+
+    Top-level keys are always the 12 derivative names. With several trials the values are
+    those of the first input, ``"trial"`` names it and ``"by_trial"`` holds every trial's.
+    """
+    def one(e: Estimate, n: str) -> dict:
+        err = e.errors_pct()
+        d = {"estimate": e.final[n]}
+        if err is not None:
+            d["true"] = e.data.true_values[n]
+            d["error_pct"] = err[n]
+        return d
+    out = {}
+    for n in DERIVATIVES:
+        d = one(ests[0], n)
+        if len(ests) > 1:
+            d["trial"] = ests[0].name
+            d["by_trial"] = {e.name: one(e, n) for e in ests}
+        out[n] = d
+    return out
+
+
+def error_table(ests: list[Estimate]) -> pd.DataFrame:
+    """Table 10 layout: per derivative the real value, and per trial final value and % error."""
+    rows = []
+    for n in DERIVATIVES:
+        row = {"coeff": n}
+        tv = next((e.data.true_values for e in ests if e.data.true_values), None)
+        row["real"] = tv[n] if tv else np.nan
+        for e in ests:
+            row[f"{e.name} final"] = e.final[n]
+            err = e.errors_pct()
+            row[f"{e.name} err(%)"] = err[n] if err else np.nan
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def to_markdown(df: pd.DataFrame) -> str:
+    cols = list(df.columns)
+    lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
+    for _, r in df.iterrows():
+        cells = []
+        for c in cols:
+            v = r[c]
+            if isinstance(v, str):
+                cells.append(v)
+            elif "err" in c:
+                cells.append("" if not np.isfinite(v) else f"{v:.2f}")
+            else:
+                cells.append("" if not np.isfinite(v) else f"{v:+.4e}")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+LABELS = {"Y_beta": r"$Y'_\beta$", "Y_r": r"$Y'_r$", "Y_bb": r"$Y'_{\beta|\beta|}$", "Y_rr": r"$Y'_{r|r|}$",
+          "Y_bbr": r"$Y'_{\beta\beta r}$", "Y_brr": r"$Y'_{\beta rr}$", "N_beta": r"$N'_\beta$", "N_r": r"$N'_r$",
+          "N_bb": r"$N'_{\beta|\beta|}$", "N_rr": r"$N'_{r|r|}$", "N_bbr": r"$N'_{\beta\beta r}$",
+          "N_brr": r"$N'_{\beta rr}$"}
+
+
+def plot_convergence(ests: list[Estimate], out_dir: str | Path, stride: int = 10) -> list[Path]:
+    """One PNG per derivative with every trial's estimate history (Rhee & Kim Figs 15-26)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for i, n in enumerate(DERIVATIVES):
+        fig, ax = plt.subplots(figsize=(7, 4))
+        for e in ests:
+            r = e.result
+            ax.plot(r.t[::stride], r.z[::stride, NS + i], lw=1.0, label=e.name)
+        tv = next((e.data.true_values for e in ests if e.data.true_values), None)
+        if tv:
+            ax.axhline(tv[n], color="k", ls="--", lw=1.0, label="real")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel(f"{LABELS[n]} [-] (non-dimensional)")
+        ax.set_title(f"Convergence of {n} (augmented EKF, cf. Rhee & Kim Figs 15-26)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        p = out_dir / f"convergence_{n}.png"
+        fig.savefig(p, dpi=100)
+        plt.close(fig)
+        paths.append(p)
+    return paths
+
+
+def write_reports(ests: list[Estimate], out, plots: bool = True) -> dict:
+    """estimates.json, error_table.csv/.md, final_estimates.csv, convergence_*.png, preprocessing_*.png.
+
+    ``out`` is a folder path or a staging object with ``.path(name)``.
+    """
+    def P(name):
+        if hasattr(out, "path"):
+            return out.path(name)
+        p = Path(out) / name
+        p.parent.mkdir(parents=True, exist_ok=True)
+        return p
+
+    with open(P("estimates.json"), "w") as fh:
+        json.dump(estimates_json(ests), fh, indent=2)
+    tab = error_table(ests)
+    tab.to_csv(P("error_table.csv"), index=False, float_format="%.6g")
+    P("error_table.md").write_text(to_markdown(tab))
+    fin = pd.DataFrame({e.name: e.final for e in ests})
+    fin.index.name = "derivative"
+    fin.to_csv(P("final_estimates.csv"), float_format="%.6g")
+    rms = {}
+    if plots:
+        plot_convergence(ests, P("convergence_Y_beta.png").parent)
+        for e in ests:
+            if e.data.truth is not None:
+                safe = e.name.replace(" ", "_").replace("/", "_")
+                rms[e.name] = plot_comparison(e.data.meas, e.data.truth, P(f"preprocessing_{safe}.png"))
+    else:
+        for e in ests:
+            if e.data.truth is not None:
+                rms[e.name] = compare_with_truth(e.data.meas, e.data.truth)
+    if rms:
+        with open(P("preprocessing_rms.json"), "w") as fh:
+            json.dump(rms, fh, indent=2)
+    return {"table": tab, "rms": rms}
