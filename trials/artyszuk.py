@@ -256,6 +256,11 @@ def _window_scale(z: nm.ZigzagData, spec: dict, half_width: float) -> nm.ZigzagD
             m = np.abs(z.s - at[p]) <= half_width
             arr[m] *= f
         kw[ch] = arr
+        if ch == "psi" and z.psi_raw is not None:  # the fits read the raw heading
+            raw = kw.get("psi_raw", z.psi_raw.copy())
+            for p, f in pts.items():
+                raw[np.abs(z.s - at[p]) <= half_width] *= f
+            kw["psi_raw"] = raw
     return dataclasses.replace(z, **kw)
 
 
@@ -385,6 +390,7 @@ def reproduce(fast: bool = False) -> dict:
     }
     cl = nm.classical_first_order(sim2, n_half=3)
     cdf = cl.to_pandas()
+    cdf["half_cycle"] = cdf["half_cycle"].astype(object)
     cdf.loc[len(cdf)] = {"half_cycle": "mean", "K": cl.K, "T_cr": cl.T, "K_os": cl.K_os, "T_os": cl.T_os,
                          "T_zero": float(np.nanmean(cdf["T_zero"]))}
     cdf.loc[len(cdf)] = {"half_cycle": "paper (Artyszuk 2016)", "K": PAPER_CLASSICAL["K"], "T_cr": PAPER_CLASSICAL["T"]}

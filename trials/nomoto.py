@@ -443,8 +443,14 @@ def _state_space(model: NomotoModel):
         A = np.array([[0.0, 1.0], [0.0, -1.0 / T1]])
         B = np.array([0.0, K / T1])
         return A, B, None
-    a0, a1 = 1.0 / (T1 * T2), (T1 + T2) / (T1 * T2)
-    b1, b0 = K * T3 / (T1 * T2), K / (T1 * T2)
+    return _state_space_x(K, T1 * T2, T1 + T2, T3)
+
+
+def _state_space_x(K, x1, x2, T3):
+    """State space of eq. (13) from K, x1 = T1 T2, x2 = T1 + T2, T3 (valid for complex T1, T2 too)."""
+    T1T2 = x1
+    a0, a1 = 1.0 / x1, x2 / x1
+    b1, b0 = K * T3 / T1T2, K / T1T2
     A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, -a0, -a1]])
     B = np.array([0.0, b1, b0 - a1 * b1])
     return A, B, b1
@@ -460,8 +466,9 @@ def simulate_response(model: NomotoModel, s, delta, psi0: float = 0.0, omega0: f
 
     Parameters
     ----------
-    model : NomotoModel
-        Model.
+    model : NomotoModel or tuple
+        Model, or a tuple (K, x1, x2, T3) with x1 = T1 T2, x2 = T1 + T2 (eq. 16),
+        which also covers complex T1, T2.
     s : ndarray
         Dimensionless distances [-], increasing.  Non-uniform steps are allowed
         (a matrix exponential is computed per distinct step).
@@ -476,7 +483,7 @@ def simulate_response(model: NomotoModel, s, delta, psi0: float = 0.0, omega0: f
     """
     s = np.asarray(s, float)
     u = np.asarray(delta, float) - delta_bias
-    A, B, b1 = _state_space(model)
+    A, B, b1 = _state_space_x(*model) if isinstance(model, tuple) else _state_space(model)
     n = A.shape[0]
     x = np.array([psi0, omega0] + ([] if b1 is None else [eps0 - b1 * u[0]]), float)
     out = np.empty((len(s), n))
@@ -819,7 +826,7 @@ def zigzag_data(record: TrialRecord, L: float, U: Optional[float] = None, per_kn
         if b + 2 - ie < len(s):
             i1, i2 = b + 1 - ie, b + 2 - ie
             slope = (dl[i2] - dl[i1]) / (s[i2] - s[i1])
-            if slope * sg < 0:
+            if slope * sg * sign < 0:
                 sc = float(np.clip(s[i1] - (dl[i1] - level) / slope, s[a - ie] if a >= ie else s[0], s[i1]))
         s_cr.append(float(sc))
     s_cr = tuple(s_cr)
@@ -1322,8 +1329,9 @@ def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bia
 
     The model is simulated exactly (:func:`simulate_response`) from the state at
     the execute; K, T1, T2, T3 (and a neutral rudder angle) minimise the heading
-    residual over the whole zigzag (``scipy.optimize.least_squares``, T1, T2 kept
-    positive and T2 <= T1 by parametrisation T2 = T1 * sigmoid).  Only heading and
+    residual over the whole zigzag (``scipy.optimize.least_squares`` over K,
+    T1 T2, T1 + T2, T3, unconstrained, so a course-unstable ship with T1 < 0 or
+    complex T1, T2 can be fitted).  Only heading and
     rudder enter, so errors in the derived yaw rate and acceleration do not bias
     the parameters (they only set the initial state).  95 % intervals from
     sigma^2 (J^T J)^-1 at the optimum (optimistic if residuals are correlated).
@@ -1345,47 +1353,39 @@ def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bia
     ss, dd, pp = s[idx], (z.delta + z.delta_e)[idx], (z.psi if z.psi_raw is None else z.psi_raw)[idx]
     if start is None:
         ls = fit_least_squares(z, fit_bias=fit_bias)
-        ok = np.isfinite([ls.K, ls.T1, ls.T2, ls.T3]).all() and ls.T1 > 0 and ls.T2 > 0 and ls.K > 0
+        ok = np.isfinite([ls.K, ls.T1, ls.T2, ls.T3]).all() and abs(ls.T1 * ls.T2) > 1e-6
         start = ls.model if ok else NomotoModel(2.0, 3.0, 0.3, 1.0)
-
     nb = 1 if fit_bias else 0
 
-    def unpack(p):
-        K, T1, frac, T3 = p[:4]
-        T2 = T1 / (1 + np.exp(-frac))
-        return NomotoModel(K, T1, T2, T3), (p[4] if fit_bias else 0.0)
+    # parameters q = (K, x1 = T1 T2, x2 = T1 + T2, T3[, delta_bias], psi_0, omega'_0, eps'_0): no bounds,
+    # so unstable ships (T1 < 0) and complex T1, T2 are reachable; the state at the execute is fitted too
+    def resid(q):
+        return simulate_response((q[0], q[1], q[2], q[3]), ss, dd, q[4 + nb], q[5 + nb], q[6 + nb],
+                                 q[4] if fit_bias else 0.0) - pp
 
-    def resid(p):
-        m, db = unpack(p)
-        p0_, w0, e0 = p[4 + nb:7 + nb]
-        psi = simulate_response(m, ss, dd, p0_, w0, e0, db)
-        return psi - pp
-
-    T1s, T2s = max(start.T1, 1e-3), min(max(start.T2, 1e-4), 0.99 * max(start.T1, 1e-3))
-    frac0 = np.log((T2s / T1s) / (1 - T2s / T1s))
-    init = [0.0, z.omega_e, z.eps_e]  # heading offset, omega', eps' at the execute: nuisance parameters
-    p0 = [start.K, T1s, frac0, start.T3] + ([0.0] if fit_bias else []) + init
-    lb = [-np.inf, 1e-4, -20, -np.inf] + ([-np.inf] if fit_bias else []) + [-np.inf] * 3
-    ub = [np.inf, np.inf, 20, np.inf] + ([np.inf] if fit_bias else []) + [np.inf] * 3
-    sol = optimize.least_squares(resid, p0, bounds=(lb, ub), x_scale="jac", max_nfev=400)
-    m, db = unpack(sol.x)
-    ini = sol.x[4 + nb:7 + nb]
-
-    # covariance in the natural parameters K, T1, T2, T3 (, bias), initial state included
-    def resid_nat(q):
-        mm = NomotoModel(q[0], q[1], q[2], q[3])
-        return simulate_response(mm, ss, dd, q[4 + nb], q[5 + nb], q[6 + nb], q[4] if fit_bias else 0.0) - pp
-
-    q = np.array([m.K, m.T1, m.T2, m.T3] + ([db] if fit_bias else []) + list(ini))
-    J = _jac(resid_nat, q)
+    q0 = np.array([start.K, start.T1 * start.T2, start.T1 + start.T2, start.T3] + ([0.0] if fit_bias else [])
+                  + [0.0, z.omega_e, z.eps_e])
+    sol = optimize.least_squares(resid, q0, x_scale="jac", max_nfev=600)
+    q = sol.x
+    J = _jac(resid, q)
     r = sol.fun
     n, p = len(r), len(q)
     s2 = r @ r / max(n - p, 1)
     cov = s2 * np.linalg.pinv(J.T @ J)
-    sd = np.sqrt(np.abs(np.diag(cov)))
+
+    def to_params(th):
+        K, T1, T2, T3, _ = _params_from_x(np.array([th[1], th[2], -th[0], -th[0] * th[3]]))
+        return np.array([K, T1, T2, T3] + ([th[4]] if fit_bias else []), float)
+
+    par = to_params(q)
     names = ["K", "T1", "T2", "T3"] + (["delta_bias"] if fit_bias else [])
-    ci = {nm: (float(v - Z95 * e), float(v + Z95 * e)) for nm, v, e in zip(names, q, sd)}
+    ci = _delta_method(q, cov, to_params, names)
     note = "" if sol.success else f"optimiser: {sol.message}"
+    if not np.isfinite(par[1]):
+        note = (note + "; " if note else "") + f"T1, T2 not real (T1 T2 = {q[1]:.4g}, T1 + T2 = {q[2]:.4g})"
+    m = NomotoModel(par[0], par[1], par[2], par[3])
+    db = par[4] if fit_bias else 0.0
+    ini = q[4 + nb:7 + nb]
     res = FitResult("output_error", float(m.K), float(m.T1), float(m.T2), float(m.T3), ci, float(db),
                     float(np.sqrt(np.mean(r ** 2))), n, note)
     object.__setattr__(res, "initial_state", tuple(float(v) for v in ini))
@@ -1417,7 +1417,8 @@ def heading_rms(model: NomotoModel, z: ZigzagData, delta_bias: float = 0.0) -> f
     delta_bias : float
         Neutral rudder angle [rad].
     """
-    if not np.all(np.isfinite([model.K, model.T1, model.T2, model.T3])) or model.T1 <= 0 or model.T2 < 0:
+    if not np.all(np.isfinite([model.K, model.T1, model.T2, model.T3])) or model.T1 == 0 or \
+            (model.order == 2 and model.T2 == 0):
         return float("nan")
     psi = simulate_response(model, z.s, z.delta + z.delta_e, 0.0, z.omega_e, z.eps_e, delta_bias)
     return float(np.sqrt(np.mean((psi - z.psi) ** 2)))
@@ -1520,6 +1521,6 @@ def identify(record: TrialRecord, L: float, U: Optional[float] = None, output_er
     rms = {"first_order": heading_rms(cl.model, z), "four_point": heading_rms(fp.model, z),
            "least_squares": heading_rms(ls.model, z, ls.delta_bias)}
     if oe is not None:
-        rms["output_error"] = heading_rms(oe.model, z, oe.delta_bias)
+        rms["output_error"] = oe.rms  # from its own fitted state at the execute
     rms = {k: float(np.degrees(v)) for k, v in rms.items()}
     return NomotoIdentification(z, pts, cl, fp, ls, oe, rms)
