@@ -10,12 +10,11 @@
    3 m Esso Osaka model's measured turning metrics (computed here from the
    FRT-DS-ESSO files when ``../shared/data/frt-ds-esso`` is present);
 5. step convergence and port/starboard symmetry checks;
-6. the parts other modules provide when installed: Nomoto identification
-   (Artyszuk 2018 tables) and the EKF reproduction (Rhee & Kim Tables 9-10).
+6. the Nomoto models and their identification (Artyszuk 2018, Tables 1-8);
+7. the EKF reproduction (Rhee & Kim 1999, Tables 9-10).
 """
 from __future__ import annotations
 
-import importlib
 import io
 import sys
 import time
@@ -162,20 +161,29 @@ def checks_section(ship):
     print()
 
 
-def optional_sections(out: Path, quick: bool):
-    for mod, fn, title in (("trials.artyszuk", "reproduce_all", "## 6. Nomoto models: Artyszuk (2018) tables"),
-                           ("ekf.reproduce", "reproduce_rhee_kim", "## 7. EKF: Rhee & Kim (1999) Tables 9-10")):
-        try:
-            m = importlib.import_module(mod)
-        except ModuleNotFoundError:
-            continue
-        f = getattr(m, fn, None)
-        if f is None:
-            continue
-        print(title + "\n")
-        t0 = time.perf_counter()
-        f(out / mod.split(".")[-1])
-        print(f"\n({time.perf_counter() - t0:.1f} s)\n")
+def nomoto_section(out: Path, quick: bool):
+    from . import artyszuk
+
+    print("## 6. Nomoto models: Artyszuk (2018) Tables 1-8\n")
+    t0 = time.perf_counter()
+    tables = artyszuk.reproduce(fast=quick)
+    artyszuk.write_tables(tables, out / "nomoto")
+    for key, title in artyszuk.TITLES.items():
+        if key in tables:
+            print(f"### {title}\n")
+            print(artyszuk.to_markdown(tables[key]))
+            print()
+    print(f"(tables in {out / 'nomoto'}; {time.perf_counter() - t0:.1f} s)\n")
+
+
+def ekf_section(out: Path, quick: bool):
+    from ekf.reproduce import reproduce_rhee_kim
+
+    print("## 7. EKF: Rhee & Kim (1999) Tables 9-10\n")
+    t0 = time.perf_counter()
+    reproduce_rhee_kim(out / "ekf", verbose=False)
+    print((out / "ekf" / "comparison.md").read_text())
+    print(f"\n(outputs in {out / 'ekf'}; {time.perf_counter() - t0:.1f} s)\n")
 
 
 def reproduce(args) -> int:
@@ -193,7 +201,8 @@ def reproduce(args) -> int:
         runs = trials_section(out)
         plausibility_section(runs, ship)
         checks_section(ship)
-        optional_sections(out, getattr(args, "quick", False))
+        nomoto_section(out, args.quick)
+        ekf_section(out, args.quick)
         print(f"Total {time.perf_counter() - t0:.1f} s. Report: {out / 'report.md'}")
     finally:
         sys.stdout = old
