@@ -54,7 +54,10 @@ def _set(cfg: dict, assignment: str) -> None:
         if not isinstance(d.get(p), dict):
             d[p] = {}
         d = d[p]
-    d[parts[-1]] = yaml.safe_load(val)
+    try:
+        d[parts[-1]] = float(val)
+    except ValueError:
+        d[parts[-1]] = yaml.safe_load(val)
 
 
 def load_config(path: str | Path | None = None, sets=()) -> dict:
@@ -76,7 +79,7 @@ def load_config(path: str | Path | None = None, sets=()) -> dict:
         cfg = _merge(cfg, over)
     for s in sets:
         _set(cfg, s)
-    _validate(cfg, src)
+    _validate(cfg, src + (" with --set " + " ".join(sets) if sets else ""))
     return cfg
 
 
@@ -260,8 +263,10 @@ def estimate(data: TrialData, cfg: dict) -> Estimate:
     R = R_for(cfg, data.name)
     P0 = P0_for(cfg)
     q = float(cfg.get("Q", 0.0))
+    dv = cfg.get("divergence", {})
     res = run_filter(data.packed, data.slots, data.meas.t, data.meas.z(), data.meas.delta, z0, P0, R,
-                     trial=data.name, q=q)
+                     trial=data.name, q=q, nis_window_s=float(dv.get("nis_window_s", 60.0)),
+                     nis_max=float(dv.get("nis_max", 400.0)))
     return Estimate(data, res, dict(zip(DERIVATIVES, z0[NS:])), R)
 
 

