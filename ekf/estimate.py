@@ -266,7 +266,7 @@ def estimate(data: TrialData, cfg: dict) -> Estimate:
     dv = cfg.get("divergence", {})
     res = run_filter(data.packed, data.slots, data.meas.t, data.meas.z(), data.meas.delta, z0, P0, R,
                      trial=data.name, q=q, nis_window_s=float(dv.get("nis_window_s", 60.0)),
-                     nis_max=float(dv.get("nis_max", 400.0)))
+                     nis_max=float(dv.get("nis_max", 20.0)))
     return Estimate(data, res, dict(zip(DERIVATIVES, z0[NS:])), R)
 
 
@@ -429,7 +429,7 @@ def joint_estimate(datas: list[TrialData], cfg: dict, name: str = "joint") -> Es
         P_start = P0.copy()
         P_start[NS:, NS:] = P[NS:, NS:]
         res = run_filter(d.packed, d.slots, m.t, m.z(), m.delta, z0, P_start, R_for(cfg, d.name), trial=d.name, q=q,
-                         nis_window_s=float(dv.get("nis_window_s", 60.0)), nis_max=float(dv.get("nis_max", 400.0)))
+                         nis_window_s=float(dv.get("nis_window_s", 60.0)), nis_max=float(dv.get("nis_max", 20.0)))
         z, P = res.z[-1], res.P
         ts.append(m.t + offset)
         zs.append(res.z)

@@ -375,7 +375,7 @@ class FilterResult:
 
 
 def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str = "", q: float = 0.0,
-               nis_window_s: float = 60.0, nis_max: float = 400.0) -> FilterResult:
+               nis_window_s: float = 60.0, nis_max: float = 20.0) -> FilterResult:
     """Run the compiled EKF over a whole record; raises FilterDivergence on failure.
 
     t (N,) equally spaced [s]; meas (N, 4) u, v, r, n; delta (N,) rudder [rad];

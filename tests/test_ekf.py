@@ -158,3 +158,11 @@ def test_divergence_on_nonfinite(packed):
     with pytest.raises(FilterDivergence, match=r"'T' at t = 0\.1 s"):
         run_filter(pk, slots, np.arange(N) * 0.1, meas, np.zeros(N), z0, np.eye(NZ) * 1e-2,
                    np.eye(4) * 1e-2, "T")
+
+
+def test_absurd_initial_guess_is_refused(short_zz, tmp_path, capsys):
+    _, d = short_zz
+    rc = main(["estimate", str(d / "log.csv"), "--out", str(tmp_path / "a"), "--no-plots", "--set", "initial.scale=-50"])
+    assert rc == 3
+    err = capsys.readouterr().err
+    assert "ZZ20" in err and "t = " in err and "nan" not in err.lower()
