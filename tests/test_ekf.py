@@ -162,7 +162,7 @@ def test_divergence_on_nonfinite(packed):
 
 def test_absurd_initial_guess_is_refused(short_zz, tmp_path, capsys):
     _, d = short_zz
-    rc = main(["estimate", str(d / "log.csv"), "--out", str(tmp_path / "a"), "--no-plots", "--set", "initial.scale=-50"])
+    rc = main(["estimate", str(d / "log.csv"), "--out", str(tmp_path / "a"), "--no-plots", "--set", "initial.scale=-1000"])
     assert rc == 3
     err = capsys.readouterr().err
     assert "ZZ20" in err and "t = " in err and "nan" not in err.lower()
