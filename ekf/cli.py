@@ -54,6 +54,9 @@ def _run(args, cfg, StagedOutput, data_from_log, data_from_trial, estimate, writ
         if len(set(names)) != len(names):
             raise InputError(args.inputs[0], "trial", f"two inputs have the same trial name ({names})")
         ests = [estimate(d, cfg) for d in datas]
+        if args.joint and len(datas) > 1:
+            from .estimate import joint_estimate
+            ests.append(joint_estimate(datas, cfg, name="joint"))
         rep = write_reports(ests, out, plots=not args.no_plots)
     return rep
 
@@ -81,4 +84,6 @@ def register(subparsers) -> None:
     p.add_argument("--ship", default=None, help="ship YAML for logs (default: configs/ships/esso_osaka.yaml)")
     p.add_argument("--truth", default=None, help="truth.csv of a simulated log (enables true values and errors)")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
+    p.add_argument("--joint", action="store_true",
+                   help="also one joint estimate running through all inputs in turn (column 'joint')")
     p.set_defaults(func=cmd_estimate)
