@@ -58,7 +58,7 @@ class CommandLaw:
         return CommandLaw(HEADING_SWITCH, par, z, z, z)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _interp(tq, ts, vs, k):
     """Linear interpolation with a moving pointer k (ts increasing); holds the ends."""
     nt = ts.shape[0]
@@ -72,7 +72,7 @@ def _interp(tq, ts, vs, k):
     return vs[k] + w * (vs[k + 1] - vs[k]), k
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
                     kind, cpar, st, sd, sn, states, orders):
     """Integrate ``nsteps`` RK4 steps from ``x0``; fill ``states`` (nsteps+1, 8) and ``orders``.

@@ -128,7 +128,7 @@ def polyval(c, x):
     return acc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def kinematics(u, v, r, L):
     """Speed U [m/s], drift angle beta = atan(-v/u) [rad], v' and r' at midship."""
     U = np.sqrt(u * u + v * v)
@@ -136,7 +136,7 @@ def kinematics(u, v, r, L):
     return U, beta, v / U, r_prime(r, L, U)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
     """Primed hull forces (X_H', Y_H', N_H') = sum of coefficient x term per axis."""
     X = 0.0 * beta
@@ -154,7 +154,7 @@ def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
     return X, Y, N
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def one_minus_wake(u, beta, rp, p, poly):
     """(1 - w_P) in manoeuvring: Kijima exp(-C beta_P^2) or MMG 2015 form, beta_P = beta - x_P' r'."""
     w0 = polyval(poly[POLY_WP0], u)
@@ -165,7 +165,7 @@ def one_minus_wake(u, beta, rp, p, poly):
     return (1.0 - w0) * (1.0 + (1.0 - np.exp(-p[P_C1] * sabs(bp))) * (c2 - 1.0))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def propeller(u, n, one_minus_wP, p, poly):
     """Advance ratio J_P, thrust coefficient K_T and surge force X_P [N] (eq. 12)."""
     D = p[P_D]
@@ -176,7 +176,7 @@ def propeller(u, n, one_minus_wP, p, poly):
     return J, KT, XP
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rudder(u, U, beta, rp, delta, one_minus_wP, J, KT, p):
     """MMG rudder forces (X_R, Y_R, N_R) [N, N, N m] and the normal force F_N [N]."""
     d = delta + p[P_RUDDER_OFFSET]
@@ -195,7 +195,7 @@ def rudder(u, U, beta, rp, delta, one_minus_wP, J, KT, p):
     return XR, YR, NR, FN
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def steering_rate(delta_cmd, delta, p):
     """Steering gear, Rhee & Kim eq. (20): rudder rate [rad/s] towards the clipped order."""
     dmax = p[P_DMAX]
@@ -206,7 +206,7 @@ def steering_rate(delta_cmd, delta, p):
     return (p[P_RATE] if err.real > 0.0 else -p[P_RATE]) + 0.0 * err
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def shaft_acceleration(u, n, J, p, poly):
     """dn/dt [rps/s] of the shaft, eq. (15): 2 pi (I+J) dn/dt = Q_P + Q_E (constant power)."""
     if p[P_ENGINE] != ENGINE_CONSTANT_POWER:
@@ -218,7 +218,7 @@ def shaft_acceleration(u, n, J, p, poly):
     return (QP + QE) / (2.0 * np.pi * p[P_SHAFT_I])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def forces(x, p, poly, hull_axis, hull_term, hull_coef):
     """Total surge and sway force [N] and yaw moment [N m] about midship, and J_P."""
     u, v, r, delta, n = x[U_], x[V_], x[R_], x[DELTA_], x[N_]
@@ -236,7 +236,7 @@ def forces(x, p, poly, hull_axis, hull_term, hull_coef):
     return X, Y, N, J
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rhs(x, delta_cmd, p, poly, hull_axis, hull_term, hull_coef, out):
     """Time derivative of the state, written into ``out`` (MMG equations of motion).
 

@@ -45,13 +45,13 @@ TERM_NAMES = {i: k for k, i in TERMS.items()}
 AXES = {"X": 0, "Y": 1, "N": 2}
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def sabs(x):
     """|x| written so that complex-step differentiation stays analytic (sign from the real part)."""
     return x if x.real >= 0.0 else -x
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def term_value(tid, beta, vp, rp):
     """Value of term ``tid`` at drift angle beta [rad], v' and r' (dimensionless)."""
     if tid == 0:
