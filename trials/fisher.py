@@ -1,0 +1,274 @@
+"""Fisher information of the 12 sway/yaw derivatives in a trial, and the Cramer-Rao bound.
+
+Unlike the sensitivities of eqs. (21)-(22) (:mod:`trials.sensitivity`), which are shares of a
+total over the trials being compared, the Fisher information of a trial depends only on that
+trial, its duration and the measurement noise.
+
+Output sensitivities (exact, from the model)
+    The EKF's own model (:mod:`ekf.filter`: RK4 on :func:`mmg.model.rhs` over the 0.1 s
+    filter step, states u, v, r, n, rudder angle an input interpolated linearly over the
+    step) is run from the trial's start state with the rudder angle of the simulated trial.
+    The 16-state augmented transition Jacobian F_k (:func:`ekf.filter._propagate_ws`,
+    complex step, exact to rounding) propagates the tangent
+        S_{k+1} = F_k[:4, :] [S_k; 0 I],   S_0 = [I_4 0],
+    S_k = d(u, v, r, n)(t_k) / d(u0, v0, r0, n0, c_1..c_12).  The rudder angle is treated as
+    a known input, as the EKF treats it (in a closed-loop trial a changed derivative would
+    also move the switching times; that is not information the filter uses).  The start
+    state enters as four nuisance parameters.
+
+Noise models (``noise=``)
+    ``"filter"``  what the EKF assumes: R of Rhee & Kim Table 8 for the trial
+        (``configs/estimation``), every 0.1 s sample independent:
+        I = sum_k S_k^T R^-1 S_k.  The 0.1 s "measurements" are in fact interpolated from a
+        5 s log (3-point parabolas, :mod:`ekf.preprocess`) and their errors are strongly
+        correlated (lag-1 correlation ~0.9, sign change near 5 s), and Table 8's R is 10^2 to
+        10^6 times the variance of the recovered errors, so this is the information the
+        filter *believes* it has (its P without the prior), not what the data hold.
+    ``"log"`` (default)  the information of the data actually recorded: the 5 s log's
+        latitude, longitude, heading and rpm, each sample independent with uniform noise of
+        the trial's half-widths a (variance a^2 / 3); the speed channel (noise-free in the
+        paper's logs) is not used, as the estimator does not use it.  Position and heading
+        sensitivities are integrated from those of u, v, r along the track
+        (psi' = r, x' = u cos psi - v sin psi, y' = u sin psi + v cos psi, trapezoid on the
+        0.1 s grid); the start position and heading are three more nuisance parameters.
+        This is the exact way to count the correlated interpolated samples: go back to the
+        independent samples they were interpolated from.
+    ``"thinned"``  the recovered 0.1 s u, v, r, n with the *empirical* variance of their
+        errors (given by ``recovered_var``), counting one independent sample per log
+        interval (information x dt / interval): the usual rule of thumb, for comparison.
+
+CRB
+    cov >= I^-1; the bound on a derivative's standard deviation is sqrt of its diagonal
+    element of the inverse of the full matrix (nuisances marginalised).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ekf.filter import NS, NZ, _propagate_ws
+from mmg.integrate import integrate
+from mmg.model import DELTA_, N_, PSI_, R_, U_, V_
+from mmg.simulation import prepare
+
+from .sensitivity import DERIVATIVES, LINEAR, NONLINEAR
+
+NOISE_MODELS = ("log", "filter", "thinned")
+OUTPUTS = ("u", "v", "r", "n")
+
+
+@njit(cache=True)
+def _tangent_kernel(z0, delta, dt, p, poly, hull_axis, hull_term, hull_coef, idx, Y, S):
+    """Fill Y (N, 4) with the model's u, v, r, n and S (N, 4, 16) with their sensitivities to z0."""
+    nz = z0.shape[0]
+    N = delta.shape[0]
+    z = z0.copy()
+    zn = np.empty(nz)
+    F = np.empty((nz, nz))
+    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
+    for i in range(hull_coef.shape[0]):
+        coef[i] = hull_coef[i]
+    zc = np.empty(nz, dtype=np.complex128)
+    xs = np.empty(8, dtype=np.complex128)
+    k1 = np.empty(8, dtype=np.complex128)
+    k2 = np.empty(8, dtype=np.complex128)
+    k3 = np.empty(8, dtype=np.complex128)
+    k4 = np.empty(8, dtype=np.complex128)
+    out = np.empty(NS, dtype=np.complex128)
+    for i in range(NS):
+        Y[0, i] = z[i]
+        for j in range(nz):
+            S[0, i, j] = 1.0 if i == j else 0.0
+    for k in range(1, N):
+        _propagate_ws(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs,
+                      k1, k2, k3, k4, out, zn, F)
+        for i in range(nz):
+            z[i] = zn[i]
+        for i in range(NS):
+            Y[k, i] = z[i]
+            for j in range(nz):
+                acc = F[i, j] if j >= NS else 0.0
+                for m in range(NS):
+                    acc += F[i, m] * S[k - 1, m, j]
+                S[k, i, j] = acc
+    return N
+
+
+@dataclass
+class Tangent:
+    """A trial's model outputs and their exact sensitivities.
+
+    t (N,) [s]; y (N, 4) u, v, r, n of the EKF model; S (N, 4, 16) d y / d(u0, v0, r0, n0, c);
+    delta (N,) rudder angle used [rad]; sim (N, 8) the simulator's states; values (12,) the
+    derivatives; psi0 start heading.
+    """
+
+    trial: str
+    t: np.ndarray
+    y: np.ndarray
+    S: np.ndarray
+    delta: np.ndarray
+    sim: np.ndarray
+    values: np.ndarray
+    log_interval: float
+    noise: dict
+
+    def track_sensitivities(self):
+        """psi, x, y of the model and their sensitivities (N, 3, 16) by integrating along the track."""
+        t, y, S = self.t, self.y, self.S
+        dt = np.diff(t)
+        psi = np.concatenate([[self.sim[0, PSI_]], self.sim[0, PSI_] + np.cumsum(0.5 * dt * (y[1:, 2] + y[:-1, 2]))])
+        Spsi = np.concatenate([np.zeros((1, S.shape[2])),
+                               np.cumsum(0.5 * dt[:, None] * (S[1:, 2] + S[:-1, 2]), axis=0)])
+        c, s = np.cos(psi), np.sin(psi)
+        xd = y[:, 0] * c - y[:, 1] * s
+        yd = y[:, 0] * s + y[:, 1] * c
+        Sxd = c[:, None] * S[:, 0] - s[:, None] * S[:, 1] - yd[:, None] * Spsi
+        Syd = s[:, None] * S[:, 0] + c[:, None] * S[:, 1] + xd[:, None] * Spsi
+
+        def cumtrap(f):
+            return np.concatenate([np.zeros((1,) + f.shape[1:]),
+                                   np.cumsum(0.5 * dt.reshape((-1,) + (1,) * (f.ndim - 1)) * (f[1:] + f[:-1]), axis=0)])
+
+        return psi, cumtrap(xd), cumtrap(yd), np.stack([Spsi, cumtrap(Sxd), cumtrap(Syd)], axis=1)
+
+
+def tangent(trial, dt: float | None = None) -> Tangent:
+    """Simulate ``trial`` and propagate the exact output sensitivities along it (EKF model, rudder as input)."""
+    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances)
+    law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
+    x0 = eq.state()
+    step = float(dt or trial.dt)
+    _, sim, _, _ = integrate(pk, x0, law, trial.duration, step)
+    idx = np.array([trial.ship.hull.index(n) for n in DERIVATIVES], dtype=np.int64)
+    values = pk.hull_coef[idx].copy()
+    z0 = np.r_[x0[U_], x0[V_], x0[R_], x0[N_], values]
+    delta = np.ascontiguousarray(sim[:, DELTA_])
+    N = len(delta)
+    Y = np.empty((N, NS))
+    S = np.empty((N, NS, NZ))
+    _tangent_kernel(z0, delta, step, *pk.args(), idx, Y, S)
+    lg = trial.log
+    from .logio import M_PER_DEG_LAT, M_PER_DEG_LON
+
+    noise = {"x_m": np.degrees(lg.noise_lat) * M_PER_DEG_LAT, "y_m": np.degrees(lg.noise_lon) * M_PER_DEG_LON,
+             "psi_rad": lg.noise_heading, "n_rps": lg.noise_rpm}
+    return Tangent(trial.name, np.arange(N) * step, Y, S, delta, sim, values, float(lg.interval), noise)
+
+
+def R_table(trial_name: str, config=None) -> np.ndarray:
+    """The EKF's measurement noise variances (u, v, r, n) for a trial (Rhee & Kim Table 8)."""
+    from ekf.estimate import R_for, load_config
+
+    return np.diag(R_for(load_config(config), trial_name))
+
+
+def fisher(tan: Tangent, noise: str = "log", R=None, recovered_var=None) -> tuple[np.ndarray, list[str]]:
+    """Fisher information (all parameters: nuisances first, then the 12 derivatives) and the parameter names."""
+    names = ["u0", "v0", "r0", "n0"] + list(DERIVATIVES)
+    if noise == "filter":
+        var = np.asarray(R if R is not None else R_table(tan.trial), float)
+        W = 1.0 / var
+        I = np.einsum("kij,i,kil->jl", tan.S, W, tan.S)
+    elif noise == "thinned":
+        var = np.asarray(recovered_var, float)
+        dt = tan.t[1] - tan.t[0]
+        I = (dt / tan.log_interval) * np.einsum("kij,i,kil->jl", tan.S, 1.0 / var, tan.S)
+    elif noise == "log":
+        dt = tan.t[1] - tan.t[0]
+        stride = int(round(tan.log_interval / dt))
+        sel = np.arange(0, len(tan.t), stride)
+        _, _, _, T = tan.track_sensitivities()
+        # channels: heading, x (lat), y (lon), rpm; nuisances psi0, x0, y0 add unit sensitivities
+        nz = tan.S.shape[2]
+        G = np.zeros((len(sel), 4, nz + 3))
+        G[:, 0, :nz] = T[sel, 0]
+        G[:, 1, :nz] = T[sel, 1]
+        G[:, 2, :nz] = T[sel, 2]
+        G[:, 3, :nz] = tan.S[sel, 3]
+        G[:, 0, nz] = 1.0
+        G[:, 1, nz + 1] = 1.0
+        G[:, 2, nz + 2] = 1.0
+        a = np.array([tan.noise["psi_rad"], tan.noise["x_m"], tan.noise["y_m"], tan.noise["n_rps"]])
+        W = 3.0 / a ** 2                         # uniform on [-a, a]: variance a^2 / 3
+        I = np.einsum("kij,i,kil->jl", G, W, G)
+        # put the three extra nuisances first
+        order = [nz, nz + 1, nz + 2] + list(range(nz))
+        I = I[np.ix_(order, order)]
+        names = ["psi0", "x0", "y0"] + names
+    else:
+        raise ValueError(f"noise model must be one of {NOISE_MODELS}, got {noise!r}")
+    return 0.5 * (I + I.T), names
+
+
+def crb(I: np.ndarray, names: list[str]) -> dict:
+    """Cramer-Rao bound on each derivative's standard deviation (nuisances marginalised)."""
+    # scale to unit diagonal before inverting (the parameters differ by orders of magnitude)
+    d = np.sqrt(np.diag(I))
+    C = np.linalg.inv(I / np.outer(d, d)) / np.outer(d, d)
+    return {n: float(np.sqrt(C[i, i])) for i, n in enumerate(names) if n in DERIVATIVES}
+
+
+def derivative_covariance(I: np.ndarray, names: list[str], subset=DERIVATIVES) -> np.ndarray:
+    """CRB covariance block of ``subset`` (the other parameters marginalised)."""
+    d = np.sqrt(np.diag(I))
+    C = np.linalg.inv(I / np.outer(d, d)) / np.outer(d, d)
+    ix = [names.index(n) for n in subset]
+    return C[np.ix_(ix, ix)]
+
+
+def criteria(I: np.ndarray, names: list[str], values: np.ndarray) -> dict:
+    """Design criteria on the nonlinear derivatives (relative to their values; lower is better).
+
+    ``mean_rel_crb_nonlinear_pct``: mean over the 8 nonlinear derivatives of CRB std / |value| (%);
+    ``d_opt_nonlinear_pct``: (det of the relative CRB covariance of the 8)^(1/16) in % - the
+    geometric-mean standard deviation of D-optimal design (minimising it = maximising det I);
+    the same two for the 4 linear derivatives.
+    """
+    val = dict(zip(DERIVATIVES, values))
+    out = {}
+    for tag, grp in (("nonlinear", NONLINEAR), ("linear", LINEAR)):
+        C = derivative_covariance(I, names, grp)
+        sc = np.array([abs(val[n]) for n in grp])
+        Cr = C / np.outer(sc, sc)
+        sign, logdet = np.linalg.slogdet(Cr)
+        out[f"mean_rel_crb_{tag}_pct"] = float(100.0 * np.mean(np.sqrt(np.diag(Cr))))
+        out[f"d_opt_{tag}_pct"] = float(100.0 * np.exp(logdet / (2 * len(grp)))) if sign > 0 else np.inf
+    return out
+
+
+def trial_crb(trial, noise: str = "log", **kw) -> dict:
+    """Convenience: CRB std of each derivative and the design criteria for one trial."""
+    tan = tangent(trial)
+    I, names = fisher(tan, noise, **kw)
+    return {"trial": trial.name, "crb": crb(I, names), **criteria(I, names, tan.values)}
+
+
+def crb_vs_montecarlo(runs: "pd.DataFrame", trial_files: dict, noises=("log", "filter")) -> "pd.DataFrame":
+    """CRB std beside the Monte Carlo std of the EKF's final estimates, per trial and derivative.
+
+    ``runs`` is the EKF Monte Carlo's runs.csv (:func:`ekf.montecarlo.monte_carlo`: one row per
+    trial and seed with ``final_<derivative>``, diverged runs flagged); ``trial_files`` maps the
+    trial names in it to trial YAML paths.
+    """
+    import pandas as pd
+
+    from .trial import load_trial
+
+    rows = []
+    for trial, g in runs.groupby("trial", sort=False):
+        ok = g[g["diverged"].fillna("") == ""] if "diverged" in g else g
+        tr = load_trial(trial_files[trial])
+        tan = tangent(tr)
+        bounds = {nm: crb(*fisher(tan, nm)) for nm in noises}
+        for i, n in enumerate(DERIVATIVES):
+            vals = ok[f"final_{n}"].to_numpy(float)
+            row = {"trial": trial, "derivative": n, "value": tan.values[i], "runs": len(vals),
+                   "mc_mean": float(np.mean(vals)), "mc_std": float(np.std(vals, ddof=1))}
+            for nm in noises:
+                row[f"crb_std_{nm}"] = bounds[nm][n]
+                row[f"mc_over_crb_{nm}"] = row["mc_std"] / bounds[nm][n]
+            rows.append(row)
+    return pd.DataFrame(rows)

@@ -1,0 +1,335 @@
+"""``mmg sensitivity``: derivative sensitivities (Rhee & Kim eqs. 21-22), the paper's figures,
+Fisher information / Cramer-Rao bounds and the trial-design search.
+
+    mmg sensitivity TRIAL.yaml [TRIAL.yaml ...] --out DIR [--fisher]
+    mmg sensitivity --paper-figures --out DIR [--ekf-comparison comparison.csv]
+    mmg sensitivity --crb-vs-mc MC_DIR --out DIR [--mc-seeds N]
+    mmg sensitivity --design --out DIR
+
+Everything is written into a staging folder and moved to ``--out`` only on success.
+"""
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from mmg.errors import InputError
+
+REPO = Path(__file__).resolve().parents[1]
+TRIALS_DIR = REPO / "configs" / "trials"
+
+# Rhee & Kim's figure groups: (file stem, title, trial files)
+FIGURES = [
+    ("fig02_conventional", "Fig. 2 - sensitivity in conventional trials: ST35, ZZ10, ZZ20", ["st35", "zz10", "zz20"]),
+    ("fig08_09_sine_sawtooth", "Figs 8-9 trials - sine and sawtooth rudder beside the conventional trials: "
+                               "ST35, ZZ10, ZZ20, Sine, Sawtooth", ["st35", "zz10", "zz20", "sine", "sawtooth"]),
+    ("fig12_stype", "Fig. 12 - sensitivity between S-type trials: S-type 60, 120, 180",
+     ["stype60", "stype120", "stype180"]),
+    ("fig13_conventional_vs_stype120", "Fig. 13 - conventional trials vs S-type 120: ST35, ZZ10, ZZ20, S-type 120",
+     ["st35", "zz10", "zz20", "stype120"]),
+]
+FIG14_GROUP = "fig13_conventional_vs_stype120"
+EKF_TRIALS = {"ST35": "st35", "ZZ10": "zz10", "ZZ20": "zz20", "S-type 120": "stype120"}
+
+
+def _load(paths):
+    from .trial import load_trial
+
+    return [load_trial(p) for p in paths]
+
+
+def _md(df: pd.DataFrame, fmt="{:.3g}") -> str:
+    cols = [str(c) for c in df.columns]
+    lines = ["| " + " | ".join([df.index.name or ""] + cols) + " |", "|" + "---|" * (len(cols) + 1)]
+    for idx, r in df.iterrows():
+        lines.append("| " + " | ".join([str(idx)] + [fmt.format(v) if isinstance(v, (float, np.floating)) else str(v)
+                                                       for v in r.to_numpy()]) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _wide(df: pd.DataFrame) -> pd.DataFrame:
+    from .sensitivity import DERIVATIVES
+
+    trials = list(dict.fromkeys(df["trial"]))
+    w = df.pivot(index="derivative", columns="trial", values="sensitivity_pct").reindex(DERIVATIVES)[trials]
+    w.index.name = "derivative"
+    return w
+
+
+# --------------------------------------------------------------------------- trials given on the command line
+
+def cmd_trials(args, stage) -> None:
+    from .sensitivity import group_sums, sensitivity
+    from .sensitivity_plots import plot_groups, plot_sensitivity
+
+    trials = _load(args.trials)
+    names = [t.name for t in trials]
+    if len(set(names)) != len(names):
+        raise InputError(" ".join(args.trials), "name", f"two trials share a name ({', '.join(names)}); "
+                                                        "the sensitivities are per trial name")
+    df = sensitivity(trials, backend=args.backend, n_jobs=args.jobs)
+    df.to_csv(stage.path("sensitivity.csv"), index=False, float_format="%.6g")
+    w = _wide(df)
+    stage.path("sensitivity.md").write_text(
+        f"Sensitivity [%] (Rhee & Kim eq. 22, absolute differences; the group sums to 100 %): {', '.join(names)}\n\n"
+        + _md(w, "{:.2f}"))
+    plot_sensitivity(df, stage.path("sensitivity.png"))
+    gs = group_sums(df)
+    gs.to_csv(stage.path("group_sums.csv"), float_format="%.6g")
+    plot_groups(gs, stage.path("group_sums.png"), f"Sum of sensitivities: {', '.join(names)}",
+                "sum of sensitivities [%] (eq. 22)")
+    print(f"sensitivity [%] (eq. 22, absolute differences summed over the record; group total 100 %):")
+    print(w.round(2).to_string())
+    print(gs.round(2).to_string())
+    if args.fisher:
+        from .fisher import crb, fisher, tangent
+
+        rows = []
+        for t in trials:
+            tan = tangent(t)
+            c = crb(*fisher(tan, "log"))
+            rows.append({"trial": t.name, **c})
+        cr = pd.DataFrame(rows).set_index("trial")
+        cr.to_csv(stage.path("crb_std.csv"), float_format="%.6g")
+        print("Cramer-Rao bound on the standard deviation (log noise model):")
+        print(cr.T.to_string(float_format=lambda v: f"{v:.3g}"))
+
+
+# --------------------------------------------------------------------------- the paper's figures
+
+def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, verbose: bool = True) -> dict:
+    """Figs 2, 8-9, 12, 13, 14 and 28 into ``out`` (a folder path or a StagedOutput); returns the tables.
+
+    Each distinct trial is simulated once (13 runs), then each figure's group is normalised
+    by eqs. (21)-(22) on its own.  Fig. 28 needs the EKF's final % errors: ``ekf_comparison``
+    (comparison.csv of :func:`ekf.reproduce.reproduce_rhee_kim`, columns trial, coeff,
+    our_err_pct, paper_err_pct), or None to run that reproduction here (one noise seed per trial).
+    """
+    from .sensitivity import efficiency, group_differences, group_sums, normalise
+    from .sensitivity_plots import plot_groups, plot_sensitivity
+
+    P = out.path if hasattr(out, "path") else (lambda n: Path(out) / n)
+    if not hasattr(out, "path"):
+        Path(out).mkdir(parents=True, exist_ok=True)
+    stems = list(dict.fromkeys(s for _, _, group in FIGURES for s in group))
+    trials = _load([TRIALS_DIR / f"{s}.yaml" for s in stems])
+    t0 = time.perf_counter()
+    diffs = dict(zip(stems, group_differences(trials, backend=backend, n_jobs=n_jobs, progress=verbose)))
+    if verbose:
+        print(f"simulated {len(stems)} trials x 13 runs in {time.perf_counter() - t0:.1f} s")
+    tables = {}
+    md = ["# Sensitivity figures (Rhee & Kim 1999, section 3.2 and 6.1)\n",
+          "Sensitivity S of eq. (22) in %: absolute differences of u, v, r between the run with one derivative "
+          "at 120 % and the reference run, summed over every 0.1 s step of the 3000 s record, each channel "
+          "normalised over all derivatives and trials of the figure; each figure's bars sum to 100 %.\n"]
+    for stem, title, group in FIGURES:
+        df = normalise([diffs[s] for s in group])
+        tables[stem] = df
+        df.to_csv(P(f"{stem}.csv"), index=False, float_format="%.6g")
+        plot_sensitivity(df, P(f"{stem}.png"), title)
+        md += [f"## {title}\n", _md(_wide(df), "{:.2f}")]
+    gs = group_sums(tables[FIG14_GROUP])
+    tables["fig14_sums"] = gs
+    gs.to_csv(P("fig14_sums.csv"), float_format="%.6g")
+    plot_groups(gs, P("fig14_sums.png"), "Fig. 14 - sums of sensitivities: ST35, ZZ10, ZZ20, S-type 120 "
+                                        "(normalised over these four)", "sum of sensitivities [%] (eq. 22)")
+    md += ["## Fig. 14 - sums of linear, nonlinear and all sensitivities [%] (group of Fig. 13)\n", _md(gs, "{:.2f}")]
+    # Fig. 28 from the EKF's % errors
+    if ekf_comparison is None:
+        from ekf.reproduce import reproduce_rhee_kim
+
+        if verbose:
+            print("running the EKF on ST35, ZZ10, ZZ20, S-type 120 for Fig. 28 ...", flush=True)
+        cmp_ = reproduce_rhee_kim(Path(str(P("ekf/comparison.csv"))).parent, plots=False, verbose=False, joint=False)
+    else:
+        try:
+            cmp_ = pd.read_csv(ekf_comparison)
+        except FileNotFoundError:
+            raise InputError(str(ekf_comparison), "", "file not found") from None
+        need = {"trial", "coeff", "our_err_pct"}
+        if not need <= set(cmp_.columns):
+            raise InputError(str(ekf_comparison), ",".join(sorted(need - set(cmp_.columns))),
+                             "missing column(s); expected the comparison.csv of mmg reproduce / reproduce_rhee_kim")
+    cmp_ = cmp_[cmp_["trial"].isin(EKF_TRIALS)]
+    ours = efficiency(cmp_.rename(columns={"our_err_pct": "err_pct"})[["trial", "coeff", "err_pct"]])
+    tables["fig28_efficiency"] = ours
+    ours.to_csv(P("fig28_efficiency.csv"), float_format="%.6g")
+    plot_groups(ours, P("fig28_efficiency.png"), "Fig. 28 - estimation efficiency (ours, EKF): "
+                                                 + ", ".join(ours.index), "normalised efficiency [%] (1 / sum of % errors)")
+    md += ["## Fig. 28 - estimation efficiency, ours [%] (1 / sum of the group's % errors, normalised over the trials)\n",
+           _md(ours, "{:.1f}")]
+    if "paper_err_pct" in cmp_:
+        paper = efficiency(cmp_.rename(columns={"paper_err_pct": "err_pct"})[["trial", "coeff", "err_pct"]])
+        tables["fig28_paper"] = paper
+        paper.to_csv(P("fig28_efficiency_paper_table10.csv"), float_format="%.6g")
+        md += ["## Fig. 28 - the same from the paper's Table 10 errors [%]\n", _md(paper, "{:.1f}")]
+    P("sensitivity_figures.md").write_text("\n".join(md))
+    if verbose:
+        print("\n".join(md))
+    return tables
+
+
+def cmd_paper(args, stage) -> None:
+    paper_figures(stage, args.ekf_comparison, backend=args.backend, n_jobs=args.jobs)
+
+
+# --------------------------------------------------------------------------- CRB vs Monte Carlo
+
+def crb_table(mc_dir, out, n_seeds: int = 20, verbose: bool = True) -> pd.DataFrame:
+    """CRB vs the EKF Monte Carlo (runs.csv in ``mc_dir``; run with ``n_seeds`` seeds when missing)."""
+    from .fisher import LINEAR, crb_vs_montecarlo
+    from .sensitivity_plots import plot_crb_vs_mc
+
+    P = out.path if hasattr(out, "path") else (lambda n: Path(out) / n)
+    runs_csv = Path(mc_dir) / "runs.csv"
+    if not runs_csv.exists():
+        from ekf.montecarlo import monte_carlo
+
+        if verbose:
+            print(f"no {runs_csv}: running the EKF Monte Carlo ({n_seeds} seeds per trial) ...", flush=True)
+        monte_carlo(mc_dir, n_seeds=n_seeds, verbose=verbose)
+    runs = pd.read_csv(runs_csv, keep_default_na=False, na_values=[""])
+    if "trial" not in runs or not any(c.startswith("final_") for c in runs.columns):
+        raise InputError(str(runs_csv), "final_*", "not an EKF Monte Carlo runs.csv (ekf.montecarlo)")
+    unknown = set(runs["trial"]) - set(EKF_TRIALS)
+    if unknown:
+        raise InputError(str(runs_csv), "trial", f"unknown trial(s) {', '.join(sorted(unknown))}")
+    tab = crb_vs_montecarlo(runs, {k: TRIALS_DIR / f"{v}.yaml" for k, v in EKF_TRIALS.items()})
+    tab.to_csv(P("crb_vs_mc.csv"), index=False, float_format="%.6g")
+    plot_crb_vs_mc(tab.rename(columns={"crb_std_log": "crb_std"}), P("crb_vs_mc.png"),
+                   "Cramer-Rao bound (log noise) vs Monte Carlo std of the EKF estimates, per trial")
+    lin = tab[tab.derivative.isin(LINEAR)]
+    cols = ["trial", "derivative", "value", "runs", "mc_std", "crb_std_log", "mc_over_crb_log", "crb_std_filter",
+            "mc_over_crb_filter"]
+    text = ("CRB standard deviation vs the Monte Carlo standard deviation of the EKF's final estimates\n"
+            "(log: the information of the 5 s log actually recorded; filter: Table 8 R on independent 0.1 s "
+            "samples, what the filter assumes)\n\nLinear derivatives:\n\n"
+            + lin[cols].to_string(index=False, float_format=lambda v: f"{v:.3g}")
+            + "\n\nAll derivatives:\n\n" + tab[cols].to_string(index=False, float_format=lambda v: f"{v:.3g}") + "\n")
+    P("crb_vs_mc.txt").write_text(text)
+    if verbose:
+        print(text)
+    return tab
+
+
+def cmd_crb(args, stage) -> None:
+    crb_table(args.crb_vs_mc, stage, n_seeds=args.mc_seeds)
+
+
+# --------------------------------------------------------------------------- design search
+
+def design(out, backend: str = "loky", n_jobs=None, verbose: bool = True, grid=None) -> pd.DataFrame:
+    from .design import CRITERION, PARAM, best, search
+    from .sensitivity_plots import plot_design
+
+    P = out.path if hasattr(out, "path") else (lambda n: Path(out) / n)
+    base, *refs = _load([TRIALS_DIR / f"{s}.yaml" for s in ("stype120", "st35", "zz10", "zz20", "sine", "sawtooth")])
+    df = search(base, grid, references=[base] + refs, backend=backend, n_jobs=n_jobs, progress=verbose)
+    df.to_csv(P("design.csv"), index=False, float_format="%.6g")
+    refs_df = df[df.family == "reference"]
+    ref = {row.trial: row for row in refs_df.itertuples()}
+    ref = {k: {"mean_rel_crb_nonlinear_pct": v.mean_rel_crb_nonlinear_pct, "d_opt_nonlinear_pct": v.d_opt_nonlinear_pct}
+           for k, v in ref.items() if k in ("S-type 120", "ST35", "ZZ20")}
+    sweep = df[df.family != "reference"].copy()
+    sweep["x"] = sweep["value_deg"]
+    stype = sweep[sweep.family.isin(["S-type psi_S"])].rename(columns={"x": "psi_S_deg"})
+    plot_design(stype, P("design_stype_psiS.png"), "psi_S_deg",
+                "S-type (35 deg rudder), 3000 s: CRB of the nonlinear derivatives vs switching heading psi_S "
+                "(lower is better)", ref)
+    zz = sweep[sweep.family.isin(["zigzag a/a", "zigzag 35/a", "S-type 120, rudder"])].rename(columns={"x": "angle_deg"})
+    plot_design(zz, P("design_zigzag.png"), "angle_deg",
+                "Zigzag a/a and 35/a, S-type 120 with rudder a, 3000 s: CRB of the nonlinear derivatives vs angle a "
+                "(lower is better)", ref)
+    b = best(df)
+    s120 = refs_df[refs_df.trial == "S-type 120"].iloc[0]
+    cols = ["family", "value_deg", "trial", CRITERION, "d_opt_nonlinear_pct", "mean_rel_crb_linear_pct"]
+    lines = ["Trial design, 3000 s each, log noise model; criterion = mean over the 8 nonlinear derivatives of "
+             "CRB std / |value| [%] (lower is better); D = det(relative CRB covariance)^(1/16) [%]\n",
+             df.sort_values(CRITERION)[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}"), "",
+             f"best: {b.trial} ({b.family}) {CRITERION} = {b[CRITERION]:.4g} % vs S-type 120: "
+             f"{s120[CRITERION]:.4g} % (ratio {s120[CRITERION] / b[CRITERION]:.2f}); "
+             f"D: {b.d_opt_nonlinear_pct:.4g} % vs {s120.d_opt_nonlinear_pct:.4g} %"]
+    bd = df.loc[df["d_opt_nonlinear_pct"].idxmin()]
+    lines.append(f"best by the D-criterion: {bd.trial} ({bd.d_opt_nonlinear_pct:.4g} %)")
+    text = "\n".join(lines) + "\n"
+    P("design.txt").write_text(text)
+    if verbose:
+        print(text)
+    return df
+
+
+def cmd_design(args, stage) -> None:
+    design(stage, backend=args.backend, n_jobs=args.jobs)
+
+
+# --------------------------------------------------------------------------- registration
+
+def cmd_sensitivity(args) -> int:
+    from .cli import StagedOutput
+
+    modes = [bool(args.trials), args.paper_figures, args.crb_vs_mc is not None, args.design]
+    if sum(modes) != 1:
+        raise InputError("mmg sensitivity", "arguments", "give trial YAMLs, or exactly one of --paper-figures, "
+                                                          "--crb-vs-mc DIR, --design")
+    if args.jobs is not None and args.jobs < 1:
+        raise InputError("--jobs", str(args.jobs), "must be at least 1")
+    for p in args.trials:
+        if not Path(p).is_file():
+            raise InputError(p, "", "file not found")
+    if args.backend == "dask":
+        try:
+            from distributed import Client, LocalCluster  # noqa: F401
+        except ImportError:
+            raise InputError("--backend", "dask", "needs the optional extra: pip install 'mmg-toolkit[dask]'") from None
+    t0 = time.perf_counter()
+    cluster = client = None
+    if args.backend == "dask":
+        from distributed import Client, LocalCluster
+
+        cluster = LocalCluster(n_workers=args.jobs or 2, processes=True, threads_per_worker=1)
+        client = Client(cluster)
+    try:
+        with StagedOutput(args.out) as stage:
+            if args.trials:
+                cmd_trials(args, stage)
+            elif args.paper_figures:
+                cmd_paper(args, stage)
+            elif args.crb_vs_mc is not None:
+                cmd_crb(args, stage)
+            else:
+                cmd_design(args, stage)
+    finally:
+        if client is not None:
+            client.close()
+            cluster.close()
+    print(f"wrote {args.out} ({time.perf_counter() - t0:.1f} s)")
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("sensitivity", help="derivative sensitivities (Rhee & Kim eqs. 21-22), Fisher information, "
+                                           "trial design")
+    p.add_argument("trials", nargs="*", help="trial YAMLs to compare (their sensitivities are normalised together)")
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--paper-figures", action="store_true",
+                   help="Rhee & Kim Figs 2, 8-9, 12, 13, 14 and 28 in one go")
+    p.add_argument("--ekf-comparison", help="comparison.csv of the EKF reproduction for Fig. 28 (default: run it)")
+    p.add_argument("--fisher", action="store_true", help="also write the Cramer-Rao bounds of the given trials")
+    p.add_argument("--crb-vs-mc", metavar="MC_DIR", help="CRB vs the EKF Monte Carlo in MC_DIR (runs.csv; "
+                                                          "run there when missing)")
+    p.add_argument("--mc-seeds", type=int, default=20, help="seeds per trial when the Monte Carlo must be run")
+    p.add_argument("--design", action="store_true", help="trial-design search (S-type psi_S, zigzag angles)")
+    p.add_argument("--backend", choices=["serial", "loky", "threads", "dask"], default="loky",
+                   help="parallel backend of the sweeps (dask: a local distributed cluster; optional extra)")
+    p.add_argument("--jobs", type=int, default=None, help="workers (default: all cores)")
+    p.set_defaults(func=cmd_sensitivity)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    from .cli import main
+
+    sys.exit(main(["sensitivity", *sys.argv[1:]]))
