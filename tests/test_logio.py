@@ -75,7 +75,8 @@ def test_reader_accepts_any_well_formed_log(tmp_path_factory, rows):
     write_csv(p, df, {"trial": "h"})
     rec = read_record(p)
     assert len(rec.t) == len(rows)
-    np.testing.assert_allclose(np.mod(np.degrees(rec.psi), 360) % 360, df["heading_deg"] % 360, atol=1e-6)
+    diff = (np.degrees(rec.psi) - df["heading_deg"].to_numpy() + 180.0) % 360.0 - 180.0
+    assert np.max(np.abs(diff)) < 1e-6
 
 
 @settings(max_examples=40, deadline=None)
