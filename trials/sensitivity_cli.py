@@ -101,6 +101,24 @@ def cmd_trials(args, stage) -> None:
 
 # --------------------------------------------------------------------------- the paper's figures
 
+def read_comparison(path) -> pd.DataFrame:
+    """The EKF reproduction's comparison.csv (trial, coeff, our_err_pct[, paper_err_pct]), checked."""
+    try:
+        cmp_ = pd.read_csv(path)
+    except FileNotFoundError:
+        raise InputError(str(path), "", "file not found") from None
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as e:
+        raise InputError(str(path), "", f"not a readable CSV ({str(e).splitlines()[0]})") from None
+    need = {"trial", "coeff", "our_err_pct"}
+    if not need <= set(cmp_.columns):
+        raise InputError(str(path), ",".join(sorted(need - set(cmp_.columns))),
+                         "missing column(s); expected the comparison.csv of mmg reproduce / reproduce_rhee_kim")
+    missing = set(EKF_TRIALS) - set(cmp_["trial"])
+    if missing:
+        raise InputError(str(path), "trial", f"no rows for {', '.join(sorted(missing))}")
+    return cmp_
+
+
 def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, verbose: bool = True) -> dict:
     """Figs 2, 8-9, 12, 13, 14 and 28 into ``out`` (a folder path or a StagedOutput); returns the tables.
 
@@ -146,14 +164,7 @@ def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, 
             print("running the EKF on ST35, ZZ10, ZZ20, S-type 120 for Fig. 28 ...", flush=True)
         cmp_ = reproduce_rhee_kim(Path(str(P("ekf/comparison.csv"))).parent, plots=False, verbose=False, joint=False)
     else:
-        try:
-            cmp_ = pd.read_csv(ekf_comparison)
-        except FileNotFoundError:
-            raise InputError(str(ekf_comparison), "", "file not found") from None
-        need = {"trial", "coeff", "our_err_pct"}
-        if not need <= set(cmp_.columns):
-            raise InputError(str(ekf_comparison), ",".join(sorted(need - set(cmp_.columns))),
-                             "missing column(s); expected the comparison.csv of mmg reproduce / reproduce_rhee_kim")
+        cmp_ = read_comparison(ekf_comparison)
     cmp_ = cmp_[cmp_["trial"].isin(EKF_TRIALS)]
     ours = efficiency(cmp_.rename(columns={"our_err_pct": "err_pct"})[["trial", "coeff", "err_pct"]])
     tables["fig28_efficiency"] = ours
@@ -277,6 +288,8 @@ def cmd_sensitivity(args) -> int:
                                                           "--crb-vs-mc DIR, --design")
     if args.jobs is not None and args.jobs < 1:
         raise InputError("--jobs", str(args.jobs), "must be at least 1")
+    if args.ekf_comparison is not None:
+        read_comparison(args.ekf_comparison)
     for p in args.trials:
         if not Path(p).is_file():
             raise InputError(p, "", "file not found")

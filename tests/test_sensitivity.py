@@ -1,0 +1,172 @@
+"""Sensitivity (Rhee & Kim eqs. 21-22), Fisher information and CRB, design criteria, mmg sensitivity."""
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from mmg.integrate import integrate
+from mmg.simulation import prepare
+from trials.cli import main
+from trials.fisher import crb, criteria, fisher, tangent
+from trials.sensitivity import (DERIVATIVES, LINEAR, NONLINEAR, efficiency, group_sums, normalise,
+                                sensitivity, trial_differences)
+from trials.trial import load_trial
+
+from .conftest import CONFIGS
+
+
+def short(stem, duration=300.0):
+    return replace(load_trial(CONFIGS / "trials" / f"{stem}.yaml"), duration=duration)
+
+
+@pytest.fixture(scope="module")
+def diffs():
+    return [trial_differences(short(s)) for s in ("st35", "zz10", "stype120")]
+
+
+def test_sensitivities_sum_to_100_over_the_group(diffs):
+    df = normalise(diffs)
+    assert df["sensitivity_pct"].sum() == pytest.approx(100.0, abs=1e-9)
+    assert (df["sensitivity_pct"] >= 0).all()
+    # eq. (21): per channel the normalised differences of the whole group sum to one
+    for col in ("sum_abs_du_m_s", "sum_abs_dv_m_s", "sum_abs_dr_rad_s"):
+        assert (df[col] / df[col].sum()).sum() == pytest.approx(1.0)
+    # a different group gives a different normalisation, but each group sums to 100 again
+    two = normalise(diffs[:2])
+    assert two["sensitivity_pct"].sum() == pytest.approx(100.0)
+    assert not np.allclose(two["sensitivity_pct"], df["sensitivity_pct"][: len(two)])
+    gs = group_sums(df)
+    assert np.allclose(gs["linear"] + gs["nonlinear"], gs["total"])
+    assert gs["total"].sum() == pytest.approx(100.0)
+
+
+def test_differences_are_absolute_sums_of_a_perturbed_rerun(diffs):
+    tr = short("zz10")
+    d = diffs[1]
+    assert d.sums.shape == (12, 3) and d.completed
+    pk, eq = prepare(tr.ship, tr.u0, tr.n0, tr.trim)
+    law = tr.command_law(trim_rudder=eq.delta)
+    _, ref, _, _ = integrate(pk, eq.state(), law, tr.duration, tr.dt)
+    coef = pk.hull_coef.copy()
+    coef[tr.ship.hull.index("N_r")] *= 1.2
+    _, per, _, _ = integrate(replace(pk, hull_coef=coef), eq.state(), law, tr.duration, tr.dt)
+    assert np.allclose(d.sums[DERIVATIVES.index("N_r")], np.abs(per[:, :3] - ref[:, :3]).sum(axis=0))
+    # zigzag: the linear derivatives dominate the nonlinear ones (Rhee & Kim section 3.2)
+    lin = sum(d.sums[DERIVATIVES.index(n)].sum() for n in LINEAR)
+    non = sum(d.sums[DERIVATIVES.index(n)].sum() for n in NONLINEAR)
+    assert lin > non
+
+
+def test_efficiency_is_reciprocal_sum_normalised():
+    rows = [{"trial": t, "coeff": n, "err_pct": e} for t, e in (("A", 1.0), ("B", 3.0)) for n in DERIVATIVES]
+    eff = efficiency(pd.DataFrame(rows))
+    assert np.allclose(eff.sum(axis=0), 100.0)
+    assert eff.loc["A", "linear"] == pytest.approx(75.0)   # 1/4 : 1/12 -> 75 % : 25 %
+
+
+@pytest.fixture(scope="module")
+def turn_tangent():
+    return short("st35", 200.0), tangent(short("st35", 200.0))
+
+
+def test_tangent_matches_finite_differences_of_the_simulator(turn_tangent):
+    tr, tan = turn_tangent
+    # the EKF model follows the simulator
+    assert np.abs(tan.y - tan.sim[:, [0, 1, 2, 7]]).max() < 1e-5
+    pk, eq = prepare(tr.ship, tr.u0, tr.n0, tr.trim)
+    law = tr.command_law(trim_rudder=eq.delta)
+    for name in ("Y_beta", "N_r", "N_brr"):
+        j = tr.ship.hull.index(name)
+        h = 1e-4 * abs(pk.hull_coef[j])
+        runs = []
+        for s in (+1, -1):
+            coef = pk.hull_coef.copy()
+            coef[j] += s * h
+            runs.append(integrate(replace(pk, hull_coef=coef), eq.state(), law, tr.duration, tr.dt)[1])
+        fd = (runs[0][:, [0, 1, 2, 7]] - runs[1][:, [0, 1, 2, 7]]) / (2 * h)
+        ex = tan.S[:, :, 4 + DERIVATIVES.index(name)]
+        scale = np.abs(fd).max(axis=0)
+        assert np.all(np.abs(ex - fd).max(axis=0) <= 2e-3 * scale + 1e-12), name
+
+
+def test_fisher_symmetric_psd_and_equal_to_finite_difference_information(turn_tangent):
+    tr, tan = turn_tangent
+    R = np.array([0.08, 0.06, 2e-4, 0.4])
+    I, names = fisher(tan, "filter", R=R)
+    assert np.allclose(I, I.T)
+    assert np.linalg.eigvalsh(I / np.sqrt(np.outer(np.diag(I), np.diag(I)))).min() > -1e-10
+    # information of the derivatives from finite-difference sensitivities of the simulator
+    pk, eq = prepare(tr.ship, tr.u0, tr.n0, tr.trim)
+    law = tr.command_law(trim_rudder=eq.delta)
+    cols = []
+    for name in DERIVATIVES:
+        j = tr.ship.hull.index(name)
+        h = 1e-4 * abs(pk.hull_coef[j])
+        st = []
+        for s in (+1, -1):
+            coef = pk.hull_coef.copy()
+            coef[j] += s * h
+            st.append(integrate(replace(pk, hull_coef=coef), eq.state(), law, tr.duration, tr.dt)[1][:, [0, 1, 2, 7]])
+        cols.append((st[0] - st[1]) / (2 * h))
+    Sfd = np.stack(cols, axis=2)
+    Ifd = np.einsum("kij,i,kil->jl", Sfd, 1 / R, Sfd)
+    Id = I[4:, 4:]
+    assert np.allclose(Id, Ifd, rtol=5e-3, atol=5e-3 * np.abs(np.diag(Id)).max())
+    # CRB scales with the noise: 4 x R -> 2 x the standard deviation
+    c1 = crb(I, names)
+    c4 = crb(fisher(tan, "filter", R=4 * R)[0], names)
+    assert all(c4[n] == pytest.approx(2 * c1[n], rel=1e-9) for n in DERIVATIVES)
+
+
+def test_log_information_grows_with_the_record_and_criteria_are_finite(turn_tangent):
+    tr, tan = turn_tangent
+    I, names = fisher(tan, "log")
+    assert I.shape == (19, 19) and np.allclose(I, I.T)
+    crit = criteria(I, names, tan.values)
+    assert all(np.isfinite(v) and v > 0 for v in crit.values())
+    # a longer record of the same trial never has less information (CRB cannot grow)
+    longer = tangent(short("st35", 400.0))
+    I2, _ = fisher(longer, "log")
+    c, c2 = crb(I, names), crb(I2, names)
+    assert all(c2[n] <= c[n] * (1 + 1e-9) for n in DERIVATIVES)
+
+
+def test_cli_writes_csv_and_charts(tmp_path, capsys):
+    out = tmp_path / "sens"
+    code = main(["sensitivity", str(CONFIGS / "trials" / "zz10.yaml"), str(CONFIGS / "trials" / "zz20.yaml"),
+                 "--out", str(out), "--backend", "serial"])
+    assert code == 0
+    df = pd.read_csv(out / "sensitivity.csv")
+    assert set(df.trial) == {"ZZ10", "ZZ20"} and len(df) == 24
+    assert df.sensitivity_pct.sum() == pytest.approx(100.0, abs=1e-3)
+    assert (out / "sensitivity.png").stat().st_size > 10_000
+    assert (out / "group_sums.png").exists()
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["sensitivity", "nope.yaml"], "nope.yaml"),
+    (["sensitivity"], "arguments"),
+    (["sensitivity", "--paper-figures", "--design"], "arguments"),
+    (["sensitivity", "--paper-figures", "--ekf-comparison", "missing.csv"], "missing.csv"),
+    (["sensitivity", "--paper-figures", "--jobs", "0"], "--jobs"),
+])
+def test_bad_input_exit_2(tmp_path, capsys, argv, field):
+    out = tmp_path / "out"
+    code = main(argv + ["--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and field in err[0], err
+    assert not out.exists() or not any(out.iterdir())
+    assert not list(tmp_path.glob(".staging-*"))
+
+
+def test_bad_trial_yaml_exit_2(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text((CONFIGS / "trials" / "zz10.yaml").read_text().replace("rudder: 10 deg", "rudder: 10 m")
+                   .replace("../ships/esso_osaka.yaml", str(CONFIGS / "ships" / "esso_osaka.yaml")))
+    out = tmp_path / "out"
+    assert main(["sensitivity", str(bad), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "manoeuvre.rudder" in err
+    assert not out.exists()

@@ -1,0 +1,44 @@
+"""One sweep mechanism: serial, joblib (loky) and joblib's dask backend give the same numbers."""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from trials.sensitivity import _task
+from trials.sweep import run_sweep
+from trials.trial import load_trial
+
+from .conftest import CONFIGS
+
+
+def tasks():
+    return [replace(load_trial(CONFIGS / "trials" / f"{s}.yaml"), duration=120.0) for s in ("zz10", "stype60", "st35")]
+
+
+@pytest.fixture(scope="module")
+def serial():
+    return run_sweep(_task, tasks(), backend="serial", progress=False)
+
+
+def test_serial_equals_joblib(serial, capsys):
+    par = run_sweep(_task, tasks(), backend="loky", n_jobs=2, labels=["a", "b", "c"])
+    err = capsys.readouterr().err
+    assert "[3/3]" in err                      # progress shown
+    assert [p.trial for p in par] == [s.trial for s in serial]   # task order kept
+    for p, s in zip(par, serial):
+        assert np.array_equal(p.sums, s.sums)
+
+
+def test_serial_equals_dask(serial):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, processes=False, threads_per_worker=1,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        par = run_sweep(_task, tasks(), backend="dask", client=client, progress=False)
+    for p, s in zip(par, serial):
+        assert p.trial == s.trial
+        assert np.array_equal(p.sums, s.sums)
+
+
+def test_unknown_backend():
+    with pytest.raises(ValueError, match="unknown sweep backend"):
+        run_sweep(abs, [1], backend="mpi")
