@@ -25,8 +25,7 @@ TRIALS_DIR = REPO / "configs" / "trials"
 # Rhee & Kim's figure groups: (file stem, title, trial files)
 FIGURES = [
     ("fig02_conventional", "Fig. 2 - sensitivity in conventional trials: ST35, ZZ10, ZZ20", ["st35", "zz10", "zz20"]),
-    ("fig08_09_sine_sawtooth", "Figs 8-9 trials - sine and sawtooth rudder beside the conventional trials: "
-                               "ST35, ZZ10, ZZ20, Sine, Sawtooth", ["st35", "zz10", "zz20", "sine", "sawtooth"]),
+    ("fig08_09_sine_sawtooth", "Figs 8-9 - sine and sawtooth vs conventional: ST35, ZZ10, ZZ20, Sine, Sawtooth", ["st35", "zz10", "zz20", "sine", "sawtooth"]),
     ("fig12_stype", "Fig. 12 - sensitivity between S-type trials: S-type 60, 120, 180",
      ["stype60", "stype120", "stype180"]),
     ("fig13_conventional_vs_stype120", "Fig. 13 - conventional trials vs S-type 120: ST35, ZZ10, ZZ20, S-type 120",
@@ -153,8 +152,7 @@ def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, 
     gs = group_sums(tables[FIG14_GROUP])
     tables["fig14_sums"] = gs
     gs.to_csv(P("fig14_sums.csv"), float_format="%.6g")
-    plot_groups(gs, P("fig14_sums.png"), "Fig. 14 - sums of sensitivities: ST35, ZZ10, ZZ20, S-type 120 "
-                                        "(normalised over these four)", "sum of sensitivities [%] (eq. 22)")
+    plot_groups(gs, P("fig14_sums.png"), "Fig. 14 - sums of sensitivities: ST35, ZZ10, ZZ20, S-type 120", "sum of sensitivities [%] (eq. 22)")
     md += ["## Fig. 14 - sums of linear, nonlinear and all sensitivities [%] (group of Fig. 13)\n", _md(gs, "{:.2f}")]
     # Fig. 28 from the EKF's % errors
     if ekf_comparison is None:
@@ -169,7 +167,7 @@ def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, 
     ours = efficiency(cmp_.rename(columns={"our_err_pct": "err_pct"})[["trial", "coeff", "err_pct"]])
     tables["fig28_efficiency"] = ours
     ours.to_csv(P("fig28_efficiency.csv"), float_format="%.6g")
-    plot_groups(ours, P("fig28_efficiency.png"), "Fig. 28 - estimation efficiency (ours, EKF): "
+    plot_groups(ours, P("fig28_efficiency.png"), "Fig. 28 - estimation efficiency (EKF): "
                                                  + ", ".join(ours.index), "normalised efficiency [%] (1 / sum of % errors)")
     md += ["## Fig. 28 - estimation efficiency, ours [%] (1 / sum of the group's % errors, normalised over the trials)\n",
            _md(ours, "{:.1f}")]

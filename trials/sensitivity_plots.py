@@ -59,7 +59,7 @@ def plot_groups(tab: pd.DataFrame, path, title: str, ylabel: str) -> Path:
     ``tab`` index = trials, columns = groups.
     """
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
     _bars(ax, tab.T, list(tab.columns))
     ax.set_xlabel("derivative group")
     ax.set_ylabel(ylabel)
