@@ -48,7 +48,7 @@ def variant(base, family: str, value_deg: float):
 DEFAULT_GRID = {
     "S-type psi_S": [20, 30, 45, 60, 75, 90, 105, 120, 135, 150, 180, 240, 360],
     "zigzag a/a": [5, 10, 15, 20, 25, 30, 35],
-    "zigzag 35/a": [5, 10, 20, 30, 45, 60, 90],
+    "zigzag 35/a": [5, 10, 20, 30, 45, 60, 90, 120],
     "S-type 120, rudder": [10, 15, 20, 25, 30, 35],
 }
 PARAM = {"S-type psi_S": "psi_S_deg", "zigzag a/a": "angle_deg", "zigzag 35/a": "angle_deg",

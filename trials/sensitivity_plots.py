@@ -81,8 +81,8 @@ def plot_design(df: pd.DataFrame, path, param: str, title: str, reference: dict 
         for fam, g in df.groupby("family", sort=False):
             g = g.sort_values(param)
             ax.plot(g[param], g[c], "o-", label=fam)
-        for name, row in (reference or {}).items():
-            ax.axhline(row[c], ls="--", lw=1, color="k" if "120" in name else "0.5", label=name)
+        for (name, row), ls in zip((reference or {}).items(), ("--", ":", "-.", (0, (5, 1)))):
+            ax.axhline(row[c], ls=ls, lw=1.2, color="k" if "120" in name else "0.45", label=name)
         ax.set_yscale("log")
         ax.set_xlabel(param.replace("_deg", " [deg]"))
         ax.set_ylabel(lab, fontsize=9)
