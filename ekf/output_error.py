@@ -74,7 +74,7 @@ def _noise_half_widths(meta: dict) -> dict:
                 except ValueError:
                     continue
                 key = {"lat": "lat_deg", "lon": "lon_deg", "heading": "heading_deg", "rpm": "rpm"}.get(w[0])
-                if key:
+                if key and val > 0:  # a noise-free log keeps the default weights
                     out[key] = val
     return out
 
