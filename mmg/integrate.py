@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .model import DELTA_, N_, P_ENGINE, PSI_, U_, ENGINE_CONSTANT_RPM, PackedShip, rhs
+from .model import N_, P_ENGINE, PSI_, U_, ENGINE_CONSTANT_RPM, PackedShip, rhs
 
 SCHEDULE, HEADING_SWITCH = 0, 1
 
