@@ -11,7 +11,8 @@
    FRT-DS-ESSO files when ``../shared/data/frt-ds-esso`` is present);
 5. step convergence and port/starboard symmetry checks;
 6. the Nomoto models and their identification (Artyszuk 2018, Tables 1-8);
-7. the EKF reproduction (Rhee & Kim 1999, Tables 9-10).
+7. the EKF reproduction (Rhee & Kim 1999, Tables 9-10);
+8. the sensitivity figures (Rhee & Kim Figs 2, 8-9, 12, 13, 14 and 28).
 """
 from __future__ import annotations
 
@@ -186,6 +187,16 @@ def ekf_section(out: Path, quick: bool):
     print(f"\n(outputs in {out / 'ekf'}; {time.perf_counter() - t0:.1f} s)\n")
 
 
+def sensitivity_section(out: Path):
+    from .sensitivity_cli import paper_figures
+
+    print("## 8. Derivative sensitivity: Rhee & Kim Figs 2, 8-9, 12, 13, 14, 28\n")
+    t0 = time.perf_counter()
+    cmp_ = out / "ekf" / "comparison.csv"
+    paper_figures(out / "sensitivity", ekf_comparison=cmp_ if cmp_.exists() else None, verbose=True)
+    print(f"\n(figures and CSVs in {out / 'sensitivity'}; {time.perf_counter() - t0:.1f} s)\n")
+
+
 def reproduce(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -203,6 +214,7 @@ def reproduce(args) -> int:
         checks_section(ship)
         nomoto_section(out, args.quick)
         ekf_section(out, args.quick)
+        sensitivity_section(out)
         print(f"Total {time.perf_counter() - t0:.1f} s. Report: {out / 'report.md'}")
     finally:
         sys.stdout = old
