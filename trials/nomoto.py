@@ -702,12 +702,18 @@ def approach_speed(record: TrialRecord, t_execute: float) -> float:
 
 def _plateaus(delta):
     """Zigzag rudder plateaus: list of (start, end, sign) with alternating sign, and delta0 [rad]."""
-    dp = np.max(delta)
-    dm = np.min(delta)
+    # plateau levels from the samples where the rudder is held still, so that operator
+    # steering before the execute (which may go beyond the zigzag angle) is ignored
+    amax = np.max(np.abs(delta))
+    d = np.diff(delta)
+    flat = np.zeros(len(delta), bool)
+    flat[1:-1] = (np.abs(d[:-1]) < 1e-3 * amax) & (np.abs(d[1:]) < 1e-3 * amax)
+    dp = np.max(delta[flat], initial=0.0)
+    dm = np.min(delta[flat], initial=0.0)
     if dp <= 0 or dm >= 0:
         return [], 0.0
-    lp = np.median(delta[delta >= 0.8 * dp])
-    lm = np.median(delta[delta <= 0.8 * dm])
+    lp = np.median(delta[flat & (delta >= 0.5 * dp)])
+    lm = np.median(delta[flat & (delta <= 0.5 * dm)])
     d0 = 0.5 * (lp - lm)
     tol = max(0.05 * d0, np.radians(0.25))
     n = len(delta)
@@ -1341,8 +1347,8 @@ def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bia
     z : ZigzagData
         Dimensionless zigzag.
     start : NomotoModel, optional
-        Starting point (default: the least-squares fit if it has real positive
-        T1, T2, else T1 = 3, T2 = 0.3, T3 = 1, K = 2).
+        Starting point (default: the best of three starts, the least-squares
+        fit, the four-point result and the classical K, T with T2 = T3 = 0.1 T).
     fit_bias : bool
         Also fit a neutral rudder angle [rad].
     """
@@ -1352,9 +1358,23 @@ def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bia
     idx = np.arange(0, len(s), step)
     ss, dd, pp = s[idx], (z.delta + z.delta_e)[idx], (z.psi if z.psi_raw is None else z.psi_raw)[idx]
     if start is None:
+        starts = []
         ls = fit_least_squares(z, fit_bias=fit_bias)
-        ok = np.isfinite([ls.K, ls.T1, ls.T2, ls.T3]).all() and abs(ls.T1 * ls.T2) > 1e-6
-        start = ls.model if ok else NomotoModel(2.0, 3.0, 0.3, 1.0)
+        starts.append(ls.model)
+        try:
+            fp = four_point(z.points(2))
+            starts.append(fp.model)
+        except InputError:
+            pass
+        try:  # the robust first-order estimate, with a small T2 and T3 = T2
+            cl = classical_first_order(z)
+            starts.append(NomotoModel(cl.K, cl.T, 0.1 * abs(cl.T), 0.1 * abs(cl.T)))
+        except InputError:
+            pass
+    else:
+        starts = [start]
+    starts = [m for m in starts if np.isfinite([m.K, m.T1, m.T2, m.T3]).all() and abs(m.T1 * m.T2) > 1e-6] \
+        or [NomotoModel(2.0, 3.0, 0.3, 1.0)]
     nb = 1 if fit_bias else 0
 
     # parameters q = (K, x1 = T1 T2, x2 = T1 + T2, T3[, delta_bias], psi_0, omega'_0, eps'_0): no bounds,
@@ -1363,9 +1383,19 @@ def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bia
         return simulate_response((q[0], q[1], q[2], q[3]), ss, dd, q[4 + nb], q[5 + nb], q[6 + nb],
                                  q[4] if fit_bias else 0.0) - pp
 
-    q0 = np.array([start.K, start.T1 * start.T2, start.T1 + start.T2, start.T3] + ([0.0] if fit_bias else [])
-                  + [0.0, z.omega_e, z.eps_e])
-    sol = optimize.least_squares(resid, q0, x_scale="jac", max_nfev=600)
+    sol = None
+    for st in starts:  # several starts: the heading misfit is not convex in these parameters
+        q0 = np.array([st.K, st.T1 * st.T2, st.T1 + st.T2, st.T3] + ([0.0] if fit_bias else [])
+                      + [0.0, z.omega_e, z.eps_e])
+        try:
+            with np.errstate(all="ignore"):
+                cand = optimize.least_squares(resid, q0, x_scale="jac", max_nfev=300)
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+        if np.isfinite(cand.cost) and (sol is None or cand.cost < sol.cost):
+            sol = cand
+    if sol is None:
+        raise InputError(z.name, "heading", "output-error fit failed from every starting point")
     q = sol.x
     J = _jac(resid, q)
     r = sol.fun
