@@ -249,17 +249,18 @@ def table8(points: nm.ZigzagPoints, true: dict) -> pd.DataFrame:
 def _window_scale(z: nm.ZigzagData, spec: dict, half_width: float) -> nm.ZigzagData:
     """Scale channels by factors in windows |s' - s'_point| <= half_width around named points."""
     at = {"CR1": z.s_cr[0], "OS1": z.s_os[0], "CR2": z.s_cr[1], "OS2": z.s_os[1]}
+    # half_width 0: the one sample nearest to the point
+    near = {p: np.abs(z.s - v) <= max(half_width, np.min(np.abs(z.s - v))) for p, v in at.items()}
     kw = {}
     for ch, pts in spec.items():
         arr = getattr(z, ch).copy()
         for p, f in pts.items():
-            m = np.abs(z.s - at[p]) <= half_width
-            arr[m] *= f
+            arr[near[p]] *= f
         kw[ch] = arr
         if ch == "psi" and z.psi_raw is not None:  # the fits read the raw heading
             raw = kw.get("psi_raw", z.psi_raw.copy())
             for p, f in pts.items():
-                raw[np.abs(z.s - at[p]) <= half_width] *= f
+                raw[near[p]] *= f
             kw["psi_raw"] = raw
     return dataclasses.replace(z, **kw)
 
