@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from mmg.integrate import CommandLaw, integrate
-from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_, PackedShip
+from mmg.model import DELTA_, N_, P_RATE, P_TE, PSI_, R_, U_, V_, X_, Y_, PackedShip
 from mmg.units import DEG, KNOT
 
 from .filter import DERIVATIVES, FilterDivergence
@@ -100,6 +100,8 @@ class OETrial:
     dt: float
     idx: np.ndarray = field(default=None)
     order: np.ndarray | None = None   # open-loop rudder order on the 0.1 s grid (rudder="reconstructed")
+    tsw: np.ndarray | None = None     # start values of the rudder reversal times [s] (rudder="ramp")
+    levels: np.ndarray | None = None  # rudder order before the first reversal and after each one [rad]
 
     def __post_init__(self):
         if self.idx is None:
@@ -109,18 +111,79 @@ class OETrial:
     def nres(self) -> int:
         return self.obs.size
 
-    def nuisance0(self) -> np.ndarray:
-        return np.array([self.x0[V_], self.obs[0, 0], self.obs[0, 1], self.obs[0, 2]])
+    @property
+    def nnuis(self) -> int:
+        return NNUIS + (0 if self.tsw is None else len(self.tsw))
 
-    def simulate(self, theta, nuis) -> np.ndarray | None:
-        """(K, 4) simulated psi, x, y, n at the log times, or None when the run stopped early."""
+    def nuisance0(self) -> np.ndarray:
+        nu = np.array([self.x0[V_], self.obs[0, 0], self.obs[0, 1], self.obs[0, 2]])
+        return nu if self.tsw is None else np.r_[nu, self.tsw]
+
+    def ramp_law(self, tsw, t_shift: float = 0.0) -> CommandLaw:
+        """Open-loop order: ``levels`` with reversals at the continuous times ``tsw``.
+
+        The loop samples the order at each step start (zero-order hold) and the steering gear is
+        rate-limited, so a plain order ramp would act only through the sign of the order error
+        (the cost stays flat over most of a step). Instead the one step i whose start lies in
+        (t_k - dt/2, t_k + dt/2] gets the order that moves the rudder, over that step, by the
+        fraction f = (i dt - t_k + dt/2) / dt of a full-rate step (exact in the steering gear's
+        linear zone, f < ~0.98; beyond, a continuous blend up to an order saturated over the whole
+        step, which moves the rudder like the full reversal). The rudder then
+        leaves its old angle at t_k + dt/2 whatever the step grid: the simulation is continuous
+        in every t_k, and t_k = (i - 1/2) dt is the heading-switch law's reversal at step i exactly.
+        """
+        dt = self.dt
+        te, rate = float(self.packed.p[P_TE]), float(self.packed.p[P_RATE])
+        lam = te * rate
+        g = 1.0 - np.exp(-dt / te)
+        dfull = rate * dt
+        flin = min(lam * g / dfull, 1.0)
+        tk = np.sort(np.asarray(tsw, float))
+        ik = np.floor(tk / dt - 0.5) + 1.0   # the step whose start lies in (t_k - dt/2, t_k + dt/2]
+        ik = np.maximum(ik, 1.0)
+        ik = np.maximum.accumulate(ik + 2.0 * np.arange(len(ik))) - 2.0 * np.arange(len(ik))
+        f = np.clip((ik * dt - tk + 0.5 * dt) / dt, 0.0, 1.0)
+        e = 1e-6 * dt
+        ts, vs = [-1e9], [self.levels[0]]
+        for k in range(len(tk)):
+            a, b = self.levels[k], self.levels[k + 1]
+            sgn, span = np.sign(b - a), abs(b - a)
+            if f[k] <= flin:
+                c = a + sgn * f[k] * dfull / g
+            else:
+                c = a + sgn * min(lam + (f[k] - flin) / (1.0 - flin) * dfull, span)  # saturated all step at f = 1
+            t0 = (ik[k] - 0.5) * dt
+            ts += [t0 - e, t0 + e, t0 + dt - e, t0 + dt + e]
+            vs += [a, c, c, b]
+        ts.append(max(self.duration + 1.0, ts[-1] + 1.0))
+        vs.append(self.levels[-1])
+        return CommandLaw.schedule(np.array(ts) - t_shift, vs)
+
+    def _pk(self, theta) -> PackedShip:
         coef = self.packed.hull_coef.copy()
         coef[self.slots] = theta
-        pk = PackedShip(self.packed.p, self.packed.poly, self.packed.hull_axis, self.packed.hull_term, coef)
+        return PackedShip(self.packed.p, self.packed.poly, self.packed.hull_axis, self.packed.hull_term, coef)
+
+    def states(self, theta, nuis, restart=None) -> np.ndarray | None:
+        """(steps+1, 8) simulated states, or None when the run stopped early.
+
+        ``restart=(i0, states)``: continue from row i0 of an earlier run (rows before i0 are copied);
+        used for the switch-time Jacobian columns, where nothing changes before the reversal.
+        """
+        pk = self._pk(theta)
+        if restart is not None and self.tsw is not None:
+            i0, S0 = restart
+            law = self.ramp_law(nuis[NNUIS:], t_shift=i0 * self.dt)
+            _, S, _, done = integrate(pk, S0[i0], law, self.duration - i0 * self.dt, self.dt)
+            if not done or not np.all(np.isfinite(S)):
+                return None
+            return np.concatenate([S0[:i0], S])
         x0 = self.x0.copy()
-        x0[V_], x0[PSI_], x0[X_], x0[Y_] = nuis
+        x0[V_], x0[PSI_], x0[X_], x0[Y_] = nuis[:NNUIS]
         law = self.law
-        if self.order is not None:
+        if self.tsw is not None:
+            law = self.ramp_law(nuis[NNUIS:])
+        elif self.order is not None:
             law = CommandLaw.schedule(np.arange(len(self.order)) * self.dt, self.order)
         elif law.kind == 1:  # heading switch relative to the start heading
             par = law.params.copy()
@@ -129,17 +192,28 @@ class OETrial:
         t, S, _, done = integrate(pk, x0, law, self.duration, self.dt)
         if not done or not np.all(np.isfinite(S)):
             return None
-        return S[self.idx][:, [PSI_, X_, Y_, N_]]
+        return S
 
-    def residuals(self, theta, nuis) -> np.ndarray:
-        sim = self.simulate(theta, nuis)
+    def simulate(self, theta, nuis, restart=None) -> np.ndarray | None:
+        """(K, 4) simulated psi, x, y, n at the log times, or None when the run stopped early."""
+        S = self.states(theta, nuis, restart)
+        return None if S is None else S[self.idx][:, [PSI_, X_, Y_, N_]]
+
+    def residuals(self, theta, nuis, restart=None) -> np.ndarray:
+        sim = self.simulate(theta, nuis, restart)
         if sim is None:
             return np.full(self.nres, 1e6)
         return ((sim - self.obs) / self.sigma).ravel()
 
 
-def trial_from_data(data, rudder: str = "law", duration: float | None = None) -> OETrial:
-    """An :class:`OETrial` from a :class:`ekf.estimate.TrialData` (re-reads its raw log)."""
+def trial_from_data(data, rudder: str = "ramp", duration: float | None = None) -> OETrial:
+    """An :class:`OETrial` from a :class:`ekf.estimate.TrialData` (re-reads its raw log).
+
+    rudder: "ramp" (default; zigzag/S-type reversal times as continuous nuisance parameters,
+    started where the recovered heading reaches the switching heading), "law" (closed-loop heading
+    switch on the simulated heading) or "reconstructed" (the rebuilt order, whole-step switches).
+    Turning trials use their constant order in every mode.
+    """
     from trials.logio import read_record
 
     rec = read_record(data.source)
@@ -160,12 +234,22 @@ def trial_from_data(data, rudder: str = "law", duration: float | None = None) ->
     x0[U_], x0[V_], x0[R_], x0[DELTA_], x0[N_] = u0, 0.0, 0.0, trim, n0
     x0[PSI_], x0[X_], x0[Y_] = obs[0, 0], obs[0, 1], obs[0, 2]
     kind, man = manoeuvre_from_meta(meta, data.source)
+    if rudder == "ramp" and kind != "turning":
+        order, _ = reconstruct_rudder(data.meas.t, data.meas.psi, kind, man, data.packed.p, trim)
+        sw = switches(order)
+        tm = data.meas.t - data.meas.t[0]
+        keep_sw = sw[tm[sw] < dur]
+        tsw = (tm[keep_sw] - 0.5 * dt).astype(float)
+        levels = np.asarray(order, float)[np.r_[0, keep_sw]].copy()
+        law = CommandLaw.schedule([0.0, 1.0], [levels[0], levels[0]])
+        return OETrial(data.name, data.packed, np.asarray(data.slots), t[keep], obs, sigma, x0, law, dur, dt,
+                       tsw=tsw, levels=levels)
     if rudder == "reconstructed":
         order, _ = reconstruct_rudder(data.meas.t, data.meas.psi, kind, man, data.packed.p, trim)
         law = CommandLaw.schedule(data.meas.t - data.meas.t[0], order)
         return OETrial(data.name, data.packed, np.asarray(data.slots), t[keep], obs, sigma, x0, law, dur, dt,
                        order=np.asarray(order, float).copy())
-    elif rudder == "law":
+    elif rudder in ("law", "ramp"):
         side = 1.0 if man.get("first", "starboard") == "starboard" else -1.0
         if kind == "turning":
             te = float(meta.get("execute_s", 0.0))
@@ -180,15 +264,18 @@ def trial_from_data(data, rudder: str = "law", duration: float | None = None) ->
             hi, lo = (h, 0.0) if side > 0 else (0.0, -h)
             law = CommandLaw.heading_switch(man["rudder"], hi, lo, side, psi0=x0[PSI_])
     else:
-        raise ValueError(f"rudder must be 'law' or 'reconstructed', not {rudder!r}")
+        raise ValueError(f"rudder must be 'ramp', 'law' or 'reconstructed', not {rudder!r}")
     return OETrial(data.name, data.packed, np.asarray(data.slots), t[keep], obs, sigma, x0, law, dur, dt)
 
 
 # --------------------------------------------------------------------------- the joint fit
 
 
-def _sim_task(tr: OETrial, theta, nuis):
-    return tr.residuals(theta, nuis)
+def _sim_task(tr: OETrial, theta, nuis, restart=None):
+    return tr.residuals(theta, nuis, restart)
+
+
+TSW_FD = 0.01  # forward-difference step of a reversal time, in steps (stays inside one ramp cell)
 
 
 @dataclass
@@ -199,7 +286,7 @@ class OEResult:
     theta: np.ndarray
     se: np.ndarray
     cov: np.ndarray
-    nuisance: np.ndarray          # (n_trials, 4) v0, psi0, x0, y0
+    nuisance: list                # per trial: v0, psi0, x0, y0 [, reversal times t_k]
     cost: float                   # 0.5 * sum of squared whitened residuals
     nres: int
     nfev: int
@@ -218,33 +305,50 @@ class OEResult:
         return dict(zip(self.names, map(float, self.se)))
 
     @property
+    def nparams(self) -> int:
+        return len(self.theta) + sum(len(n) for n in self.nuisance)
+
+    @property
     def chi2_per_dof(self) -> float:
-        return 2.0 * self.cost / max(self.nres - len(self.theta) - self.nuisance.size, 1)
+        return 2.0 * self.cost / max(self.nres - self.nparams, 1)
 
 
 class _Problem:
-    """Scaled least-squares problem: q = [theta / scale, nuisance / nscale]."""
+    """Scaled least-squares problem: q = [theta / scale, nuisance_1 / nscale_1, ...].
+
+    Nuisances per trial: v0 (scale 0.01 m/s), psi0 (1e-3 rad), x0, y0 (1 m) and, for open-loop
+    ramp rudders, the reversal times t_k (0.1 s). Jacobian: forward differences for the derivatives
+    and v0 (full runs), for t_k a run restarted just before the reversal (each t_k touches one trial
+    and only the samples after it), analytic for psi0, x0, y0 (rotation about / shift of the start).
+    """
 
     def __init__(self, trials: list[OETrial], theta0, scale, n_jobs: int = 1, verbose: bool = False):
         self.trials = trials
         self.scale = np.asarray(scale, float)
         self.nt = len(trials)
         self.nd = len(theta0)
-        nus = np.array([tr.nuisance0() for tr in trials])
-        # v0 in m/s (scale 0.01), psi0 rad (1e-3), x0, y0 m (1)
-        self.nscale = np.tile([1e-2, 1e-3, 1.0, 1.0], self.nt)
-        self.q0 = np.r_[np.asarray(theta0, float) / self.scale, nus.ravel() / self.nscale]
+        self.nn = [tr.nnuis for tr in trials]
+        self.noff = self.nd + np.cumsum([0] + self.nn)  # column of each trial's first nuisance
+        self.nscale = np.concatenate([np.r_[1e-2, 1e-3, 1.0, 1.0, np.full(n - NNUIS, 0.1)] for n in self.nn])
+        nus = np.concatenate([tr.nuisance0() for tr in trials])
+        self.q0 = np.r_[np.asarray(theta0, float) / self.scale, nus / self.nscale]
         self.offsets = np.cumsum([0] + [tr.nres for tr in trials])
         self.n_jobs = n_jobs
         self.verbose = verbose
         self._cache = None
+        self._states = None
         self.t0 = time.perf_counter()
         self.nsim = 0
+        self.free_theta = True
 
     def split(self, q):
         theta = q[: self.nd] * self.scale
-        nuis = (q[self.nd:] * self.nscale).reshape(self.nt, NNUIS)
+        flat = q[self.nd:] * self.nscale
+        nuis = [flat[a - self.nd: b - self.nd] for a, b in zip(self.noff[:-1], self.noff[1:])]
         return theta, nuis
+
+    def join_nuisance(self, nuis) -> np.ndarray:
+        return np.concatenate(nuis) / self.nscale
 
     def _run(self, tasks):
         self.nsim += len(tasks)
@@ -267,7 +371,7 @@ class _Problem:
         f0 = self.fun(q)
         J = np.zeros((len(f0), len(q)))
         tasks, where = [], []
-        for j in range(self.nd):
+        for j in (range(self.nd) if self.free_theta else ()):
             th = theta.copy()
             h = FD_STEP * max(abs(theta[j]), 1e-3 * self.scale[j])
             th[j] += h
@@ -279,7 +383,25 @@ class _Problem:
             h = 1e-6
             nu[0] += h
             tasks.append((tr, theta, nu))
-            where.append((i, self.nd + NNUIS * i, h / self.nscale[NNUIS * i]))
+            c = self.noff[i]
+            where.append((i, c, h / self.nscale[c - self.nd]))
+        for i, tr in enumerate(self.trials):  # reversal times: restart a step before the ramp
+            if tr.tsw is None or len(tr.tsw) == 0:
+                continue
+            S0 = tr.states(theta, nuis[i])
+            if S0 is None:
+                continue
+            for k in range(len(tr.tsw)):
+                nu = nuis[i].copy()
+                h = TSW_FD * tr.dt
+                tk = nu[NNUIS + k]
+                if np.floor(tk / tr.dt + 0.5 + TSW_FD) != np.floor(tk / tr.dt + 0.5):
+                    h = -h  # stay inside the ramp cell (the simulation is linear in t_k there)
+                nu[NNUIS + k] += h
+                i0 = int(max(0, min(len(S0) - 2, np.floor((min(tk, tk + h) - 0.5 * tr.dt) / tr.dt) - 1)))
+                tasks.append((tr, theta, nu, (i0, S0)))
+                c = self.noff[i] + NNUIS + k
+                where.append((i, c, h / self.nscale[c - self.nd]))
         outs = self._run(tasks)
         for (i, col, hq), r in zip(where, outs):
             a, b = self.offsets[i], self.offsets[i + 1]
@@ -287,8 +409,8 @@ class _Problem:
         for i, tr in enumerate(self.trials):  # psi0, x0, y0: analytic (rotation about / shift of the start)
             a, b = self.offsets[i], self.offsets[i + 1]
             r = f0[a:b].reshape(-1, 4) * tr.sigma + tr.obs  # simulated psi, x, y, n
-            x0, y0 = nuis[i, 2], nuis[i, 3]
-            c = self.nd + NNUIS * i
+            x0, y0 = nuis[i][2], nuis[i][3]
+            c = self.noff[i]
             blk = np.zeros((r.shape[0], 4, 3))
             blk[:, 0, 0] = 1.0
             blk[:, 1, 0] = -(r[:, 2] - y0)
@@ -296,12 +418,41 @@ class _Problem:
             blk[:, 1, 1] = 1.0
             blk[:, 2, 2] = 1.0
             blk /= tr.sigma[None, :, None]
-            blk *= self.nscale[NNUIS * i + 1: NNUIS * i + 4][None, None, :]
+            blk *= self.nscale[c - self.nd + 1: c - self.nd + 4][None, None, :]
             J[a:b, c + 1: c + 4] = blk.reshape(-1, 3)
         if self.verbose:
             print(f"    jacobian {self.nsim} simulations, cost {0.5 * f0 @ f0:.6g} "
                   f"({time.perf_counter() - self.t0:.0f} s)", flush=True)
         return J
+
+
+def fit_nuisance(trials: list[OETrial], theta, nuis=None, max_nfev: int = 30,
+                 only_switching: bool = True) -> list[np.ndarray]:
+    """Per trial, the nuisances (start sway/heading/position, reversal times) at fixed derivatives ``theta``.
+
+    Cheap (no derivative columns; trials are independent) and it takes the start heading and the
+    reversal times, which the positions see as hundreds of sigma over 3000 s, to their optimum
+    before the derivatives move, so the joint fit starts near its valley floor. Trials without
+    reversal times keep their start values unless ``only_switching`` is False (their v0 fitted at
+    a wrong theta can take the joint fit away, e.g. ST35 from a 120 % start).
+    """
+    from scipy.optimize import least_squares
+
+    out = []
+    for i, tr in enumerate(trials):
+        if only_switching and tr.tsw is None:
+            out.append(tr.nuisance0() if nuis is None else np.asarray(nuis[i], float).copy())
+            continue
+        prob = _Problem([tr], theta, np.abs(theta))
+        prob.free_theta = False
+        if nuis is not None:
+            prob.q0[prob.nd:] = prob.join_nuisance([nuis[i]])
+        qt = prob.q0[: prob.nd]
+        sol = least_squares(lambda z: prob.fun(np.r_[qt, z]), prob.q0[prob.nd:],
+                            jac=lambda z: prob.jac(np.r_[qt, z])[:, prob.nd:], method="trf", max_nfev=max_nfev,
+                            xtol=1e-8, ftol=1e-9, gtol=1e-10)
+        out.append(prob.split(np.r_[qt, sol.x])[1][0].copy())
+    return out
 
 
 def switches(order: np.ndarray) -> np.ndarray:
@@ -361,7 +512,8 @@ def search_switches(trials: list[OETrial], theta, nuis, verbose: bool = False) -
 
 
 def fit(trials: list[OETrial], theta0, names=DERIVATIVES, n_jobs: int = 1, verbose: bool = False,
-        max_nfev: int = 60, stages=None, max_rounds: int = 6) -> OEResult:
+        max_nfev: int = 60, stages=None, max_rounds: int = 6, prefit_nuisance: bool = True, xtol: float = 1e-8,
+        ftol: float = 1e-9) -> OEResult:
     """Joint output-error fit of the derivatives ``names`` (start ``theta0``) over ``trials``.
 
     ``stages``: optional record lengths [s] fitted in turn (continuation: a short record first,
@@ -380,16 +532,20 @@ def fit(trials: list[OETrial], theta0, names=DERIVATIVES, n_jobs: int = 1, verbo
         trs = trials if L is None else [replace(tr, duration=min(L, tr.duration), t_log=tr.t_log[tr.t_log <= L],
                                                 obs=tr.obs[tr.t_log <= L], idx=None) for tr in trials]
         prob = _Problem(trs, theta, np.abs(theta0), n_jobs=n_jobs, verbose=verbose)
+        if nuis0 is None and prefit_nuisance:
+            nuis0 = fit_nuisance(trs, theta)
+            if verbose:
+                print(f"    nuisance pre-fit: cost {0.5 * np.sum(prob.fun(np.r_[prob.q0[:prob.nd], prob.join_nuisance(nuis0)]) ** 2):.6g}", flush=True)
         if nuis0 is not None:
-            prob.q0[prob.nd:] = nuis0.ravel() / prob.nscale
+            prob.q0[prob.nd:] = prob.join_nuisance(nuis0)
         if verbose:
             print(f"  stage {'full' if L is None else f'{L:g} s'}: {len(trs)} trials, "
                   f"{sum(t.nres for t in trs)} residuals", flush=True)
         for rnd in range(max_rounds):
             sol = least_squares(prob.fun, prob.q0, jac=prob.jac, method="trf", x_scale=1.0, max_nfev=max_nfev,
-                                xtol=1e-10, ftol=1e-12, gtol=1e-10)
+                                xtol=xtol, ftol=ftol, gtol=1e-10)
             theta, nuis = prob.split(sol.x)
-            nuis0 = nuis
+            nuis0 = [n.copy() for n in nuis]
             nfev += sol.nfev
             njev += sol.njev or 0
             if not any(tr.order is not None for tr in trs):
@@ -410,7 +566,7 @@ def fit(trials: list[OETrial], theta0, names=DERIVATIVES, n_jobs: int = 1, verbo
     sc = np.r_[prob.scale, prob.nscale]
     cov = covq * np.outer(sc, sc)
     nd = len(theta)
-    return OEResult(tuple(names), theta, np.sqrt(np.diag(cov)[:nd]), cov[:nd, :nd], nuis, float(sol.cost),
+    return OEResult(tuple(names), theta, np.sqrt(np.diag(cov)[:nd]), cov[:nd, :nd], [n.copy() for n in nuis], float(sol.cost),
                     len(sol.fun), nfev, njev, tuple(tr.name for tr in trials), theta0, time.perf_counter() - t0,
                     sol.message)
 
@@ -428,7 +584,7 @@ def information(trials: list[OETrial], theta) -> tuple[np.ndarray, np.ndarray]:
 # --------------------------------------------------------------------------- EKF start + refinement
 
 
-def refine(datas, cfg, rudder: str = "law", n_jobs: int = 1, verbose: bool = False, start: str = "ekf",
+def refine(datas, cfg, rudder: str = "ramp", n_jobs: int = 1, verbose: bool = False, start: str = "ekf",
            stages=None):
     """EKF (joint over ``datas``) then the joint output-error fit. Returns (ekf_final dict, OEResult)."""
     from .estimate import initial_state, joint_estimate
@@ -501,7 +657,7 @@ def _mc_one(seed: int, trials, cfg, rudder: str) -> dict:
 
 
 def monte_carlo(out_dir, n_seeds: int = 20, trials=PAPER_TRIALS, n_jobs: int = 2, first_seed: int = 1000,
-                config=None, rudder: str = "law", verbose: bool = True):
+                config=None, rudder: str = "ramp", verbose: bool = True):
     """Seeds x (joint EKF, then joint output error); writes runs.csv, summary.csv/.md; returns the summary."""
     import pandas as pd
     from joblib import Parallel, delayed
@@ -556,7 +712,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--first-seed", type=int, default=1000)
     ap.add_argument("--trials", nargs="+", default=list(PAPER_TRIALS), help="trial names (ST35 ZZ10 ZZ20 'S-type 120')")
-    ap.add_argument("--rudder", choices=("law", "reconstructed"), default="law")
+    ap.add_argument("--rudder", choices=("ramp", "law", "reconstructed"), default="ramp")
     ap.add_argument("--jobs", type=int, default=2)
     a = ap.parse_args(argv)
     monte_carlo(a.out, a.seeds, tuple(a.trials), n_jobs=a.jobs, first_seed=a.first_seed, rudder=a.rudder)
