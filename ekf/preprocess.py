@@ -25,14 +25,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from mmg.errors import InputError
-from mmg.model import steering_rate
-from mmg.units import DEG, KNOT
+from mmg.units import DEG
 
-M_PER_DEG_LAT = 1852.0 * 60.0
-M_PER_DEG_LON = 1526.16 * 60.0
+from trials.logio import M_PER_DEG_LAT, M_PER_DEG_LON  # noqa: F401
+from trials.rudder import manoeuvre_from_meta, reconstruct_rudder  # noqa: F401
 
 CHANNELS = ("u", "v", "r", "delta", "n")
 UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "delta": "rad", "n": "rps"}
@@ -91,75 +89,6 @@ def quadratic3(ts: np.ndarray, ys: np.ndarray, tq: np.ndarray):
     d1 = (2 * tq - t0 - t2) / ((t1 - t0) * (t1 - t2))
     d2 = (2 * tq - t0 - t1) / ((t2 - t0) * (t2 - t1))
     return y0 * l0 + y1 * l1 + y2 * l2, y0 * d0 + y1 * d1 + y2 * d2
-
-
-@njit(cache=True)
-def _steer(t, psi, law, amp, hi, lo, first, delta0, p, out_order, out_delta):
-    """Rudder order by the trial's law and the rudder through the steering gear (RK4 on 0.1 s)."""
-    side = first
-    d = delta0
-    psi0 = psi[0]
-    for k in range(t.shape[0]):
-        if law == 0:
-            cmd = amp
-        else:
-            dpsi = psi[k] - psi0
-            if side > 0.0 and dpsi >= hi:
-                side = -1.0
-            elif side < 0.0 and dpsi <= lo:
-                side = 1.0
-            cmd = side * amp
-        out_order[k] = cmd
-        out_delta[k] = d
-        if k + 1 < t.shape[0]:
-            h = t[k + 1] - t[k]
-            k1 = steering_rate(cmd, d, p)
-            k2 = steering_rate(cmd, d + 0.5 * h * k1, p)
-            k3 = steering_rate(cmd, d + 0.5 * h * k2, p)
-            k4 = steering_rate(cmd, d + h * k3, p)
-            d = d + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-
-
-def reconstruct_rudder(t, psi, kind: str, manoeuvre: dict, p: np.ndarray, delta0: float = 0.0):
-    """Rudder order and angle [rad] at times ``t`` from the trial's logic and a heading series.
-
-    kind : "turning" (constant order ``rudder``), "zigzag" (``rudder``, ``heading``, ``first``)
-    or "stype" (``rudder``, ``switch_heading``, ``first``); angles in rad. ``p`` is the packed
-    parameter vector (steering gear constants). ``delta0`` is the rudder at t[0].
-    """
-    amp = float(manoeuvre["rudder"])
-    side = 1.0 if manoeuvre.get("first", "starboard") == "starboard" else -1.0
-    if kind == "turning":
-        law, hi, lo = 0, 0.0, 0.0
-    elif kind == "zigzag":
-        law, hi, lo = 1, float(manoeuvre["heading"]), -float(manoeuvre["heading"])
-    elif kind == "stype":
-        h = float(manoeuvre["switch_heading"])
-        law, (hi, lo) = 1, ((h, 0.0) if side > 0 else (0.0, -h))
-    else:
-        raise ValueError(f"cannot reconstruct the rudder of a {kind!r} trial")
-    order = np.empty(len(t))
-    delta = np.empty(len(t))
-    _steer(np.asarray(t, float), np.asarray(psi, float), law, amp, hi, lo, side, float(delta0),
-           np.asarray(p, float), order, delta)
-    return order, delta
-
-
-def manoeuvre_from_meta(meta: dict, source: str = "log") -> tuple[str, dict]:
-    """The trial kind and its rudder logic (SI) from a log header."""
-    kind = str(meta.get("kind", ""))
-    if kind not in ("turning", "zigzag", "stype"):
-        raise InputError(source, "kind", f"the log has no rudder channel and its header gives no turning/zigzag/stype "
-                                         f"trial kind to rebuild it from (kind: {kind or 'missing'})")
-    try:
-        m = {"rudder": float(meta["rudder_deg"]) * DEG, "first": str(meta.get("first", "starboard"))}
-        if kind == "zigzag":
-            m["heading"] = float(meta["heading_deg"]) * DEG
-        elif kind == "stype":
-            m["switch_heading"] = float(meta["switch_heading_deg"]) * DEG
-    except KeyError as e:
-        raise InputError(source, str(e.args[0]), "missing from the log header; needed to rebuild the rudder") from None
-    return kind, m
 
 
 def recover(record, p: np.ndarray, dt: float = 0.1, kind: str | None = None, manoeuvre: dict | None = None,

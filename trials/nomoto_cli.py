@@ -74,6 +74,11 @@ def cmd_nomoto(args) -> int:
     if args.speed is not None and (not np.isfinite(args.speed) or args.speed <= 0):
         raise InputError("--speed", "", f"speed must be a positive number of m/s, got {args.speed}")
     rec = read_record(args.log)
+    if rec.delta is None and rec.meta.get("format") == "log":
+        from trials.rudder import with_rebuilt_rudder
+
+        rec = with_rebuilt_rudder(rec)
+        print(f"{rec.name}: no rudder channel in the log; rudder rebuilt from the {rec.meta.get('kind')} logic in its header")
     ident = nm.identify(rec, args.length, args.speed, output_error=not args.no_output_error)
     print(report(ident))
     if args.json:

@@ -43,7 +43,10 @@ class TrialRun:
                 "start_lat_deg": np.degrees(lg.start_lat), "start_lon_deg": np.degrees(lg.start_lon),
                 "m_per_deg_lat": M_PER_DEG_LAT, "m_per_deg_lon": M_PER_DEG_LON,
                 "interval_s": lg.interval, "dt_s": self.trial.dt, "length_m": self.trial.ship.particulars.L,
-                "approach_rpm": round(eq.n * 60, 4), "trim_rudder_deg": round(eq.delta / DEG, 5),
+                "approach_rpm": round(eq.n * 60, 4), "trim_rudder_deg": round(eq.delta / DEG, 8),
+                "steering_T_E_s": self.trial.ship.steering.T_E,
+                "steering_rate_deg_s": self.trial.ship.steering.rate_max / DEG,
+                "steering_delta_max_deg": self.trial.ship.steering.delta_max / DEG,
                 "noise": f"uniform: lat {np.degrees(lg.noise_lat):g} deg, lon {np.degrees(lg.noise_lon):g} deg, "
                          f"heading {np.degrees(lg.noise_heading):g} deg, speed {lg.noise_speed / 0.514444:g} kn, "
                          f"rpm {lg.noise_rpm * 60:g} rpm"}
