@@ -88,3 +88,67 @@ def test_joint_information_of_the_paper_trials(tmp_path):
         if n != "N_bb":
             assert p < 2.0, (n, p)
     assert pct[DERIVATIVES.index("N_bb")] > 5.0
+
+
+# --------------------------------------------------------------------------- zigzag: reversal times as parameters
+
+
+@pytest.fixture(scope="module")
+def zz20_short(tmp_path_factory):
+    return _data(tmp_path_factory.mktemp("zz20"), "zz20.yaml", 600.0)
+
+
+def _law_switch_times(data, tv):
+    """The heading-switch law's reversal steps at the truth, as ramp times (i - 1/2) dt."""
+    from mmg.integrate import integrate
+    law = oe.trial_from_data(data, rudder="law")
+    x0 = law.x0.copy()
+    x0[oe.V_] = -0.000830334
+    _, S, orders, _ = integrate(law._pk(tv), x0, law.law, law.duration, law.dt)
+    return law, x0, S, (oe.switches(orders) - 0.5) * law.dt
+
+
+def test_ramp_rudder_reproduces_the_switch_law_exactly(zz20_short):
+    tv = np.array([zz20_short.true_values[n] for n in DERIVATIVES])
+    law, x0, S, tsw = _law_switch_times(zz20_short, tv)
+    tr = oe.trial_from_data(zz20_short)  # rudder="ramp"
+    assert tr.tsw is not None and len(tr.tsw) == len(tsw) == 2
+    assert np.all(np.abs(tr.tsw - tsw) <= 2 * tr.dt + 1e-9)  # start values from the recovered heading
+    nu = np.r_[x0[oe.V_], x0[oe.PSI_], x0[oe.X_], x0[oe.Y_], tsw]
+    assert np.abs(tr.states(tv, nu) - S).max() < 1e-9
+
+
+def test_cost_is_continuous_in_a_reversal_time(zz20_short):
+    tv = np.array([zz20_short.true_values[n] for n in DERIVATIVES])
+    _, x0, _, tsw = _law_switch_times(zz20_short, tv)
+    tr = oe.trial_from_data(zz20_short)
+    nu = np.r_[x0[oe.V_], x0[oe.PSI_], x0[oe.X_], x0[oe.Y_], tsw]
+    s = np.linspace(-1.0, 1.0, 17)  # crosses two step boundaries
+    cost = []
+    for d in s:
+        n2 = nu.copy()
+        n2[oe.NNUIS] += d * tr.dt
+        r = tr.residuals(tv, n2)
+        cost.append(r @ r)
+    cost = np.array(cost)
+    assert cost[8] < 1e-2 and np.all(cost[[0, -1]] > 100.0)  # ~0 at the law's reversal (log rounding), steep off it
+    q = np.polyval(np.polyfit(s, cost, 2), s)  # nearly a parabola: no steps (the old law jumped by a cell)
+    assert np.abs(cost - q).max() < 0.05 * cost.max()
+    assert np.all(np.diff(cost[:9]) < 0) and np.all(np.diff(cost[8:]) > 0)
+
+
+def test_switch_time_jacobian_columns_match_full_differences(zz20_short):
+    tv = np.array([zz20_short.true_values[n] for n in DERIVATIVES])
+    tr = oe.trial_from_data(zz20_short)
+    prob = oe._Problem([tr], tv, np.abs(tv))
+    prob.free_theta = False
+    q = prob.q0.copy()
+    q[prob.nd + oe.NNUIS:] += 0.3  # 0.03 s, inside a ramp cell
+    J = prob.jac(q)
+    for k in range(len(tr.tsw)):
+        c = prob.nd + oe.NNUIS + k
+        h = 1e-3
+        qq = q.copy()
+        qq[c] += h
+        fd = (prob.fun(qq) - prob.fun(q)) / h
+        assert np.allclose(J[:, c], fd, rtol=1e-3, atol=1e-3 * np.abs(fd).max())
