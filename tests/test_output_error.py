@@ -152,3 +152,25 @@ def test_switch_time_jacobian_columns_match_full_differences(zz20_short):
         qq[c] += h
         fd = (prob.fun(qq) - prob.fun(q)) / h
         assert np.allclose(J[:, c], fd, rtol=1e-3, atol=1e-3 * np.abs(fd).max())
+
+
+def test_cli_estimate_output_error(tmp_path):
+    import json
+
+    from trials.cli import main
+
+    d = tmp_path / "zz"
+    d.mkdir()
+    _data(d, "zz20.yaml", 600.0)
+    out = tmp_path / "out"
+    rc = main(["estimate", str(d / "log.csv"), "--truth", str(d / "truth.csv"), "--out", str(out),
+               "--method", "output-error"])
+    assert rc == 0
+    js = json.loads((out / "estimates.json").read_text())
+    assert set(js) == set(DERIVATIVES)
+    for v in js.values():
+        assert {"estimate", "true", "error_pct", "std_error"} <= set(v)
+        assert np.isfinite(v["estimate"]) and np.isfinite(v["error_pct"]) and v["std_error"] > 0
+    fit = json.loads((out / "oe_fit.json").read_text())
+    assert len(fit["nuisance"]["ZZ20"]["reversal_times_s"]) == 2 and fit["chi2_per_dof"] < 1.0
+    assert (out / "error_table.md").exists()
