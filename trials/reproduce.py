@@ -119,7 +119,8 @@ def plausibility_section(runs, ship):
     model_rows = [{"run": "ours, full scale, 10 kn, +35 deg", "U0": "10 kn", **{k: st.get(k) for k in
                    ("advance_L", "transfer_L", "tactical_diameter_L", "steady_diameter_L", "speed_loss")}}]
     if FRT.is_dir():
-        for f in sorted((FRT / "turning").glob("turn_14-Sep-2020_1[34]_*.csv")):
+        # the three 35 deg turns at n = 10 rps (FRT-DS-ESSO README)
+        for f in [FRT / "turning" / f"turn_14-Sep-2020_{s}.csv" for s in ("13_39_32", "13_51_45", "14_16_04")]:
             from .logio import read_record
 
             rec = read_record(f)
@@ -155,7 +156,7 @@ def checks_section(ship):
     rel = max(np.max(np.abs(a.states[:, j] - mirror[j] * b.states[:, j])) / (np.max(np.abs(a.states[:, j])) or 1)
               for j in range(8))
     print(table([
-        {"check": "tactical diameter, dt 0.2 / 0.1 / 0.05 s (L)", "value": fmt(tds, 5)},
+        {"check": "tactical diameter, dt 0.2 / 0.1 / 0.05 s (L)", "value": " / ".join(f"{v:.7f}" for v in tds)},
         {"check": "relative change halving dt 0.1 -> 0.05 s", "value": f"{abs(tds[2] - tds[1]) / tds[2]:.2e}"},
         {"check": "port/starboard mirror (Y_0 = N_0 = 0), max relative difference", "value": f"{rel:.2e}"},
     ], ["check", "value"]))
