@@ -700,8 +700,8 @@ def summarise(out_dir, trials=PAPER_TRIALS, rudder: str = "ramp", ekf_summary=No
     import pandas as pd
 
     out = Path(out_dir)
-    runs = pd.read_csv(out / "runs.csv", keep_default_na=False, na_values=[""])
-    runs["diverged"] = runs["diverged"].fillna("").astype(str)
+    runs = pd.read_csv(out / "runs.csv", dtype={"diverged": str})
+    runs["diverged"] = runs["diverged"].fillna("")
     ok = runs[runs["diverged"] == ""]
     per_trial = None
     if ekf_summary is not None and Path(ekf_summary).exists():
