@@ -63,6 +63,9 @@ def _run(args, cfg, StagedOutput, data_from_log, data_from_trial, estimate, writ
         if getattr(args, "method", "ekf") == "output-error":
             return _run_output_error(datas, cfg, out)
         ests = [estimate(d, cfg) for d in datas]
+        for e in ests:
+            for w in e.warnings():
+                print(f"warning: {w}", file=sys.stderr)
         if args.joint and len(datas) > 1:
             from .estimate import joint_estimate
             ests.append(joint_estimate(datas, cfg, name="joint"))

@@ -241,6 +241,23 @@ class Estimate:
     def final(self) -> dict:
         return self.result.final
 
+    def warnings(self, min_shrink: float = 0.1) -> list[str]:
+        """Signs that the pass is not to be trusted although it did not diverge.
+
+        A filter whose derivative standard deviations shrank, in the median, by less than
+        ``min_shrink`` (10 %) of their start values over the record has learned almost nothing
+        from it: typically R is far too large, or the trial does not excite the derivatives.
+        (With the paper's settings the median shrink is about 40 %; with R 1e6 times larger, 0.2 %.)
+        """
+        sd0 = np.sqrt(self.result.pdiag[0, NS:])
+        sd1 = np.sqrt(np.maximum(self.result.pdiag[-1, NS:], 0.0))
+        shrink = 1.0 - sd1 / sd0
+        if np.median(shrink) < min_shrink:
+            return [f"trial {self.name!r}: the filter learned almost nothing over {self.result.t[-1]:.0f} s "
+                    f"(the derivatives' standard deviations shrank by {100 * np.median(shrink):.1f} % in the median, "
+                    f"at most {100 * shrink.max():.1f} %): R is probably far too large, or the trial does not excite them"]
+        return []
+
     def errors_pct(self) -> dict | None:
         tv = self.data.true_values
         if tv is None:

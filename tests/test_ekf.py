@@ -166,3 +166,12 @@ def test_absurd_initial_guess_is_refused(short_zz, tmp_path, capsys):
     assert rc == 3
     err = capsys.readouterr().err
     assert "ZZ20" in err and "t = " in err and "nan" not in err.lower()
+
+
+def test_r_far_too_large_warns_that_the_filter_learned_nothing(short_zz, tmp_path, capsys):
+    _, d = short_zz
+    big = ["--set", "R.ZZ20.u=8e4", "--set", "R.ZZ20.v=6e4", "--set", "R.ZZ20.r=200", "--set", "R.ZZ20.n=4e5"]
+    assert main(["estimate", str(d / "log.csv"), "--out", str(tmp_path / "big"), "--no-plots"] + big) == 0
+    assert "learned almost nothing" in capsys.readouterr().err
+    assert main(["estimate", str(d / "log.csv"), "--out", str(tmp_path / "ok"), "--no-plots"]) == 0
+    assert "learned almost nothing" not in capsys.readouterr().err
