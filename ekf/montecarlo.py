@@ -78,12 +78,38 @@ def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_
             r = summary[(summary.trial == t) & (summary.coeff == n)].iloc[0]
             cells += [f"{r.mean_err_pct:.2f} +- {r.std_err_pct:.2f}", f"{r.paper_err_pct:.2f}"]
         lines.append(f"| {n} | " + " | ".join(cells) + " |")
+    lines += ["", *group_table(summary)]
     (out / "summary.md").write_text("\n".join(lines) + "\n")
     if verbose:
         print("\n".join(lines))
     return summary
 
 
-if __name__ == "__main__":
+LINEAR = ("Y_beta", "Y_r", "N_beta", "N_r")
+
+
+def group_table(summary: pd.DataFrame) -> list[str]:
+    """Mean % error of the linear, nonlinear and all derivatives per trial, ours (MC mean) and the
+    paper's (Table 10), with the best trial of each group: the paper's qualitative claims in numbers."""
+    rows = []
+    for t in summary["trial"].unique():
+        g = summary[summary.trial == t]
+        lin = g.coeff.isin(LINEAR)
+        rows.append((t, g[lin].mean_err_pct.mean(), g[~lin].mean_err_pct.mean(), g.mean_err_pct.mean(),
+                     g[lin].paper_err_pct.mean(), g[~lin].paper_err_pct.mean(), g.paper_err_pct.mean()))
+    out = ["Mean % error by group (lower is better): ours (Monte Carlo mean) | paper (Table 10)", "",
+           "| trial | linear ours | nonlinear ours | all ours | linear paper | nonlinear paper | all paper |",
+           "|---|---|---|---|---|---|---|"]
+    out += [f"| {r[0]} | " + " | ".join(f"{v:.2f}" for v in r[1:]) + " |" for r in rows]
+    for k, label in ((1, "linear"), (2, "nonlinear"), (3, "all")):
+        ours = sorted(rows, key=lambda r: r[k])
+        paper = sorted(rows, key=lambda r: r[k + 3])
+        out.append(f"\nbest {label}: ours {' < '.join(r[0] for r in ours)}; paper {' < '.join(r[0] for r in paper)}")
+    return out
+
+
+if __name__ == "__main__" and len(sys.argv) > 1 and sys.argv[1] == "--summarise-only":
+    print("\n".join(group_table(pd.read_csv(Path(sys.argv[2]) / "summary.csv"))))
+elif __name__ == "__main__":
     monte_carlo(sys.argv[1] if len(sys.argv) > 1 else "out/ekf_montecarlo",
                 int(sys.argv[2]) if len(sys.argv) > 2 else 20)

@@ -93,6 +93,6 @@ def test_real_turn_metrics_match_fact_sheet():
 def test_reproduce_main_job(tmp_path):
     from trials.cli import main
 
-    assert main(["reproduce", "--out", str(tmp_path), "--quick"]) == 0
+    assert main(["reproduce", "--out", str(tmp_path)]) == 0
     text = (tmp_path / "report.md").read_text()
     assert "approach rpm" in text and (tmp_path / "trials" / "st35" / "log.csv").exists()

@@ -157,7 +157,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("reproduce", help="the main job: reproduce the papers on the default Esso Osaka configs")
     p.add_argument("--out", default="out", help="output folder (default: out)")
-    p.add_argument("--quick", action="store_true", help="skip the slow parts (Monte Carlo)")
+    p.add_argument("--full", action="store_true",
+                   help="also the Monte Carlo runs (EKF and output error, 20 seeds) and the full Nomoto Table 8 (~25 min)")
     p.set_defaults(func=cmd_reproduce)
 
     for mod in ("trials.nomoto_cli", "ekf.cli", "trials.sensitivity_cli"):
