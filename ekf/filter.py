@@ -105,6 +105,24 @@ def _rk4_aug(z, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2
 
 
 @njit(cache=True)
+def workspace(nz, hull_coef):
+    """Work arrays of :func:`propagate_step`: (zc, coef, xs, k1, k2, k3, k4, out, z_next, F)."""
+    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
+    for i in range(hull_coef.shape[0]):
+        coef[i] = hull_coef[i]
+    return (np.empty(nz, dtype=np.complex128), coef, np.empty(8, dtype=np.complex128),
+            np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
+            np.empty(8, dtype=np.complex128), np.empty(NS, dtype=np.complex128), np.empty(nz), np.empty((nz, nz)))
+
+
+@njit(cache=True)
+def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
+    """One RK4 step of the augmented state and its exact Jacobian into ``ws`` (z_next = ws[8], F = ws[9])."""
+    zc, coef, xs, k1, k2, k3, k4, out, zn, F = ws
+    _propagate_ws(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs, k1, k2, k3, k4, out, zn, F)
+
+
+@njit(cache=True)
 def _propagate_ws(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs, k1, k2, k3, k4, out, z_next, F):
     """:func:`propagate_jacobian` with caller-supplied work arrays (``coef`` holds hull_coef as complex)."""
     nz = z.shape[0]
@@ -267,27 +285,16 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
     N = meas.shape[0]
     z = z0.copy()
     P = P0.copy()
-    zn = np.empty(nz)
-    F = np.empty((nz, nz))
     FP = np.empty((nz, nz))
-    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
-    for i in range(hull_coef.shape[0]):
-        coef[i] = hull_coef[i]
-    zc = np.empty(nz, dtype=np.complex128)
-    xs = np.empty(8, dtype=np.complex128)
-    k1 = np.empty(8, dtype=np.complex128)
-    k2 = np.empty(8, dtype=np.complex128)
-    k3 = np.empty(8, dtype=np.complex128)
-    k4 = np.empty(8, dtype=np.complex128)
-    out = np.empty(NS, dtype=np.complex128)
+    ws = workspace(nz, hull_coef)
+    zn, F = ws[8], ws[9]
     for i in range(nz):
         zs[0, i] = z[i]
         pdiag[0, i] = P[i, i]
     ring = np.zeros(max(nis_window, 1))
     nis_sum = 0.0
     for k in range(1, N):
-        _propagate_ws(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs,
-                      k1, k2, k3, k4, out, zn, F)
+        propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
         z[:] = zn
         _fpft(F, P, FP, P)
         if q > 0.0:

@@ -8,7 +8,7 @@ Output sensitivities (exact, from the model)
     The EKF's own model (:mod:`ekf.filter`: RK4 on :func:`mmg.model.rhs` over the 0.1 s
     filter step, states u, v, r, n, rudder angle an input interpolated linearly over the
     step) is run from the trial's start state with the rudder angle of the simulated trial.
-    The 16-state augmented transition Jacobian F_k (:func:`ekf.filter._propagate_ws`,
+    The 16-state augmented transition Jacobian F_k (:func:`ekf.filter.propagate_step`,
     complex step, exact to rounding) propagates the tangent
         S_{k+1} = F_k[:4, :] [S_k; 0 I],   S_0 = [I_4 0],
     S_k = d(u, v, r, n)(t_k) / d(u0, v0, r0, n0, c_1..c_12).  The rudder angle is treated as
@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ekf.filter import NS, NZ, _propagate_ws
+from ekf.filter import NS, NZ, propagate_step, workspace
 from mmg.integrate import integrate
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_
 from mmg.simulation import prepare
@@ -65,25 +65,14 @@ def _tangent_kernel(z0, delta, dt, p, poly, hull_axis, hull_term, hull_coef, idx
     nz = z0.shape[0]
     N = delta.shape[0]
     z = z0.copy()
-    zn = np.empty(nz)
-    F = np.empty((nz, nz))
-    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
-    for i in range(hull_coef.shape[0]):
-        coef[i] = hull_coef[i]
-    zc = np.empty(nz, dtype=np.complex128)
-    xs = np.empty(8, dtype=np.complex128)
-    k1 = np.empty(8, dtype=np.complex128)
-    k2 = np.empty(8, dtype=np.complex128)
-    k3 = np.empty(8, dtype=np.complex128)
-    k4 = np.empty(8, dtype=np.complex128)
-    out = np.empty(NS, dtype=np.complex128)
+    ws = workspace(nz, hull_coef)
+    zn, F = ws[8], ws[9]
     for i in range(NS):
         Y[0, i] = z[i]
         for j in range(nz):
             S[0, i, j] = 1.0 if i == j else 0.0
     for k in range(1, N):
-        _propagate_ws(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs,
-                      k1, k2, k3, k4, out, zn, F)
+        propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
         for i in range(nz):
             z[i] = zn[i]
         for i in range(NS):
