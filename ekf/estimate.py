@@ -22,8 +22,8 @@ from mmg.simulation import prepare
 from mmg.ship import Ship, load_ship
 from mmg.units import KNOT, to_si
 
-from .filter import DERIVATIVES, NS, NZ, STATES, FilterResult, derivative_slots, run_filter
-from .preprocess import Measurements, compare_with_truth, plot_comparison, recover
+from .filter import DERIVATIVES, NS, STATES, FilterResult, derivative_slots, run_filter
+from .preprocess import Measurements, compare_with_truth, recover
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_CONFIG = REPO / "configs" / "estimation" / "rhee_kim.yaml"
@@ -345,41 +345,6 @@ def to_markdown(df: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
-LABELS = {"Y_beta": r"$Y'_\beta$", "Y_r": r"$Y'_r$", "Y_bb": r"$Y'_{\beta|\beta|}$", "Y_rr": r"$Y'_{r|r|}$",
-          "Y_bbr": r"$Y'_{\beta\beta r}$", "Y_brr": r"$Y'_{\beta rr}$", "N_beta": r"$N'_\beta$", "N_r": r"$N'_r$",
-          "N_bb": r"$N'_{\beta|\beta|}$", "N_rr": r"$N'_{r|r|}$", "N_bbr": r"$N'_{\beta\beta r}$",
-          "N_brr": r"$N'_{\beta rr}$"}
-
-
-def plot_convergence(ests: list[Estimate], out_dir: str | Path, stride: int = 10) -> list[Path]:
-    """One PNG per derivative with every trial's estimate history (Rhee & Kim Figs 15-26)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for i, n in enumerate(DERIVATIVES):
-        fig, ax = plt.subplots(figsize=(7, 4))
-        for e in ests:
-            r = e.result
-            ax.plot(r.t[::stride], r.z[::stride, NS + i], lw=1.0, label=e.name)
-        tv = next((e.data.true_values for e in ests if e.data.true_values), None)
-        if tv:
-            ax.axhline(tv[n], color="k", ls="--", lw=1.0, label="real")
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel(f"{LABELS[n]} [-] (non-dimensional)")
-        ax.set_title(f"Convergence of {n} (augmented EKF, cf. Rhee & Kim Figs 15-26)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        p = out_dir / f"convergence_{n}.png"
-        fig.savefig(p, dpi=100)
-        plt.close(fig)
-        paths.append(p)
-    return paths
 
 
 def write_reports(ests: list[Estimate], out, plots: bool = True) -> dict:
@@ -405,6 +370,8 @@ def write_reports(ests: list[Estimate], out, plots: bool = True) -> dict:
     rms = {}
     if plots:
         # a joint (multi-trial) history spans all trials end to end: not on the per-trial time axis
+        from .plots import plot_comparison, plot_convergence
+
         plot_convergence([e for e in ests if "+" not in e.data.source], P("convergence_Y_beta.png").parent)
         for e in ests:
             if e.data.truth is not None:

@@ -17,7 +17,7 @@ Steps (the paper's numbering):
    (:func:`mmg.model.steering_rate`, Rhee & Kim eq. 20) starting at the trim rudder.
 
 :func:`recover` returns a :class:`Measurements`; :func:`compare_with_truth` gives the
-RMS of each recovered channel against a truth file and :func:`plot_comparison`
+RMS of each recovered channel against a truth file and :func:`ekf.plots.plot_comparison`
 draws Rhee & Kim Figs 4-5 for all five channels.
 """
 from __future__ import annotations
@@ -151,28 +151,3 @@ def compare_with_truth(meas: Measurements, truth) -> dict:
     return out
 
 
-def plot_comparison(meas: Measurements, truth, path, title: str = "") -> dict:
-    """Rhee & Kim Figs 4-5 for all channels: recovered vs true, with RMS in each panel. Returns the RMS."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    rms = compare_with_truth(meas, truth)
-    scale = {"u": (1.0, "m/s"), "v": (1.0, "m/s"), "r": (1 / DEG, "deg/s"), "delta": (1 / DEG, "deg"),
-             "n": (60.0, "rpm")}
-    fig, axs = plt.subplots(len(CHANNELS), 1, figsize=(9, 11), sharex=True)
-    for ax, ch in zip(axs, CHANNELS):
-        k, unit = scale[ch]
-        ax.plot(truth.t, getattr(truth, ch) * k, "k-", lw=1.0, label="true (simulation)")
-        ax.plot(meas.t, getattr(meas, ch) * k, "r-", lw=0.6, alpha=0.8, label="recovered from log")
-        ax.set_ylabel(f"{ch} [{unit}]")
-        ax.set_title(f"{ch}: RMS difference {rms[ch] * k:.3g} {unit}", fontsize=9)
-        ax.grid(alpha=0.3)
-    axs[0].legend(fontsize=8)
-    axs[-1].set_xlabel("time [s]")
-    fig.suptitle(title or f"Recovered measurements vs truth: {meas.name} (Rhee & Kim Figs 4-5)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return rms
