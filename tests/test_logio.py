@@ -88,3 +88,26 @@ def test_reader_never_crashes_on_garbage(tmp_path_factory, text):
         read_record(p)
     except InputError as e:
         assert str(p) in str(e)
+
+
+def test_sensor_bias_shifts_the_log(tmp_path):
+    import yaml
+    from dataclasses import replace
+
+    from mmg.disturbances import SensorBias
+
+    tr = load_trial(CONFIGS / "trials" / "zz10.yaml")
+    tr = replace(tr, duration=100.0)
+    run = run_trial(tr)
+    biased = run_trial(replace(tr, log=replace(tr.log, bias=SensorBias(np.radians(0.5), 0.0, 1.0 / 60))))
+    a, b = run.log(), biased.log()
+    d = (b["heading_deg"] - a["heading_deg"] + 180) % 360 - 180
+    np.testing.assert_allclose(d, 0.5, atol=1e-9)
+    np.testing.assert_allclose(b["rpm"] - a["rpm"], 1.0, atol=1e-9)
+    # and from YAML
+    data = yaml.safe_load((CONFIGS / "trials" / "zz10.yaml").read_text())
+    data["ship"] = str(CONFIGS / "ships" / "esso_osaka.yaml")
+    data["log"]["bias"] = {"heading": "0.5 deg", "rpm": "1 rpm"}
+    p = tmp_path / "t.yaml"
+    p.write_text(yaml.safe_dump(data))
+    assert load_trial(p).log.bias == SensorBias(np.radians(0.5), 0.0, 1.0 / 60)

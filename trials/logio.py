@@ -57,7 +57,8 @@ def log_frame(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None
     t, x, y, psi, sog, n : arrays at the integration step
         Time [s], position north/east [m], heading [rad], speed over ground [m/s], rpm [rps].
     spec : trials.trial.LogSpec
-        Interval, start position, noise levels (half-widths of the uniform noise) and seed.
+        Interval, start position, noise levels (half-widths of the uniform noise), seed and
+        constant sensor biases (heading, speed, rpm; :class:`mmg.disturbances.SensorBias`).
     rng : numpy Generator, optional
         Defaults to ``np.random.default_rng(spec.seed)``.
     """
@@ -72,9 +73,10 @@ def log_frame(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None
 
     lat = np.degrees(spec.start_lat) + x[sel] / M_PER_DEG_LAT + noise(np.degrees(spec.noise_lat))
     lon = np.degrees(spec.start_lon) + y[sel] / M_PER_DEG_LON + noise(np.degrees(spec.noise_lon))
-    hdg = np.mod(np.degrees(psi[sel]) + noise(np.degrees(spec.noise_heading)), 360.0)
-    spd = sog[sel] / KNOT + noise(spec.noise_speed / KNOT)
-    rpm = n[sel] * 60.0 + noise(spec.noise_rpm * 60.0)
+    b = spec.bias
+    hdg = np.mod(np.degrees(psi[sel] + b.heading) + noise(np.degrees(spec.noise_heading)), 360.0)
+    spd = (sog[sel] + b.speed) / KNOT + noise(spec.noise_speed / KNOT)
+    rpm = (n[sel] + b.rpm) * 60.0 + noise(spec.noise_rpm * 60.0)
     return pd.DataFrame({"time_s": ts, "lat_deg": lat, "lon_deg": lon, "heading_deg": hdg,
                          "speed_kn": spd, "rpm": rpm})
 

@@ -49,7 +49,9 @@ class TrialRun:
                 "steering_delta_max_deg": self.trial.ship.steering.delta_max / DEG,
                 "noise": f"uniform: lat {np.degrees(lg.noise_lat):g} deg, lon {np.degrees(lg.noise_lon):g} deg, "
                          f"heading {np.degrees(lg.noise_heading):g} deg, speed {lg.noise_speed / 0.514444:g} kn, "
-                         f"rpm {lg.noise_rpm * 60:g} rpm"}
+                         f"rpm {lg.noise_rpm * 60:g} rpm",
+                "bias": f"heading {np.degrees(lg.bias.heading):g} deg, speed {lg.bias.speed / 0.514444:g} kn, "
+                        f"rpm {lg.bias.rpm * 60:g} rpm"}
 
     def truth(self) -> pd.DataFrame:
         """States at every integration step (SI)."""

@@ -29,7 +29,7 @@ from typing import Annotated, Literal, Optional, Union
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from mmg.disturbances import RudderOffset, UniformCurrent
+from mmg.disturbances import RudderOffset, SensorBias, UniformCurrent
 from mmg.errors import InputError
 from mmg.integrate import CommandLaw
 from mmg.ship import Ship, load_ship, read_yaml
@@ -122,12 +122,22 @@ class _Noise(_Strict):
     _r = field_validator("rpm")(_q("revolutions"))
 
 
+class _Bias(_Strict):
+    heading: str = "0 deg"
+    speed: str = "0 kn"
+    rpm: str = "0 rpm"
+    _a = field_validator("heading")(_q("angle"))
+    _s = field_validator("speed")(_q("speed"))
+    _r = field_validator("rpm")(_q("revolutions"))
+
+
 class _Log(_Strict):
     interval: str = "5 s"
     seed: int = 0
     start_lat: str = "35.0 deg"
     start_lon: str = "129.0 deg"
     noise: _Noise = _Noise()
+    bias: _Bias = _Bias()
     _i = field_validator("interval")(_q("time"))
     _l = field_validator("start_lat", "start_lon")(_q("angle"))
 
@@ -171,6 +181,7 @@ class LogSpec:
     noise_heading: float
     noise_speed: float
     noise_rpm: float
+    bias: SensorBias = SensorBias()
 
 
 @dataclass(frozen=True)
@@ -325,7 +336,9 @@ def load_trial(path: str | Path) -> Trial:
     nz = lg.noise
     log = LogSpec(interval, lg.seed, to_si(lg.start_lat, "angle"), to_si(lg.start_lon, "angle"),
                   to_si(nz.lat, "angle"), to_si(nz.lon, "angle"), to_si(nz.heading, "angle"),
-                  to_si(nz.speed, "speed"), to_si(nz.rpm, "revolutions"))
+                  to_si(nz.speed, "speed"), to_si(nz.rpm, "revolutions"),
+                  SensorBias(to_si(lg.bias.heading, "angle"), to_si(lg.bias.speed, "speed"),
+                             to_si(lg.bias.rpm, "revolutions")))
     dist = []
     d = f.disturbances
     if d.current is not None:
