@@ -96,3 +96,16 @@ def test_reproduce_main_job(tmp_path):
     assert main(["reproduce", "--out", str(tmp_path)]) == 0
     text = (tmp_path / "report.md").read_text()
     assert "approach rpm" in text and (tmp_path / "trials" / "st35" / "log.csv").exists()
+
+
+@needs_frt()
+def test_real_zigzag_ignores_small_approach_rudder_motions():
+    from trials.cli import record_metrics
+    from trials.logio import read_record
+
+    rec = read_record(FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv")
+    m = record_metrics(rec, kind="zigzag", length=3.0)
+    # the rudder twitches by up to 6 deg during the approach; executes are the +/-20 deg moves
+    assert len(m["execute_times_s"]) == 5
+    assert m["execute_times_s"][0] > 40.0
+    assert len(m["overshoots_deg"]) == 3 and all(2.0 < o < 12.0 for o in m["overshoots_deg"])

@@ -130,20 +130,29 @@ def turning_metrics(t, x, y, psi, U, L, t_execute=None, delta=None, order=None) 
 def zigzag_switches(t, psi, order=None, angle=None, first=None):
     """Indices of the rudder executes of a zigzag.
 
-    With the rudder order (or angle) ``order``: the first sample where it leaves its
-    initial value, then every sign change.  Without it: heading-triggered switches for
-    a zigzag of switching heading ``angle`` [rad], first side +1 (starboard) or -1, taken
-    from the first clear heading change when None.
+    With the rudder order (or measured angle) ``order``: the samples where it first
+    reaches half of the zigzag's rudder amplitude (the largest |order|) on one side, then
+    each time it reaches half the amplitude on the other side -- so small rudder motions
+    during the approach are not taken for executes.  For a measured rudder the index is
+    moved back to where the rudder started to move towards the new side (the order
+    instant).  Without a rudder: heading-triggered switches for a zigzag of switching
+    heading ``angle`` [rad], first side +1 (starboard) or -1, taken from the first clear
+    heading change when None.
     """
     t, psi = np.asarray(t), np.asarray(psi)
     if order is not None:
         o = np.asarray(order, dtype=float)
-        sig = np.where(np.abs(o) > 0.5 * DEG, np.sign(o), 0.0)
+        half = 0.5 * np.max(np.abs(o))
+        sig = np.where(np.abs(o) >= half, np.sign(o), 0.0)
         idx = []
         cur = 0.0
         for i, sg in enumerate(sig):
             if sg != 0.0 and sg != cur:
-                idx.append(i)
+                j = i
+                # back to where the rudder began moving towards this side
+                while j > 0 and sg * (o[j] - o[j - 1]) > 1e-9 and (not idx or j - 1 > idx[-1]):
+                    j -= 1
+                idx.append(j + 1 if j < i else i)  # first sample of the move
                 cur = sg
         return np.array(idx, dtype=int)
     if angle is None:
