@@ -1,0 +1,63 @@
+"""The EKF on the raw 5 s log (ekf/log_filter.py): runs, keeps P symmetric PD, learns."""
+import numpy as np
+import pytest
+
+from ekf.estimate import REPO, data_from_trial, load_config
+from ekf.filter import DERIVATIVES, is_pd
+from ekf.log_filter import ND, NZ, log_measurements, run_log_filter
+from trials.logio import read_record
+
+LINEAR = ("Y_beta", "Y_r", "N_beta", "N_r")
+
+
+@pytest.fixture(scope="module")
+def zz20_600(tmp_path_factory):
+    cfg = load_config()
+    data = data_from_trial(REPO / "configs" / "trials" / "zz20.yaml", cfg, seed=1000,
+                           workdir=tmp_path_factory.mktemp("zz20"))
+    rec = read_record(data.source)
+    return cfg, data, rec, run_log_filter(data, rec, cfg, duration=600.0, passes=1)
+
+
+def test_measurement_noise_from_header(zz20_600):
+    _, _, rec, _ = zz20_600
+    t, obs, R = log_measurements(rec)
+    assert obs.shape == (len(t), 4)
+    # lat 8e-7 deg x 1852*60 m/deg, heading 0.012 deg, rpm 0.2: variance a^2 / 3
+    np.testing.assert_allclose(np.sqrt(np.diag(R) * 3.0),
+                               [8e-7 * 1852 * 60, 4e-7 * 1526.16 * 60, np.radians(0.012), 0.2 / 60], rtol=1e-9)
+
+
+def test_runs_and_P_symmetric_pd(zz20_600):
+    _, _, _, res = zz20_600
+    assert res.z.shape == (6001, NZ) and np.all(np.isfinite(res.z))
+    P = res.P
+    np.testing.assert_allclose(P, P.T, rtol=0, atol=1e-14 * np.abs(P).max())
+    assert is_pd(P)
+    assert np.all(np.linalg.eigvalsh(P / np.sqrt(np.outer(np.diag(P), np.diag(P)))) > -1e-9)
+    assert np.all(res.pdiag[-1, ND:] < res.pdiag[0, ND:])
+    # the filter is consistent: mean normalised innovation squared ~ 4 (4 channels)
+    assert 2.0 < np.nanmean(res.nis) < 8.0
+
+
+def test_linear_derivatives_move_towards_truth(zz20_600):
+    cfg, data, _, res = zz20_600
+    tv = data.true_values
+    for i, n in enumerate(DERIVATIVES):
+        if n in LINEAR:
+            start = res.z[0, ND + i]
+            assert start == pytest.approx(1.2 * tv[n])
+            assert abs(res.final[n] - tv[n]) < 0.25 * abs(start - tv[n]), n
+
+
+def test_second_pass_relinearises(zz20_600):
+    cfg, data, rec, res1 = zz20_600
+    res2 = run_log_filter(data, rec, cfg, duration=600.0, passes=2)
+    # pass 2 starts at pass 1's estimates with 100 x its final covariance as prior
+    np.testing.assert_allclose(res2.z[0, ND:], res1.z[-1, ND:])
+    np.testing.assert_allclose(res2.pdiag[0, ND:], 100.0 * res1.pdiag[-1, ND:], rtol=1e-12)
+    assert is_pd(res2.P)
+    assert 2.0 < np.nanmean(res2.nis) < 8.0
+    tv = data.true_values
+    for n in LINEAR:
+        assert abs(res2.final[n] - tv[n]) < 0.25 * 0.2 * abs(tv[n]), n
