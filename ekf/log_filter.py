@@ -53,7 +53,6 @@ from __future__ import annotations
 
 import argparse
 import tempfile
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -378,11 +377,15 @@ def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15) -> d
             "mean_nis": float(np.nanmean(res.nis))}
 
 
+def _task(task) -> dict:
+    return _one(*task)
+
+
 def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_seed: int = 1000,
-                config=None, q=None, sigma_tau: float = 0.15, verbose: bool = True):
+                config=None, q=None, sigma_tau: float = 0.15, verbose: bool = True, backend: str = "loky"):
     """``n_seeds`` seeds per trial (ST35, ZZ10, ZZ20, S-type 120); writes OUT/runs.csv; returns it."""
     import pandas as pd
-    from joblib import Parallel, delayed
+    from trials.sweep import run_sweep
 
     from .estimate import REPO, load_config
     from .reproduce import TRIALS
@@ -390,18 +393,10 @@ def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = load_config(config)
-    jobs = [(str(REPO / "configs" / "trials" / TRIALS[t]), first_seed + s)
+    jobs = [(str(REPO / "configs" / "trials" / TRIALS[t]), first_seed + s, cfg, q, sigma_tau)
             for t in (trials or TRIALS) for s in range(n_seeds)]
-    t0 = time.perf_counter()
-    rows = []
-    gen = Parallel(n_jobs=n_jobs, return_as="generator")(delayed(_one)(f, s, cfg, q, sigma_tau) for f, s in jobs)
-    for i, r in enumerate(gen, 1):
-        rows.append(r)
-        if verbose:
-            status = ("DIVERGED " + r["diverged"]) if r["diverged"] else \
-                f"Y_beta {r['Y_beta']:.3f} %, N_r {r['N_r']:.3f} %, mean NIS {r['mean_nis']:.2f}"
-            print(f"  [{i}/{len(jobs)}] {r['trial']} seed {r['seed']}: {status} "
-                  f"({time.perf_counter() - t0:.0f} s)", flush=True)
+    rows = run_sweep(_task, jobs, backend=backend, n_jobs=n_jobs, progress=verbose,
+                     labels=[f"{Path(j[0]).stem} seed {j[1]}" for j in jobs])
     runs = pd.DataFrame(rows)
     runs.to_csv(out / "runs.csv", index=False, float_format="%.8g")
     return runs

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -32,29 +31,26 @@ def _one(trial_file: str, seed: int, cfg: dict) -> dict:
                 **{f"final_{n}": v for n, v in e.final.items()}}
 
 
+def _task(task) -> dict:
+    return _one(*task)
+
+
 def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_seed: int = 1000,
-                config=None, verbose: bool = True) -> pd.DataFrame:
+                config=None, verbose: bool = True, backend: str = "loky") -> pd.DataFrame:
     """Run ``n_seeds`` seeds of each trial; writes runs.csv and summary.csv/.md; returns the summary.
 
     summary: one row per (trial, derivative) with mean and std of the % error, the number of
     runs that converged, and the paper's single-run % error (Table 10) beside it.
     """
-    from joblib import Parallel, delayed
+    from trials.sweep import run_sweep
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = load_config(config)
-    jobs = [(str(REPO / "configs" / "trials" / TRIALS[t]), first_seed + s)
+    jobs = [(str(REPO / "configs" / "trials" / TRIALS[t]), first_seed + s, cfg)
             for t in (trials or TRIALS) for s in range(n_seeds)]
-    t0 = time.perf_counter()
-    rows = []
-    gen = Parallel(n_jobs=n_jobs, return_as="generator")(delayed(_one)(f, s, cfg) for f, s in jobs)
-    for i, r in enumerate(gen, 1):
-        rows.append(r)
-        if verbose:
-            status = "DIVERGED" if r["diverged"] else f"Y_beta {r['Y_beta']:.2f} %, N_r {r['N_r']:.2f} %"
-            print(f"  [{i}/{len(jobs)}] {r['trial']} seed {r['seed']}: {status} "
-                  f"({time.perf_counter() - t0:.0f} s)", flush=True)
+    rows = run_sweep(_task, jobs, backend=backend, n_jobs=n_jobs, progress=verbose,
+                     labels=[f"{Path(f).stem} seed {s}" for f, s, _ in jobs])
     runs = pd.DataFrame(rows)
     runs.to_csv(out / "runs.csv", index=False, float_format="%.6g")
     summ = []

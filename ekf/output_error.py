@@ -663,11 +663,15 @@ def _mc_one(seed: int, trials, cfg, rudder: str) -> dict:
     return row
 
 
+def _mc_task(task) -> dict:
+    return _mc_one(*task)
+
+
 def monte_carlo(out_dir, n_seeds: int = 20, trials=PAPER_TRIALS, n_jobs: int = 2, first_seed: int = 1000,
-                config=None, rudder: str = "ramp", verbose: bool = True, ekf_summary=None):
+                config=None, rudder: str = "ramp", verbose: bool = True, ekf_summary=None, backend: str = "loky"):
     """Seeds x (joint EKF, then joint output error); writes runs.csv, summary.csv/.md; returns the summary."""
     import pandas as pd
-    from joblib import Parallel, delayed
+    from trials.sweep import run_sweep
 
     from .estimate import load_config
 
@@ -676,15 +680,8 @@ def monte_carlo(out_dir, n_seeds: int = 20, trials=PAPER_TRIALS, n_jobs: int = 2
     cfg = load_config(config)
     seeds = [first_seed + s for s in range(n_seeds)]
     t0 = time.perf_counter()
-    rows = []
-    gen = Parallel(n_jobs=n_jobs, return_as="generator")(delayed(_mc_one)(s, tuple(trials), cfg, rudder) for s in seeds)
-    for i, r in enumerate(gen, 1):
-        rows.append(r)
-        if verbose:
-            msg = ("DIVERGED " + r["diverged"]) if r["diverged"] else (
-                f"worst OE {max(r[f'oe_{n}'] for n in DERIVATIVES):.2f} %, worst EKF "
-                f"{max(r[f'ekf_{n}'] for n in DERIVATIVES):.2f} %, chi2/dof {r['chi2_dof']:.3f}, {r['seconds']:.0f} s")
-            print(f"  [{i}/{len(seeds)}] seed {r['seed']}: {msg} ({time.perf_counter() - t0:.0f} s)", flush=True)
+    rows = run_sweep(_mc_task, [(s, tuple(trials), cfg, rudder) for s in seeds], backend=backend,
+                     n_jobs=n_jobs, progress=verbose, labels=[f"seed {s}" for s in seeds])
     runs = pd.DataFrame(rows)
     runs.to_csv(out / "runs.csv", index=False, float_format="%.6g")
     if verbose:
