@@ -143,6 +143,7 @@ class TrialData:
     truth: object = None     # TrialRecord of the truth file, when known
     true_values: dict | None = None
     source: str = ""
+    record: object = None    # the log as read (TrialRecord), so later stages need not read it again
 
 
 def _fit_checks(rec, ship: Ship, n_eq: float, cfg: dict, src: str) -> None:
@@ -195,7 +196,7 @@ def data_from_log(path: str | Path, cfg: dict, ship_path: str | Path | None = No
         truth = read_record(truth_path)
         tv = ship.hull.as_dict()
     ref = ship.hull.as_dict()
-    return TrialData(rec.name, meas, ship, pk, derivative_slots(pk, DERIVATIVES, ship), ref, truth, tv, src)
+    return TrialData(rec.name, meas, ship, pk, derivative_slots(pk, DERIVATIVES, ship), ref, truth, tv, src, rec)
 
 
 def data_from_trial(path: str | Path, cfg: dict, seed: int | None = None, workdir: str | Path | None = None) -> TrialData:

@@ -364,7 +364,7 @@ def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15) -> d
 
     with tempfile.TemporaryDirectory(prefix="ekf-log-mc-") as td:
         data = data_from_trial(trial_file, cfg, seed=seed, workdir=td)
-        rec = read_record(data.source)
+        rec = data.record if data.record is not None else read_record(data.source)
         try:
             res = run_log_filter(data, rec, cfg, q=q, sigma_tau=sigma_tau)
         except FilterDivergence as exc:

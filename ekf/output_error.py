@@ -42,7 +42,6 @@ simulations of one Jacobian can go to joblib workers (``n_jobs``).
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tempfile
 import time
@@ -223,7 +222,7 @@ def trial_from_data(data, rudder: str = "ramp", duration: float | None = None) -
     """
     from trials.logio import read_record
 
-    rec = read_record(data.source)
+    rec = data.record if data.record is not None else read_record(data.source)
     meta = rec.meta
     hw = _noise_half_widths(meta)
     mlat = float(meta.get("m_per_deg_lat", M_PER_DEG_LAT))
