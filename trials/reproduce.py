@@ -145,6 +145,35 @@ model's measured ones. No full-scale Crane (1979) numbers were available to us.
 """)
 
 
+def st35_variants_section(ship):
+    """ST35 heading change after 3000 s under the alternatives to the fact sheet's assumptions.
+
+    Rhee & Kim chose t_f = 3000 s "to make the ship turn 560 deg"; this shows how far each
+    unpublished constant moves ours.
+    """
+    from dataclasses import replace
+
+    print("### ST35: heading change after 3000 s (paper: 560 deg) under alternative assumptions\n")
+    variants = [
+        ("as configured (fact sheet)", ship),
+        ("no wake change in the turn (C_wake = 0)", replace(ship, propeller=replace(ship.propeller, C_wake=0.0))),
+        ("kappa = 0.5 (KVLCC2)", replace(ship, rudder=replace(ship.rudder, kappa=0.5))),
+        ("l_R' = -0.71 (KVLCC2)", replace(ship, rudder=replace(ship.rudder, l_R_prime=-0.71))),
+        ("k_zz = 0.27 L", replace(ship, mass=replace(ship.mass, I_zG_prime=0.01976))),
+        ("constant rpm engine", replace(ship, engine=replace(ship.engine, mode="constant_rpm"))),
+    ]
+    rows = []
+    law = CommandLaw.schedule([0.0, 3000.0], [35 * DEG] * 2)
+    for label, sh in variants:
+        r = simulate(sh, law, 3000.0, 0.1, 10 * KNOT)
+        m = turning_metrics(r.t, r.x, r.y, r.psi, r.U, sh.particulars.L, t_execute=0.0)
+        rows.append({"variant": label, "heading": float(r.psi[-1] / DEG), "TD": m["tactical_diameter_L"],
+                     "U": float(r.U[-1] / r.U[0])})
+    print(table(rows, ["variant", "heading", "TD", "U"],
+                ["variant", "heading change at 3000 s (deg)", "tactical D (L)", "final U / U0"]))
+    print()
+
+
 def checks_section(ship):
     print("## 5. Numerical checks\n")
     L = ship.particulars.L
@@ -239,6 +268,7 @@ def reproduce(args) -> int:
         kijima_section(ship)
         runs = trials_section(out)
         plausibility_section(runs, ship)
+        st35_variants_section(ship)
         checks_section(ship)
         nomoto_section(out, args.full)
         ekf_section(out)
