@@ -82,13 +82,14 @@ def cmd_nomoto(args) -> int:
     ident = nm.identify(rec, args.length, args.speed, output_error=not args.no_output_error)
     print(report(ident))
     if args.json:
-        out = Path(args.json)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(json.dumps(ident.to_dict(), indent=2))
         from trials.nomoto_plot import plot_identification
+        from trials.output import StagedOutput
 
-        png = plot_identification(ident, out.with_suffix(".png"))
-        print(f"wrote {out} and {png}")
+        out = Path(args.json)
+        with StagedOutput(out.parent) as stage:  # JSON and PNG appear together or not at all
+            stage.path(out.name).write_text(json.dumps(ident.to_dict(), indent=2))
+            plot_identification(ident, stage.path(out.with_suffix(".png").name))
+        print(f"wrote {out} and {out.with_suffix('.png')}")
     return 0
 
 
