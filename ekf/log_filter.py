@@ -26,9 +26,13 @@ Rudder timing
     filter therefore uses delta(t) + tau g(t), g = -d(delta)/dt (the rebuilt rudder moved by
     tau in time) and estimates tau; before each rudder movement (order change of the
     rebuilt logic, and at the start) tau is marginalised out (its effect already lives in
-    u, v, r, x, y, psi) and restarted at 0 with std ``sigma_tau`` (0.15 s).  Marginalising
-    these nuisances costs some information on the Y derivatives (P ~ 1.9 x CRB on ZZ20,
-    N ~ 1.1-1.3 x), the price of not knowing the rudder the CRB assumes known.
+    u, v, r, x, y, psi) and restarted at 0 with std ``sigma_tau`` (0.15 s; the rebuilt
+    movements are off by 0.05-0.07 s rms).  Marginalising these nuisances costs information
+    on the sway derivatives: the CRB with the same per-movement nuisances
+    (:func:`trials.fisher.fisher`, ``rudder_timing=0.15``) is 2.2 x the rudder-known one for
+    ZZ20 Y_beta, 1.1-1.4 x for the N derivatives - the price of a log without a rudder
+    channel.  ``rudder="true"`` runs the filter on the truth file's rudder instead, to check
+    it against the rudder-known bound.
 Measurement update (only at the log samples, every 5 s)
     z = [x, y, psi, n]: x, y from lat/lon with the paper's metres per degree
     (:func:`trials.logio.read_record`), psi the unwrapped logged heading, n = rpm / 60;
@@ -85,7 +89,7 @@ _REASON = {NONFINITE: "a state or covariance became non-finite",
 
 
 @njit(cache=True)
-def _rk4_log(z, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2, k3, k4, out):
+def rk4_log_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2, k3, k4, out):
     """One RK4 step of the 7 dynamic states of z (complex), rudder d0 -> d1 (complex allowed);
     derivatives (z[ND:]) held. z_next[:7] -> out."""
     for j in range(idx.shape[0]):
@@ -136,7 +140,7 @@ def propagate_log(z, d0, d1, g0, g1, dt, p, poly, hull_axis, hull_term, idx, ws)
         for i in range(NZ):
             zc[i] = z[i]
         zc[j] += 1j * CSTEP
-        _rk4_log(zc, d0 + zc[TAU] * g0, d1 + zc[TAU] * g1, dt, p, poly, hull_axis, hull_term, coef, idx,
+        rk4_log_step(zc, d0 + zc[TAU] * g0, d1 + zc[TAU] * g1, dt, p, poly, hull_axis, hull_term, coef, idx,
                  xs, k1, k2, k3, k4, out)
         for i in range(NS):
             F[i, j] = out[i].imag / CSTEP
@@ -281,7 +285,7 @@ def log_measurements(record):
 
 def run_log_filter(data, record, cfg: dict, q=None, duration: float | None = None,
                    passes: int = 2, sigma_tau: float = 0.15, uvr_std=None,
-                   inflate: float = 100.0) -> LogFilterResult:
+                   inflate: float = 100.0, rudder: str = "rebuilt") -> LogFilterResult:
     """Run the filter on a TrialData (``data.meas``: the rebuilt rudder at 0.1 s) and its raw log record.
 
     q: per-step process noise variances, a dict by state name (default none: Q = 0).
@@ -299,16 +303,28 @@ def run_log_filter(data, record, cfg: dict, q=None, duration: float | None = Non
     derivatives within 1 sd, NIS 4.1).
     uvr_std: start std of u, v, r (default Table 7's variances).
     sigma_tau: prior std [s] of the timing offset of each rudder movement.
+    rudder: "rebuilt" (from the trial logic on the logged heading, what a real log allows) or
+        "true" (the truth file's rudder angle: a check of the filter against the CRB with the
+        rudder known; use a tiny ``sigma_tau`` with it).
     Raises FilterDivergence.
     """
-    res = _run_once(data, record, cfg, q, duration, None, sigma_tau, uvr_std)
+    res = _run_once(data, record, cfg, q, duration, None, sigma_tau, uvr_std, rudder=rudder)
     for _ in range(passes - 1):
         res = _run_once(data, record, cfg, q, duration, res.z[-1, ND:], sigma_tau, uvr_std,
-                        P_der=inflate * res.P[ND:, ND:])
+                        P_der=inflate * res.P[ND:, ND:], rudder=rudder)
     return res
 
 
-def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=None, P_der=None) -> LogFilterResult:
+def _true_rudder(data, t: np.ndarray) -> np.ndarray:
+    from mmg.errors import InputError
+
+    if data.truth is None or getattr(data.truth, "delta", None) is None:
+        raise InputError(data.source, "delta", "rudder='true' needs a truth file with the rudder angle")
+    return np.interp(t, np.asarray(data.truth.t, float), np.asarray(data.truth.delta, float))
+
+
+def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=None, P_der=None,
+              rudder: str = "rebuilt") -> LogFilterResult:
     from trials.rudder import manoeuvre_from_meta, reconstruct_rudder
 
     from .estimate import P0_for, initial_state
@@ -319,7 +335,10 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
     keep = np.ones(len(t), bool) if duration is None else (t - t[0] <= duration + 1e-9)
     t = t[keep]
     N = len(t)
-    delta = np.ascontiguousarray(np.asarray(m.delta, float)[:N])
+    if rudder not in ("rebuilt", "true"):
+        raise ValueError(f"rudder must be 'rebuilt' or 'true', got {rudder!r}")
+    delta = np.asarray(m.delta, float)[:N] if rudder == "rebuilt" else _true_rudder(data, t)
+    delta = np.ascontiguousarray(delta)
     g = -np.gradient(delta, dt)
     # rudder movements start where the rebuilt order changes (and at the start)
     meta = m.meta
@@ -357,7 +376,7 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
 # --------------------------------------------------------------------------- Monte Carlo
 
 
-def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15) -> dict:
+def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15, rudder: str = "rebuilt") -> dict:
     from trials.logio import read_record
 
     from .estimate import data_from_trial
@@ -366,7 +385,7 @@ def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15) -> d
         data = data_from_trial(trial_file, cfg, seed=seed, workdir=td)
         rec = data.record if data.record is not None else read_record(data.source)
         try:
-            res = run_log_filter(data, rec, cfg, q=q, sigma_tau=sigma_tau)
+            res = run_log_filter(data, rec, cfg, q=q, sigma_tau=sigma_tau, rudder=rudder)
         except FilterDivergence as exc:
             return {"trial": data.name, "seed": seed, "diverged": str(exc)}
     tv = data.true_values
@@ -382,8 +401,11 @@ def _task(task) -> dict:
 
 
 def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_seed: int = 1000,
-                config=None, q=None, sigma_tau: float = 0.15, verbose: bool = True, backend: str = "loky"):
-    """``n_seeds`` seeds per trial (ST35, ZZ10, ZZ20, S-type 120); writes OUT/runs.csv; returns it."""
+                config=None, q=None, sigma_tau: float = 0.15, verbose: bool = True, backend: str = "loky",
+                rudder: str = "rebuilt"):
+    """``n_seeds`` seeds per trial (ST35, ZZ10, ZZ20, S-type 120); writes OUT/runs.csv; returns it.
+
+    rudder: "rebuilt" (default) or "true" (:func:`run_log_filter`)."""
     import pandas as pd
     from trials.sweep import run_sweep
 
@@ -393,7 +415,7 @@ def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = load_config(config)
-    jobs = [(str(REPO / "configs" / "trials" / TRIALS[t]), first_seed + s, cfg, q, sigma_tau)
+    jobs = [(str(REPO / "configs" / "trials" / TRIALS[t]), first_seed + s, cfg, q, sigma_tau, rudder)
             for t in (trials or TRIALS) for s in range(n_seeds)]
     rows = run_sweep(_task, jobs, backend=backend, n_jobs=n_jobs, progress=verbose,
                      labels=[f"{Path(j[0]).stem} seed {j[1]}" for j in jobs])
@@ -409,8 +431,13 @@ def main(argv=None) -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--trials", nargs="*", default=None, help="trial names (default ST35 ZZ10 ZZ20 'S-type 120')")
     ap.add_argument("--sigma-tau", type=float, default=0.15, help="prior std [s] of each rudder movement's timing")
+    ap.add_argument("--first-seed", type=int, default=1000, help="noise seed of the first run of each trial")
+    ap.add_argument("--true-rudder", action="store_true",
+                    help="give the filter the truth file's rudder instead of the rebuilt one (a check against the "
+                         "CRB with the rudder known; pair with a tiny --sigma-tau, e.g. 1e-4)")
     args = ap.parse_args(argv)
-    monte_carlo(args.out, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=args.sigma_tau)
+    monte_carlo(args.out, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=args.sigma_tau,
+                first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt")
 
 
 if __name__ == "__main__":

@@ -8,7 +8,7 @@ import pytest
 from mmg.integrate import integrate
 from mmg.simulation import prepare
 from trials.cli import main
-from trials.fisher import crb, criteria, fisher, tangent
+from trials.fisher import _tangent_kernel, crb, criteria, fisher, movements, tangent
 from trials.sensitivity import (DERIVATIVES, LINEAR, NONLINEAR, efficiency, group_sums, normalise,
                                 sensitivity, trial_differences)
 from trials.trial import load_trial
@@ -130,6 +130,70 @@ def test_log_information_grows_with_the_record_and_criteria_are_finite(turn_tang
     I2, _ = fisher(longer, "log")
     c, c2 = crb(I, names), crb(I2, names)
     assert all(c2[n] <= c[n] * (1 + 1e-9) for n in DERIVATIVES)
+
+
+def test_movements_start_one_second_before_each_order_change():
+    order = np.r_[np.zeros(25), np.ones(35), -np.ones(40)]
+    seg = movements(order, 0.1)
+    assert seg.dtype.kind == "i" and seg[0] == 0 and seg[-1] == 2
+    assert list(np.nonzero(np.diff(seg))[0] + 1) == [15, 50]
+    # an order change within the first second still starts its own movement (at step 1)
+    assert movements(np.r_[0.0, 0.0, np.ones(20)], 0.1)[1] == 1
+
+
+@pytest.fixture(scope="module")
+def zigzag_tangent():
+    tr = short("zz10", 500.0)                          # order changes at 129.9 s and 442.5 s
+    return tr, tangent(tr, rudder_timing=True)
+
+
+def test_rudder_timing_sensitivities_match_finite_differences(zigzag_tangent):
+    """d(u, v, r, n)/d tau_j (complex step through the raw-log EKF's RK4) against central
+    differences of the other EKF model (ekf.filter) run with movement j shifted in time."""
+    tr, tan = zigzag_tangent
+    n_mov = tan.S_tau.shape[2]
+    assert n_mov >= 3                                   # the start and the two switches
+    pk, eq = prepare(tr.ship, tr.u0, tr.n0, tr.trim)
+    orders = integrate(pk, eq.state(), tr.command_law(trim_rudder=eq.delta), tr.duration, tr.dt)[2]
+    seg = movements(orders, tr.dt)
+    g = -np.gradient(tan.delta, tr.dt)
+    idx = np.array([tr.ship.hull.index(n) for n in DERIVATIVES], dtype=np.int64)
+    z0 = np.r_[tan.y[0], tan.values]
+    N = len(tan.delta)
+    for j in (1, 2):
+        h = 1e-3                                        # [s]
+        runs = []
+        for sgn in (+1, -1):
+            d = np.ascontiguousarray(tan.delta + sgn * h * g * (seg == j))
+            Y, S = np.empty((N, 4)), np.empty((N, 4, 16))
+            _tangent_kernel(z0, d, tr.dt, *pk.args(), idx, Y, S)
+            runs.append(Y)
+        fd = (runs[0] - runs[1]) / (2 * h)
+        ex = tan.S_tau[:, :, j]
+        scale = np.abs(fd).max(axis=0)
+        assert scale[2] > 0                             # the movement does turn the ship
+        assert np.all(np.abs(ex - fd).max(axis=0) <= 1e-4 * scale + 1e-12), j
+        assert np.all(ex[seg < j] == 0.0)               # nothing before the movement starts
+
+
+def test_rudder_timing_nuisances_can_only_widen_the_bound(zigzag_tangent):
+    tr, tan = zigzag_tangent
+    known = crb(*fisher(tan, "log"))
+    I, names = fisher(tan, "log", rudder_timing=0.15)
+    assert [n for n in names if n.startswith("tau_")] == [f"tau_{j + 1}" for j in range(tan.S_tau.shape[2])]
+    assert names[-12:] == list(DERIVATIVES)
+    assert I.shape == (19 + tan.S_tau.shape[2],) * 2 and np.allclose(I, I.T)
+    prior = crb(I, names)
+    free = crb(*fisher(tan, "log", rudder_timing=np.inf))
+    tight = crb(*fisher(tan, "log", rudder_timing=1e-7))
+    for n in DERIVATIVES:
+        assert known[n] * (1 - 1e-9) <= prior[n] <= free[n] * (1 + 1e-9), n
+        assert tight[n] == pytest.approx(known[n], rel=1e-4), n
+    # the timing is not free information: the bound of the sway derivatives does widen
+    # (by 2 % here, two movements; by 2.2 x over the 3000 s ZZ20 with its 9 movements)
+    assert prior["Y_beta"] > 1.01 * known["Y_beta"]
+    with pytest.raises(ValueError):
+        fisher(tangent(short("st35", 50.0)), "log", rudder_timing=0.15)
 
 
 def test_cli_writes_csv_and_charts(tmp_path, capsys):

@@ -37,6 +37,19 @@ Noise models (``noise=``)
         errors (given by ``recovered_var``), counting one independent sample per log
         interval (information x dt / interval): the usual rule of thumb, for comparison.
 
+Rudder timing (``rudder_timing=``)
+    The log has no rudder channel: the estimators rebuild the rudder from the trial's logic
+    on the *logged* heading (:mod:`trials.rudder`), so each rudder movement of a zigzag or
+    S-type trial starts a fraction of a 0.1 s step early or late.  ``rudder_timing=None``
+    (default) takes the rudder as known exactly (the bound of an estimator given the true
+    rudder).  ``rudder_timing=sigma`` [s] adds one nuisance per rudder movement, tau_j, the
+    time shift of movement j: the rudder is delta(t) + tau_j g(t) over that movement
+    (g = -d(delta)/dt; movements start 1 s before each order change, and at the start),
+    each tau_j with a Gaussian prior of std sigma (``np.inf``: no prior).  This is exactly the
+    nuisance the raw-log EKF (:mod:`ekf.log_filter`) estimates and marginalises, so with its
+    ``sigma_tau`` it is the bound for the information that filter is given.  The output
+    sensitivities to tau_j are exact (one complex-step run of the EKF model per movement).
+
 CRB
     cov >= I^-1; the bound on a derivative's standard deviation is sqrt of its diagonal
     element of the inverse of the full matrix (nuisances marginalised).
@@ -48,7 +61,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ekf.filter import NS, NZ, propagate_step, workspace
+from ekf.filter import CSTEP, NS, NZ, propagate_step, workspace
+from ekf.log_filter import rk4_log_step, workspace_log
 from mmg.integrate import integrate
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_
 from mmg.simulation import prepare
@@ -85,6 +99,36 @@ def _tangent_kernel(z0, delta, dt, p, poly, hull_axis, hull_term, hull_coef, idx
     return N
 
 
+@njit(cache=True)
+def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, hull_coef, idx, out):
+    """out (N, 4, n_seg): d(u, v, r, n)(t_k) / d tau_j, the rudder being delta + tau_j g over the
+    steps with seg == j; one complex-step run of the raw-log EKF's RK4 step per movement.
+
+    z0 (20,) the raw-log filter's state layout (x, y, psi, n, u, v, r, tau, derivatives)."""
+    N = delta.shape[0]
+    h = CSTEP
+    ws = workspace_log(hull_coef)
+    coef, xs, k1, k2, k3, k4, nxt = ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
+    z = np.empty(z0.shape[0], dtype=np.complex128)
+    for j in range(n_seg):
+        for i in range(z0.shape[0]):
+            z[i] = z0[i]
+        for i in range(4):
+            out[0, i, j] = 0.0
+        for k in range(1, N):
+            a0 = 1j * h * g[k - 1] if seg[k - 1] == j else 0.0j
+            a1 = 1j * h * g[k] if seg[k - 1] == j else 0.0j
+            rk4_log_step(z, delta[k - 1] + a0, delta[k] + a1, dt, p, poly, hull_axis, hull_term, coef, idx,
+                     xs, k1, k2, k3, k4, nxt)
+            for i in range(7):
+                z[i] = nxt[i]
+            out[k, 0, j] = z[4].imag / h
+            out[k, 1, j] = z[5].imag / h
+            out[k, 2, j] = z[6].imag / h
+            out[k, 3, j] = z[3].imag / h
+    return n_seg
+
+
 @dataclass
 class Tangent:
     """A trial's model outputs and their exact sensitivities.
@@ -103,10 +147,15 @@ class Tangent:
     values: np.ndarray
     log_interval: float
     noise: dict
+    S_tau: np.ndarray | None = None
+    """(N, 4, M) d(u, v, r, n) / d tau_j for the M rudder movements (``tangent(..., rudder_timing=True)``)."""
 
-    def track_sensitivities(self):
-        """psi, x, y of the model and their sensitivities (N, 3, 16) by integrating along the track."""
-        t, y, S = self.t, self.y, self.S
+    def track_sensitivities(self, S=None):
+        """psi, x, y of the model and their sensitivities (N, 3, ncol) by integrating along the track.
+
+        S (N, 4, ncol) the u, v, r, n sensitivities to integrate (default ``self.S``)."""
+        t, y = self.t, self.y
+        S = self.S if S is None else S
         dt = np.diff(t)
         psi = np.concatenate([[self.sim[0, PSI_]], self.sim[0, PSI_] + np.cumsum(0.5 * dt * (y[1:, 2] + y[:-1, 2]))])
         Spsi = np.concatenate([np.zeros((1, S.shape[2])),
@@ -124,13 +173,26 @@ class Tangent:
         return psi, cumtrap(xd), cumtrap(yd), np.stack([Spsi, cumtrap(Sxd), cumtrap(Syd)], axis=1)
 
 
-def tangent(trial, dt: float | None = None) -> Tangent:
-    """Simulate ``trial`` and propagate the exact output sensitivities along it (EKF model, rudder as input)."""
+def movements(order: np.ndarray, dt: float, lead: float = 1.0) -> np.ndarray:
+    """Rudder-movement index of every step (int, from 0): a movement starts ``lead`` [s] before
+    each change of the rudder order, and at the start (the segmentation of :mod:`ekf.log_filter`)."""
+    sw = np.nonzero(np.diff(order) != 0)[0] + 1
+    starts = np.unique(np.r_[0, np.maximum(sw - int(round(lead / dt)), 1)])
+    seg = np.zeros(len(order), dtype=np.int64)
+    seg[starts[1:]] = 1
+    return np.cumsum(seg)
+
+
+def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tangent:
+    """Simulate ``trial`` and propagate the exact output sensitivities along it (EKF model, rudder as input).
+
+    rudder_timing: also the sensitivities to the timing of each rudder movement (``Tangent.S_tau``).
+    """
     pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances)
     law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
     x0 = eq.state()
     step = float(dt or trial.dt)
-    _, sim, _, _ = integrate(pk, x0, law, trial.duration, step)
+    _, sim, orders, _ = integrate(pk, x0, law, trial.duration, step)
     idx = np.array([trial.ship.hull.index(n) for n in DERIVATIVES], dtype=np.int64)
     values = pk.hull_coef[idx].copy()
     z0 = np.r_[x0[U_], x0[V_], x0[R_], x0[N_], values]
@@ -139,12 +201,20 @@ def tangent(trial, dt: float | None = None) -> Tangent:
     Y = np.empty((N, NS))
     S = np.empty((N, NS, NZ))
     _tangent_kernel(z0, delta, step, *pk.args(), idx, Y, S)
+    S_tau = None
+    if rudder_timing:
+        seg = movements(np.asarray(orders, float), step)
+        n_seg = int(seg[-1]) + 1
+        g = -np.gradient(delta, step)
+        zl = np.r_[0.0, 0.0, x0[PSI_], x0[N_], x0[U_], x0[V_], x0[R_], 0.0, values]
+        S_tau = np.empty((N, NS, n_seg))
+        _timing_kernel(zl, delta, g, seg, n_seg, step, *pk.args(), idx, S_tau)
     lg = trial.log
     from .logio import M_PER_DEG_LAT, M_PER_DEG_LON
 
     noise = {"x_m": np.degrees(lg.noise_lat) * M_PER_DEG_LAT, "y_m": np.degrees(lg.noise_lon) * M_PER_DEG_LON,
              "psi_rad": lg.noise_heading, "n_rps": lg.noise_rpm}
-    return Tangent(trial.name, np.arange(N) * step, Y, S, delta, sim, values, float(lg.interval), noise)
+    return Tangent(trial.name, np.arange(N) * step, Y, S, delta, sim, values, float(lg.interval), noise, S_tau)
 
 
 def R_table(trial_name: str, config=None) -> np.ndarray:
@@ -154,29 +224,46 @@ def R_table(trial_name: str, config=None) -> np.ndarray:
     return np.diag(R_for(load_config(config), trial_name))
 
 
-def fisher(tan: Tangent, noise: str = "log", R=None, recovered_var=None) -> tuple[np.ndarray, list[str]]:
-    """Fisher information (all parameters: nuisances first, then the 12 derivatives) and the parameter names."""
+def fisher(tan: Tangent, noise: str = "log", R=None, recovered_var=None,
+           rudder_timing: float | None = None) -> tuple[np.ndarray, list[str]]:
+    """Fisher information (all parameters: nuisances first, then the 12 derivatives) and the parameter names.
+
+    tan: the trial's :func:`tangent` (with ``rudder_timing=True`` when ``rudder_timing`` is given).
+    noise: "log" (default), "filter" or "thinned" (module docstring).
+    R: the "filter" model's variances of u, v, r, n (default Rhee & Kim Table 8 for the trial).
+    recovered_var: the "thinned" model's variances of u, v, r, n.
+    rudder_timing: None (rudder known) or the prior std [s] of each rudder movement's timing
+        nuisance tau_j (``np.inf``: no prior), named ``tau_1``.. among the nuisances.
+    """
+    S = tan.S
     names = ["u0", "v0", "r0", "n0"] + list(DERIVATIVES)
+    n_tau = 0
+    if rudder_timing is not None:
+        if tan.S_tau is None:
+            raise ValueError("rudder_timing needs tangent(..., rudder_timing=True)")
+        n_tau = tan.S_tau.shape[2]
+        S = np.concatenate([tan.S_tau, S], axis=2)
+        names = [f"tau_{j + 1}" for j in range(n_tau)] + names
     if noise == "filter":
         var = np.asarray(R if R is not None else R_table(tan.trial), float)
         W = 1.0 / var
-        I = np.einsum("kij,i,kil->jl", tan.S, W, tan.S)
+        I = np.einsum("kij,i,kil->jl", S, W, S)
     elif noise == "thinned":
         var = np.asarray(recovered_var, float)
         dt = tan.t[1] - tan.t[0]
-        I = (dt / tan.log_interval) * np.einsum("kij,i,kil->jl", tan.S, 1.0 / var, tan.S)
+        I = (dt / tan.log_interval) * np.einsum("kij,i,kil->jl", S, 1.0 / var, S)
     elif noise == "log":
         dt = tan.t[1] - tan.t[0]
         stride = int(round(tan.log_interval / dt))
         sel = np.arange(0, len(tan.t), stride)
-        _, _, _, T = tan.track_sensitivities()
+        _, _, _, T = tan.track_sensitivities(S)
         # channels: heading, x (lat), y (lon), rpm; nuisances psi0, x0, y0 add unit sensitivities
-        nz = tan.S.shape[2]
+        nz = S.shape[2]
         G = np.zeros((len(sel), 4, nz + 3))
         G[:, 0, :nz] = T[sel, 0]
         G[:, 1, :nz] = T[sel, 1]
         G[:, 2, :nz] = T[sel, 2]
-        G[:, 3, :nz] = tan.S[sel, 3]
+        G[:, 3, :nz] = S[sel, 3]
         G[:, 0, nz] = 1.0
         G[:, 1, nz + 1] = 1.0
         G[:, 2, nz + 2] = 1.0
@@ -189,6 +276,10 @@ def fisher(tan: Tangent, noise: str = "log", R=None, recovered_var=None) -> tupl
         names = ["psi0", "x0", "y0"] + names
     else:
         raise ValueError(f"noise model must be one of {NOISE_MODELS}, got {noise!r}")
+    if n_tau and np.isfinite(rudder_timing):
+        for j in range(n_tau):
+            k = names.index(f"tau_{j + 1}")
+            I[k, k] += 1.0 / float(rudder_timing) ** 2
     return 0.5 * (I + I.T), names
 
 
@@ -235,12 +326,18 @@ def trial_crb(trial, noise: str = "log", **kw) -> dict:
     return {"trial": trial.name, "crb": crb(I, names), **criteria(I, names, tan.values)}
 
 
-def crb_vs_montecarlo(runs: "pd.DataFrame", trial_files: dict, noises=("log", "filter")) -> "pd.DataFrame":
+def crb_vs_montecarlo(runs: "pd.DataFrame", trial_files: dict, noises=("log", "filter"),
+                      rudder_timing: float | None = 0.15) -> "pd.DataFrame":
     """CRB std beside the Monte Carlo std of the EKF's final estimates, per trial and derivative.
 
-    ``runs`` is the EKF Monte Carlo's runs.csv (:func:`ekf.montecarlo.monte_carlo`: one row per
-    trial and seed with ``final_<derivative>``, diverged runs flagged); ``trial_files`` maps the
-    trial names in it to trial YAML paths.
+    runs: the EKF Monte Carlo's runs.csv (:func:`ekf.montecarlo.monte_carlo` or
+        :func:`ekf.log_filter.monte_carlo`: one row per trial and seed with ``final_<derivative>``,
+        diverged runs flagged).
+    trial_files: maps the trial names in it to trial YAML paths.
+    noises: noise models of the bounds with the rudder known (columns ``crb_std_<noise>``).
+    rudder_timing: also the "log" bound with a timing nuisance per rudder movement of this prior
+        std [s] (columns ``crb_std_log_timing``, ``mc_over_crb_log_timing``; 0.15 s is the raw-log
+        EKF's ``sigma_tau``); None to leave it out.
     """
     import pandas as pd
 
@@ -248,16 +345,18 @@ def crb_vs_montecarlo(runs: "pd.DataFrame", trial_files: dict, noises=("log", "f
 
     rows = []
     for trial, g in runs.groupby("trial", sort=False):
-        ok = g[g["diverged"].fillna("") == ""] if "diverged" in g else g
+        ok = g[g["diverged"].isna() | (g["diverged"].astype(str) == "")] if "diverged" in g else g
         tr = load_trial(trial_files[trial])
-        tan = tangent(tr)
+        tan = tangent(tr, rudder_timing=rudder_timing is not None)
         bounds = {nm: crb(*fisher(tan, nm)) for nm in noises}
+        if rudder_timing is not None:
+            bounds["log_timing"] = crb(*fisher(tan, "log", rudder_timing=rudder_timing))
         for i, n in enumerate(DERIVATIVES):
             vals = ok[f"final_{n}"].to_numpy(float)
             row = {"trial": trial, "derivative": n, "value": tan.values[i], "runs": len(vals),
                    "mc_mean": float(np.mean(vals)), "mc_std": float(np.std(vals, ddof=1))}
-            for nm in noises:
-                row[f"crb_std_{nm}"] = bounds[nm][n]
-                row[f"mc_over_crb_{nm}"] = row["mc_std"] / bounds[nm][n]
+            for nm, b in bounds.items():
+                row[f"crb_std_{nm}"] = b[n]
+                row[f"mc_over_crb_{nm}"] = row["mc_std"] / b[n]
             rows.append(row)
     return pd.DataFrame(rows)

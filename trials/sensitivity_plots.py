@@ -96,15 +96,20 @@ def plot_design(df: pd.DataFrame, path, param: str, title: str, reference: dict 
 
 
 def plot_crb_vs_mc(tab: pd.DataFrame, path, title: str) -> Path:
-    """CRB std and Monte Carlo std of the EKF estimates, per trial and derivative (log scale)."""
+    """CRB std (``crb_std_log``, and ``crb_std_log_timing`` when present) and Monte Carlo std
+    (``mc_std``) of the EKF estimates, per trial and derivative (log scale)."""
     plt = _plt()
     trials = list(dict.fromkeys(tab["trial"]))
     fig, axes = plt.subplots(1, len(trials), figsize=(3.4 * len(trials), 4.2), sharey=True, squeeze=False)
     for ax, tr in zip(axes[0], trials):
         g = tab[tab.trial == tr].set_index("derivative").reindex(DERIVATIVES)
         x = np.arange(len(DERIVATIVES))
-        ax.bar(x - 0.2, g["crb_std"], 0.4, label="CRB (log noise)")
-        ax.bar(x + 0.2, g["mc_std"], 0.4, label="EKF Monte Carlo")
+        bars = [("crb_std_log", "CRB, rudder known"), ("crb_std_log_timing", "CRB, rudder timing unknown"),
+                ("mc_std", "EKF Monte Carlo")]
+        bars = [b for b in bars if b[0] in g]
+        w = 0.8 / len(bars)
+        for i, (col, lab) in enumerate(bars):
+            ax.bar(x + (i - (len(bars) - 1) / 2) * w, g[col], w, label=lab)
         ax.set_xticks(x)
         ax.set_xticklabels([LABELS[n] for n in DERIVATIVES], rotation=90, fontsize=7)
         ax.set_yscale("log")
