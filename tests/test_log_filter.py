@@ -61,3 +61,15 @@ def test_second_pass_relinearises(zz20_600):
     tv = data.true_values
     for n in LINEAR:
         assert abs(res2.final[n] - tv[n]) < 0.25 * 0.2 * abs(tv[n]), n
+
+
+def test_true_rudder_variant_uses_the_truth_file_rudder(zz20_600):
+    cfg, data, rec, res_rebuilt = zz20_600
+    res = run_log_filter(data, rec, cfg, duration=600.0, passes=1, rudder="true", sigma_tau=1e-4)
+    assert is_pd(res.P) and 2.0 < np.nanmean(res.nis) < 8.0
+    # the timing state stays at its prior (the rudder is right) ...
+    assert np.all(np.sqrt(res.pdiag[:, ND - 1]) <= 1.0001e-4)
+    # ... and the result differs from the rebuilt-rudder run, whose rudder switches a step off
+    assert any(res.final[n] != res_rebuilt.final[n] for n in LINEAR)
+    with pytest.raises(ValueError):
+        run_log_filter(data, rec, cfg, duration=60.0, passes=1, rudder="measured")
