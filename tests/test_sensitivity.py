@@ -196,6 +196,14 @@ def test_rudder_timing_nuisances_can_only_widen_the_bound(zigzag_tangent):
         fisher(tangent(short("st35", 50.0)), "log", rudder_timing=0.15)
 
 
+def test_a_time_scheduled_rudder_has_no_timing_nuisance():
+    tan = tangent(short("sine", 100.0), rudder_timing=True)
+    assert tan.S_tau.shape == (len(tan.t), 4, 0)
+    I, names = fisher(tan, "log", rudder_timing=0.15)
+    I0, names0 = fisher(tan, "log")
+    assert names == names0 and np.array_equal(I, I0)
+
+
 def test_cli_writes_csv_and_charts(tmp_path, capsys):
     out = tmp_path / "sens"
     code = main(["sensitivity", str(CONFIGS / "trials" / "zz10.yaml"), str(CONFIGS / "trials" / "zz20.yaml"),
@@ -234,3 +242,20 @@ def test_bad_trial_yaml_exit_2(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "manoeuvre.rudder" in err
     assert not out.exists()
+
+
+def test_design_search_rows_carry_both_criteria():
+    from trials.design import CRITERION, TIMING, best, search
+
+    base = short("stype120", 600.0)
+    df = search(base, {"S-type psi_S": [60, 120]}, references=[short("sine", 600.0)], backend="serial")
+    assert list(df.trial) == ["S-type 60", "S-type 120", "Sine"]
+    assert list(df.param[:2]) == ["psi_S_deg"] * 2 and df.family.iloc[2] == "reference"
+    # not knowing when the rudder moved can only cost information; the sine's schedule is known
+    assert (df[TIMING + CRITERION] >= df[CRITERION] * (1 - 1e-9)).all()
+    assert (df.rudder_movements[:2] >= 2).all() and df.rudder_movements.iloc[2] == 0
+    assert df[TIMING + CRITERION].iloc[2] == pytest.approx(df[CRITERION].iloc[2], rel=1e-12)
+    assert best(df).trial == df.loc[df[CRITERION].idxmin(), "trial"]
+    known_only = search(base, {"S-type psi_S": [60]}, rudder_timing=None, backend="serial")
+    assert TIMING + CRITERION not in known_only
+    assert known_only[CRITERION].iloc[0] == pytest.approx(df[CRITERION].iloc[0], rel=1e-12)

@@ -12,7 +12,11 @@ Criterion (lower is better): the mean over the 8 nonlinear derivatives of the Cr
 on the standard deviation relative to the derivative's value, in % (A-optimality on the
 relative scale), from :mod:`trials.fisher` with the ``log`` noise model (the information in
 the 5 s log actually recorded).  The D-criterion (geometric-mean relative std,
-det^(1/16)) is reported beside it.  Every point is one task of :func:`trials.sweep.run_sweep`.
+det^(1/16)) is reported beside it.  Both are computed twice: with the rudder known (columns
+``mean_rel_crb_nonlinear_pct`` ...) and, as the log has no rudder channel, with the timing of
+every rudder movement a nuisance (prior std ``rudder_timing``, 0.15 s; columns prefixed
+``timing_``; :func:`trials.fisher.fisher`).  A trial with many short rudder movements loses
+more to the second.  Every point is one task of :func:`trials.sweep.run_sweep`.
 """
 from __future__ import annotations
 
@@ -23,9 +27,10 @@ import pandas as pd
 
 from mmg.units import DEG
 
-from .fisher import trial_crb
+from .fisher import crb, criteria, fisher, tangent
 
 CRITERION = "mean_rel_crb_nonlinear_pct"
+TIMING = "timing_"          # column prefix of the criteria with the rudder timing unknown
 
 
 def variant(base, family: str, value_deg: float):
@@ -56,22 +61,34 @@ PARAM = {"S-type psi_S": "psi_S_deg", "zigzag a/a": "angle_deg", "zigzag 35/a": 
 
 
 def _task(args):
-    base, family, value, noise = args
+    base, family, value, noise, rudder_timing = args
     tr = variant(base, family, value) if family else base
-    r = trial_crb(tr, noise=noise)
-    crb = r.pop("crb")
-    return {"family": family or "reference", "value_deg": value, **r, **{f"crb_{k}": v for k, v in crb.items()}}
+    tan = tangent(tr, rudder_timing=rudder_timing is not None)
+    I, names = fisher(tan, noise)
+    row = {"family": family or "reference", "value_deg": value, "trial": tr.name,
+           **criteria(I, names, tan.values), **{f"crb_{k}": v for k, v in crb(I, names).items()}}
+    if rudder_timing is not None:
+        It, nt = fisher(tan, noise, rudder_timing=rudder_timing)
+        row["rudder_movements"] = tan.S_tau.shape[2]
+        row.update({TIMING + k: v for k, v in criteria(It, nt, tan.values).items()})
+    return row
 
 
-def search(base, grid: dict | None = None, references=(), noise: str = "log", **sweep_kw) -> pd.DataFrame:
+def search(base, grid: dict | None = None, references=(), noise: str = "log", rudder_timing: float | None = 0.15,
+           **sweep_kw) -> pd.DataFrame:
     """Criteria for every design point of ``grid`` (family -> parameter values [deg]) and for the
-    ``references`` (loaded trials, e.g. the paper's S-type 120); one row per trial."""
+    ``references`` (loaded trials, e.g. the paper's S-type 120); one row per trial.
+
+    noise: noise model of :func:`trials.fisher.fisher`; rudder_timing: prior std [s] of the
+    per-movement timing nuisances of the ``timing_`` criteria (None: rudder-known criteria only);
+    sweep_kw: :func:`trials.sweep.run_sweep` options (backend, n_jobs, progress).
+    """
     from .sweep import run_sweep
 
     grid = DEFAULT_GRID if grid is None else grid
-    tasks = [(base, fam, v, noise) for fam, vals in grid.items() for v in vals]
-    tasks += [(ref, None, np.nan, noise) for ref in references]
-    labels = [variant(base, f, v).name if f else t.name for t, f, v, _ in tasks]
+    tasks = [(base, fam, v, noise, rudder_timing) for fam, vals in grid.items() for v in vals]
+    tasks += [(ref, None, np.nan, noise, rudder_timing) for ref in references]
+    labels = [variant(base, f, v).name if f else t.name for t, f, v, *_ in tasks]
     rows = run_sweep(_task, tasks, labels=labels, **sweep_kw)
     df = pd.DataFrame(rows)
     df.insert(1, "param", df["family"].map(PARAM).fillna(""))

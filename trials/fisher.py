@@ -70,6 +70,7 @@ from mmg.simulation import prepare
 from .sensitivity import DERIVATIVES, LINEAR, NONLINEAR
 
 NOISE_MODELS = ("log", "filter", "thinned")
+HEADING_TRIGGERED = ("turning", "zigzag", "stype")   # the trial kinds the estimators rebuild the rudder of
 OUTPUTS = ("u", "v", "r", "n")
 
 
@@ -186,7 +187,9 @@ def movements(order: np.ndarray, dt: float, lead: float = 1.0) -> np.ndarray:
 def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tangent:
     """Simulate ``trial`` and propagate the exact output sensitivities along it (EKF model, rudder as input).
 
-    rudder_timing: also the sensitivities to the timing of each rudder movement (``Tangent.S_tau``).
+    rudder_timing: also the sensitivities to the timing of each rudder movement (``Tangent.S_tau``);
+        only trials whose rudder is rebuilt from heading-switch logic (``HEADING_TRIGGERED``) have
+        such nuisances, a time-scheduled rudder (sine, sawtooth, schedule) has none.
     """
     pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances)
     law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
@@ -202,7 +205,9 @@ def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tang
     S = np.empty((N, NS, NZ))
     _tangent_kernel(z0, delta, step, *pk.args(), idx, Y, S)
     S_tau = None
-    if rudder_timing:
+    if rudder_timing and trial.kind not in HEADING_TRIGGERED:
+        S_tau = np.empty((N, NS, 0))          # a time schedule: the rudder's timing is known
+    elif rudder_timing:
         seg = movements(np.asarray(orders, float), step)
         n_seg = int(seg[-1]) + 1
         g = -np.gradient(delta, step)

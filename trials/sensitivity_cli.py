@@ -250,40 +250,53 @@ def cmd_crb(args, stage) -> None:
 
 # --------------------------------------------------------------------------- design search
 
-def design(out, backend: str = "loky", n_jobs=None, verbose: bool = True, grid=None) -> pd.DataFrame:
-    from .design import CRITERION, PARAM, best, search
+def design(out, backend: str = "loky", n_jobs=None, verbose: bool = True, grid=None,
+           rudder_timing: float | None = 0.15) -> pd.DataFrame:
+    """The trial-design search (:mod:`trials.design`): design.csv, design.txt and two plots in ``out``."""
+    from .design import CRITERION, TIMING, best, search
     from .sensitivity_plots import plot_design
 
     P = out.path if hasattr(out, "path") else (lambda n: Path(out) / n)
     base, *refs = _load([TRIALS_DIR / f"{s}.yaml" for s in ("stype120", "st35", "zz10", "zz20", "sine", "sawtooth")])
-    df = search(base, grid, references=[base] + refs, backend=backend, n_jobs=n_jobs, progress=verbose)
+    df = search(base, grid, references=[base] + refs, rudder_timing=rudder_timing, backend=backend, n_jobs=n_jobs,
+                progress=verbose)
     df.to_csv(P("design.csv"), index=False, float_format="%.6g")
+    timing = rudder_timing is not None
+    crit_cols = [c for c in df.columns if "nonlinear_pct" in c]
     refs_df = df[df.family == "reference"]
-    ref = {row.trial: row for row in refs_df.itertuples()}
-    ref = {k: {"mean_rel_crb_nonlinear_pct": v.mean_rel_crb_nonlinear_pct, "d_opt_nonlinear_pct": v.d_opt_nonlinear_pct}
-           for k, v in ref.items() if k in ("S-type 120", "ST35", "ZZ20")}
+    ref = {row["trial"]: row[crit_cols] for _, row in refs_df.iterrows() if row["trial"] in ("S-type 120", "ST35", "ZZ20")}
     sweep = df[df.family != "reference"].copy()
     sweep["x"] = sweep["value_deg"]
+    which = "solid: rudder known" + (f"; dashed: rudder timing unknown ({rudder_timing:g} s prior)" if timing else "")
     stype = sweep[sweep.family.isin(["S-type psi_S"])].rename(columns={"x": "psi_S_deg"})
     plot_design(stype, P("design_stype_psiS.png"), "psi_S_deg",
                 "S-type (35 deg rudder), 3000 s: CRB of the nonlinear derivatives vs switching heading psi_S "
-                "(lower is better)", ref)
+                f"(lower is better)\n{which}", ref, alt_prefix=TIMING if timing else None)
     zz = sweep[sweep.family.isin(["zigzag a/a", "zigzag 35/a", "S-type 120, rudder"])].rename(columns={"x": "angle_deg"})
     plot_design(zz, P("design_zigzag.png"), "angle_deg",
                 "Zigzag a/a and 35/a, S-type 120 with rudder a, 3000 s: CRB of the nonlinear derivatives vs angle a "
-                "(lower is better)", ref)
-    b = best(df)
+                f"(lower is better)\n{which}", ref, alt_prefix=TIMING if timing else None)
     s120 = refs_df[refs_df.trial == "S-type 120"].iloc[0]
-    cols = ["family", "value_deg", "trial", CRITERION, "d_opt_nonlinear_pct", "mean_rel_crb_linear_pct"]
-    lines = ["Trial design, 3000 s each, log noise model; criterion = mean over the 8 nonlinear derivatives of "
-             "CRB std / |value| [%] (lower is better); D = det(relative CRB covariance)^(1/16) [%]\n",
-             df.sort_values(CRITERION)[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}"), "",
-             f"best: {b.trial} ({b.family}) {CRITERION} = {b[CRITERION]:.4g} % vs S-type 120: "
-             f"{s120[CRITERION]:.4g} % (ratio {s120[CRITERION] / b[CRITERION]:.2f}); "
-             f"D: {b.d_opt_nonlinear_pct:.4g} % vs {s120.d_opt_nonlinear_pct:.4g} %"]
-    bd = df.loc[df["d_opt_nonlinear_pct"].idxmin()]
-    lines.append(f"best by the D-criterion: {bd.trial} ({bd.d_opt_nonlinear_pct:.4g} %)")
-    text = "\n".join(lines) + "\n"
+    lines = []
+    for prefix, what in [("", "rudder known")] + ([(TIMING, f"rudder timing unknown, prior std {rudder_timing:g} s "
+                                                             f"per movement")] if timing else []):
+        crit, dopt = prefix + CRITERION, prefix + "d_opt_nonlinear_pct"
+        cols = ["family", "value_deg", "trial"] + (["rudder_movements"] if timing else []) + [
+            crit, dopt, prefix + "mean_rel_crb_linear_pct"]
+        b = best(df, crit)
+        bd = df.loc[df[dopt].idxmin()]
+        better = df[(df[crit] < s120[crit]) & (df.trial != "S-type 120")]
+        lines += [f"Trial design, 3000 s each, log noise model, {what}; criterion = mean over the 8 nonlinear "
+                  "derivatives of CRB std / |value| [%] (lower is better); D = det(relative CRB covariance)^(1/16) "
+                  "[%]\n",
+                  df.sort_values(crit)[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}"), "",
+                  f"best ({what}): {b.trial} ({b.family}) {crit} = {b[crit]:.4g} % vs S-type 120: "
+                  f"{s120[crit]:.4g} % (ratio {s120[crit] / b[crit]:.2f}); "
+                  f"D: {b[dopt]:.4g} % vs {s120[dopt]:.4g} %",
+                  f"best by the D-criterion: {bd.trial} ({bd[dopt]:.4g} %)",
+                  f"trials beating S-type 120 on {crit}: "
+                  + (", ".join(better.sort_values(crit).trial) if len(better) else "none"), "", ""]
+    text = "\n".join(lines)
     P("design.txt").write_text(text)
     if verbose:
         print(text)
@@ -291,7 +304,8 @@ def design(out, backend: str = "loky", n_jobs=None, verbose: bool = True, grid=N
 
 
 def cmd_design(args, stage) -> None:
-    design(stage, backend=args.backend, n_jobs=args.jobs)
+    rt = None if args.rudder_timing.lower() == "none" else float(args.rudder_timing)
+    design(stage, backend=args.backend, n_jobs=args.jobs, rudder_timing=rt)
 
 
 # --------------------------------------------------------------------------- registration
@@ -353,8 +367,9 @@ def register(sub) -> None:
                                                           "run there when missing)")
     p.add_argument("--mc-seeds", type=int, default=20, help="seeds per trial when the Monte Carlo must be run")
     p.add_argument("--rudder-timing", default="0.15", metavar="SIGMA_S",
-                   help="with --crb-vs-mc: prior std [s] of the per-movement rudder-timing nuisances of the second "
-                        "log bound (default 0.15, the raw-log EKF's; 'inf' no prior; 'none' leaves that bound out)")
+                   help="with --crb-vs-mc or --design: prior std [s] of the per-movement rudder-timing nuisances of the "
+                        "second log bound (default 0.15, the raw-log EKF's; 'inf' no prior; 'none' leaves that "
+                        "bound out)")
     p.add_argument("--design", action="store_true", help="trial-design search (S-type psi_S, zigzag angles)")
     p.add_argument("--backend", choices=["serial", "loky", "threads", "dask"], default="loky",
                    help="parallel backend of the sweeps (dask: a local distributed cluster; optional extra)")

@@ -71,16 +71,23 @@ def plot_groups(tab: pd.DataFrame, path, title: str, ylabel: str) -> Path:
 
 
 def plot_design(df: pd.DataFrame, path, param: str, title: str, reference: dict | None = None,
-                criterion: str = "mean_rel_crb_nonlinear_pct") -> Path:
-    """Criterion against the swept parameter, one line per trial family; optional reference lines."""
+                criterion: str = "mean_rel_crb_nonlinear_pct", alt_prefix: str | None = None) -> Path:
+    """Criterion against the swept parameter, one line per trial family; optional reference lines.
+
+    reference: trial name -> row (mapping of criterion columns) drawn as horizontal lines;
+    alt_prefix: also draw the columns ``alt_prefix + criterion`` dashed in the family's colour
+    (e.g. the criteria with the rudder timing unknown).
+    """
     plt = _plt()
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6))
     crit2 = criterion.replace("mean_rel_crb", "d_opt")
     for ax, c, lab in ((axes[0], criterion, "mean CRB std / |value| of the 8 nonlinear derivatives [%]"),
                        (axes[1], crit2, "D-criterion: det(rel. CRB cov)^(1/16) [%]")):
         for fam, g in df.groupby("family", sort=False):
             g = g.sort_values(param)
-            ax.plot(g[param], g[c], "o-", label=fam)
+            line, = ax.plot(g[param], g[c], "o-", label=fam)
+            if alt_prefix and alt_prefix + c in g:
+                ax.plot(g[param], g[alt_prefix + c], "o--", mfc="none", color=line.get_color())
         for (name, row), ls in zip((reference or {}).items(), ("--", ":", "-.", (0, (5, 1)))):
             ax.axhline(row[c], ls=ls, lw=1.2, color="k" if "120" in name else "0.45", label=name)
         ax.set_yscale("log")
