@@ -20,7 +20,8 @@ Measurement update
     for positive definiteness (Cholesky); a non-PD P, a non-finite state or u <= 0
     raises :class:`FilterDivergence` naming the trial and the time.
 
-Two drivers share the compiled kernels:
+The RK4 step, its complex-step Jacobian and F P F^T are the kernels of :mod:`ekf.kernels`,
+shared with the raw-log filter (:mod:`ekf.log_filter`).  Two drivers share them:
 
 * :class:`AugmentedEKF`, a subclass of filterpy's ``ExtendedKalmanFilter`` whose
   ``predict`` is the compiled propagation above and whose ``update`` is filterpy's;
@@ -38,14 +39,16 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 from numba import njit
 
-from mmg.model import DELTA_, N_, R_, U_, V_, PackedShip, rhs
+from mmg.model import N_, R_, U_, V_, PackedShip
+
+from .kernels import CSTEP, fpft, jacobian_step, make_workspace, symmetrise  # noqa: F401 (CSTEP re-exported)
 
 DERIVATIVES = ("Y_beta", "Y_r", "Y_bb", "Y_rr", "Y_bbr", "Y_brr",
                "N_beta", "N_r", "N_bb", "N_rr", "N_bbr", "N_brr")
 STATES = ("u", "v", "r", "n")
 NS = 4
 NZ = NS + len(DERIVATIVES)
-CSTEP = 1e-30
+SLOTS = np.array([U_, V_, R_, N_], dtype=np.int64)   # mmg state slot of each dynamic state
 PD_TOL = 1e-9
 
 OK, NONFINITE, NEG_SPEED, NOT_PD, NIS_HIGH = 0, 1, 2, 3, 4
@@ -69,119 +72,33 @@ class FilterDivergence(RuntimeError):
 
 
 @njit(cache=True)
-def _rk4_aug(z, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2, k3, k4, out):
-    """One RK4 step of the 4 dynamic states of z (complex); derivatives held. Writes z_next[:4] to out."""
-    nd = idx.shape[0]
-    for j in range(nd):
-        coef[idx[j]] = z[NS + j]
-    for j in range(xs.shape[0]):
-        xs[j] = 0.0 * z[0]
-    dm = 0.5 * (d0 + d1)
-    # stage 1
-    xs[U_], xs[V_], xs[R_], xs[N_], xs[DELTA_] = z[0], z[1], z[2], z[3], d0 + 0.0 * z[0]
-    rhs(xs, d0, p, poly, hull_axis, hull_term, coef, k1)
-    xs[U_] = z[0] + 0.5 * dt * k1[U_]
-    xs[V_] = z[1] + 0.5 * dt * k1[V_]
-    xs[R_] = z[2] + 0.5 * dt * k1[R_]
-    xs[N_] = z[3] + 0.5 * dt * k1[N_]
-    xs[DELTA_] = dm + 0.0 * z[0]
-    rhs(xs, dm, p, poly, hull_axis, hull_term, coef, k2)
-    xs[U_] = z[0] + 0.5 * dt * k2[U_]
-    xs[V_] = z[1] + 0.5 * dt * k2[V_]
-    xs[R_] = z[2] + 0.5 * dt * k2[R_]
-    xs[N_] = z[3] + 0.5 * dt * k2[N_]
-    rhs(xs, dm, p, poly, hull_axis, hull_term, coef, k3)
-    xs[U_] = z[0] + dt * k3[U_]
-    xs[V_] = z[1] + dt * k3[V_]
-    xs[R_] = z[2] + dt * k3[R_]
-    xs[N_] = z[3] + dt * k3[N_]
-    xs[DELTA_] = d1 + 0.0 * z[0]
-    rhs(xs, d1, p, poly, hull_axis, hull_term, coef, k4)
-    c6 = dt / 6.0
-    out[0] = z[0] + c6 * (k1[U_] + 2.0 * k2[U_] + 2.0 * k3[U_] + k4[U_])
-    out[1] = z[1] + c6 * (k1[V_] + 2.0 * k2[V_] + 2.0 * k3[V_] + k4[V_])
-    out[2] = z[2] + c6 * (k1[R_] + 2.0 * k2[R_] + 2.0 * k3[R_] + k4[R_])
-    out[3] = z[3] + c6 * (k1[N_] + 2.0 * k2[N_] + 2.0 * k3[N_] + k4[N_])
-
-
-@njit(cache=True)
 def workspace(nz, hull_coef):
-    """Work arrays of :func:`propagate_step`: (zc, coef, xs, k1, k2, k3, k4, out, z_next, F)."""
-    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
-    for i in range(hull_coef.shape[0]):
-        coef[i] = hull_coef[i]
-    return (np.empty(nz, dtype=np.complex128), coef, np.empty(8, dtype=np.complex128),
-            np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
-            np.empty(8, dtype=np.complex128), np.empty(NS, dtype=np.complex128), np.empty(nz), np.empty((nz, nz)))
+    """Work arrays of :func:`propagate_step` (:func:`ekf.kernels.make_workspace`): z_next = ws[8], F = ws[9]."""
+    return make_workspace(nz, NS, hull_coef)
 
 
 @njit(cache=True)
 def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
-    """One RK4 step of the augmented state and its exact Jacobian into ``ws`` (z_next = ws[8], F = ws[9])."""
-    zc, coef, xs, k1, k2, k3, k4, out, zn, F = ws
-    _propagate_ws(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs, k1, k2, k3, k4, out, zn, F)
+    """One RK4 step of the augmented state z (nz,) and its exact Jacobian into ``ws`` (z_next = ws[8], F = ws[9]).
 
-
-@njit(cache=True)
-def _propagate_ws(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, zc, coef, xs, k1, k2, k3, k4, out, z_next, F):
-    """:func:`propagate_jacobian` with caller-supplied work arrays (``coef`` holds hull_coef as complex)."""
-    nz = z.shape[0]
-    for j in range(nz):
-        for i in range(nz):
-            zc[i] = z[i]
-        zc[j] += 1j * CSTEP
-        _rk4_aug(zc, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2, k3, k4, out)
-        for i in range(NS):
-            F[i, j] = out[i].imag / CSTEP
-        if j == 0:
-            for i in range(NS):
-                z_next[i] = out[i].real
-    for i in range(NS, nz):
-        z_next[i] = z[i]
-        for j in range(nz):
-            F[i, j] = 1.0 if i == j else 0.0
+    d0, d1 rudder angle [rad] at the start and end of the step (an input, linear over it), dt [s];
+    idx the derivatives' slots in ``hull_coef``; ws from :func:`workspace`."""
+    jacobian_step(z, d0, d1, 0.0, 0.0, -1, SLOTS, NS, dt, p, poly, hull_axis, hull_term, idx, ws)
 
 
 @njit(cache=True)
 def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, idx, z_next, F):
     """Propagate z over one step (RK4 on mmg.model.rhs) and fill F = d z_next / d z (complex step).
 
-    z (16,) real; d0, d1 rudder angle [rad] at the start and end of the step;
+    z (16,) real; d0, d1 rudder angle [rad] at the start and end of the step; dt [s];
     hull_coef the packed ship's coefficients (the derivative slots ``idx`` are overwritten
     by z[4:] in a complex copy); z_next (16,) and F (16, 16) are written.  Column j of F is
     Im(step(z + i h e_j)) / h with h = 1e-30: exact to rounding, no truncation error.
     """
-    nz = z.shape[0]
-    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
-    for i in range(hull_coef.shape[0]):
-        coef[i] = hull_coef[i]
-    _propagate_ws(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, np.empty(nz, dtype=np.complex128), coef,
-                  np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
-                  np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
-                  np.empty(8, dtype=np.complex128), np.empty(NS, dtype=np.complex128), z_next, F)
-
-
-@njit(cache=True)
-def _fpft(F, P, FP, out):
-    """out = F P F^T for F = [[A], [0 I]] (A = F[:4]); uses the identity block."""
-    nz = P.shape[0]
-    for i in range(NS):
-        for j in range(nz):
-            acc = 0.0
-            for k in range(nz):
-                acc += F[i, k] * P[k, j]
-            FP[i, j] = acc
-    for i in range(NS, nz):
-        for j in range(nz):
-            FP[i, j] = P[i, j]
-    for i in range(nz):
-        for j in range(NS):
-            acc = 0.0
-            for k in range(nz):
-                acc += FP[i, k] * F[j, k]
-            out[i, j] = acc
-        for j in range(NS, nz):
-            out[i, j] = FP[i, j]
+    ws = workspace(z.shape[0], hull_coef)
+    propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws)
+    z_next[:] = ws[8]
+    F[:, :] = ws[9]
 
 
 @njit(cache=True)
@@ -249,12 +166,7 @@ def joseph_update(z, P, meas, R):
         for j in range(m):
             A[i, j] -= K[i, j]
     KR = K @ R
-    Pn = A @ P @ A.T + KR @ K.T
-    for i in range(nz):
-        for j in range(i, nz):
-            s = 0.5 * (Pn[i, j] + Pn[j, i])
-            P[i, j] = s
-            P[j, i] = s
+    symmetrise(A @ P @ A.T + KR @ K.T, P)
     return nis
 
 
@@ -296,7 +208,7 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
     for k in range(1, N):
         propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
         z[:] = zn
-        _fpft(F, P, FP, P)
+        fpft(F, P, NS, FP, P)
         if q > 0.0:
             for i in range(nz):
                 P[i, i] += q

@@ -63,12 +63,11 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_
-from mmg.model import rhs
+from mmg.model import N_, PSI_, R_, U_, V_, X_, Y_
 from mmg.units import DEG
 
-from .filter import (CSTEP, DERIVATIVES, NEG_SPEED, NONFINITE, NOT_PD, OK, FilterDivergence, is_pd,
-                     joseph_update)
+from .filter import DERIVATIVES, NEG_SPEED, NONFINITE, NOT_PD, OK, FilterDivergence, is_pd, joseph_update
+from .kernels import fpft, jacobian_step, make_workspace, symmetrise
 
 STATES = ("x", "y", "psi", "n", "u", "v", "r", "tau")
 NS = 7                      # dynamic states (propagated by RK4)
@@ -77,7 +76,7 @@ ND = 8                      # first derivative slot
 NM = 4                      # measured: x, y, psi, n (the first four states)
 NZ = ND + len(DERIVATIVES)  # 20
 # mmg state slot of each dynamic filter state
-_SLOT = np.array([X_, Y_, PSI_, N_, U_, V_, R_], dtype=np.int64)
+SLOTS = np.array([X_, Y_, PSI_, N_, U_, V_, R_], dtype=np.int64)
 _IU = 4                     # index of u in z
 
 _REASON = {NONFINITE: "a state or covariance became non-finite",
@@ -89,95 +88,14 @@ _REASON = {NONFINITE: "a state or covariance became non-finite",
 
 
 @njit(cache=True)
-def rk4_log_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2, k3, k4, out):
-    """One RK4 step of the 7 dynamic states of z (complex), rudder d0 -> d1 (complex allowed);
-    derivatives (z[ND:]) held. z_next[:7] -> out."""
-    for j in range(idx.shape[0]):
-        coef[idx[j]] = z[ND + j]
-    zero = 0.0 * z[0]
-    dm = 0.5 * (d0 + d1)
-    for i in range(NS):
-        xs[_SLOT[i]] = z[i]
-    xs[DELTA_] = d0 + zero
-    rhs(xs, d0.real, p, poly, hull_axis, hull_term, coef, k1)
-    for i in range(NS):
-        xs[_SLOT[i]] = z[i] + 0.5 * dt * k1[_SLOT[i]]
-    xs[DELTA_] = dm + zero
-    rhs(xs, dm.real, p, poly, hull_axis, hull_term, coef, k2)
-    for i in range(NS):
-        xs[_SLOT[i]] = z[i] + 0.5 * dt * k2[_SLOT[i]]
-    rhs(xs, dm.real, p, poly, hull_axis, hull_term, coef, k3)
-    for i in range(NS):
-        xs[_SLOT[i]] = z[i] + dt * k3[_SLOT[i]]
-    xs[DELTA_] = d1 + zero
-    rhs(xs, d1.real, p, poly, hull_axis, hull_term, coef, k4)
-    c6 = dt / 6.0
-    for i in range(NS):
-        s = _SLOT[i]
-        out[i] = z[i] + c6 * (k1[s] + 2.0 * k2[s] + 2.0 * k3[s] + k4[s])
-
-
-@njit(cache=True)
-def workspace_log(hull_coef):
-    """Work arrays of :func:`propagate_log`: (zc, coef, xs, k1, k2, k3, k4, out, z_next, F)."""
-    coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
-    for i in range(hull_coef.shape[0]):
-        coef[i] = hull_coef[i]
-    return (np.empty(NZ, dtype=np.complex128), coef, np.zeros(8, dtype=np.complex128),
-            np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
-            np.empty(8, dtype=np.complex128), np.empty(NS, dtype=np.complex128), np.empty(NZ), np.empty((NZ, NZ)))
-
-
-@njit(cache=True)
 def propagate_log(z, d0, d1, g0, g1, dt, p, poly, hull_axis, hull_term, idx, ws):
-    """One RK4 step of z and its exact (complex-step) Jacobian: z_next = ws[8], F = ws[9].
+    """One RK4 step of z (20,) and its exact (complex-step) Jacobian: z_next = ws[8], F = ws[9].
 
-    The rudder over the step is d + tau g (d0 -> d1, g0 -> g1): the rebuilt rudder moved
-    by -tau in time, g = -d(delta)/dt, so the timing offset tau is estimated like the rest.
+    The rudder [rad] over the step (dt [s]) is d + tau g (d0 -> d1, g0 -> g1 [rad/s]): the
+    rebuilt rudder moved by -tau in time, g = -d(delta)/dt, so the timing offset tau [s] is
+    estimated like the rest.  ws from :func:`ekf.kernels.make_workspace` (NZ, NS, hull_coef).
     """
-    zc, coef, xs, k1, k2, k3, k4, out, zn, F = ws
-    for j in range(NZ):
-        for i in range(NZ):
-            zc[i] = z[i]
-        zc[j] += 1j * CSTEP
-        rk4_log_step(zc, d0 + zc[TAU] * g0, d1 + zc[TAU] * g1, dt, p, poly, hull_axis, hull_term, coef, idx,
-                 xs, k1, k2, k3, k4, out)
-        for i in range(NS):
-            F[i, j] = out[i].imag / CSTEP
-        if j == 0:
-            for i in range(NS):
-                zn[i] = out[i].real
-    for i in range(NS, NZ):
-        zn[i] = z[i]
-        for j in range(NZ):
-            F[i, j] = 1.0 if i == j else 0.0
-
-
-@njit(cache=True)
-def _fpft_log(F, P, FP, out):
-    """out = F P F^T for F = [[A], [0 I]] (A = F[:7]); symmetrised."""
-    for i in range(NS):
-        for j in range(NZ):
-            acc = 0.0
-            for k in range(NZ):
-                acc += F[i, k] * P[k, j]
-            FP[i, j] = acc
-    for i in range(NS, NZ):
-        for j in range(NZ):
-            FP[i, j] = P[i, j]
-    for i in range(NZ):
-        for j in range(NS):
-            acc = 0.0
-            for k in range(NZ):
-                acc += FP[i, k] * F[j, k]
-            out[i, j] = acc
-        for j in range(NS, NZ):
-            out[i, j] = FP[i, j]
-    for i in range(NZ):
-        for j in range(i + 1, NZ):
-            s = 0.5 * (out[i, j] + out[j, i])
-            out[i, j] = s
-            out[j, i] = s
+    jacobian_step(z, d0, d1, g0, g1, TAU, SLOTS, ND, dt, p, poly, hull_axis, hull_term, idx, ws)
 
 
 @njit(cache=True)
@@ -211,7 +129,7 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
     z = z0.copy()
     P = P0.copy()
     FP = np.empty((NZ, NZ))
-    ws = workspace_log(hull_coef)
+    ws = make_workspace(NZ, NS, hull_coef)
     zn, F = ws[8], ws[9]
     j = 0
     while j < M and meas_k[j] < 1:
@@ -231,7 +149,8 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
         propagate_log(z, delta[k - 1], delta[k], g[k - 1], g[k], dt, p, poly, hull_axis, hull_term, idx, ws)
         for i in range(NZ):
             z[i] = zn[i]
-        _fpft_log(F, P, FP, P)
+        fpft(F, P, NS, FP, P)
+        symmetrise(P, P)
         for i in range(NZ):
             P[i, i] += q[i]
         st = _check_log(z, P)

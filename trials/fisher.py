@@ -61,8 +61,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ekf.filter import CSTEP, NS, NZ, propagate_step, workspace
-from ekf.log_filter import rk4_log_step, workspace_log
+from ekf.filter import NS, NZ, propagate_step, workspace
+from ekf.kernels import CSTEP, make_workspace, rk4_step
+from ekf.log_filter import ND as LOG_ND, NS as LOG_NS, NZ as LOG_NZ, SLOTS as LOG_SLOTS
 from mmg.integrate import integrate
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_
 from mmg.simulation import prepare
@@ -108,7 +109,7 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
     z0 (20,) the raw-log filter's state layout (x, y, psi, n, u, v, r, tau, derivatives)."""
     N = delta.shape[0]
     h = CSTEP
-    ws = workspace_log(hull_coef)
+    ws = make_workspace(LOG_NZ, LOG_NS, hull_coef)
     coef, xs, k1, k2, k3, k4, nxt = ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
     z = np.empty(z0.shape[0], dtype=np.complex128)
     for j in range(n_seg):
@@ -119,9 +120,9 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
         for k in range(1, N):
             a0 = 1j * h * g[k - 1] if seg[k - 1] == j else 0.0j
             a1 = 1j * h * g[k] if seg[k - 1] == j else 0.0j
-            rk4_log_step(z, delta[k - 1] + a0, delta[k] + a1, dt, p, poly, hull_axis, hull_term, coef, idx,
-                     xs, k1, k2, k3, k4, nxt)
-            for i in range(7):
+            rk4_step(z, LOG_SLOTS, LOG_ND, delta[k - 1] + a0, delta[k] + a1, dt, p, poly, hull_axis, hull_term,
+                     coef, idx, xs, k1, k2, k3, k4, nxt)
+            for i in range(LOG_NS):
                 z[i] = nxt[i]
             out[k, 0, j] = z[4].imag / h
             out[k, 1, j] = z[5].imag / h
