@@ -259,3 +259,12 @@ def test_design_search_rows_carry_both_criteria():
     known_only = search(base, {"S-type psi_S": [60]}, rudder_timing=None, backend="serial")
     assert TIMING + CRITERION not in known_only
     assert known_only[CRITERION].iloc[0] == pytest.approx(df[CRITERION].iloc[0], rel=1e-12)
+
+
+@pytest.mark.parametrize("value", ["abc", "0", "-1", "nan"])
+def test_bad_rudder_timing_exits_2_naming_the_option(tmp_path, capsys, value):
+    with pytest.raises(SystemExit) as e:
+        main(["sensitivity", "--crb-vs-mc", str(tmp_path), f"--rudder-timing={value}", "--out", str(tmp_path / "o")])
+    assert e.value.code == 2
+    assert "--rudder-timing" in capsys.readouterr().err.strip().splitlines()[-1]
+    assert not (tmp_path / "o").exists()

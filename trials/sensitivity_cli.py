@@ -244,8 +244,7 @@ def crb_table(mc_dir, out, n_seeds: int = 20, verbose: bool = True, rudder_timin
 
 
 def cmd_crb(args, stage) -> None:
-    rt = None if args.rudder_timing.lower() == "none" else float(args.rudder_timing)
-    crb_table(args.crb_vs_mc, stage, n_seeds=args.mc_seeds, rudder_timing=rt)
+    crb_table(args.crb_vs_mc, stage, n_seeds=args.mc_seeds, rudder_timing=args.rudder_timing)
 
 
 # --------------------------------------------------------------------------- design search
@@ -304,8 +303,22 @@ def design(out, backend: str = "loky", n_jobs=None, verbose: bool = True, grid=N
 
 
 def cmd_design(args, stage) -> None:
-    rt = None if args.rudder_timing.lower() == "none" else float(args.rudder_timing)
-    design(stage, backend=args.backend, n_jobs=args.jobs, rudder_timing=rt)
+    design(stage, backend=args.backend, n_jobs=args.jobs, rudder_timing=args.rudder_timing)
+
+
+def _rudder_timing(text: str) -> float | None:
+    """--rudder-timing: a prior std [s] > 0, 'inf' (no prior) or 'none' (no timing nuisances)."""
+    import argparse
+
+    if text.strip().lower() == "none":
+        return None
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not v > 0:
+        raise argparse.ArgumentTypeError(f"expected a prior std in seconds > 0, 'inf' or 'none', got {text!r}")
+    return v
 
 
 # --------------------------------------------------------------------------- registration
@@ -366,7 +379,7 @@ def register(sub) -> None:
     p.add_argument("--crb-vs-mc", metavar="MC_DIR", help="CRB vs the EKF Monte Carlo in MC_DIR (runs.csv; "
                                                           "run there when missing)")
     p.add_argument("--mc-seeds", type=int, default=20, help="seeds per trial when the Monte Carlo must be run")
-    p.add_argument("--rudder-timing", default="0.15", metavar="SIGMA_S",
+    p.add_argument("--rudder-timing", type=_rudder_timing, default=0.15, metavar="SIGMA_S",
                    help="with --crb-vs-mc or --design: prior std [s] of the per-movement rudder-timing nuisances of the "
                         "second log bound (default 0.15, the raw-log EKF's; 'inf' no prior; 'none' leaves that "
                         "bound out)")
