@@ -175,3 +175,36 @@ def test_r_far_too_large_warns_that_the_filter_learned_nothing(short_zz, tmp_pat
     assert "learned almost nothing" in capsys.readouterr().err
     assert main(["estimate", str(d / "log.csv"), "--out", str(tmp_path / "ok"), "--no-plots"]) == 0
     assert "learned almost nothing" not in capsys.readouterr().err
+
+
+def test_free_run_catches_a_filter_that_converged_to_the_wrong_model(short_zz, tmp_path, capsys):
+    """From a 500 % start the paper EKF converges to wrong derivatives without diverging and
+    with small innovations; re-simulating the trial with them shows it."""
+    _, d = short_zz
+    out = tmp_path / "ok"
+    assert main(["estimate", str(d / "log.csv"), "--truth", str(d / "truth.csv"), "--out", str(out), "--no-plots"]) == 0
+    assert "does not reproduce" not in capsys.readouterr().err
+    fr = json.loads((out / "free_run.json").read_text())["ZZ20"]
+    assert fr["ok"] and fr["completed"] and fr["heading_rms_deg"] < 1.0 and fr["position_rms_L"] < 0.1
+    out5 = tmp_path / "five"
+    assert main(["estimate", str(d / "log.csv"), "--truth", str(d / "truth.csv"), "--out", str(out5), "--no-plots",
+                 "--set", "initial.scale=5"]) == 0
+    err = capsys.readouterr().err
+    assert "ZZ20" in err and "does not reproduce the data" in err
+    fr5 = json.loads((out5 / "free_run.json").read_text())["ZZ20"]
+    assert not fr5["ok"] and fr5["heading_rms_deg"] > 1.0
+    # the estimates are indeed wrong
+    js = json.loads((out5 / "estimates.json").read_text())
+    assert max(v["error_pct"] for v in js.values()) > 50
+
+
+def test_free_run_with_the_true_derivatives_reproduces_the_log(short_zz):
+    from ekf.estimate import data_from_log, free_run, load_config
+
+    _, d = short_zz
+    data = data_from_log(d / "log.csv", load_config(), truth_path=d / "truth.csv")
+    fr = free_run(data, data.true_values)
+    assert fr.ok and fr.heading_rms_deg < 0.1 and fr.position_rms_m < 2.0
+    assert fr.t.shape == (121,) and fr.sim.shape == fr.log.shape == (121, 4)
+    wrong = {**data.true_values, "N_r": 2.0 * data.true_values["N_r"]}
+    assert not free_run(data, wrong).ok
