@@ -227,8 +227,7 @@ def data_from_trial(path: str | Path, cfg: dict, seed: int | None = None, workdi
 # --------------------------------------------------------------------------- estimation
 
 
-HEADING_RMS_MAX_DEG = 1.0      # free-run check: heading RMS [deg] above which the estimate is suspect
-POSITION_RMS_MAX_L = 0.1       # ... and position RMS in ship lengths
+HEADING_RMS_MAX_DEG = 1.0      # free-run check: heading RMS [deg] above which the model misses the log
 
 
 @dataclass(frozen=True)
@@ -243,6 +242,12 @@ class FreeRun:
     0.2-1.7 m position RMS (the start state comes from noisy samples; L = 325 m); the paper
     EKF's estimates from a 120 % start to 0.04-0.26 deg and 0.9-2.5 m; from a 500 % start,
     where it converges to wrong values without diverging, to 2.3-17 deg and 75-223 m.
+
+    Only the heading is judged (:attr:`ok`: RMS <= ``HEADING_RMS_MAX_DEG``, 1 deg): a uniform
+    current, which the model does not know of, leaves the heading alone but moves the track
+    (0.3 kn: 0.8 L position RMS over ZZ20 with the true derivatives), so the position RMS is
+    reported, not judged.  A miss means the derivatives are wrong *or* the log holds an effect
+    the model lacks: a 1 deg rudder offset alone gives 1.4 deg heading RMS on ZZ20.
 
     t (K,) log times [s]; log, sim (K, 4) heading [rad], x, y [m], shaft speed [rps] (``sim``
     None when the run stopped early, e.g. the speed fell to zero); L ship length [m].
@@ -266,19 +271,24 @@ class FreeRun:
 
     @property
     def ok(self) -> bool:
-        return self.heading_rms_deg <= HEADING_RMS_MAX_DEG and self.position_rms_m <= POSITION_RMS_MAX_L * self.L
+        return self.heading_rms_deg <= HEADING_RMS_MAX_DEG
 
     def to_dict(self) -> dict:
-        return {"heading_rms_deg": self.heading_rms_deg, "position_rms_m": self.position_rms_m,
-                "position_rms_L": self.position_rms_m / self.L, "completed": self.sim is not None, "ok": self.ok}
+        """JSON-ready summary (RMS values None when the re-simulation stopped early)."""
+        done = self.sim is not None
+        return {"heading_rms_deg": self.heading_rms_deg if done else None,
+                "position_rms_m": self.position_rms_m if done else None,
+                "position_rms_L": self.position_rms_m / self.L if done else None,
+                "heading_limit_deg": HEADING_RMS_MAX_DEG, "completed": done, "ok": self.ok}
 
 
 def free_run(data: TrialData, values: dict) -> FreeRun | None:
     """Re-simulate ``data``'s trial with the derivatives ``values`` (:class:`FreeRun`); None when the
-    log does not say how to rebuild its rudder logic (no turning/zigzag/S-type header) or is a joint record."""
+    log does not say how to rebuild its rudder logic (no turning/zigzag/S-type header) or the data
+    are a joint record of several trials (no log of their own)."""
     from .output_error import trial_from_data
 
-    if "+" in data.source:
+    if data.record is None and not Path(data.source).is_file():
         return None
     try:
         tr = trial_from_data(data, rudder="law")
@@ -316,9 +326,10 @@ class Estimate:
         ``min_shrink`` (10 %) of their start values over the record has learned almost nothing
         from it: typically R is far too large, or the trial does not excite the derivatives.
         (With the paper's settings the median shrink is about 40 %; with R 1e6 times larger, 0.2 %.)
-        And a filter whose estimates, re-simulated (:meth:`free_run`), miss the log by more than
-        1 deg heading RMS or 0.1 L position RMS has converged to a model that does not reproduce
-        the data (with the paper's R the innovations stay small even then).
+        And when the trial re-simulated with the estimates (:meth:`free_run`) misses the logged
+        heading by more than 1 deg RMS, the estimated model does not reproduce the data: the filter
+        converged to wrong values (with the paper's R the innovations stay small even then), or
+        the log holds an effect the model lacks.
         """
         out = []
         sd0 = np.sqrt(self.result.pdiag[0, NS:])
@@ -332,12 +343,12 @@ class Estimate:
         fr = self.free_run()
         if fr is not None and not fr.ok:
             miss = ("the re-simulation stopped early" if fr.sim is None else
-                    f"it misses the log by {fr.heading_rms_deg:.2f} deg heading RMS and {fr.position_rms_m:.0f} m "
-                    f"({fr.position_rms_m / fr.L:.2f} L) position RMS")
-            out.append(f"trial {self.name!r}: re-simulated with the estimated derivatives, {miss} (limits "
-                       f"{HEADING_RMS_MAX_DEG:g} deg, {POSITION_RMS_MAX_L:g} L): the filter converged to a model "
-                       f"that does not reproduce the data; try another start (initial.scale, P0) or "
-                       f"--method output-error")
+                    f"it misses the logged heading by {fr.heading_rms_deg:.2f} deg RMS (limit {HEADING_RMS_MAX_DEG:g}; "
+                    f"position RMS {fr.position_rms_m:.0f} m = {fr.position_rms_m / fr.L:.2f} L)")
+            out.append(f"trial {self.name!r}: re-simulated with the estimated derivatives, {miss}: the estimated "
+                       f"model does not reproduce the data. Either the filter converged to wrong values (try "
+                       f"another start: initial.scale, P0, or --method output-error) or the log holds an effect "
+                       f"the model lacks (rudder offset, wind, current, sensor bias)")
         return out
 
     def errors_pct(self) -> dict | None:
