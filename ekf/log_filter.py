@@ -244,7 +244,7 @@ def _true_rudder(data, t: np.ndarray) -> np.ndarray:
 
 def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=None, P_der=None,
               rudder: str = "rebuilt") -> LogFilterResult:
-    from trials.rudder import manoeuvre_from_meta, reconstruct_rudder
+    from trials.rudder import manoeuvre_from_meta, movement_starts, reconstruct_rudder
 
     from .estimate import P0_for, initial_state
 
@@ -264,8 +264,7 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
     kind, man = manoeuvre_from_meta(meta, data.source)
     order, _ = reconstruct_rudder(t, np.asarray(m.psi, float)[:N], kind, man, data.packed.p,
                                   float(meta.get("trim_rudder_deg", 0.0)) * DEG)
-    sw = np.nonzero(np.diff(order) != 0)[0] + 1
-    reset_k = np.ascontiguousarray(np.r_[0, np.maximum(sw - 10, 1)].astype(np.int64))
+    reset_k = np.ascontiguousarray(movement_starts(order, dt))
     t_log, obs, R = log_measurements(record)
     mk = np.rint((t_log - t[0]) / dt).astype(np.int64)
     sel = (mk >= 0) & (mk < N)
@@ -306,10 +305,10 @@ def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15, rudd
         try:
             res = run_log_filter(data, rec, cfg, q=q, sigma_tau=sigma_tau, rudder=rudder)
         except FilterDivergence as exc:
-            return {"trial": data.name, "seed": seed, "diverged": str(exc)}
+            return {"trial": data.name, "seed": seed, "diverged": str(exc), "rudder": rudder, "sigma_tau_s": sigma_tau}
     tv = data.true_values
     fin = res.final
-    return {"trial": data.name, "seed": seed, "diverged": "",
+    return {"trial": data.name, "seed": seed, "diverged": "", "rudder": rudder, "sigma_tau_s": sigma_tau,
             **{n: 100.0 * abs(fin[n] - tv[n]) / abs(tv[n]) for n in DERIVATIVES},
             **{f"final_{n}": v for n, v in fin.items()},
             "mean_nis": float(np.nanmean(res.nis))}
@@ -349,12 +348,17 @@ def main(argv=None) -> None:
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--trials", nargs="*", default=None, help="trial names (default ST35 ZZ10 ZZ20 'S-type 120')")
-    ap.add_argument("--sigma-tau", type=float, default=0.15, help="prior std [s] of each rudder movement's timing")
+    ap.add_argument("--sigma-tau", type=float, default=None,
+                    help="prior std [s] of each rudder movement's timing (default 0.15, or 1e-4 with --true-rudder)")
     ap.add_argument("--first-seed", type=int, default=1000, help="noise seed of the first run of each trial")
     ap.add_argument("--true-rudder", action="store_true",
                     help="give the filter the truth file's rudder instead of the rebuilt one (a check against the "
-                         "CRB with the rudder known; pair with a tiny --sigma-tau, e.g. 1e-4)")
+                         "CRB with the rudder known)")
     args = ap.parse_args(argv)
+    if args.sigma_tau is None:
+        args.sigma_tau = 1e-4 if args.true_rudder else 0.15
+    if not args.sigma_tau > 0:
+        ap.error(f"--sigma-tau must be > 0, got {args.sigma_tau}")
     monte_carlo(args.out, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=args.sigma_tau,
                 first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt")
 

@@ -176,6 +176,36 @@ def test_rudder_timing_sensitivities_match_finite_differences(zigzag_tangent):
         assert np.all(ex[seg < j] == 0.0)               # nothing before the movement starts
 
 
+def test_rudder_timing_sensitivities_are_the_raw_log_filters_tau(zigzag_tangent):
+    """The bound's nuisance tau_j is the raw-log EKF's tau: propagating that filter's own
+    Jacobian column d z_next / d tau over the steps of movement j gives the same sensitivities."""
+    from ekf.kernels import make_workspace
+    from ekf.log_filter import NS as LNS, NZ as LNZ, TAU, propagate_log
+
+    tr, tan = zigzag_tangent
+    pk, eq = prepare(tr.ship, tr.u0, tr.n0, tr.trim)
+    orders = integrate(pk, eq.state(), tr.command_law(trim_rudder=eq.delta), tr.duration, tr.dt)[2]
+    seg = movements(orders, tr.dt)
+    g = -np.gradient(tan.delta, tr.dt)
+    idx = np.array([tr.ship.hull.index(n) for n in DERIVATIVES], dtype=np.int64)
+    x0 = eq.state()
+    z = np.r_[0.0, 0.0, 0.0, tan.y[0, 3], tan.y[0, 0], tan.y[0, 1], tan.y[0, 2], 0.0, tan.values]
+    ws = make_workspace(LNZ, LNS, pk.hull_coef)
+    j = 1
+    s = np.zeros(LNS)
+    got = np.zeros((len(tan.t), 4))
+    for k in range(1, len(tan.t)):
+        propagate_log(z, tan.delta[k - 1], tan.delta[k], g[k - 1], g[k], tr.dt, *pk.args()[:4], idx, ws)
+        F = ws[9]
+        s = F[:LNS, :LNS] @ s + (F[:LNS, TAU] if seg[k - 1] == j else 0.0)
+        z[:LNS] = ws[8][:LNS]
+        got[k] = s[[4, 5, 6, 3]]                        # u, v, r, n of the filter's layout
+    assert x0[0] == pytest.approx(tan.y[0, 0])
+    scale = np.abs(got).max(axis=0)
+    assert scale[2] > 0
+    assert np.all(np.abs(tan.S_tau[:, :, j] - got).max(axis=0) <= 1e-9 * scale + 1e-15)
+
+
 def test_rudder_timing_nuisances_can_only_widen_the_bound(zigzag_tangent):
     tr, tan = zigzag_tangent
     known = crb(*fisher(tan, "log"))
@@ -194,6 +224,23 @@ def test_rudder_timing_nuisances_can_only_widen_the_bound(zigzag_tangent):
     assert prior["Y_beta"] > 1.01 * known["Y_beta"]
     with pytest.raises(ValueError):
         fisher(tangent(short("st35", 50.0)), "log", rudder_timing=0.15)
+
+
+def test_timing_bound_without_prior_drops_a_movement_the_log_never_saw():
+    from trials.fisher import trial_crb
+
+    tr = short("zz10", 129.95)                          # the first reversal's movement starts at 128.9 s
+    tan = tangent(tr, rudder_timing=True)
+    assert tan.S_tau.shape[2] == 2
+    I, names = fisher(tan, "log", rudder_timing=np.inf)
+    assert "tau_1" in names and "tau_2" not in names   # no log sample after it: no information
+    assert all(np.isfinite(v) for v in crb(I, names).values())
+    for bad in (0.0, -0.1):
+        with pytest.raises(ValueError):
+            fisher(tan, "log", rudder_timing=bad)
+    # the convenience wrapper passes the option through
+    r = trial_crb(tr, rudder_timing=0.15)
+    assert r["crb"]["Y_beta"] >= trial_crb(tr)["crb"]["Y_beta"]
 
 
 def test_a_time_scheduled_rudder_has_no_timing_nuisance():

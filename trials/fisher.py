@@ -68,10 +68,12 @@ from mmg.integrate import integrate
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_
 from mmg.simulation import prepare
 
+from .rudder import movements
 from .sensitivity import DERIVATIVES, LINEAR, NONLINEAR
 
 NOISE_MODELS = ("log", "filter", "thinned")
-HEADING_TRIGGERED = ("turning", "zigzag", "stype")   # the trial kinds the estimators rebuild the rudder of
+# the trial kinds whose rudder the estimators rebuild from the trial logic (:mod:`trials.rudder`)
+HEADING_TRIGGERED = ("turning", "zigzag", "stype")
 OUTPUTS = ("u", "v", "r", "n")
 
 
@@ -175,22 +177,13 @@ class Tangent:
         return psi, cumtrap(xd), cumtrap(yd), np.stack([Spsi, cumtrap(Sxd), cumtrap(Syd)], axis=1)
 
 
-def movements(order: np.ndarray, dt: float, lead: float = 1.0) -> np.ndarray:
-    """Rudder-movement index of every step (int, from 0): a movement starts ``lead`` [s] before
-    each change of the rudder order, and at the start (the segmentation of :mod:`ekf.log_filter`)."""
-    sw = np.nonzero(np.diff(order) != 0)[0] + 1
-    starts = np.unique(np.r_[0, np.maximum(sw - int(round(lead / dt)), 1)])
-    seg = np.zeros(len(order), dtype=np.int64)
-    seg[starts[1:]] = 1
-    return np.cumsum(seg)
-
-
 def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tangent:
     """Simulate ``trial`` and propagate the exact output sensitivities along it (EKF model, rudder as input).
 
     rudder_timing: also the sensitivities to the timing of each rudder movement (``Tangent.S_tau``);
-        only trials whose rudder is rebuilt from heading-switch logic (``HEADING_TRIGGERED``) have
-        such nuisances, a time-scheduled rudder (sine, sawtooth, schedule) has none.
+        only trials whose rudder the estimators rebuild from the trial logic (``HEADING_TRIGGERED``:
+        turning, zigzag, S-type) have such nuisances; a time-scheduled rudder (sine, sawtooth,
+        schedule) has none.
     """
     pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances)
     law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
@@ -247,8 +240,11 @@ def fisher(tan: Tangent, noise: str = "log", R=None, recovered_var=None,
     if rudder_timing is not None:
         if tan.S_tau is None:
             raise ValueError("rudder_timing needs tangent(..., rudder_timing=True)")
-        n_tau = tan.S_tau.shape[2]
-        S = np.concatenate([tan.S_tau, S], axis=2)
+        if not float(rudder_timing) > 0:
+            raise ValueError(f"rudder_timing must be a prior std > 0 [s] (or np.inf), got {rudder_timing!r}")
+        S_tau = tan.S_tau
+        n_tau = S_tau.shape[2]
+        S = np.concatenate([S_tau, S], axis=2)
         names = [f"tau_{j + 1}" for j in range(n_tau)] + names
     if noise == "filter":
         var = np.asarray(R if R is not None else R_table(tan.trial), float)
@@ -286,6 +282,11 @@ def fisher(tan: Tangent, noise: str = "log", R=None, recovered_var=None,
         for j in range(n_tau):
             k = names.index(f"tau_{j + 1}")
             I[k, k] += 1.0 / float(rudder_timing) ** 2
+    elif n_tau:
+        # without a prior, a movement the record saw nothing of (one starting after the last
+        # sample) has zero information and would make I singular: it is simply not there
+        keep = [k for k, n in enumerate(names) if not (n.startswith("tau_") and I[k, k] == 0.0)]
+        I, names = I[np.ix_(keep, keep)], [names[k] for k in keep]
     return 0.5 * (I + I.T), names
 
 
@@ -326,8 +327,9 @@ def criteria(I: np.ndarray, names: list[str], values: np.ndarray) -> dict:
 
 
 def trial_crb(trial, noise: str = "log", **kw) -> dict:
-    """Convenience: CRB std of each derivative and the design criteria for one trial."""
-    tan = tangent(trial)
+    """Convenience: CRB std of each derivative and the design criteria for one trial
+    (``kw``: :func:`fisher`'s R, recovered_var, rudder_timing)."""
+    tan = tangent(trial, rudder_timing=kw.get("rudder_timing") is not None)
     I, names = fisher(tan, noise, **kw)
     return {"trial": trial.name, "crb": crb(I, names), **criteria(I, names, tan.values)}
 

@@ -72,6 +72,27 @@ def reconstruct_rudder(t, psi, kind: str, manoeuvre: dict, p: np.ndarray, delta0
     return order, delta
 
 
+MOVEMENT_LEAD_S = 1.0   # a rudder movement is taken to start this long [s] before its order change
+
+
+def movement_starts(order: np.ndarray, dt: float, lead: float = MOVEMENT_LEAD_S) -> np.ndarray:
+    """Steps (int64, increasing) at which rudder movements start: step 0, and ``lead`` [s] before
+    each change of the rudder ``order`` sampled every ``dt`` [s] (at least step 1).
+
+    The one segmentation of the raw-log EKF's per-movement timing offset
+    (:mod:`ekf.log_filter`) and of the matching Cramer-Rao bound (:mod:`trials.fisher`).
+    """
+    sw = np.nonzero(np.diff(np.asarray(order, float)) != 0)[0] + 1
+    return np.unique(np.r_[0, np.maximum(sw - int(round(lead / dt)), 1)]).astype(np.int64)
+
+
+def movements(order: np.ndarray, dt: float, lead: float = MOVEMENT_LEAD_S) -> np.ndarray:
+    """Rudder-movement index (int64, from 0) of every step: see :func:`movement_starts`."""
+    seg = np.zeros(len(order), dtype=np.int64)
+    seg[movement_starts(order, dt, lead)[1:]] = 1
+    return np.cumsum(seg)
+
+
 def manoeuvre_from_meta(meta: dict, source: str = "log") -> tuple[str, dict]:
     """The trial kind and its rudder logic (SI) from a log header."""
     kind = str(meta.get("kind", ""))
