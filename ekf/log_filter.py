@@ -321,9 +321,13 @@ def _task(task) -> dict:
 def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_seed: int = 1000,
                 config=None, q=None, sigma_tau: float = 0.15, verbose: bool = True, backend: str = "loky",
                 rudder: str = "rebuilt"):
-    """``n_seeds`` seeds per trial (ST35, ZZ10, ZZ20, S-type 120); writes OUT/runs.csv; returns it.
+    """``n_seeds`` seeds per trial; writes OUT/runs.csv (one row per trial and seed, with the
+    ``trial_file`` it came from); returns it.
 
-    rudder: "rebuilt" (default) or "true" (:func:`run_log_filter`)."""
+    trials: names of the paper's trials (ST35, ZZ10, ZZ20, S-type 120: the default) or paths
+    of turning / zigzag / S-type trial YAMLs; rudder: "rebuilt" (default) or "true"
+    (:func:`run_log_filter`).
+    """
     import pandas as pd
     from trials.sweep import run_sweep
 
@@ -333,11 +337,18 @@ def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = load_config(config)
-    jobs = [(str(REPO / "configs" / "trials" / TRIALS[t]), first_seed + s, cfg, q, sigma_tau, rudder)
-            for t in (trials or TRIALS) for s in range(n_seeds)]
+    files = [str(REPO / "configs" / "trials" / TRIALS[t]) if t in TRIALS else str(Path(t).resolve())
+             for t in (trials or TRIALS)]
+    for f in files:
+        if not Path(f).is_file():
+            from mmg.errors import InputError
+
+            raise InputError(f, "trials", f"neither one of {', '.join(TRIALS)} nor a trial YAML")
+    jobs = [(f, first_seed + s, cfg, q, sigma_tau, rudder) for f in files for s in range(n_seeds)]
     rows = run_sweep(_task, jobs, backend=backend, n_jobs=n_jobs, progress=verbose,
                      labels=[f"{Path(j[0]).stem} seed {j[1]}" for j in jobs])
     runs = pd.DataFrame(rows)
+    runs.insert(2, "trial_file", [j[0] for j in jobs])
     runs.to_csv(out / "runs.csv", index=False, float_format="%.8g")
     return runs
 
@@ -347,7 +358,8 @@ def main(argv=None) -> None:
     ap.add_argument("out")
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--trials", nargs="*", default=None, help="trial names (default ST35 ZZ10 ZZ20 'S-type 120')")
+    ap.add_argument("--trials", nargs="*", default=None,
+                    help="trial names (default ST35 ZZ10 ZZ20 'S-type 120') or turning/zigzag/S-type trial YAMLs")
     ap.add_argument("--sigma-tau", type=float, default=None,
                     help="prior std [s] of each rudder movement's timing (default 0.15, or 1e-4 with --true-rudder)")
     ap.add_argument("--first-seed", type=int, default=1000, help="noise seed of the first run of each trial")

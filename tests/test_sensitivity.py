@@ -315,3 +315,30 @@ def test_bad_rudder_timing_exits_2_naming_the_option(tmp_path, capsys, value):
     assert e.value.code == 2
     assert "--rudder-timing" in capsys.readouterr().err.strip().splitlines()[-1]
     assert not (tmp_path / "o").exists()
+
+
+def test_crb_table_finds_a_non_paper_trial_through_its_trial_file(tmp_path):
+    """runs.csv of ekf.log_filter.monte_carlo names each run's trial YAML, so any trial can be compared."""
+    from mmg.errors import InputError
+    from trials.sensitivity_cli import crb_table
+
+    yml = tmp_path / "zz35_90_short.yaml"
+    yml.write_text((CONFIGS / "trials" / "zz35_90.yaml").read_text().replace("duration: 3000 s", "duration: 400 s")
+                   .replace("../ships/esso_osaka.yaml", str(CONFIGS / "ships" / "esso_osaka.yaml")))
+    tan = tangent(load_trial(yml))
+    rng = np.random.default_rng(0)
+    rows = [{"trial": "ZZ35/90", "seed": s, "diverged": "", "trial_file": str(yml),
+             **{f"final_{n}": v * (1 + 0.01 * rng.standard_normal()) for n, v in zip(DERIVATIVES, tan.values)}}
+            for s in range(5)]
+    mc = tmp_path / "mc"
+    mc.mkdir()
+    pd.DataFrame(rows).to_csv(mc / "runs.csv", index=False)
+    out = tmp_path / "out"
+    out.mkdir()
+    tab = crb_table(mc, out, verbose=False)
+    assert list(dict.fromkeys(tab.trial)) == ["ZZ35/90"] and len(tab) == 12
+    assert (tab.crb_std_log_timing >= tab.crb_std_log * (1 - 1e-9)).all()
+    assert (out / "crb_vs_mc.csv").exists() and (out / "crb_vs_mc.png").exists()
+    pd.DataFrame(rows).drop(columns="trial_file").to_csv(mc / "runs.csv", index=False)
+    with pytest.raises(InputError, match="trial_file"):
+        crb_table(mc, out, verbose=False)
