@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import json
 from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -205,10 +206,11 @@ def data_from_trial(path: str | Path, cfg: dict, seed: int | None = None, workdi
 
     from trials.logio import write_csv
     from trials.run import run_trial
+    from trials.rudder import REBUILT_KINDS
     from trials.trial import load_trial
 
     tr = load_trial(path)
-    if tr.kind not in ("turning", "zigzag", "stype"):
+    if tr.kind not in REBUILT_KINDS:
         raise InputError(str(path), "manoeuvre.kind", f"the estimator rebuilds the rudder of turning, zigzag and S-type "
                                                       f"trials only, not {tr.kind}")
     if seed is not None:
@@ -313,11 +315,10 @@ class Estimate:
     def final(self) -> dict:
         return self.result.final
 
+    @cached_property
     def free_run(self) -> FreeRun | None:
         """The trial re-simulated with the final estimates, against the log (:func:`free_run`)."""
-        if not hasattr(self, "_free_run"):
-            self._free_run = free_run(self.data, self.final)
-        return self._free_run
+        return free_run(self.data, self.final)
 
     def warnings(self, min_shrink: float = 0.1) -> list[str]:
         """Signs that the pass is not to be trusted although it did not diverge.
@@ -326,7 +327,7 @@ class Estimate:
         ``min_shrink`` (10 %) of their start values over the record has learned almost nothing
         from it: typically R is far too large, or the trial does not excite the derivatives.
         (With the paper's settings the median shrink is about 40 %; with R 1e6 times larger, 0.2 %.)
-        And when the trial re-simulated with the estimates (:meth:`free_run`) misses the logged
+        And when the trial re-simulated with the estimates (:attr:`free_run`) misses the logged
         heading by more than 1 deg RMS, the estimated model does not reproduce the data: the filter
         converged to wrong values (with the paper's R the innovations stay small even then), or
         the log holds an effect the model lacks.
@@ -340,7 +341,7 @@ class Estimate:
                        f"(the derivatives' standard deviations shrank by {100 * np.median(shrink):.1f} % in the median, "
                        f"at most {100 * shrink.max():.1f} %): R is probably far too large, or the trial does not "
                        f"excite them")
-        fr = self.free_run()
+        fr = self.free_run
         if fr is not None and not fr.ok:
             miss = ("the re-simulation stopped early" if fr.sim is None else
                     f"it misses the logged heading by {fr.heading_rms_deg:.2f} deg RMS (limit {HEADING_RMS_MAX_DEG:g}; "
@@ -477,7 +478,7 @@ def write_reports(ests: list[Estimate], out, plots: bool = True) -> dict:
     if rms:
         with open(P("preprocessing_rms.json"), "w") as fh:
             json.dump(rms, fh, indent=2)
-    runs = {e.name: e.free_run() for e in ests if isinstance(e, Estimate)}
+    runs = {e.name: e.free_run for e in ests if isinstance(e, Estimate)}
     runs = {k: v.to_dict() for k, v in runs.items() if v is not None}
     if runs:
         with open(P("free_run.json"), "w") as fh:

@@ -68,12 +68,10 @@ from mmg.integrate import integrate
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_
 from mmg.simulation import prepare
 
-from .rudder import movements
+from .rudder import REBUILT_KINDS, movements
 from .sensitivity import DERIVATIVES, LINEAR, NONLINEAR
 
 NOISE_MODELS = ("log", "filter", "thinned")
-# the trial kinds whose rudder the estimators rebuild from the trial logic (:mod:`trials.rudder`)
-HEADING_TRIGGERED = ("turning", "zigzag", "stype")
 OUTPUTS = ("u", "v", "r", "n")
 
 
@@ -106,7 +104,8 @@ def _tangent_kernel(z0, delta, dt, p, poly, hull_axis, hull_term, hull_coef, idx
 @njit(cache=True)
 def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, hull_coef, idx, out):
     """out (N, 4, n_seg): d(u, v, r, n)(t_k) / d tau_j, the rudder being delta + tau_j g over the
-    steps with seg == j; one complex-step run of the raw-log EKF's RK4 step per movement.
+    steps with seg == j (seg non-decreasing); one complex-step run of the raw-log EKF's RK4 step
+    per movement, started where the movement starts from a stored unperturbed run.
 
     z0 (20,) the raw-log filter's state layout (x, y, psi, n, u, v, r, tau, derivatives)."""
     N = delta.shape[0]
@@ -114,12 +113,27 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
     ws = make_workspace(LOG_NZ, LOG_NS, hull_coef)
     coef, xs, k1, k2, k3, k4, nxt = ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
     z = np.empty(z0.shape[0], dtype=np.complex128)
+    for i in range(z0.shape[0]):
+        z[i] = z0[i]
+    # the unperturbed run, in complex arithmetic like the perturbed ones (same rounding)
+    zh = np.empty((N, LOG_NS), dtype=np.complex128)
+    zh[0, :] = z[:LOG_NS]
+    for k in range(1, N):
+        rk4_step(z, LOG_SLOTS, LOG_ND, delta[k - 1] + 0.0j, delta[k] + 0.0j, dt, p, poly, hull_axis, hull_term,
+                 coef, idx, xs, k1, k2, k3, k4, nxt)
+        for i in range(LOG_NS):
+            z[i] = nxt[i]
+        zh[k, :] = nxt
+    k0 = 0
     for j in range(n_seg):
-        for i in range(z0.shape[0]):
-            z[i] = z0[i]
-        for i in range(4):
-            out[0, i, j] = 0.0
-        for k in range(1, N):
+        while seg[k0] < j:
+            k0 += 1
+        for k in range(k0 + 1):
+            for i in range(4):
+                out[k, i, j] = 0.0
+        for i in range(LOG_NS):
+            z[i] = zh[k0, i]
+        for k in range(k0 + 1, N):
             a0 = 1j * h * g[k - 1] if seg[k - 1] == j else 0.0j
             a1 = 1j * h * g[k] if seg[k - 1] == j else 0.0j
             rk4_step(z, LOG_SLOTS, LOG_ND, delta[k - 1] + a0, delta[k] + a1, dt, p, poly, hull_axis, hull_term,
@@ -181,7 +195,7 @@ def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tang
     """Simulate ``trial`` and propagate the exact output sensitivities along it (EKF model, rudder as input).
 
     rudder_timing: also the sensitivities to the timing of each rudder movement (``Tangent.S_tau``);
-        only trials whose rudder the estimators rebuild from the trial logic (``HEADING_TRIGGERED``:
+        only trials whose rudder the estimators rebuild from the trial logic (``REBUILT_KINDS``:
         turning, zigzag, S-type) have such nuisances; a time-scheduled rudder (sine, sawtooth,
         schedule) has none.
     """
@@ -199,7 +213,7 @@ def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tang
     S = np.empty((N, NS, NZ))
     _tangent_kernel(z0, delta, step, *pk.args(), idx, Y, S)
     S_tau = None
-    if rudder_timing and trial.kind not in HEADING_TRIGGERED:
+    if rudder_timing and trial.kind not in REBUILT_KINDS:
         S_tau = np.empty((N, NS, 0))          # a time schedule: the rudder's timing is known
     elif rudder_timing:
         seg = movements(np.asarray(orders, float), step)

@@ -72,6 +72,7 @@ def reconstruct_rudder(t, psi, kind: str, manoeuvre: dict, p: np.ndarray, delta0
     return order, delta
 
 
+REBUILT_KINDS = ("turning", "zigzag", "stype")   # trial kinds whose rudder is rebuilt from their logic
 MOVEMENT_LEAD_S = 1.0   # a rudder movement is taken to start this long [s] before its order change
 
 
@@ -96,7 +97,7 @@ def movements(order: np.ndarray, dt: float, lead: float = MOVEMENT_LEAD_S) -> np
 def manoeuvre_from_meta(meta: dict, source: str = "log") -> tuple[str, dict]:
     """The trial kind and its rudder logic (SI) from a log header."""
     kind = str(meta.get("kind", ""))
-    if kind not in ("turning", "zigzag", "stype"):
+    if kind not in REBUILT_KINDS:
         raise InputError(source, "kind", f"the log has no rudder channel and its header gives no turning/zigzag/stype "
                                          f"trial kind to rebuild it from (kind: {kind or 'missing'})")
     try:
