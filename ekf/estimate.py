@@ -442,7 +442,8 @@ def to_markdown(df: pd.DataFrame) -> str:
 
 
 def write_reports(ests: list[Estimate], out, plots: bool = True) -> dict:
-    """estimates.json, error_table.csv/.md, final_estimates.csv, convergence_*.png, preprocessing_*.png.
+    """estimates.json, error_table.csv/.md, final_estimates.csv, convergence_*.png, preprocessing_*.png,
+    free_run.json (:class:`FreeRun` of each trial; with ``true_derivatives`` when the truth is known).
 
     ``out`` is a folder path or a staging object with ``.path(name)``.
     """
@@ -478,8 +479,14 @@ def write_reports(ests: list[Estimate], out, plots: bool = True) -> dict:
     if rms:
         with open(P("preprocessing_rms.json"), "w") as fh:
             json.dump(rms, fh, indent=2)
-    runs = {e.name: e.free_run for e in ests if isinstance(e, Estimate)}
-    runs = {k: v.to_dict() for k, v in runs.items() if v is not None}
+    runs = {}
+    for e in ests:
+        fr = e.free_run if isinstance(e, Estimate) else None
+        if fr is None:
+            continue
+        runs[e.name] = fr.to_dict()
+        if e.data.true_values:            # the check's floor: the same re-simulation with the truth
+            runs[e.name]["true_derivatives"] = free_run(e.data, e.data.true_values).to_dict()
     if runs:
         with open(P("free_run.json"), "w") as fh:
             json.dump(runs, fh, indent=2)

@@ -56,6 +56,7 @@ writes ``OUT/runs.csv`` in the format of :mod:`ekf.montecarlo` (``mmg sensitivit
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -63,6 +64,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from mmg.errors import InputError
 from mmg.model import N_, PSI_, R_, U_, V_, X_, Y_
 from mmg.units import DEG
 
@@ -235,8 +237,6 @@ def run_log_filter(data, record, cfg: dict, q=None, duration: float | None = Non
 
 
 def _true_rudder(data, t: np.ndarray) -> np.ndarray:
-    from mmg.errors import InputError
-
     if data.truth is None or getattr(data.truth, "delta", None) is None:
         raise InputError(data.source, "delta", "rudder='true' needs a truth file with the rudder angle")
     return np.interp(t, np.asarray(data.truth.t, float), np.asarray(data.truth.delta, float))
@@ -294,6 +294,19 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
 # --------------------------------------------------------------------------- Monte Carlo
 
 
+def _timing_error(data) -> dict:
+    """How far the rebuilt rudder's reversals are from the truth file's (rms, max [s], count)."""
+    from trials.rudder import reversal_timing_errors
+
+    if data.truth is None or getattr(data.truth, "delta", None) is None:
+        return {}
+    e = reversal_timing_errors(data.meas.t, data.meas.delta, data.truth.t, data.truth.delta)
+    if len(e) == 0:
+        return {"rudder_timing_n": 0, "rudder_timing_rms_s": np.nan, "rudder_timing_max_s": np.nan}
+    return {"rudder_timing_n": len(e), "rudder_timing_rms_s": float(np.sqrt(np.mean(e ** 2))),
+            "rudder_timing_max_s": float(np.abs(e).max())}
+
+
 def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15, rudder: str = "rebuilt") -> dict:
     from trials.logio import read_record
 
@@ -309,6 +322,7 @@ def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15, rudd
     tv = data.true_values
     fin = res.final
     return {"trial": data.name, "seed": seed, "diverged": "", "rudder": rudder, "sigma_tau_s": sigma_tau,
+            **_timing_error(data),
             **{n: 100.0 * abs(fin[n] - tv[n]) / abs(tv[n]) for n in DERIVATIVES},
             **{f"final_{n}": v for n, v in fin.items()},
             "mean_nis": float(np.nanmean(res.nis))}
@@ -334,26 +348,30 @@ def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_
     from .estimate import REPO, load_config
     from .reproduce import TRIALS
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    from trials.rudder import REBUILT_KINDS
+    from trials.trial import load_trial
+
     cfg = load_config(config)
     files = [str(REPO / "configs" / "trials" / TRIALS[t]) if t in TRIALS else str(Path(t).resolve())
              for t in (trials or TRIALS)]
-    for f in files:
+    for f in files:                       # all inputs checked before any run or output
         if not Path(f).is_file():
-            from mmg.errors import InputError
-
             raise InputError(f, "trials", f"neither one of {', '.join(TRIALS)} nor a trial YAML")
+        if (kind := load_trial(f).kind) not in REBUILT_KINDS:
+            raise InputError(f, "manoeuvre.kind", f"the raw-log EKF rebuilds the rudder of turning, zigzag and "
+                                                  f"S-type trials only, not {kind}")
     jobs = [(f, first_seed + s, cfg, q, sigma_tau, rudder) for f in files for s in range(n_seeds)]
     rows = run_sweep(_task, jobs, backend=backend, n_jobs=n_jobs, progress=verbose,
                      labels=[f"{Path(j[0]).stem} seed {j[1]}" for j in jobs])
     runs = pd.DataFrame(rows)
     runs.insert(2, "trial_file", [j[0] for j in jobs])
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
     runs.to_csv(out / "runs.csv", index=False, float_format="%.8g")
     return runs
 
 
-def main(argv=None) -> None:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m ekf.log_filter", description="Monte Carlo of the raw-log EKF")
     ap.add_argument("out")
     ap.add_argument("--seeds", type=int, default=20)
@@ -371,9 +389,14 @@ def main(argv=None) -> None:
         args.sigma_tau = 1e-4 if args.true_rudder else 0.15
     if not args.sigma_tau > 0:
         ap.error(f"--sigma-tau must be > 0, got {args.sigma_tau}")
-    monte_carlo(args.out, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=args.sigma_tau,
-                first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt")
+    try:
+        monte_carlo(args.out, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=args.sigma_tau,
+                    first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt")
+    except InputError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

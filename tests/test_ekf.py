@@ -186,6 +186,7 @@ def test_free_run_catches_a_filter_that_converged_to_the_wrong_model(short_zz, t
     assert "does not reproduce" not in capsys.readouterr().err
     fr = json.loads((out / "free_run.json").read_text())["ZZ20"]
     assert fr["ok"] and fr["completed"] and fr["heading_rms_deg"] < 1.0 and fr["position_rms_L"] < 0.01
+    assert fr["true_derivatives"]["ok"] and fr["true_derivatives"]["heading_rms_deg"] < fr["heading_rms_deg"]
     out5 = tmp_path / "five"
     assert main(["estimate", str(d / "log.csv"), "--truth", str(d / "truth.csv"), "--out", str(out5), "--no-plots",
                  "--set", "initial.scale=5"]) == 0

@@ -6,6 +6,7 @@ from ekf.estimate import REPO, data_from_trial, load_config
 from ekf.filter import DERIVATIVES, is_pd
 from ekf.log_filter import ND, NZ, log_measurements, run_log_filter
 from trials.logio import read_record
+from trials.rudder import reversal_timing_errors
 
 LINEAR = ("Y_beta", "Y_r", "N_beta", "N_r")
 
@@ -63,20 +64,13 @@ def test_second_pass_relinearises(zz20_600):
         assert abs(res2.final[n] - tv[n]) < 0.25 * 0.2 * abs(tv[n]), n
 
 
-def _zero_crossings(t, d):
-    k = np.nonzero(np.diff(np.sign(d)) != 0)[0]
-    return t[k] - d[k] * (t[k + 1] - t[k]) / (d[k + 1] - d[k])
-
-
 def test_timing_state_recovers_the_rebuilt_rudders_timing_error(zz20_600):
     """The first reversal of the rebuilt rudder is a step (0.1 s) late on this seed; the filter's
     tau for that movement finds it, and with the truth file's rudder it finds nothing."""
     from ekf.log_filter import TAU
 
     cfg, data, rec, _ = zz20_600
-    t = np.asarray(data.meas.t)
-    late = (_zero_crossings(t, np.asarray(data.meas.delta))[0]
-            - _zero_crossings(t, np.interp(t, np.asarray(data.truth.t), np.asarray(data.truth.delta)))[0])
+    late = reversal_timing_errors(data.meas.t, data.meas.delta, data.truth.t, data.truth.delta)[0]
     assert late == pytest.approx(0.1, abs=1e-6)
     taus = {}
     for rudder in ("rebuilt", "true"):
@@ -91,3 +85,23 @@ def test_timing_state_recovers_the_rebuilt_rudders_timing_error(zz20_600):
     assert abs(taus["true"]) < 0.03
     with pytest.raises(ValueError):
         run_log_filter(data, rec, cfg, duration=60.0, passes=1, rudder="measured")
+
+
+def test_reversal_timing_errors_pair_each_true_reversal_with_the_nearest_rebuilt_one():
+    t = np.arange(0.0, 100.0, 0.1)
+    true = np.sin(2 * np.pi * t / 40.0 + 0.3)
+    late = np.sin(2 * np.pi * (t - 0.07) / 40.0 + 0.3)
+    e = reversal_timing_errors(t, late, t, true)
+    assert len(e) == 5 and np.allclose(e, 0.07, atol=2e-3)     # linear interpolation of a sine
+    assert len(reversal_timing_errors(t, np.ones_like(t), t, true)) == 0
+
+
+def test_monte_carlo_cli_refuses_bad_trials_before_writing(tmp_path, capsys):
+    from ekf.log_filter import main
+
+    out = tmp_path / "mc"
+    assert main([str(out), "--seeds", "1", "--trials", str(tmp_path / "nope.yaml")]) == 2
+    assert main([str(out), "--seeds", "1", "--trials", str(REPO / "configs" / "trials" / "sine.yaml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "nope.yaml" in err[0] and "manoeuvre.kind" in err[1]
+    assert not out.exists()

@@ -342,3 +342,16 @@ def test_crb_table_finds_a_non_paper_trial_through_its_trial_file(tmp_path):
     pd.DataFrame(rows).drop(columns="trial_file").to_csv(mc / "runs.csv", index=False)
     with pytest.raises(InputError, match="trial_file"):
         crb_table(mc, out, verbose=False)
+    # several folders pool per trial; the same trial and seed twice is refused
+    pd.DataFrame(rows).to_csv(mc / "runs.csv", index=False)
+    more = tmp_path / "more"
+    more.mkdir()
+    extra = [{**r, "seed": r["seed"] + 100} for r in rows]
+    pd.DataFrame(extra).to_csv(more / "runs.csv", index=False)
+    assert crb_table([mc, more], out, verbose=False).runs.iloc[0] == 10
+    text = (out / "crb_vs_mc.txt").read_text()
+    assert "all derivatives with MC std within a factor 2" in text and "nonlinear derivatives, std / |value|" in text
+    with pytest.raises(InputError, match="more than one"):
+        crb_table([mc, mc], out, verbose=False)
+    with pytest.raises(InputError, match="not found"):
+        crb_table([mc, tmp_path / "nothing"], out, verbose=False)

@@ -94,6 +94,22 @@ def movements(order: np.ndarray, dt: float, lead: float = MOVEMENT_LEAD_S) -> np
     return np.cumsum(seg)
 
 
+def reversal_times(t: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    """Times [s] at which the rudder angle ``delta`` crosses zero (linear between samples)."""
+    t, d = np.asarray(t, float), np.asarray(delta, float)
+    k = np.nonzero(np.diff(np.sign(d)) != 0)[0]
+    return t[k] - d[k] * (t[k + 1] - t[k]) / (d[k + 1] - d[k])
+
+
+def reversal_timing_errors(t: np.ndarray, rebuilt: np.ndarray, t_true: np.ndarray, true: np.ndarray) -> np.ndarray:
+    """Rebuilt minus true reversal time [s] of every reversal of the true rudder (``true`` at
+    ``t_true``), paired with the nearest reversal of the ``rebuilt`` rudder (at ``t``)."""
+    tr, rb = reversal_times(t_true, true), reversal_times(t, rebuilt)
+    if len(tr) == 0 or len(rb) == 0:
+        return np.empty(0)
+    return np.array([rb[np.argmin(np.abs(rb - x))] - x for x in tr])
+
+
 def manoeuvre_from_meta(meta: dict, source: str = "log") -> tuple[str, dict]:
     """The trial kind and its rudder logic (SI) from a log header."""
     kind = str(meta.get("kind", ""))

@@ -3,7 +3,7 @@ Fisher information / Cramer-Rao bounds and the trial-design search.
 
     mmg sensitivity TRIAL.yaml [TRIAL.yaml ...] --out DIR [--fisher]
     mmg sensitivity --paper-figures --out DIR [--ekf-comparison comparison.csv]
-    mmg sensitivity --crb-vs-mc MC_DIR --out DIR [--mc-seeds N]
+    mmg sensitivity --crb-vs-mc MC_DIR [MC_DIR ...] --out DIR [--mc-seeds N] [--rudder-timing S]
     mmg sensitivity --design --out DIR
 
 Everything is written into a staging folder and moved to ``--out`` only on success.
@@ -188,8 +188,65 @@ def cmd_paper(args, stage) -> None:
 
 # --------------------------------------------------------------------------- CRB vs Monte Carlo
 
+def _read_runs(mc_dirs, n_seeds: int, verbose: bool) -> tuple[pd.DataFrame, str]:
+    """The runs.csv of every Monte Carlo folder, concatenated (a single missing folder is run)."""
+    dirs = [mc_dirs] if isinstance(mc_dirs, (str, Path)) else list(mc_dirs)
+    csvs = [Path(d) / "runs.csv" for d in dirs]
+    if len(csvs) == 1 and not csvs[0].exists():
+        from ekf.montecarlo import monte_carlo
+
+        if verbose:
+            print(f"no {csvs[0]}: running the EKF Monte Carlo ({n_seeds} seeds per trial) ...", flush=True)
+        monte_carlo(dirs[0], n_seeds=n_seeds, verbose=verbose)
+    parts = []
+    for c in csvs:
+        if not c.is_file():
+            raise InputError(str(c), "", "file not found (a Monte Carlo folder holds runs.csv)")
+        r = pd.read_csv(c, keep_default_na=False, na_values=[""])
+        if "trial" not in r or "seed" not in r or not any(k.startswith("final_") for k in r.columns):
+            raise InputError(str(c), "final_*", "not an EKF Monte Carlo runs.csv (ekf.montecarlo, ekf.log_filter)")
+        parts.append(r)
+    runs = pd.concat(parts, ignore_index=True)
+    dup = runs[runs.duplicated(["trial", "seed"])]
+    if len(dup):
+        raise InputError(str(csvs[-1]), "seed", f"trial {dup.trial.iloc[0]!r} seed {dup.seed.iloc[0]} is in more than "
+                                                f"one of the Monte Carlo folders")
+    return runs, ", ".join(str(c) for c in csvs)
+
+
+def _summary_lines(tab: pd.DataFrame, runs: pd.DataFrame, bounds: list[str]) -> list[str]:
+    """Factor-2 counts and ranges of MC/CRB, the rebuilt rudder's timing error, and the design
+    criteria (median and mean relative std of the nonlinear derivatives) from the Monte Carlo."""
+    from .fisher import LINEAR, NONLINEAR
+
+    lines = []
+    for what, t in (("linear derivatives", tab[tab.derivative.isin(LINEAR)]), ("all derivatives", tab)):
+        parts = []
+        for b in bounds:
+            r = t[f"mc_over_crb_{b}"].to_numpy(float)
+            parts.append(f"{b} {int(np.sum((r >= 0.5) & (r <= 2.0)))}/{len(r)} (MC/CRB {r.min():.2f}-{r.max():.2f})")
+        lines.append(f"{what} with MC std within a factor 2 of the bound: " + ", ".join(parts))
+    if "rudder_timing_rms_s" in runs and runs["rudder_timing_n"].fillna(0).sum() > 0:
+        ok = runs[runs["rudder_timing_n"].fillna(0) > 0]
+        n = ok["rudder_timing_n"].to_numpy(float)
+        rms = float(np.sqrt(np.sum(n * ok["rudder_timing_rms_s"].to_numpy(float) ** 2) / n.sum()))
+        lines.append(f"rebuilt rudder's reversal times against the truth file's: rms {rms:.3f} s, max "
+                     f"{ok['rudder_timing_max_s'].max():.3f} s over {int(n.sum())} reversals "
+                     f"({', '.join(f'{t} {np.sqrt(np.average(g.rudder_timing_rms_s ** 2, weights=g.rudder_timing_n)):.3f} s' for t, g in ok.groupby('trial', sort=False))})")
+    nl = tab[tab.derivative.isin(NONLINEAR)].assign(rel_mc=lambda d: 100 * d.mc_std / d.value.abs())
+    b = bounds[-1]
+    nl = nl.assign(rel_crb=100 * nl[f"crb_std_{b}"] / nl.value.abs())
+    lines.append(f"nonlinear derivatives, std / |value| [%] (the design criteria of mmg sensitivity --design, "
+                 f"bound {b}): " + "; ".join(
+                     f"{t}: MC median {g.rel_mc.median():.3g} mean {g.rel_mc.mean():.3g}, CRB median "
+                     f"{g.rel_crb.median():.3g} mean {g.rel_crb.mean():.3g}" for t, g in nl.groupby("trial", sort=False)))
+    return lines
+
+
 def crb_table(mc_dir, out, n_seeds: int = 20, verbose: bool = True, rudder_timing: float | None = 0.15) -> pd.DataFrame:
-    """CRB vs the EKF Monte Carlo (runs.csv in ``mc_dir``; run with ``n_seeds`` seeds when missing).
+    """CRB vs the EKF Monte Carlo: runs.csv of one folder ``mc_dir`` (run there with ``n_seeds``
+    seeds per trial when missing) or of several folders (a list; e.g. more seeds run later with
+    ``--first-seed``), pooled per trial.
 
     rudder_timing: prior std [s] of the per-movement rudder-timing nuisances of the second "log"
     bound (:func:`trials.fisher.fisher`); None for the rudder-known bounds only.
@@ -198,26 +255,18 @@ def crb_table(mc_dir, out, n_seeds: int = 20, verbose: bool = True, rudder_timin
     from .sensitivity_plots import plot_crb_vs_mc
 
     P = out.path if hasattr(out, "path") else (lambda n: Path(out) / n)
-    runs_csv = Path(mc_dir) / "runs.csv"
-    if not runs_csv.exists():
-        from ekf.montecarlo import monte_carlo
-
-        if verbose:
-            print(f"no {runs_csv}: running the EKF Monte Carlo ({n_seeds} seeds per trial) ...", flush=True)
-        monte_carlo(mc_dir, n_seeds=n_seeds, verbose=verbose)
-    runs = pd.read_csv(runs_csv, keep_default_na=False, na_values=[""])
-    if "trial" not in runs or not any(c.startswith("final_") for c in runs.columns):
-        raise InputError(str(runs_csv), "final_*", "not an EKF Monte Carlo runs.csv (ekf.montecarlo)")
+    runs, src = _read_runs(mc_dir, n_seeds, verbose)
     files = {k: TRIALS_DIR / f"{v}.yaml" for k, v in EKF_TRIALS.items()}
     if "trial_file" in runs:
-        files.update({t: Path(f) for t, f in runs.groupby("trial")["trial_file"].first().items()})
+        files.update({t: Path(f) for t, f in runs.dropna(subset=["trial_file"]).groupby("trial")["trial_file"]
+                      .first().items()})
     unknown = set(runs["trial"]) - set(files)
     if unknown:
-        raise InputError(str(runs_csv), "trial", f"unknown trial(s) {', '.join(sorted(unknown))} and no trial_file "
-                                                 f"column to find them")
+        raise InputError(src, "trial", f"unknown trial(s) {', '.join(sorted(unknown))} and no trial_file "
+                                       f"column to find them")
     missing = sorted(str(f) for t, f in files.items() if t in set(runs["trial"]) and not Path(f).is_file())
     if missing:
-        raise InputError(str(runs_csv), "trial_file", f"trial file(s) not found: {', '.join(missing)}")
+        raise InputError(src, "trial_file", f"trial file(s) not found: {', '.join(missing)}")
     tab = crb_vs_montecarlo(runs, files, rudder_timing=rudder_timing)
     tab.to_csv(P("crb_vs_mc.csv"), index=False, float_format="%.6g")
     timing = rudder_timing is not None
@@ -227,20 +276,13 @@ def crb_table(mc_dir, out, n_seeds: int = 20, verbose: bool = True, rudder_timin
     cols = ["trial", "derivative", "value", "runs", "mc_std", "crb_std_log", "mc_over_crb_log"]
     cols += ["crb_std_log_timing", "mc_over_crb_log_timing"] if timing else []
     cols += ["crb_std_filter", "mc_over_crb_filter"]
-
-    def within2(col):
-        r = lin[col].to_numpy(float)
-        return f"{int(np.sum((r >= 0.5) & (r <= 2.0)))}/{len(r)}"
-
-    summary = f"linear derivatives with MC std within a factor 2 of the bound: log {within2('mc_over_crb_log')}"
-    if timing:
-        summary += f", log_timing {within2('mc_over_crb_log_timing')}"
+    summary = _summary_lines(tab, runs, ["log", "log_timing"] if timing else ["log"])
     text = ("CRB standard deviation vs the Monte Carlo standard deviation of the EKF's final estimates\n"
-            "(log: the information of the 5 s log actually recorded, rudder known; "
+            f"(runs: {src}; log: the information of the 5 s log actually recorded, rudder known; "
             + (f"log_timing: the same with the timing of each rudder movement a nuisance of prior std "
                f"{rudder_timing:g} s, as the log has no rudder channel; " if timing else "")
             + "filter: Table 8 R on independent 0.1 s samples, what the paper's filter assumes)\n\n"
-            + summary + "\n\nLinear derivatives:\n\n"
+            + "\n".join(summary) + "\n\nLinear derivatives:\n\n"
             + lin[cols].to_string(index=False, float_format=lambda v: f"{v:.3g}")
             + "\n\nAll derivatives:\n\n" + tab[cols].to_string(index=False, float_format=lambda v: f"{v:.3g}") + "\n")
     P("crb_vs_mc.txt").write_text(text)
@@ -385,8 +427,9 @@ def register(sub) -> None:
                    help="Rhee & Kim Figs 2, 8-9, 12, 13, 14 and 28 in one go")
     p.add_argument("--ekf-comparison", help="comparison.csv of the EKF reproduction for Fig. 28 (default: run it)")
     p.add_argument("--fisher", action="store_true", help="also write the Cramer-Rao bounds of the given trials")
-    p.add_argument("--crb-vs-mc", metavar="MC_DIR", help="CRB vs the EKF Monte Carlo in MC_DIR (runs.csv; "
-                                                          "run there when missing)")
+    p.add_argument("--crb-vs-mc", metavar="MC_DIR", nargs="+",
+                   help="CRB vs the EKF Monte Carlo in MC_DIR (runs.csv; run there when a single folder is missing); "
+                        "several folders are pooled per trial")
     p.add_argument("--mc-seeds", type=int, default=20, help="seeds per trial when the Monte Carlo must be run")
     p.add_argument("--rudder-timing", type=_rudder_timing, default=0.15, metavar="SIGMA_S",
                    help="with --crb-vs-mc or --design: prior std [s] of the per-movement rudder-timing nuisances of the "
