@@ -12,7 +12,8 @@ Criterion (lower is better): the mean over the 8 nonlinear derivatives of the Cr
 on the standard deviation relative to the derivative's value, in % (A-optimality on the
 relative scale), from :mod:`trials.fisher` with the ``log`` noise model (the information in
 the 5 s log actually recorded).  The D-criterion (geometric-mean relative std,
-det^(1/16)) is reported beside it.  Both are computed twice: with the rudder known (columns
+det^(1/16)) and the median relative std (N_bb, nearly zero, has ~100 % relative std in every
+trial and dominates the mean) are reported beside it.  Both are computed twice: with the rudder known (columns
 ``mean_rel_crb_nonlinear_pct`` ...) and, as the log has no rudder channel, with the timing of
 every rudder movement a nuisance (prior std ``rudder_timing``, 0.15 s; columns prefixed
 ``timing_``; :func:`trials.fisher.fisher`).  A trial with many short rudder movements loses
