@@ -14,8 +14,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from ekf.estimate import REPO, data_from_trial, initial_state, load_config, P0_for, R_for  # noqa: E402
+from ekf.estimate import P0_for, R_for, initial_state, load_config  # noqa: E402
 from ekf.filter import run_filter  # noqa: E402
+from trials.estimation import data_from_trial  # noqa: E402
 
 
 def main() -> None:
@@ -24,9 +25,10 @@ def main() -> None:
     a = ap.parse_args()
     cfg = load_config()
     with tempfile.TemporaryDirectory() as td:
-        data = data_from_trial(REPO / "configs" / "trials" / "zz20.yaml", cfg, workdir=td)
+        data = data_from_trial("zz20", cfg)
         m = data.meas
-        args = (data.packed, data.slots, m.t, m.z(), m.delta, initial_state(data, cfg), P0_for(cfg), R_for(cfg, data.name))
+        args = (data.packed, data.slots, m.t, m.z(), m.delta, initial_state(data, cfg),
+                P0_for(cfg, data.names, data.reference), R_for(cfg, data.name))
         t0 = time.perf_counter()
         run_filter(*args, trial=data.name)
         first = time.perf_counter() - t0
@@ -39,7 +41,7 @@ def main() -> None:
               f"median {statistics.median(times):.3f} s of 5 (min {min(times):.3f} s; first call incl. "
               f"compilation/cache load {first:.2f} s)")
         if not a.skip_reproduce:
-            from ekf.reproduce import reproduce_rhee_kim
+            from trials.rhee_kim import reproduce_rhee_kim
 
             t0 = time.perf_counter()
             reproduce_rhee_kim(Path(td) / "rk", plots=False, verbose=False)

@@ -1,16 +1,17 @@
-"""From a sea-trial log (or a trial YAML, simulated first) to derivative estimates and reports.
+"""The augmented EKF estimate of one trial (or several in turn), and its checks.
 
-:func:`load_config` reads ``configs/estimation/rhee_kim.yaml`` (overridable);
-:func:`data_from_log` / :func:`data_from_trial` give a :class:`TrialData` (the recovered
-0.1 s measurements, the packed ship, the truth if known); :func:`estimate` runs the
-filter; :func:`write_reports` writes the estimates, the Table-10-style error table and
-the convergence figures (Rhee & Kim Figs 15-26, all trials on one figure per derivative).
+:func:`load_config` reads the estimation config (the bundled
+``configs/estimation/rhee_kim.yaml``, overridable, keyed by coefficient name with defaults
+for names it does not list); :func:`estimate` runs the filter on a
+:class:`ekf.data.TrialData` and returns an :class:`Estimate` (``.final``, ``.to_pandas()``,
+``.plot()``, ``.warnings()``, ``.free_run``); :func:`joint_estimate` runs it through several
+trials in turn.  Building a TrialData from a log file or a trial YAML, and writing the
+reports, is the trials layer's job (:mod:`trials.estimation`).
 """
 from __future__ import annotations
 
 import copy
-import json
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
@@ -19,20 +20,21 @@ import pandas as pd
 import yaml
 
 from mmg.errors import InputError
-from mmg.simulation import prepare
-from mmg.ship import Ship, load_ship
-from mmg.units import KNOT, to_si
+from mmg.resources import config_path
+from mmg.units import to_si
 
-from .filter import DERIVATIVES, NS, STATES, FilterResult, derivative_slots, run_filter
-from .preprocess import Measurements, compare_with_truth, recover
+from .data import PAPER_DERIVATIVES, TrialData
+from .filter import NS, STATES, FilterResult, run_filter
 
-REPO = Path(__file__).resolve().parents[1]
-DEFAULT_CONFIG = REPO / "configs" / "estimation" / "rhee_kim.yaml"
-DEFAULT_SHIP = REPO / "configs" / "ships" / "esso_osaka.yaml"
-G = 9.80665
+CONFIG_KEYS = ("dt", "initial", "P0_is", "P0", "P0_default_relative_std", "Q", "R", "fit_checks", "divergence")
+"""The keys of an estimation config; anything else is refused."""
 
 
 # --------------------------------------------------------------------------- configuration
+
+
+_NESTED = {"initial": ("scale", "values"), "fit_checks": ("froude_min", "froude_max", "rpm_mismatch", "length_mismatch"),
+           "divergence": ("nis_window_s", "nis_max")}
 
 
 def _merge(base: dict, over: dict) -> dict:
@@ -45,11 +47,29 @@ def _merge(base: dict, over: dict) -> dict:
     return out
 
 
+def _check_keys(cfg: dict, src: str) -> None:
+    """Refuse keys the estimator does not know (a typo must not be ignored)."""
+    for k in cfg:
+        if k not in CONFIG_KEYS and k != "dt_s":
+            raise InputError(src, str(k), f"unknown key; known: {', '.join(CONFIG_KEYS)}")
+    for k, allowed in _NESTED.items():
+        sub = cfg.get(k)
+        if sub is None:
+            continue
+        if not isinstance(sub, dict):
+            raise InputError(src, k, "expected a mapping")
+        for kk in sub:
+            if kk not in allowed:
+                raise InputError(src, f"{k}.{kk}", f"unknown key; known: {', '.join(allowed)}")
+
+
 def _set(cfg: dict, assignment: str) -> None:
     if "=" not in assignment:
         raise InputError("--set", assignment, "expected key.path=value")
     key, val = assignment.split("=", 1)
     parts = key.strip().split(".")
+    if parts[0] not in CONFIG_KEYS:
+        raise InputError("--set", key, f"unknown key {parts[0]!r}; known: {', '.join(CONFIG_KEYS)}")
     d = cfg
     for p in parts[:-1]:
         if not isinstance(d.get(p), dict):
@@ -61,27 +81,64 @@ def _set(cfg: dict, assignment: str) -> None:
         d[parts[-1]] = yaml.safe_load(val)
 
 
-def load_config(path: str | Path | None = None, sets=()) -> dict:
-    """The estimation config: the default file, merged with ``path`` and ``--set`` assignments; validated."""
-    with open(DEFAULT_CONFIG) as fh:
+def default_config_path() -> Path:
+    """The bundled estimation config (Rhee & Kim's settings)."""
+    return config_path("estimation", "rhee_kim.yaml")
+
+
+def load_config(path: str | Path | dict | None = None, sets=()) -> dict:
+    """The estimation config: the bundled default merged with ``path`` and ``--set`` assignments; validated.
+
+    Parameters
+    ----------
+    path : str, Path or dict, optional
+        A YAML file with any subset of the keys (:data:`CONFIG_KEYS`), or a dict of them.
+    sets : sequence of str
+        ``key.path=value`` assignments (``initial.scale=1.5``, ``R.ZZ20.u=0.1``, ``P0.Y_v=0.01``).
+
+    Returns
+    -------
+    dict
+        Validated; ``dt_s`` holds the filter step in seconds.
+
+    Raises
+    ------
+    InputError
+        Naming the file and the field: unknown keys, non-positive covariances, a bad step.
+    """
+    default = default_config_path()
+    with open(default) as fh:
         cfg = yaml.safe_load(fh)
-    src = str(DEFAULT_CONFIG)
-    if path is not None:
+    src = str(default)
+    if isinstance(path, dict):
+        src = "<config dict>"
+        _check_keys(path, src)
+        cfg = _merge(cfg, path)
+    elif path is not None:
         src = str(path)
         try:
             with open(path) as fh:
                 over = yaml.safe_load(fh) or {}
         except FileNotFoundError:
             raise InputError(src, "", "file not found") from None
+        except (IsADirectoryError, UnicodeDecodeError) as e:
+            raise InputError(src, "", f"cannot read as a YAML text file ({e.__class__.__name__})") from None
         except yaml.YAMLError as e:
             raise InputError(src, "", f"not valid YAML ({str(e).splitlines()[0]})") from None
         if not isinstance(over, dict):
             raise InputError(src, "", "expected a mapping")
+        _check_keys(over, src)
         cfg = _merge(cfg, over)
     for s in sets:
         _set(cfg, s)
-    _validate(cfg, src + (" with --set " + " ".join(sets) if sets else ""))
+    src = src + (" with --set " + " ".join(sets) if sets else "")
+    _check_keys(cfg, src)
+    _validate(cfg, src)
     return cfg
+
+
+def _positive(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and bool(np.isfinite(v)) and v > 0
 
 
 def _validate(cfg: dict, src: str) -> None:
@@ -89,23 +146,26 @@ def _validate(cfg: dict, src: str) -> None:
         cfg["dt_s"] = to_si(str(cfg["dt"]), "time")
     except Exception as e:  # noqa: BLE001 - any bad dt is an input error
         raise InputError(src, "dt", f"bad time step ({e})") from None
-    if not cfg["dt_s"] > 0:
+    if not (cfg["dt_s"] > 0 and np.isfinite(cfg["dt_s"])):
         raise InputError(src, "dt", "must be positive")
     if cfg.get("P0_is") not in ("variance", "std"):
         raise InputError(src, "P0_is", "must be 'variance' or 'std'")
-    for name in STATES + DERIVATIVES:
-        v = cfg.get("P0", {}).get(name)
-        if not isinstance(v, (int, float)) or not np.isfinite(v) or v <= 0:
+    P0 = cfg.get("P0") or {}
+    for name in STATES:
+        if not _positive(P0.get(name)):
+            raise InputError(src, f"P0.{name}", f"must be a positive number, got {P0.get(name)!r}")
+    for name, v in P0.items():
+        if not _positive(v):
             raise InputError(src, f"P0.{name}", f"must be a positive number, got {v!r}")
+    if not _positive(cfg.get("P0_default_relative_std", 0.5)):
+        raise InputError(src, "P0_default_relative_std", "must be a positive number")
     q = cfg.get("Q", 0.0)
-    if not isinstance(q, (int, float)) or q < 0:
+    if not isinstance(q, (int, float)) or not np.isfinite(q) or q < 0:
         raise InputError(src, "Q", "must be a non-negative number")
     sc = cfg.get("initial", {}).get("scale", 1.2)
     if not isinstance(sc, (int, float)) or not np.isfinite(sc):
         raise InputError(src, "initial.scale", "must be a number")
     for k, v in (cfg.get("initial", {}).get("values") or {}).items():
-        if k not in DERIVATIVES:
-            raise InputError(src, f"initial.values.{k}", f"unknown derivative; known: {', '.join(DERIVATIVES)}")
         if not isinstance(v, (int, float)) or not np.isfinite(v):
             raise InputError(src, f"initial.values.{k}", "must be a finite number")
     if "default" not in cfg.get("R", {}):
@@ -113,117 +173,40 @@ def _validate(cfg: dict, src: str) -> None:
     for trial, row in cfg["R"].items():
         for ch in STATES:
             v = (row or {}).get(ch)
-            if not isinstance(v, (int, float)) or not np.isfinite(v) or v <= 0:
+            if not _positive(v):
                 raise InputError(src, f"R.{trial}.{ch}", f"must be a positive number, got {v!r}")
 
 
 def R_for(cfg: dict, trial: str) -> np.ndarray:
-    """Diagonal R (4x4) for a trial name (Table 8; ``default`` otherwise)."""
+    """Diagonal R (4x4) of u, v, r, n for a trial name (Table 8; ``default`` otherwise)."""
     row = cfg["R"].get(trial, cfg["R"]["default"])
     return np.diag([float(row[c]) for c in STATES])
 
 
-def P0_for(cfg: dict) -> np.ndarray:
-    v = np.array([float(cfg["P0"][n]) for n in STATES + DERIVATIVES])
-    return np.diag(v if cfg["P0_is"] == "variance" else v * v)
+def P0_for(cfg: dict, names=PAPER_DERIVATIVES, reference: dict | None = None) -> np.ndarray:
+    """Diagonal P0 of u, v, r, n and the coefficients ``names``.
 
+    A coefficient the config's ``P0`` lists gets that entry (a variance or a std, ``P0_is``);
+    any other gets the std ``P0_default_relative_std`` x |its reference value| (the ship
+    file's; 0.5 by default, i.e. a prior wide enough for a 120 % start).
 
-# --------------------------------------------------------------------------- data
-
-
-@dataclass
-class TrialData:
-    """What the filter needs for one trial, and the truth when it is known."""
-
-    name: str
-    meas: Measurements
-    ship: Ship
-    packed: object
-    slots: np.ndarray
-    reference: dict          # the ship file's derivatives (initial guess = scale x these)
-    truth: object = None     # TrialRecord of the truth file, when known
-    true_values: dict | None = None
-    source: str = ""
-    record: object = None    # the log as read (TrialRecord), so later stages need not read it again
-
-
-def _fit_checks(rec, ship: Ship, n_eq: float, cfg: dict, src: str) -> None:
-    fc = cfg.get("fit_checks", {})
-    L = ship.particulars.L
-    if "length_m" in rec.meta:
-        lm = float(rec.meta["length_m"])
-        if abs(lm / L - 1) > fc.get("length_mismatch", 0.05):
-            raise InputError(src, "length_m", f"log is for a {lm:g} m ship but {ship.name} is {L:g} m long")
-    if rec.U is not None:
-        Fn = np.asarray(rec.U) / np.sqrt(G * L)
-        lo, hi = fc.get("froude_min", 0.01), fc.get("froude_max", 0.35)
-        if np.nanmax(Fn) > hi or np.nanmedian(Fn) < lo:
-            raise InputError(src, "speed_kn", f"logged speeds {np.nanmin(rec.U) / KNOT:.3g}-{np.nanmax(rec.U) / KNOT:.3g} kn "
-                                              f"(Froude {np.nanmin(Fn):.3g}-{np.nanmax(Fn):.3g}) are outside the range "
-                                              f"{lo:g}-{hi:g} the {ship.name} model covers")
-    n0 = float(rec.n[0])
-    if not n0 > 0 or abs(n0 / n_eq - 1) > fc.get("rpm_mismatch", 0.25):
-        raise InputError(src, "rpm", f"first logged rpm {n0 * 60:.4g} does not fit {ship.name}: its straight run at "
-                                     f"the logged speed needs {n_eq * 60:.4g} rpm")
-
-
-def data_from_log(path: str | Path, cfg: dict, ship_path: str | Path | None = None,
-                  truth_path: str | Path | None = None) -> TrialData:
-    """Read a project log, check it fits the ship, recover the 0.1 s measurements."""
-    from trials.logio import read_record
-
-    rec = read_record(path)
-    src = str(path)
-    if rec.meta.get("format") != "log":
-        raise InputError(src, "", f"expected a project sea-trial log (time_s, lat_deg, lon_deg, heading_deg, speed_kn, "
-                                  f"rpm), got a {rec.meta.get('format')} file")
-    if len(rec.t) < 10:
-        raise InputError(src, "time_s", f"only {len(rec.t)} samples; too short to estimate from")
-    ship = load_ship(ship_path or DEFAULT_SHIP)
-    u0 = float(rec.meta.get("approach_speed_kn", rec.U[0] / KNOT)) * KNOT
-    if not (u0 > 0 and np.isfinite(u0)):
-        raise InputError(src, "speed_kn", "the approach speed must be positive")
-    if u0 / np.sqrt(G * ship.particulars.L) > cfg.get("fit_checks", {}).get("froude_max", 0.35):
-        raise InputError(src, "speed_kn", f"approach speed {u0 / KNOT:.3g} kn is far beyond what the {ship.name} model covers")
-    try:
-        pk, eq = prepare(ship, u0)
-    except Exception as e:  # noqa: BLE001 - a failed equilibrium means the log doesn't fit
-        raise InputError(src, "speed_kn", f"no straight run of {ship.name} at {u0 / KNOT:.3g} kn ({e})") from None
-    _fit_checks(rec, ship, eq.n, cfg, src)
-    meas = recover(rec, pk.p, dt=cfg["dt_s"])
-    truth = None
-    tv = None
-    if truth_path is not None:
-        truth = read_record(truth_path)
-        tv = ship.hull.as_dict()
-    ref = ship.hull.as_dict()
-    return TrialData(rec.name, meas, ship, pk, derivative_slots(pk, DERIVATIVES, ship), ref, truth, tv, src, rec)
-
-
-def data_from_trial(path: str | Path, cfg: dict, seed: int | None = None, workdir: str | Path | None = None) -> TrialData:
-    """Simulate a trial YAML (with noise seed ``seed``), write its log and truth, recover the measurements."""
-    import tempfile
-
-    from trials.logio import write_csv
-    from trials.run import run_trial
-    from trials.rudder import REBUILT_KINDS
-    from trials.trial import load_trial
-
-    tr = load_trial(path)
-    if tr.kind not in REBUILT_KINDS:
-        raise InputError(str(path), "manoeuvre.kind", f"the estimator rebuilds the rudder of turning, zigzag and S-type "
-                                                      f"trials only, not {tr.kind}")
-    if seed is not None:
-        tr = replace(tr, log=replace(tr.log, seed=int(seed)))
-    run = run_trial(tr)
-    wd = Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="ekf-"))
-    wd.mkdir(parents=True, exist_ok=True)
-    meta = run.log_meta()
-    log_path, truth_path = wd / "log.csv", wd / "truth.csv"
-    write_csv(log_path, run.log(), meta)
-    write_csv(truth_path, run.truth(), meta)
-    ship_path = tr.ship_path
-    return data_from_log(log_path, cfg, ship_path=ship_path, truth_path=truth_path)
+    Raises
+    ------
+    InputError
+        When a name is neither listed nor has a nonzero reference value.
+    """
+    P0 = cfg["P0"]
+    rel = float(cfg.get("P0_default_relative_std", 0.5))
+    v = []
+    for n in tuple(STATES) + tuple(names):
+        if n in P0:
+            x = float(P0[n])
+            v.append(x if cfg["P0_is"] == "variance" else x * x)
+        elif reference is not None and reference.get(n):
+            v.append((rel * float(reference[n])) ** 2)
+        else:
+            raise InputError("estimation config", f"P0.{n}", "not given, and no nonzero reference value to scale a default from")
+    return np.diag(np.asarray(v, float))
 
 
 # --------------------------------------------------------------------------- estimation
@@ -288,20 +271,33 @@ def free_run(data: TrialData, values: dict) -> FreeRun | None:
     """Re-simulate ``data``'s trial with the derivatives ``values`` (:class:`FreeRun`); None when the
     log does not say how to rebuild its rudder logic (no turning/zigzag/S-type header) or the data
     are a joint record of several trials (no log of their own)."""
-    from .output_error import trial_from_data
+    from .output_error.trial import trial_from_data
 
-    if data.record is None and not Path(data.source).is_file():
+    if data.record is None or data.joint:
         return None
     try:
         tr = trial_from_data(data, rudder="law")
     except (InputError, KeyError, ValueError):
         return None
-    theta = np.array([values[n] for n in DERIVATIVES], float)
+    theta = np.array([values[n] for n in data.names], float)
     return FreeRun(data.name, tr.t_log, tr.obs, tr.simulate(theta, tr.nuisance0()), data.ship.particulars.L)
 
 
 @dataclass
 class Estimate:
+    """An augmented-EKF estimate of one trial (or several in turn, :func:`joint_estimate`).
+
+    Attributes
+    ----------
+    data : TrialData
+    result : FilterResult
+        The pass: time history of the states and coefficients and their variances.
+    initial : dict
+        Start values of the coefficients.
+    R : ndarray (4, 4)
+        Measurement covariance used.
+    """
+
     data: TrialData
     result: FilterResult
     initial: dict
@@ -353,18 +349,48 @@ class Estimate:
         return out
 
     def errors_pct(self) -> dict | None:
+        """|final - true| / |true| in % by coefficient; None when the truth is not known."""
         tv = self.data.true_values
         if tv is None:
             return None
-        return {n: 100.0 * abs(self.final[n] - tv[n]) / abs(tv[n]) for n in DERIVATIVES}
+        return {n: 100.0 * abs(self.final[n] - tv[n]) / abs(tv[n]) for n in self.final}
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The estimates: one row per coefficient with ``initial``, ``estimate``, ``std`` and,
+        when the truth is known, ``true`` and ``error_pct``."""
+        std = self.result.std
+        err = self.errors_pct()
+        rows = []
+        for n, v in self.final.items():
+            row = {"coefficient": n, "initial": self.initial[n], "estimate": v, "std": std[n]}
+            if err is not None:
+                row.update(true=self.data.true_values[n], error_pct=err[n])
+            rows.append(row)
+        return pd.DataFrame(rows).set_index("coefficient")
+
+    def history(self) -> pd.DataFrame:
+        """The filter's time history (:meth:`FilterResult.to_pandas`)."""
+        return self.result.to_pandas()
+
+    def plot(self, names=None, show: bool = False):
+        """Convergence of the coefficients over the record (true values dashed where known); a Figure."""
+        from .plots import convergence_figure
+
+        return convergence_figure([self], names=names, show=show)
 
 
 def initial_state(data: TrialData, cfg: dict) -> np.ndarray:
+    """Start state: u, v, r, n of the first measurement, then the coefficients at ``initial.scale``
+    x the reference values (or ``initial.values``)."""
     m = data.meas
     ini = cfg.get("initial", {})
     sc = float(ini.get("scale", 1.2))
     vals = ini.get("values") or {}
-    der = [float(vals[n]) if n in vals else sc * data.reference[n] for n in DERIVATIVES]
+    for k in vals:
+        if k not in data.names:
+            raise InputError("estimation config", f"initial.values.{k}",
+                             f"not an estimated coefficient of {data.ship.name}; estimated: {', '.join(data.names)}")
+    der = [float(vals[n]) if n in vals else sc * data.reference[n] for n in data.names]
     return np.r_[m.u[0], m.v[0], m.r[0], m.n[0], der]
 
 
@@ -372,25 +398,26 @@ def estimate(data: TrialData, cfg: dict) -> Estimate:
     """Run the augmented EKF on one trial (raises FilterDivergence naming the trial and time)."""
     z0 = initial_state(data, cfg)
     R = R_for(cfg, data.name)
-    P0 = P0_for(cfg)
+    P0 = P0_for(cfg, data.names, data.reference)
     q = float(cfg.get("Q", 0.0))
     dv = cfg.get("divergence", {})
     res = run_filter(data.packed, data.slots, data.meas.t, data.meas.z(), data.meas.delta, z0, P0, R,
                      trial=data.name, q=q, nis_window_s=float(dv.get("nis_window_s", 60.0)),
-                     nis_max=float(dv.get("nis_max", 20.0)))
-    return Estimate(data, res, dict(zip(DERIVATIVES, z0[NS:])), R)
+                     nis_max=float(dv.get("nis_max", 20.0)), names=data.names)
+    return Estimate(data, res, dict(zip(data.names, z0[NS:])), R)
 
 
-# --------------------------------------------------------------------------- reports
+# --------------------------------------------------------------------------- summaries
 
 
-def estimates_json(ests: list[Estimate]) -> dict:
-    """{derivative: {"estimate", "true", "error_pct"}} (true/error_pct when the truth is known).
+def estimates_json(ests) -> dict:
+    """{coefficient: {"estimate", "true", "error_pct"}} (true/error_pct when the truth is known).
 
-    Top-level keys are always the 12 derivative names. With several trials the values are
-    those of the first input, ``"trial"`` names it and ``"by_trial"`` holds every trial's.
+    Top-level keys are the estimated coefficients of the first estimate.  With several trials
+    the values are those of the first input, ``"trial"`` names it and ``"by_trial"`` holds
+    every trial's.
     """
-    def one(e: Estimate, n: str) -> dict:
+    def one(e, n: str) -> dict:
         err = e.errors_pct()
         d = {"estimate": e.final[n]}
         if err is not None:
@@ -398,7 +425,7 @@ def estimates_json(ests: list[Estimate]) -> dict:
             d["error_pct"] = err[n]
         return d
     out = {}
-    for n in DERIVATIVES:
+    for n in ests[0].final:
         d = one(ests[0], n)
         if len(ests) > 1:
             d["trial"] = ests[0].name
@@ -407,90 +434,25 @@ def estimates_json(ests: list[Estimate]) -> dict:
     return out
 
 
-def error_table(ests: list[Estimate]) -> pd.DataFrame:
-    """Table 10 layout: per derivative the real value, and per trial final value and % error."""
+def error_table(ests) -> pd.DataFrame:
+    """Table 10 layout: per coefficient the true value (where known), and per trial the final value and % error.
+
+    The true values are those of the estimates' own data (the log's own ship), never a default
+    ship's; the ``real`` column is left out when no estimate knows the truth.
+    """
     rows = []
-    for n in DERIVATIVES:
+    tv = next((e.data.true_values for e in ests if e.data.true_values), None)
+    for n in ests[0].final:
         row = {"coeff": n}
-        tv = next((e.data.true_values for e in ests if e.data.true_values), None)
-        row["real"] = tv[n] if tv else np.nan
+        if tv:
+            row["real"] = tv[n]
         for e in ests:
             row[f"{e.name} final"] = e.final[n]
             err = e.errors_pct()
-            row[f"{e.name} err(%)"] = err[n] if err else np.nan
+            if err is not None:
+                row[f"{e.name} err(%)"] = err[n]
         rows.append(row)
     return pd.DataFrame(rows)
-
-
-def to_markdown(df: pd.DataFrame) -> str:
-    cols = list(df.columns)
-    lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
-    for _, r in df.iterrows():
-        cells = []
-        for c in cols:
-            v = r[c]
-            if isinstance(v, str):
-                cells.append(v)
-            elif "err" in c:
-                cells.append("" if not np.isfinite(v) else f"{v:.2f}")
-            else:
-                cells.append("" if not np.isfinite(v) else f"{v:+.4e}")
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
-
-
-
-
-def write_reports(ests: list[Estimate], out, plots: bool = True) -> dict:
-    """estimates.json, error_table.csv/.md, final_estimates.csv, convergence_*.png, preprocessing_*.png,
-    free_run.json (:class:`FreeRun` of each trial; with ``true_derivatives`` when the truth is known).
-
-    ``out`` is a folder path or a staging object with ``.path(name)``.
-    """
-    def P(name):
-        if hasattr(out, "path"):
-            return out.path(name)
-        p = Path(out) / name
-        p.parent.mkdir(parents=True, exist_ok=True)
-        return p
-
-    with open(P("estimates.json"), "w") as fh:
-        json.dump(estimates_json(ests), fh, indent=2)
-    tab = error_table(ests)
-    tab.to_csv(P("error_table.csv"), index=False, float_format="%.6g")
-    P("error_table.md").write_text(to_markdown(tab))
-    fin = pd.DataFrame({e.name: e.final for e in ests})
-    fin.index.name = "derivative"
-    fin.to_csv(P("final_estimates.csv"), float_format="%.6g")
-    rms = {}
-    if plots:
-        # a joint (multi-trial) history spans all trials end to end: not on the per-trial time axis
-        from .plots import plot_comparison, plot_convergence
-
-        plot_convergence([e for e in ests if "+" not in e.data.source], P("convergence_Y_beta.png").parent)
-        for e in ests:
-            if e.data.truth is not None:
-                safe = e.name.replace(" ", "_").replace("/", "_")
-                rms[e.name] = plot_comparison(e.data.meas, e.data.truth, P(f"preprocessing_{safe}.png"))
-    else:
-        for e in ests:
-            if e.data.truth is not None:
-                rms[e.name] = compare_with_truth(e.data.meas, e.data.truth)
-    if rms:
-        with open(P("preprocessing_rms.json"), "w") as fh:
-            json.dump(rms, fh, indent=2)
-    runs = {}
-    for e in ests:
-        fr = e.free_run if isinstance(e, Estimate) else None
-        if fr is None:
-            continue
-        runs[e.name] = fr.to_dict()
-        if e.data.true_values:            # the check's floor: the same re-simulation with the truth
-            runs[e.name]["true_derivatives"] = free_run(e.data, e.data.true_values).to_dict()
-    if runs:
-        with open(P("free_run.json"), "w") as fh:
-            json.dump(runs, fh, indent=2)
-    return {"table": tab, "rms": rms, "free_run": runs}
 
 
 # --------------------------------------------------------------------------- joint multi-trial estimate
@@ -506,10 +468,14 @@ def joint_estimate(datas: list[TrialData], cfg: dict, name: str = "joint") -> Es
     over the concatenated records. Returns an Estimate whose history spans the trials
     end to end (time offset by each trial's length).
     """
-    P0 = P0_for(cfg)
+    first = datas[0]
+    for d in datas[1:]:
+        if tuple(d.names) != tuple(first.names):
+            raise InputError(d.source, "names", "a joint estimate needs the same estimated coefficients in every trial")
+    P0 = P0_for(cfg, first.names, first.reference)
     q = float(cfg.get("Q", 0.0))
     dv = cfg.get("divergence", {})
-    z = initial_state(datas[0], cfg)
+    z = initial_state(first, cfg)
     P = P0.copy()
     ts, zs, pds = [], [], []
     offset = 0.0
@@ -519,14 +485,14 @@ def joint_estimate(datas: list[TrialData], cfg: dict, name: str = "joint") -> Es
         P_start = P0.copy()
         P_start[NS:, NS:] = P[NS:, NS:]
         res = run_filter(d.packed, d.slots, m.t, m.z(), m.delta, z0, P_start, R_for(cfg, d.name), trial=d.name, q=q,
-                         nis_window_s=float(dv.get("nis_window_s", 60.0)), nis_max=float(dv.get("nis_max", 20.0)))
+                         nis_window_s=float(dv.get("nis_window_s", 60.0)), nis_max=float(dv.get("nis_max", 20.0)),
+                         names=d.names)
         z, P = res.z[-1], res.P
         ts.append(m.t + offset)
         zs.append(res.z)
         pds.append(res.pdiag)
         offset += m.t[-1] + (m.t[1] - m.t[0])
-    res = FilterResult(np.concatenate(ts), np.vstack(zs), np.vstack(pds), P)
-    first = datas[0]
-    data = TrialData(name, first.meas, first.ship, first.packed, first.slots, first.reference, None,
-                     first.true_values, "+".join(d.name for d in datas))
-    return Estimate(data, res, dict(zip(DERIVATIVES, initial_state(first, cfg)[NS:])), R_for(cfg, first.name))
+    res = FilterResult(np.concatenate(ts), np.vstack(zs), np.vstack(pds), P, tuple(first.names))
+    data = TrialData(name, first.meas, first.ship, first.packed, first.slots, first.reference, first.names,
+                     first.info, None, first.true_values, "+".join(d.name for d in datas), joint=True)
+    return Estimate(data, res, dict(zip(first.names, initial_state(first, cfg)[NS:])), R_for(cfg, first.name))

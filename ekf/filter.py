@@ -1,9 +1,9 @@
 """State-augmented extended Kalman filter (Rhee & Kim 1999 section 4) on filterpy.
 
-State (16): z = [u, v, r, n, c_1 .. c_12] with c the hull derivatives
-``Y_beta, Y_r, Y_bb, Y_rr, Y_bbr, Y_brr, N_beta, N_r, N_bb, N_rr, N_bbr, N_brr``
-(the names of :mod:`mmg.ship`); measurements u, v, r, n (H = [I_4 0]); input the
-rudder angle delta (recovered, see :mod:`ekf.preprocess`).
+State (4 + m): z = [u, v, r, n, c_1 .. c_m] with c the estimated hull coefficients, named
+from the ship's table (:func:`ekf.data.estimable_names`: for the Esso Osaka Rhee & Kim's 12
+``Y_beta, Y_r, Y_bb, Y_rr, Y_bbr, Y_brr, N_beta, N_r, N_bb, N_rr, N_bbr, N_brr``); measurements
+u, v, r, n (H = [I_4 0]); input the rudder angle delta (recovered, see :mod:`ekf.preprocess`).
 
 Time update
     z is propagated over the 0.1 s step with RK4 on :func:`mmg.model.rhs` (the
@@ -43,11 +43,8 @@ from mmg.model import N_, R_, U_, V_, PackedShip
 
 from .kernels import CSTEP, fpft, jacobian_step, make_workspace, symmetrise  # noqa: F401 (CSTEP re-exported)
 
-DERIVATIVES = ("Y_beta", "Y_r", "Y_bb", "Y_rr", "Y_bbr", "Y_brr",
-               "N_beta", "N_r", "N_bb", "N_rr", "N_bbr", "N_brr")
 STATES = ("u", "v", "r", "n")
 NS = 4
-NZ = NS + len(DERIVATIVES)
 SLOTS = np.array([U_, V_, R_, N_], dtype=np.int64)   # mmg state slot of each dynamic state
 PD_TOL = 1e-9
 
@@ -90,9 +87,9 @@ def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
 def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, idx, z_next, F):
     """Propagate z over one step (RK4 on mmg.model.rhs) and fill F = d z_next / d z (complex step).
 
-    z (16,) real; d0, d1 rudder angle [rad] at the start and end of the step; dt [s];
+    z (nz,) real; d0, d1 rudder angle [rad] at the start and end of the step; dt [s];
     hull_coef the packed ship's coefficients (the derivative slots ``idx`` are overwritten
-    by z[4:] in a complex copy); z_next (16,) and F (16, 16) are written.  Column j of F is
+    by z[4:] in a complex copy); z_next (nz,) and F (nz, nz) are written.  Column j of F is
     Im(step(z + i h e_j)) / h with h = 1e-30: exact to rounding, no truncation error.
     """
     ws = workspace(z.shape[0], hull_coef)
@@ -190,7 +187,7 @@ def _check(z, P):
 def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag):
     """The whole pass: predict (RK4 + complex-step F), P = F P F^T, Joseph update, checks.
 
-    meas (N, 4) u, v, r, n at times k*dt; delta (N,); zs (N, 16) and pdiag (N, 16) are filled
+    meas (N, 4) u, v, r, n at times k*dt; delta (N,); zs (N, nz) and pdiag (N, nz) are filled
     (row 0 the initial values); q: Q = q I (0 in the paper). Returns (status, step index, final P).
     """
     nz = z0.shape[0]
@@ -234,35 +231,38 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
 # --------------------------------------------------------------------------- Python side
 
 
-def derivative_slots(packed: PackedShip, names, ship) -> np.ndarray:
-    """Indices in ``hull_coef`` of the estimated derivatives (in the order of ``names``)."""
-    return np.array([ship.hull.index(n) for n in names], dtype=np.int64)
-
-
 class AugmentedEKF(ExtendedKalmanFilter):
     """filterpy's EKF with the MMG propagation: ``predict((delta0, delta1))``, then filterpy's ``update``.
 
+    This is the filter a user steps by hand (``x``, ``P``, ``F``, ``Q``, ``R`` explicit, as
+    filterpy has them); :func:`run_filter` is its compiled fast path over a whole record and
+    gives the same numbers (``tests/test_ekf.py``).
+
     Parameters
     ----------
-    packed : PackedShip (K_Q-calibrated, from :func:`mmg.simulation.prepare`)
-    slots : indices of the 12 derivatives in ``packed.hull_coef``
-    dt : filter step [s]
+    packed : PackedShip
+        K_Q-calibrated, from :func:`mmg.simulation.prepare`.
+    slots : array of int
+        Indices of the m estimated coefficients in ``packed.hull_coef`` (:func:`ekf.data.hull_slots`).
+    dt : float
+        Filter step [s].
     """
 
-    H = np.hstack([np.eye(NS), np.zeros((NS, NZ - NS))])
-
     def __init__(self, packed: PackedShip, slots, dt: float = 0.1):
-        super().__init__(dim_x=NZ, dim_z=NS)
-        self.packed = packed
         self.slots = np.asarray(slots, dtype=np.int64)
+        nz = NS + len(self.slots)
+        super().__init__(dim_x=nz, dim_z=NS)
+        self.nz = nz
+        self.H = np.hstack([np.eye(NS), np.zeros((NS, nz - NS))])
+        self.packed = packed
         self.dt = float(dt)
-        self.Q = np.zeros((NZ, NZ))
+        self.Q = np.zeros((nz, nz))
 
     def predict(self, u=(0.0, 0.0)):
         d0, d1 = u
         z = np.asarray(self.x, float).reshape(-1)
-        zn = np.empty(NZ)
-        F = np.empty((NZ, NZ))
+        zn = np.empty(self.nz)
+        F = np.empty((self.nz, self.nz))
         propagate_jacobian(z, float(d0), float(d1), self.dt, *self.packed.args(), self.slots, zn, F)
         self.F = F
         self.x = zn
@@ -279,26 +279,50 @@ class AugmentedEKF(ExtendedKalmanFilter):
 
 @dataclass
 class FilterResult:
-    """A filter pass: t (N,), z (N, 16) estimates, pdiag (N, 16) variances, P final covariance."""
+    """A filter pass.
+
+    Attributes
+    ----------
+    t : ndarray (N,)
+        Time [s].
+    z, pdiag : ndarray (N, 4 + m)
+        Estimates and their variances: u, v, r, n then the coefficients :attr:`names`.
+    P : ndarray (4 + m, 4 + m)
+        Final covariance.
+    names : tuple of str
+        The estimated coefficients.
+    """
 
     t: np.ndarray
     z: np.ndarray
     pdiag: np.ndarray
     P: np.ndarray
-    names: tuple = STATES + DERIVATIVES
+    names: tuple = ()
 
     @property
     def final(self) -> dict:
-        """Final derivative estimates by name."""
-        return {n: float(self.z[-1, NS + i]) for i, n in enumerate(DERIVATIVES)}
+        """Final coefficient estimates by name."""
+        return {n: float(self.z[-1, NS + i]) for i, n in enumerate(self.names)}
+
+    @property
+    def std(self) -> dict:
+        """Final standard deviations of the coefficients by name."""
+        return {n: float(np.sqrt(max(self.P[NS + i, NS + i], 0.0))) for i, n in enumerate(self.names)}
+
+    def to_pandas(self):
+        """The estimate history as a DataFrame indexed by time [s] (states, then coefficients)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.z, columns=list(STATES + tuple(self.names)), index=pd.Index(self.t, name="t"))
 
 
 def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str = "", q: float = 0.0,
-               nis_window_s: float = 60.0, nis_max: float = 20.0) -> FilterResult:
+               nis_window_s: float = 60.0, nis_max: float = 20.0, names=()) -> FilterResult:
     """Run the compiled EKF over a whole record; raises FilterDivergence on failure.
 
     t (N,) equally spaced [s]; meas (N, 4) u, v, r, n; delta (N,) rudder [rad];
-    z0 (16,), P0 (16, 16), R (4, 4); q: Q = q I per step (0 = the paper's Q = 0).
+    z0 (4 + m,), P0 (4 + m, 4 + m), R (4, 4); q: Q = q I per step (0 = the paper's Q = 0);
+    names: the m estimated coefficients (for the result's labels).
     Divergence is also declared when the normalised innovation squared y^T S^-1 y averaged over
     ``nis_window_s`` exceeds ``nis_max`` (its expectation is 4 for a consistent filter; 0 disables).
     """
@@ -306,11 +330,12 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     dt = float(t[1] - t[0])
     meas = np.ascontiguousarray(meas, dtype=float)
     N = len(t)
-    zs = np.full((N, NZ), np.nan)
-    pd_ = np.full((N, NZ), np.nan)
+    nz = len(z0)
+    zs = np.full((N, nz), np.nan)
+    pd_ = np.full((N, nz), np.nan)
     st, k, P = filter_kernel(np.asarray(z0, float), np.asarray(P0, float), meas, np.asarray(delta, float), dt,
                              np.asarray(R, float), float(q),
                              int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max), *packed.args(), np.asarray(slots, np.int64), zs, pd_)
     if st != OK:
         raise FilterDivergence(trial, t[k], _REASON[st])
-    return FilterResult(t, zs, pd_, P)
+    return FilterResult(t, zs, pd_, P, tuple(names))

@@ -6,10 +6,11 @@ and blind to the strong correlation of the interpolated samples); its Monte Carl
 up to 12 x the Cramer-Rao bound of :mod:`trials.fisher` (noise model "log").  This filter
 measures what the log actually holds, so its information matches the CRB's:
 
-State (20), ordered so that the measured states come first (H = [I_4 0], so the Joseph
+State (8 + m), ordered so that the measured states come first (H = [I_4 0], so the Joseph
 update of :func:`ekf.filter.joseph_update` is reused as is):
-    z = [x, y, psi, n, u, v, r, tau, Y_beta .. N_brr]
-    the 19 of issue 5 plus tau, the timing offset [s] of the current rudder movement (below).
+    z = [x, y, psi, n, u, v, r, tau, c_1 .. c_m]
+    with tau the timing offset [s] of the current rudder movement (below) and c the estimated
+    hull coefficients (``data.names``; the Esso Osaka's 12 Y_beta .. N_brr by default).
 Time update (every 0.1 s)
     RK4 on :func:`mmg.model.rhs` (the only physics; the derivatives written into the
     ``hull_coef`` slots of a complex copy), rudder angle a known input rebuilt from the trial
@@ -34,10 +35,9 @@ Rudder timing
     channel.  ``rudder="true"`` runs the filter on the truth file's rudder instead, to check
     it against the rudder-known bound.
 Measurement update (only at the log samples, every 5 s)
-    z = [x, y, psi, n]: x, y from lat/lon with the paper's metres per degree
-    (:func:`trials.logio.read_record`), psi the unwrapped logged heading, n = rpm / 60;
-    R = diag(a^2 / 3) with a the uniform noise half-widths of the log header
-    (:func:`ekf.output_error._noise_half_widths`).  Joseph form, P symmetrised.
+    z = [x, y, psi, n] of the raw record (positions in metres, unwrapped heading, rpm / 60);
+    R = diag(sigma^2) with sigma the log's noise std (``data.info.noise_std``: for a uniform
+    noise of half-width a, a / sqrt(3)).  Joseph form, P symmetrised.
 Start
     Derivatives at 120 % of the ship file's values (config ``initial``), P0 from Table 7
     (``configs/estimation/rhee_kim.yaml``); x, y, psi, n the first log sample with variance
@@ -46,29 +46,20 @@ Start
     same data, the derivatives starting at the first pass's estimates with 100 x its final
     covariance as prior (relinearisation; see :func:`run_log_filter`).
 
-Monte Carlo::
-
-    python -m ekf.log_filter OUT --seeds 20 [--jobs 2]
-
-writes ``OUT/runs.csv`` in the format of :mod:`ekf.montecarlo` (``mmg sensitivity
---crb-vs-mc OUT --out DIR`` compares it with the CRB).
+Monte Carlo: ``mmg log-filter OUT --seeds 20`` (:func:`trials.montecarlo.log_filter_monte_carlo`)
+writes ``OUT/runs.csv``; ``mmg sensitivity --crb-vs-mc OUT --out DIR`` compares it with the CRB.
 """
 from __future__ import annotations
 
-import argparse
-import sys
-import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numba import njit
 
 from mmg.errors import InputError
 from mmg.model import N_, PSI_, R_, U_, V_, X_, Y_
-from mmg.units import DEG
 
-from .filter import DERIVATIVES, NEG_SPEED, NONFINITE, NOT_PD, OK, FilterDivergence, is_pd, joseph_update
+from .filter import NEG_SPEED, NONFINITE, NOT_PD, OK, FilterDivergence, is_pd, joseph_update
 from .kernels import fpft, jacobian_step, make_workspace, symmetrise
 
 STATES = ("x", "y", "psi", "n", "u", "v", "r", "tau")
@@ -76,7 +67,6 @@ NS = 7                      # dynamic states (propagated by RK4)
 TAU = 7                     # rudder-timing offset of the current rudder movement [s]
 ND = 8                      # first derivative slot
 NM = 4                      # measured: x, y, psi, n (the first four states)
-NZ = ND + len(DERIVATIVES)  # 20
 # mmg state slot of each dynamic filter state
 SLOTS = np.array([X_, Y_, PSI_, N_, U_, V_, R_], dtype=np.int64)
 _IU = 4                     # index of u in z
@@ -91,21 +81,22 @@ _REASON = {NONFINITE: "a state or covariance became non-finite",
 
 @njit(cache=True)
 def propagate_log(z, d0, d1, g0, g1, dt, p, poly, hull_axis, hull_term, idx, ws):
-    """One RK4 step of z (20,) and its exact (complex-step) Jacobian: z_next = ws[8], F = ws[9].
+    """One RK4 step of z (nz,) and its exact (complex-step) Jacobian: z_next = ws[8], F = ws[9].
 
     The rudder [rad] over the step (dt [s]) is d + tau g (d0 -> d1, g0 -> g1 [rad/s]): the
     rebuilt rudder moved by -tau in time, g = -d(delta)/dt, so the timing offset tau [s] is
-    estimated like the rest.  ws from :func:`ekf.kernels.make_workspace` (NZ, NS, hull_coef).
+    estimated like the rest.  ws from :func:`ekf.kernels.make_workspace` (nz, NS, hull_coef).
     """
     jacobian_step(z, d0, d1, g0, g1, TAU, SLOTS, ND, dt, p, poly, hull_axis, hull_term, idx, ws)
 
 
 @njit(cache=True)
 def _check_log(z, P):
-    for i in range(NZ):
+    nz = z.shape[0]
+    for i in range(nz):
         if not np.isfinite(z[i]):
             return NONFINITE
-        for j in range(NZ):
+        for j in range(nz):
             if not np.isfinite(P[i, j]):
                 return NONFINITE
     if not (z[_IU] > 0.0):
@@ -123,11 +114,12 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
     meas (M, 4) x, y, psi, n at grid steps meas_k (M,) (increasing; a sample at step 0 is taken
     to be in z0, P0); g (N,) = -d(delta)/dt; at the steps reset_k (before each rudder movement)
     tau is marginalised out (its effect already lives in the other states) and restarted at 0
-    with variance var_tau; q (20,) diagonal of Q per step; zs, pdiag (N, 20) filled; nis (M,).
+    with variance var_tau; q (nz,) diagonal of Q per step; zs, pdiag (N, nz) filled; nis (M,).
     Returns (status, step index, final P).
     """
     N = delta.shape[0]
     M = meas_k.shape[0]
+    NZ = z0.shape[0]
     z = z0.copy()
     P = P0.copy()
     FP = np.empty((NZ, NZ))
@@ -175,33 +167,34 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
 
 @dataclass
 class LogFilterResult:
-    """A pass: t (N,) the 0.1 s grid, z (N, 20) estimates, pdiag (N, 20) variances, P final, nis (M,)."""
+    """A pass: t (N,) the 0.1 s grid, z (N, 8 + m) estimates, pdiag (N, 8 + m) variances, P final,
+    nis (M,) the normalised innovations at the log samples, names the m estimated coefficients."""
 
     t: np.ndarray
     z: np.ndarray
     pdiag: np.ndarray
     P: np.ndarray
     nis: np.ndarray
-    names: tuple = STATES + DERIVATIVES
+    names: tuple = ()
 
     @property
     def final(self) -> dict:
-        return {n: float(self.z[-1, ND + i]) for i, n in enumerate(DERIVATIVES)}
+        """Final coefficient estimates by name."""
+        return {n: float(self.z[-1, ND + i]) for i, n in enumerate(self.names)}
+
+    @property
+    def std(self) -> dict:
+        """Final standard deviations of the coefficients by name."""
+        return {n: float(np.sqrt(max(self.P[ND + i, ND + i], 0.0))) for i, n in enumerate(self.names)}
 
 
-def log_measurements(record):
-    """(t_log, obs (K, 4) x, y, psi, n, R (4, 4)) of a project log's TrialRecord."""
-    from trials.logio import M_PER_DEG_LAT, M_PER_DEG_LON
-
-    from .output_error import _noise_half_widths
-
-    meta = record.meta
-    hw = _noise_half_widths(meta)
-    mlat = float(meta.get("m_per_deg_lat", M_PER_DEG_LAT))
-    mlon = float(meta.get("m_per_deg_lon", M_PER_DEG_LON))
-    a = np.array([hw["lat_deg"] * mlat, hw["lon_deg"] * mlon, hw["heading_deg"] * DEG, hw["rpm"] / 60.0])
+def log_measurements(record, info):
+    """(t_log, obs (K, 4) x, y, psi, n, R (4, 4)) of a raw record (t, x, y, psi, n arrays) and its
+    :class:`ekf.data.RecordInfo` (noise std)."""
+    sd = info.noise_std
+    a = np.array([sd["x"], sd["y"], sd["psi"], sd["n"]], float)
     obs = np.column_stack([record.x, record.y, record.psi, record.n]).astype(float)
-    return np.asarray(record.t, float), obs, np.diag(a * a / 3.0)
+    return np.asarray(record.t, float), obs, np.diag(a * a)
 
 
 def run_log_filter(data, record, cfg: dict, q=None, duration: float | None = None,
@@ -244,7 +237,7 @@ def _true_rudder(data, t: np.ndarray) -> np.ndarray:
 
 def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=None, P_der=None,
               rudder: str = "rebuilt") -> LogFilterResult:
-    from trials.rudder import manoeuvre_from_meta, movement_starts, reconstruct_rudder
+    from mmg.rudder import movement_starts, reconstruct_rudder
 
     from .estimate import P0_for, initial_state
 
@@ -260,18 +253,18 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
     delta = np.ascontiguousarray(delta)
     g = -np.gradient(delta, dt)
     # rudder movements start where the rebuilt order changes (and at the start)
-    meta = m.meta
-    kind, man = manoeuvre_from_meta(meta, data.source)
-    order, _ = reconstruct_rudder(t, np.asarray(m.psi, float)[:N], kind, man, data.packed.p,
-                                  float(meta.get("trim_rudder_deg", 0.0)) * DEG)
+    info = data.info
+    order, _ = reconstruct_rudder(t, np.asarray(m.psi, float)[:N], info.kind, info.manoeuvre, data.packed.p,
+                                  info.trim_rudder)
     reset_k = np.ascontiguousarray(movement_starts(order, dt))
-    t_log, obs, R = log_measurements(record)
+    t_log, obs, R = log_measurements(record, info)
     mk = np.rint((t_log - t[0]) / dt).astype(np.int64)
     sel = (mk >= 0) & (mk < N)
     mk, obs = np.ascontiguousarray(mk[sel]), np.ascontiguousarray(obs[sel])
-    zp = initial_state(data, cfg)                     # u, v, r, n, derivatives (16, paper layout)
+    zp = initial_state(data, cfg)                     # u, v, r, n, coefficients (paper-filter layout)
     der = zp[4:] if start_derivs is None else np.asarray(start_derivs, float)
-    P0p = P0_for(cfg)
+    P0p = P0_for(cfg, data.names)
+    NZ = ND + len(data.names)
     z0 = np.r_[obs[0], zp[0:3], 0.0, der]
     P0 = np.zeros((NZ, NZ))
     P0[:NM, :NM] = R
@@ -280,7 +273,7 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
     P0[ND:, ND:] = P0p[4:, 4:] if P_der is None else P_der
     qv = np.zeros(NZ)
     for k, v in (q or {}).items():
-        qv[(STATES + DERIVATIVES).index(k)] = float(v)
+        qv[(STATES + tuple(data.names)).index(k)] = float(v)
     zs = np.full((N, NZ), np.nan)
     pd_ = np.full((N, NZ), np.nan)
     nis = np.full(len(mk), np.nan)
@@ -288,115 +281,4 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
                                  *data.packed.args(), np.asarray(data.slots, np.int64), zs, pd_, nis)
     if st != OK:
         raise FilterDivergence(data.name, t[k], _REASON[st])
-    return LogFilterResult(t, zs, pd_, P, nis)
-
-
-# --------------------------------------------------------------------------- Monte Carlo
-
-
-def _timing_error(data) -> dict:
-    """How far the rebuilt rudder's reversals are from the truth file's (rms, max [s], count)."""
-    from trials.rudder import reversal_timing_errors
-
-    if data.truth is None or getattr(data.truth, "delta", None) is None:
-        return {}
-    e = reversal_timing_errors(data.meas.t, data.meas.delta, data.truth.t, data.truth.delta)
-    if len(e) == 0:
-        return {"rudder_timing_n": 0, "rudder_timing_rms_s": np.nan, "rudder_timing_max_s": np.nan}
-    return {"rudder_timing_n": len(e), "rudder_timing_rms_s": float(np.sqrt(np.mean(e ** 2))),
-            "rudder_timing_max_s": float(np.abs(e).max())}
-
-
-def _one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15, rudder: str = "rebuilt") -> dict:
-    from trials.logio import read_record
-
-    from .estimate import data_from_trial
-
-    with tempfile.TemporaryDirectory(prefix="ekf-log-mc-") as td:
-        data = data_from_trial(trial_file, cfg, seed=seed, workdir=td)
-        rec = data.record if data.record is not None else read_record(data.source)
-        try:
-            res = run_log_filter(data, rec, cfg, q=q, sigma_tau=sigma_tau, rudder=rudder)
-        except FilterDivergence as exc:
-            return {"trial": data.name, "seed": seed, "diverged": str(exc), "rudder": rudder, "sigma_tau_s": sigma_tau}
-    tv = data.true_values
-    fin = res.final
-    return {"trial": data.name, "seed": seed, "diverged": "", "rudder": rudder, "sigma_tau_s": sigma_tau,
-            **_timing_error(data),
-            **{n: 100.0 * abs(fin[n] - tv[n]) / abs(tv[n]) for n in DERIVATIVES},
-            **{f"final_{n}": v for n, v in fin.items()},
-            "mean_nis": float(np.nanmean(res.nis))}
-
-
-def _task(task) -> dict:
-    return _one(*task)
-
-
-def monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int = 2, first_seed: int = 1000,
-                config=None, q=None, sigma_tau: float = 0.15, verbose: bool = True, backend: str = "loky",
-                rudder: str = "rebuilt"):
-    """``n_seeds`` seeds per trial; writes OUT/runs.csv (one row per trial and seed, with the
-    ``trial_file`` it came from); returns it.
-
-    trials: names of the paper's trials (ST35, ZZ10, ZZ20, S-type 120: the default) or paths
-    of turning / zigzag / S-type trial YAMLs; rudder: "rebuilt" (default) or "true"
-    (:func:`run_log_filter`).
-    """
-    import pandas as pd
-    from trials.sweep import run_sweep
-
-    from .estimate import REPO, load_config
-    from .reproduce import TRIALS
-
-    from trials.rudder import REBUILT_KINDS
-    from trials.trial import load_trial
-
-    cfg = load_config(config)
-    files = [str(REPO / "configs" / "trials" / TRIALS[t]) if t in TRIALS else str(Path(t).resolve())
-             for t in (trials or TRIALS)]
-    for f in files:                       # all inputs checked before any run or output
-        if not Path(f).is_file():
-            raise InputError(f, "trials", f"neither one of {', '.join(TRIALS)} nor a trial YAML")
-        if (kind := load_trial(f).kind) not in REBUILT_KINDS:
-            raise InputError(f, "manoeuvre.kind", f"the raw-log EKF rebuilds the rudder of turning, zigzag and "
-                                                  f"S-type trials only, not {kind}")
-    jobs = [(f, first_seed + s, cfg, q, sigma_tau, rudder) for f in files for s in range(n_seeds)]
-    rows = run_sweep(_task, jobs, backend=backend, n_jobs=n_jobs, progress=verbose,
-                     labels=[f"{Path(j[0]).stem} seed {j[1]}" for j in jobs])
-    runs = pd.DataFrame(rows)
-    runs.insert(2, "trial_file", [j[0] for j in jobs])
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    runs.to_csv(out / "runs.csv", index=False, float_format="%.8g")
-    return runs
-
-
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m ekf.log_filter", description="Monte Carlo of the raw-log EKF")
-    ap.add_argument("out")
-    ap.add_argument("--seeds", type=int, default=20)
-    ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--trials", nargs="*", default=None,
-                    help="trial names (default ST35 ZZ10 ZZ20 'S-type 120') or turning/zigzag/S-type trial YAMLs")
-    ap.add_argument("--sigma-tau", type=float, default=None,
-                    help="prior std [s] of each rudder movement's timing (default 0.15, or 1e-4 with --true-rudder)")
-    ap.add_argument("--first-seed", type=int, default=1000, help="noise seed of the first run of each trial")
-    ap.add_argument("--true-rudder", action="store_true",
-                    help="give the filter the truth file's rudder instead of the rebuilt one (a check against the "
-                         "CRB with the rudder known)")
-    args = ap.parse_args(argv)
-    if args.sigma_tau is None:
-        args.sigma_tau = 1e-4 if args.true_rudder else 0.15
-    if not args.sigma_tau > 0:
-        ap.error(f"--sigma-tau must be > 0, got {args.sigma_tau}")
-    try:
-        monte_carlo(args.out, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=args.sigma_tau,
-                    first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt")
-    except InputError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    return LogFilterResult(t, zs, pd_, P, nis, tuple(data.names))

@@ -27,10 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mmg.errors import InputError
-from mmg.units import DEG
 
-from trials.logio import M_PER_DEG_LAT, M_PER_DEG_LON  # noqa: F401
-from trials.rudder import manoeuvre_from_meta, reconstruct_rudder  # noqa: F401
+from mmg.rudder import reconstruct_rudder
 
 CHANNELS = ("u", "v", "r", "delta", "n")
 UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "delta": "rad", "n": "rps"}
@@ -93,7 +91,7 @@ def quadratic3(ts: np.ndarray, ys: np.ndarray, tq: np.ndarray):
 
 def recover(record, p: np.ndarray, dt: float = 0.1, kind: str | None = None, manoeuvre: dict | None = None,
             delta0: float | None = None) -> Measurements:
-    """Rhee & Kim section 4.2 on a :class:`trials.records.TrialRecord` read from a project log.
+    """Rhee & Kim section 4.2 on a record (a :class:`trials.records.TrialRecord` or anything with its arrays).
 
     Parameters
     ----------
@@ -104,9 +102,10 @@ def recover(record, p: np.ndarray, dt: float = 0.1, kind: str | None = None, man
     dt : float
         Output step [s] (the filter step, 0.1 s).
     kind, manoeuvre : optional
-        Trial logic for the rudder; default from the log header.
+        Trial logic for the rudder (:class:`ekf.data.RecordInfo`); needed when the record has
+        no rudder channel.
     delta0 : float, optional
-        Rudder at the start [rad]; default the header's trim rudder (0 if absent).
+        Rudder at the start [rad] (the approach's trim rudder; 0 when None).
     """
     src = record.source or "log"
     for ch in ("x", "y", "psi", "n"):
@@ -129,10 +128,10 @@ def recover(record, p: np.ndarray, dt: float = 0.1, kind: str | None = None, man
         delta, _ = quadratic3(ts, record.delta, tq)
         dsrc = "log rudder channel"
     else:
-        if kind is None or manoeuvre is None:
-            kind, manoeuvre = manoeuvre_from_meta(meta, src)
-        if delta0 is None:
-            delta0 = float(meta.get("trim_rudder_deg", 0.0)) * DEG
+        if not kind or manoeuvre is None:
+            raise InputError(src, "kind", "the record has no rudder channel and no trial logic (turning, zigzag, "
+                                          "S-type) to rebuild it from")
+        delta0 = 0.0 if delta0 is None else float(delta0)
         _, delta = reconstruct_rudder(tq, psi, kind, manoeuvre, p, delta0)
         dsrc = f"rebuilt from the {kind} logic and the recovered heading"
     return Measurements(tq, u, v, r, delta, n, psi, x, y, record.name, src, dsrc, meta)

@@ -7,7 +7,8 @@ Two kinds of command law run inside the compiled loop, so closed-loop trials
   interpolation in a table (turning, sine, sawtooth, any table).
 * ``HEADING_SWITCH``: the rudder order is +/- delta_a; it reverses to port when
   the heading change reaches psi_hi and to starboard when it falls to psi_lo
-  (zigzag: psi_hi = -psi_lo = psi_a; S-type: psi_hi = psi_S, psi_lo = 0).
+  (zigzag: psi_hi = -psi_lo = psi_a; S-type: psi_hi = psi_S, psi_lo = 0); the law is
+  :func:`mmg.rudder.switch_side`, the same one that rebuilds the rudder of a log.
 
 The command is held over a step (zero-order hold); the steering gear and shaft
 dynamics are part of the integrated state.  Deterministic: same inputs, same
@@ -21,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from .model import N_, P_ENGINE, PSI_, U_, ENGINE_CONSTANT_RPM, PackedShip, rhs
+from .rudder import switch_side
 
 SCHEDULE, HEADING_SWITCH = 0, 1
 
@@ -103,11 +105,7 @@ def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
             if t < cpar[HS_TSTART]:
                 dcmd = cpar[HS_TRIM]
             else:
-                dpsi = x[PSI_] - cpar[HS_PSI0]
-                if side > 0.0 and dpsi >= cpar[HS_HI]:
-                    side = -1.0
-                elif side < 0.0 and dpsi <= cpar[HS_LO]:
-                    side = 1.0
+                side = switch_side(side, x[PSI_] - cpar[HS_PSI0], cpar[HS_HI], cpar[HS_LO])
                 dcmd = side * cpar[HS_AMP]
         for j in range(nx):
             states[i, j] = x[j]

@@ -107,3 +107,19 @@ def term_id(key: str) -> int:
 def evaluate_terms(term_ids, beta, vp, rp) -> np.ndarray:
     """Values of several terms at one point, as an array (Python convenience)."""
     return np.array([term_value(int(t), beta, vp, rp) for t in term_ids])
+
+
+_LATEX = {"Y_beta": r"$Y'_\beta$", "Y_r": r"$Y'_r$", "Y_bb": r"$Y'_{\beta|\beta|}$", "Y_rr": r"$Y'_{r|r|}$",
+          "Y_bbr": r"$Y'_{\beta\beta r}$", "Y_brr": r"$Y'_{\beta rr}$", "N_beta": r"$N'_\beta$", "N_r": r"$N'_r$",
+          "N_bb": r"$N'_{\beta|\beta|}$", "N_rr": r"$N'_{r|r|}$", "N_bbr": r"$N'_{\beta\beta r}$",
+          "N_brr": r"$N'_{\beta rr}$"}
+
+
+def latex_label(name: str) -> str:
+    """Matplotlib label of a hull coefficient: ``"Y_bb"`` -> ``$Y'_{\beta|\beta|}$`` (Kijima names),
+    ``"N_vvr"`` -> ``$N'_{vvr}$`` (any other ``AXIS_sub`` name)."""
+    if name in _LATEX:
+        return _LATEX[name]
+    axis, _, sub = name.partition("_")
+    sub = sub.replace("beta", "\\beta ").strip()
+    return f"${axis}'_{{{sub}}}$" if sub else f"${axis}'$"

@@ -16,6 +16,12 @@ KNOT = 1852.0 / 3600.0
 DEG = math.pi / 180.0
 """One degree in rad."""
 
+M_PER_DEG_LAT = 1852.0 * 60.0
+"""Metres per degree of latitude used by Rhee & Kim's logs (one nautical mile per minute)."""
+
+M_PER_DEG_LON = 1526.16 * 60.0
+"""Metres per degree of longitude used by Rhee & Kim's logs (about 34.5 deg N)."""
+
 UNITS: dict[str, dict[str, float]] = {
     "length": {"m": 1.0, "km": 1000.0, "nmi": 1852.0},
     "area": {"m^2": 1.0, "m2": 1.0},

@@ -8,14 +8,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ekf.filter import (DERIVATIVES, NZ, AugmentedEKF, FilterDivergence, derivative_slots, is_pd,
-                        propagate_jacobian, run_filter)
+from ekf.data import PAPER_DERIVATIVES as DERIVATIVES, estimable_names, hull_slots
+from ekf.filter import AugmentedEKF, FilterDivergence, is_pd, propagate_jacobian, run_filter
 from mmg.simulation import prepare
 from trials.cli import main
 from trials.trial import load_trial
 
 REPO = Path(__file__).resolve().parents[1]
 ZZ20 = REPO / "configs" / "trials" / "zz20.yaml"
+NZ = 4 + len(DERIVATIVES)
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +37,7 @@ def short_zz(tmp_path_factory):
 def packed():
     tr = load_trial(ZZ20)
     pk, eq = prepare(tr.ship, tr.u0)
-    return tr, pk, derivative_slots(pk, DERIVATIVES, tr.ship)
+    return tr, pk, hull_slots(tr.ship, DERIVATIVES)
 
 
 def test_jacobian_matches_finite_differences(packed):
@@ -99,7 +100,11 @@ def test_preprocessing_recovers_uvr(short_zz, packed):
 
     tr, d = short_zz
     _, pk, _ = packed
-    m = recover(read_record(d / "log.csv"), pk.p)
+    from trials.estimation import record_info
+
+    rec = read_record(d / "log.csv")
+    info = record_info(rec)
+    m = recover(rec, pk.p, kind=info.kind, manoeuvre=info.manoeuvre, delta0=info.trim_rudder)
     rms = compare_with_truth(m, read_record(d / "truth.csv"))
     # stated accuracy (Table 4 noise levels): 0.02 m/s, 0.01 m/s, 1e-4 rad/s, 0.2 deg, 0.005 rps
     assert rms["u"] < 0.02 and rms["v"] < 0.01 and rms["r"] < 1e-4
@@ -200,7 +205,8 @@ def test_free_run_catches_a_filter_that_converged_to_the_wrong_model(short_zz, t
 
 
 def test_free_run_with_the_true_derivatives_reproduces_the_log(short_zz):
-    from ekf.estimate import data_from_log, free_run, load_config
+    from ekf.estimate import free_run, load_config
+    from trials.estimation import data_from_log
 
     _, d = short_zz
     data = data_from_log(d / "log.csv", load_config(), truth_path=d / "truth.csv")
@@ -210,14 +216,15 @@ def test_free_run_with_the_true_derivatives_reproduces_the_log(short_zz):
     wrong = {**data.true_values, "N_r": 2.0 * data.true_values["N_r"]}
     assert not free_run(data, wrong).ok
     # a joint record (no log of its own) is not re-simulated
-    assert free_run(replace(data, record=None, source="ZZ20+ZZ10"), data.true_values) is None
+    assert free_run(replace(data, joint=True, source="ZZ20+ZZ10"), data.true_values) is None
 
 
 def test_free_run_judges_heading_not_a_current_drifted_track(tmp_path):
     """An unmodelled current moves the track, not the heading: the true derivatives still pass."""
-    from ekf.estimate import data_from_log, free_run, load_config
+    from ekf.estimate import free_run, load_config
     from mmg.disturbances import UniformCurrent
     from trials.logio import write_csv
+    from trials.estimation import data_from_log
     from trials.run import run_trial
 
     tr = replace(load_trial(ZZ20), duration=600.0)

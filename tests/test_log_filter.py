@@ -2,11 +2,17 @@
 import numpy as np
 import pytest
 
-from ekf.estimate import REPO, data_from_trial, load_config
-from ekf.filter import DERIVATIVES, is_pd
-from ekf.log_filter import ND, NZ, log_measurements, run_log_filter
-from trials.logio import read_record
-from trials.rudder import reversal_timing_errors
+from pathlib import Path
+
+from ekf.data import PAPER_DERIVATIVES as DERIVATIVES
+from ekf.estimate import load_config
+from ekf.filter import is_pd
+from ekf.log_filter import ND, log_measurements, run_log_filter
+from mmg.rudder import reversal_timing_errors
+from trials.estimation import data_from_trial
+
+REPO = Path(__file__).resolve().parents[1]
+NZ = ND + len(DERIVATIVES)
 
 LINEAR = ("Y_beta", "Y_r", "N_beta", "N_r")
 
@@ -14,15 +20,14 @@ LINEAR = ("Y_beta", "Y_r", "N_beta", "N_r")
 @pytest.fixture(scope="module")
 def zz20_600(tmp_path_factory):
     cfg = load_config()
-    data = data_from_trial(REPO / "configs" / "trials" / "zz20.yaml", cfg, seed=1000,
-                           workdir=tmp_path_factory.mktemp("zz20"))
-    rec = read_record(data.source)
+    data = data_from_trial(REPO / "configs" / "trials" / "zz20.yaml", cfg, seed=1000)
+    rec = data.record
     return cfg, data, rec, run_log_filter(data, rec, cfg, duration=600.0, passes=1)
 
 
 def test_measurement_noise_from_header(zz20_600):
-    _, _, rec, _ = zz20_600
-    t, obs, R = log_measurements(rec)
+    _, data, rec, _ = zz20_600
+    t, obs, R = log_measurements(rec, data.info)
     assert obs.shape == (len(t), 4)
     # lat 8e-7 deg x 1852*60 m/deg, heading 0.012 deg, rpm 0.2: variance a^2 / 3
     np.testing.assert_allclose(np.sqrt(np.diag(R) * 3.0),
@@ -97,11 +102,11 @@ def test_reversal_timing_errors_pair_each_true_reversal_with_the_nearest_rebuilt
 
 
 def test_monte_carlo_cli_refuses_bad_trials_before_writing(tmp_path, capsys):
-    from ekf.log_filter import main
+    from trials.cli import main
 
     out = tmp_path / "mc"
-    assert main([str(out), "--seeds", "1", "--trials", str(tmp_path / "nope.yaml")]) == 2
-    assert main([str(out), "--seeds", "1", "--trials", str(REPO / "configs" / "trials" / "sine.yaml")]) == 2
+    assert main(["log-filter", str(out), "--seeds", "1", "--trials", str(tmp_path / "nope.yaml")]) == 2
+    assert main(["log-filter", str(out), "--seeds", "1", "--trials", str(REPO / "configs" / "trials" / "sine.yaml")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "nope.yaml" in err[0] and "manoeuvre.kind" in err[1]
     assert not out.exists()

@@ -7,9 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ekf.estimate import data_from_log, load_config
-from ekf.filter import DERIVATIVES
 from ekf import output_error as oe
+from ekf.data import PAPER_DERIVATIVES as DERIVATIVES
+from ekf.estimate import load_config
+from ekf.output_error.fit import _Problem
+from mmg.model import PSI_, V_, X_, Y_
+from trials.estimation import data_from_log, noise_half_widths
 from trials.logio import write_csv
 from trials.run import run_trial
 from trials.trial import load_trial
@@ -35,9 +38,12 @@ def st35_short(tmp_path_factory):
 
 
 def test_noise_half_widths_from_header():
-    hw = oe._noise_half_widths({"noise": "uniform: lat 8e-07 deg, lon 4e-07 deg, heading 0.012 deg, speed 0 kn, rpm 0.2 rpm"})
+    hw = noise_half_widths({"noise": "uniform: lat 8e-07 deg, lon 4e-07 deg, heading 0.012 deg, speed 0 kn, rpm 0.2 rpm"})
     assert hw == {"lat_deg": 8e-7, "lon_deg": 4e-7, "heading_deg": 0.012, "rpm": 0.2}
-    assert oe._noise_half_widths({"noise": "uniform: lat 0 deg"})["lat_deg"] == oe.DEFAULT_HALF_WIDTH["lat_deg"]
+    # the numeric header keys win over the text line; a zero level keeps Table 4's weight
+    hw = noise_half_widths({"noise_lat_deg": 2e-6, "noise_rpm": 0.0, "noise": "uniform: lat 8e-07 deg"})
+    assert hw["lat_deg"] == 2e-6 and hw["rpm"] == 0.2
+    assert noise_half_widths({"noise": "uniform: lat 0 deg"})["lat_deg"] == 8e-7
 
 
 def test_residuals_vanish_at_truth_on_noise_free_log(st35_short):
@@ -52,7 +58,7 @@ def test_residuals_vanish_at_truth_on_noise_free_log(st35_short):
 def test_recovers_truth_from_120_percent_start(st35_short):
     tr = oe.trial_from_data(st35_short)
     tv = np.array([st35_short.true_values[n] for n in DERIVATIVES])
-    res = oe.fit([tr], 1.2 * tv, max_nfev=80)
+    res = oe.fit([tr], 1.2 * tv, DERIVATIVES, max_nfev=80)
     rel = np.abs(res.theta / tv - 1)
     well = [i for i, n in enumerate(DERIVATIVES) if n != "N_bb"]
     # 1e-3 for the well-excited ones; Y_rr, Y_bbr, Y_brr stop within 1 % on this short 600 s turn
@@ -78,9 +84,9 @@ def test_standard_errors_positive_and_shrink_with_more_data(st35_short):
 def test_joint_information_of_the_paper_trials(tmp_path):
     """Cramér-Rao standard errors of the joint four-trial fit at the paper's noise: all but N_bb well below 5 %."""
     cfg = load_config()
-    from ekf.estimate import data_from_trial
-    from ekf.reproduce import TRIALS
-    datas = [data_from_trial(REPO / "configs" / "trials" / f, cfg, workdir=tmp_path / f) for f in TRIALS.values()]
+    from trials.estimation import data_from_trial
+    from trials.rhee_kim import TRIALS
+    datas = [data_from_trial(REPO / "configs" / "trials" / f, cfg) for f in TRIALS.values()]
     tv = np.array([datas[0].true_values[n] for n in DERIVATIVES])
     _, se = oe.information([oe.trial_from_data(d) for d in datas], tv)
     pct = 100 * se / np.abs(tv)
@@ -103,7 +109,7 @@ def _law_switch_times(data, tv):
     from mmg.integrate import integrate
     law = oe.trial_from_data(data, rudder="law")
     x0 = law.x0.copy()
-    x0[oe.V_] = -0.000830334
+    x0[V_] = -0.000830334
     _, S, orders, _ = integrate(law._pk(tv), x0, law.law, law.duration, law.dt)
     return law, x0, S, (oe.switches(orders) - 0.5) * law.dt
 
@@ -114,7 +120,7 @@ def test_ramp_rudder_reproduces_the_switch_law_exactly(zz20_short):
     tr = oe.trial_from_data(zz20_short)  # rudder="ramp"
     assert tr.tsw is not None and len(tr.tsw) == len(tsw) == 2
     assert np.all(np.abs(tr.tsw - tsw) <= 2 * tr.dt + 1e-9)  # start values from the recovered heading
-    nu = np.r_[x0[oe.V_], x0[oe.PSI_], x0[oe.X_], x0[oe.Y_], tsw]
+    nu = np.r_[x0[V_], x0[PSI_], x0[X_], x0[Y_], tsw]
     assert np.abs(tr.states(tv, nu) - S).max() < 1e-9
 
 
@@ -122,7 +128,7 @@ def test_cost_is_continuous_in_a_reversal_time(zz20_short):
     tv = np.array([zz20_short.true_values[n] for n in DERIVATIVES])
     _, x0, _, tsw = _law_switch_times(zz20_short, tv)
     tr = oe.trial_from_data(zz20_short)
-    nu = np.r_[x0[oe.V_], x0[oe.PSI_], x0[oe.X_], x0[oe.Y_], tsw]
+    nu = np.r_[x0[V_], x0[PSI_], x0[X_], x0[Y_], tsw]
     s = np.linspace(-1.0, 1.0, 17)  # crosses two step boundaries
     cost = []
     for d in s:
@@ -140,7 +146,7 @@ def test_cost_is_continuous_in_a_reversal_time(zz20_short):
 def test_switch_time_jacobian_columns_match_full_differences(zz20_short):
     tv = np.array([zz20_short.true_values[n] for n in DERIVATIVES])
     tr = oe.trial_from_data(zz20_short)
-    prob = oe._Problem([tr], tv, np.abs(tv))
+    prob = _Problem([tr], tv, np.abs(tv))
     prob.free_theta = False
     q = prob.q0.copy()
     q[prob.nd + oe.NNUIS:] += 0.3  # 0.03 s, inside a ramp cell

@@ -79,7 +79,7 @@ def test_turning_metrics_on_a_circle():
 
 @needs_frt()
 def test_real_turn_metrics_match_fact_sheet():
-    from trials.cli import record_metrics
+    from trials.metrics import record_metrics
     from trials.logio import read_record
 
     m = record_metrics(read_record(FRT / "turning" / "turn_14-Sep-2020_13_39_32.csv"), kind="turning")
@@ -100,7 +100,7 @@ def test_reproduce_main_job(tmp_path):
 
 @needs_frt()
 def test_real_zigzag_ignores_small_approach_rudder_motions():
-    from trials.cli import record_metrics
+    from trials.metrics import record_metrics
     from trials.logio import read_record
 
     rec = read_record(FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv")

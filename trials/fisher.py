@@ -61,15 +61,18 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ekf.filter import NS, NZ, propagate_step, workspace
+from ekf.filter import NS, propagate_step, workspace
 from ekf.kernels import CSTEP, make_workspace, rk4_step
-from ekf.log_filter import ND as LOG_ND, NS as LOG_NS, NZ as LOG_NZ, SLOTS as LOG_SLOTS
+from ekf.log_filter import ND as LOG_ND, NS as LOG_NS, SLOTS as LOG_SLOTS
 from mmg.integrate import integrate
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_
 from mmg.simulation import prepare
 
-from .rudder import REBUILT_KINDS, movements
+from mmg.rudder import REBUILT_KINDS, movements
 from .sensitivity import DERIVATIVES, LINEAR, NONLINEAR
+
+NZ = NS + len(DERIVATIVES)              # the paper filter's state: u, v, r, n and the 12 derivatives
+LOG_NZ = LOG_ND + len(DERIVATIVES)      # the raw-log filter's
 
 NOISE_MODELS = ("log", "filter", "thinned")
 OUTPUTS = ("u", "v", "r", "n")

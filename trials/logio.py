@@ -27,12 +27,9 @@ import numpy as np
 import pandas as pd
 
 from mmg.errors import InputError
-from mmg.units import DEG, KNOT
+from mmg.units import DEG, KNOT, M_PER_DEG_LAT, M_PER_DEG_LON
 
 from .records import TrialRecord
-
-M_PER_DEG_LAT = 1852.0 * 60.0
-M_PER_DEG_LON = 1526.16 * 60.0
 
 LOG_COLUMNS = ("time_s", "lat_deg", "lon_deg", "heading_deg", "speed_kn", "rpm")
 TRUTH_COLUMNS = ("time_s", "u_mps", "v_mps", "r_radps", "delta_rad", "delta_order_rad",
@@ -81,11 +78,25 @@ def log_frame(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None
                          "speed_kn": spd, "rpm": rpm})
 
 
+FLOAT_FORMAT = "%.12g"
+"""How the log and truth files print numbers (12 significant digits)."""
+
+
 def write_csv(path: Path, df: pd.DataFrame, meta: dict) -> None:
     """Write a DataFrame with a ``# key: value`` metadata header."""
     with open(path, "w") as fh:
         fh.write(_header(meta))
-        df.to_csv(fh, index=False, float_format="%.12g")
+        df.to_csv(fh, index=False, float_format=FLOAT_FORMAT)
+
+
+def as_written(df: pd.DataFrame) -> pd.DataFrame:
+    """The table with every number as :func:`write_csv` prints it, so that a record built from a
+    simulated log in memory equals the same log read back from its file."""
+    out = df.copy()
+    for c in out.columns:
+        if out[c].dtype.kind == "f":
+            out[c] = [float(FLOAT_FORMAT % v) for v in out[c].to_numpy()]
+    return out
 
 
 def truth_frame(t, states, orders) -> pd.DataFrame:
@@ -163,11 +174,22 @@ def read_record(path: str | Path) -> TrialRecord:
         df = pd.read_csv(io.StringIO(body))
     except (pd.errors.ParserError, pd.errors.EmptyDataError) as e:
         raise InputError(src, "", f"not a readable CSV ({str(e).splitlines()[0]})") from None
+    return record_from_frame(df, meta, src, default_name=path.stem)
+
+
+def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", default_name: str = "") -> TrialRecord:
+    """A TrialRecord from a table in one of the supported column layouts and its header ``meta``.
+
+    The one conversion behind :func:`read_record`; the estimators' in-memory path
+    (:func:`trials.estimation.data_from_trial`) uses it on a simulated log and truth table
+    directly, so a simulated record and the same record read back from its files agree.
+    """
+    src = source
     cols = set(df.columns)
-    name = str(meta.get("trial", path.stem))
+    name = str(meta.get("trial", default_name))
     ship = str(meta.get("ship", ""))
     if "t [s]" in cols or "psi_hat [rad]" in cols:
-        return _read_frt(df, src, path)
+        return _read_frt(df, src, Path(src))
     if "u_mps" in cols or "psi_rad" in cols:
         _check(df, TRUTH_COLUMNS, src, "time_s")
         a = {c: df[c].to_numpy(dtype=float) for c in TRUTH_COLUMNS}

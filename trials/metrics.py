@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mmg.errors import InputError
 from mmg.units import DEG
 
 
@@ -251,3 +252,47 @@ def imo_criteria(L: float, U0: float, turning: dict | None = None, zz10: dict | 
         ov = zz20.get("overshoots_deg", [])
         add("20/20 first overshoot (deg)", ov[0] if len(ov) > 0 else None, 25.0)
     return rows
+
+
+def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
+    """Metrics of a read record (kind guessed from the heading history when not given).
+
+    Parameters
+    ----------
+    rec : TrialRecord
+    kind : {"turning", "zigzag", "stype"}, optional
+    length : float, optional
+        Ship length L [m] when the record does not say.
+    angle : float, optional
+        Switching heading [rad] of a zigzag record without rudder channel or header.
+    """
+    L = length or rec.meta.get("length_m")
+    if L is None:
+        raise InputError(rec.source, "--length", "the log does not give the ship length; pass --length")
+    L = float(L)
+    kind = kind or rec.meta.get("kind")
+    if kind not in ("turning", "zigzag", "stype"):
+        kind = "turning" if abs(rec.psi[-1] - rec.psi[0]) > np.pi else "zigzag"
+    out = {"record": rec.name, "source": rec.source, "kind": kind, "length_m": L}
+    U = rec.speed()
+    if kind == "turning":
+        if rec.x is None:
+            raise InputError(rec.source, "lat_deg", "turning metrics need the track (positions)")
+        out.update(turning_metrics(rec.t, rec.x, rec.y, rec.psi, U, L,
+                                   t_execute=rec.meta.get("execute_s"), delta=rec.delta,
+                                   order=rec.meta.get("delta_order")))
+    else:
+        order = rec.meta.get("delta_order", rec.delta)
+        ang = angle
+        if order is None and ang is None:
+            key = "heading_deg" if kind == "zigzag" else "switch_heading_deg"
+            if key not in rec.meta:
+                raise InputError(rec.source, "heading_deg", "a zigzag log without rudder needs --zigzag-angle")
+            ang = float(rec.meta[key]) * np.pi / 180
+        first = None
+        if rec.meta.get("first") in ("starboard", "port"):
+            first = 1 if rec.meta["first"] == "starboard" else -1
+        if kind == "stype" and order is None:
+            raise InputError(rec.source, "rudder", "S-type metrics from a log need the rudder channel")
+        out.update(zigzag_metrics(rec.t, rec.psi, order=order, angle=ang, first=first, U=U, L=L))
+    return out

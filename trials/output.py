@@ -57,3 +57,49 @@ def _json_default(o):
 def dump_json(obj, path: Path) -> None:
     with open(path, "w") as fh:
         json.dump(obj, fh, indent=2, default=_json_default)
+
+
+class Folder:
+    """A plain output folder with the ``.path(name)`` interface of :class:`StagedOutput` (created on use)."""
+
+    def __init__(self, out: str | Path):
+        self.out = Path(out)
+
+    def path(self, name: str) -> Path:
+        p = self.out / name
+        p.parent.mkdir(parents=True, exist_ok=True)
+        return p
+
+
+def out_path(out):
+    """``out`` when it already has ``.path(name)`` (a :class:`StagedOutput`), else a :class:`Folder` on it."""
+    return out if hasattr(out, "path") else Folder(out)
+
+
+def fmt(v, nd: int = 4) -> str:
+    """A value for a printed table: 4 significant digits, lists as [a, b, ...], None as '-'."""
+    if v is None:
+        return "-"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(f"{x:.{min(nd, 2)}f}" for x in v) + "]"
+    if isinstance(v, (float, np.floating)):
+        return f"{v:.{nd}g}"
+    return str(v)
+
+
+def write_trial_outputs(run, stage, show: bool = False) -> dict:
+    """log.csv, truth.csv, metrics.json, track.png, histories.png of one simulated trial; returns the metrics."""
+    from .logio import write_csv
+    from .plots import plot_histories, plot_track
+
+    stage = out_path(stage)
+    meta = run.log_meta()
+    write_csv(stage.path("log.csv"), run.log(), meta)
+    write_csv(stage.path("truth.csv"), run.truth(), meta)
+    m = run.metrics()
+    dump_json(m, stage.path("metrics.json"))
+    r, sh = run.result, run.trial.ship.particulars
+    plot_track(r.t, r.x, r.y, r.psi, sh.L, sh.B, f"{run.trial.name} ({run.trial.ship.name})", stage.path("track.png"), show=show)
+    plot_histories(r.t, r.psi, r.delta, r.r, r.U, r.n, f"{run.trial.name} ({run.trial.ship.name})",
+                   stage.path("histories.png"), delta_order=r.orders, show=show)
+    return m

@@ -1,27 +1,28 @@
 """The main job: reproduce the papers on the default Esso Osaka configs.
 
-``mmg reproduce --out DIR`` runs, in order, and prints as it goes (also into
-``DIR/report.md``):
+:func:`reproduce` (``mmg reproduce --out DIR``) writes ``DIR/report.md`` and, beside it, every
+file the report links to; it prints one progress line per section and returns the report's
+path.  The report, in order:
 
 1. the steady straight run (rpm beside the paper's 54.12 rpm, trim rudder, drift);
 2. the Kijima formulas beside Table 2;
 3. every default trial in ``configs/trials`` (log, truth, metrics, figures in DIR/trials/NAME);
 4. the plausibility table: our ST35, ZZ10, ZZ20 against the IMO criteria and the
    3 m Esso Osaka model's measured turning metrics (computed here from the
-   FRT-DS-ESSO files when ``../shared/data/frt-ds-esso`` is present);
+   FRT-DS-ESSO files when that folder is found: ``MMG_FRT_DATA``, else ``../shared/data/frt-ds-esso``
+   beside the checkout or the working folder);
 5. step convergence and port/starboard symmetry checks;
 6. the Nomoto models and their identification (Artyszuk 2018, Tables 1-8);
 7. the EKF reproduction (Rhee & Kim 1999, Tables 9-10);
 8. the sensitivity figures (Rhee & Kim Figs 2, 8-9, 12, 13, 14 and 28);
 9. beyond the paper: the joint output-error estimate over the four trials;
-   with ``--full`` also the Monte Carlo of the EKF and of the output-error fit over
+   with ``full`` also the Monte Carlo of the EKF and of the output-error fit over
    20 noise seeds (about 20 minutes on 2 cores), the full extended Nomoto Table 8, and
    the Monte Carlo of the raw-log EKF beside the Cramer-Rao bounds (about 3 minutes).
 """
 from __future__ import annotations
 
-import io
-import sys
+import os
 import time
 from pathlib import Path
 
@@ -29,33 +30,88 @@ import numpy as np
 
 from mmg.integrate import CommandLaw
 from mmg.kijima import compare
+from mmg.resources import trial_path
 from mmg.simulation import prepare, simulate
 from mmg.units import DEG, KNOT
 
-from .cli import CONFIGS, REPO, StagedOutput, fmt, record_metrics, write_trial_outputs
-from .metrics import imo_criteria, turning_metrics
+from .metrics import imo_criteria, record_metrics, turning_metrics
+from .output import StagedOutput, fmt, write_trial_outputs
 from .run import run_trial
 from .trial import load_trial
 
-FRT = REPO.parent / "shared" / "data" / "frt-ds-esso"
 DEFAULT_TRIALS = ("st35", "zz10", "zz20", "stype60", "stype90", "stype120", "stype180", "sine", "sawtooth")
 
+GLOSSARY = """## Symbols and terms
 
-class Tee(io.TextIOBase):
-    def __init__(self, *streams):
-        self.streams = streams
+| symbol | meaning |
+|---|---|
+| L, B, T | ship length between perpendiculars, breadth, draught [m] |
+| U, u, v, r | speed through the water, surge and sway velocity [m/s], yaw rate [rad/s] |
+| beta | drift angle atan(-v/u) [rad], > 0 in a starboard turn |
+| r' | non-dimensional yaw rate r L / U |
+| Y_beta, N_r, ... | primed hull derivatives (forces on 1/2 rho L T U^2, moments on 1/2 rho L^2 T U^2) |
+| Y_bb, N_bb | Y'_{beta\\|beta\\|}, N'_{beta\\|beta\\|}: coefficients of beta \\|beta\\| |
+| Y_rr, N_rr | Y'_{r\\|r\\|}, N'_{r\\|r\\|}: coefficients of r' \\|r'\\| |
+| Y_bbr, Y_brr, N_bbr, N_brr | coefficients of beta^2 r' and beta r'^2 |
+| s' | non-dimensional time t U / L |
+| ST35, ZZ10, ZZ20 | 35 deg turning circle; 10/10 and 20/20 deg zigzags |
+| S-type 120 | Rhee & Kim's S-type trial switching at a heading change of 120 deg |
+| advance, transfer, tactical D | IMO turning-circle measures, in ship lengths L |
+| overshoot (OS) | heading beyond the switching heading after each rudder reversal of a zigzag [deg] |
+| speed loss | 1 - U_end / U_0 over the turn |
+| K, T (T1, T2, T3) | Nomoto gain [1/s] and time constants [s] (first / second order) |
+| CRB | Cramer-Rao bound: the smallest standard deviation any unbiased estimator can reach |
+| EKF | extended Kalman filter; "augmented": the derivatives are states |
+| chi2/dof | weighted residual sum over its degrees of freedom (about 1 when the fit is noise-limited) |
+"""
 
-    def write(self, s):
-        for st in self.streams:
-            st.write(s)
-        return len(s)
 
-    def flush(self):
-        for st in self.streams:
-            st.flush()
+def progress(msg: str) -> None:
+    """One progress line on stdout (not in the report)."""
+    print(f"  {msg}", flush=True)
+
+
+class Report:
+    """The report being written: ``doc(text)`` appends a paragraph (a blank line joins the parts)."""
+
+    def __init__(self):
+        self.parts: list[str] = []
+
+    def __call__(self, text: str = "") -> None:
+        self.parts.append(str(text))
+
+    def text(self) -> str:
+        out = "\n".join(self.parts)
+        while "\n\n\n" in out:
+            out = out.replace("\n\n\n", "\n\n")
+        return out.rstrip() + "\n"
+
+
+def demote(md: str, levels: int = 1, drop_title: bool = False) -> str:
+    """Markdown headings moved ``levels`` deeper (an embedded document's '#' becomes '##', ...)."""
+    out = []
+    for ln in md.splitlines():
+        if ln.startswith("#"):
+            if drop_title and ln.startswith("# "):
+                continue
+            ln = "#" * levels + ln
+        out.append(ln)
+    return "\n".join(out)
+
+
+def frt_data_dir() -> Path | None:
+    """The FRT-DS-ESSO folder: ``MMG_FRT_DATA``, else ``../shared/data/frt-ds-esso`` beside the checkout or
+    the working folder; None when absent."""
+    cands = [os.environ.get("MMG_FRT_DATA"), Path(__file__).resolve().parents[2] / "shared" / "data" / "frt-ds-esso",
+             Path.cwd().parent / "shared" / "data" / "frt-ds-esso"]
+    for c in cands:
+        if c and Path(c).is_dir():
+            return Path(c)
+    return None
 
 
 def table(rows, cols, headers=None) -> str:
+    """A Markdown table of dict rows (numbers to 4 significant digits, None as '-')."""
     headers = headers or cols
     out = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(cols)]
     for r in rows:
@@ -63,14 +119,14 @@ def table(rows, cols, headers=None) -> str:
     return "\n".join(out)
 
 
-def straight_run_section(ship):
+def straight_run_section(doc, ship):
     u0 = 10 * KNOT
     pk, eq = prepare(ship, u0)
     law = CommandLaw.schedule([0.0, 3000.0], [eq.delta, eq.delta])
     r = simulate(ship, law, 3000.0, 0.1, u0)
     free = simulate(ship, CommandLaw.schedule([0.0, 3000.0], [0.0, 0.0]), 3000.0, 0.1, u0, trim=False)
-    print("## 1. Steady straight run at 10 kn\n")
-    print(table([
+    doc("## 1. Steady straight run at 10 kn\n")
+    doc(table([
         {"quantity": "approach rpm (solved)", "ours": eq.n * 60, "paper": 54.12},
         {"quantity": "trim rudder (deg, + starboard)", "ours": eq.delta / DEG, "paper": None},
         {"quantity": "drift angle beta (deg)", "ours": np.degrees(np.arctan(-eq.v / eq.u)), "paper": None},
@@ -81,21 +137,21 @@ def straight_run_section(ship):
         {"quantity": "rudder amidships, no trim: heading after 3000 s (deg)", "ours": float(free.psi[-1] / DEG), "paper": None},
         {"quantity": "rudder amidships, no trim: speed after 3000 s (kn)", "ours": float(free.U[-1] / KNOT), "paper": None},
     ], ["quantity", "ours", "paper"]))
-    print("\nTable 7 of the paper starts the filter at 54.21 rpm; Table 4 says 54.12 rpm.\n")
+    doc("\nTable 7 of the paper starts the filter at 54.21 rpm; Table 4 says 54.12 rpm.\n")
 
 
-def kijima_section(ship):
-    print("## 2. Kijima (1990) formulas vs Table 2\n")
-    print(table(compare(ship), ["coefficient", "kijima", "config", "difference_pct"],
+def kijima_section(doc, ship):
+    doc("## 2. Kijima (1990) formulas vs Table 2\n")
+    doc(table(compare(ship), ["coefficient", "kijima", "config", "difference_pct"],
                 ["coefficient", "Kijima formula", "Table 2", "difference (%)"]))
-    print()
+    doc()
 
 
-def trials_section(out: Path):
-    print("## 3. Default trials\n")
+def trials_section(doc, out: Path):
+    doc("## 3. Default trials\n")
     rows, runs = [], {}
     for name in DEFAULT_TRIALS:
-        tr = load_trial(CONFIGS / "trials" / f"{name}.yaml")
+        tr = load_trial(trial_path(name))
         run = run_trial(tr)
         with StagedOutput(out / "trials" / name) as stage:
             m = write_trial_outputs(run, stage)
@@ -104,27 +160,31 @@ def trials_section(out: Path):
                      "steady_diameter_L", "speed_loss", "initial_turning_time_s", "period_s",
                      "final_heading_change_deg")},
                      "overshoots_deg": fmt(m.get("overshoots_deg", [])[:3], 1) if "overshoots_deg" in m else "-"})
-    print(table(rows, ["trial", "advance_L", "transfer_L", "tactical_diameter_L", "steady_diameter_L", "speed_loss",
+    doc(table(rows, ["trial", "advance_L", "transfer_L", "tactical_diameter_L", "steady_diameter_L", "speed_loss",
                        "overshoots_deg", "initial_turning_time_s", "period_s", "final_heading_change_deg"],
                 ["trial", "advance (L)", "transfer (L)", "tactical D (L)", "steady D (L)", "speed loss",
                  "overshoots 1-3 (deg)", "initial turning (s)", "period (s)", "heading change (deg)"]))
-    print(f"\n(logs, truth files, metrics.json and figures in {out / 'trials'})\n")
+    doc("\nLogs, truth files, metrics.json and figures of each trial are in `trials/NAME/`: e.g. the ST35 "
+        "[track](trials/st35/track.png) and [time histories](trials/st35/histories.png), the ZZ20 "
+        "[track](trials/zz20/track.png) and [histories](trials/zz20/histories.png), the S-type 120 "
+        "[track](trials/stype120/track.png).\n")
     return runs
 
 
-def plausibility_section(runs, ship):
-    print("## 4. Plausibility: IMO criteria and the 3 m model\n")
+def plausibility_section(doc, runs, ship):
+    doc("## 4. Plausibility: IMO criteria and the 3 m model\n")
     L, U0 = ship.particulars.L, 10 * KNOT
     rows = imo_criteria(L, U0, runs["st35"][1], runs["zz10"][1], runs["zz20"][1])
-    print(table([{**r, "pass": "yes" if r["pass"] else ("no" if r["pass"] is False else "-")} for r in rows],
+    doc(table([{**r, "pass": "yes" if r["pass"] else ("no" if r["pass"] is False else "-")} for r in rows],
                 ["criterion", "value", "limit", "pass"]))
-    print()
+    doc()
     st = runs["st35"][1]
     model_rows = [{"run": "ours, full scale, 10 kn, +35 deg", "U0": "10 kn", **{k: st.get(k) for k in
                    ("advance_L", "transfer_L", "tactical_diameter_L", "steady_diameter_L", "speed_loss")}}]
-    if FRT.is_dir():
+    frt = frt_data_dir()
+    if frt is not None:
         # the three 35 deg turns at n = 10 rps (FRT-DS-ESSO README)
-        for f in [FRT / "turning" / f"turn_14-Sep-2020_{s}.csv" for s in ("13_39_32", "13_51_45", "14_16_04")]:
+        for f in [frt / "turning" / f"turn_14-Sep-2020_{s}.csv" for s in ("13_39_32", "13_51_45", "14_16_04")]:
             from .logio import read_record
 
             rec = read_record(f)
@@ -133,10 +193,10 @@ def plausibility_section(runs, ship):
                                **{k: m.get(k) for k in ("advance_L", "transfer_L", "tactical_diameter_L",
                                                          "steady_diameter_L", "speed_loss")}})
     else:
-        print("(FRT-DS-ESSO folder absent: 3 m model rows skipped)\n")
-    print(table(model_rows, ["run", "U0", "advance_L", "transfer_L", "tactical_diameter_L", "steady_diameter_L", "speed_loss"],
+        doc("(FRT-DS-ESSO folder not found, see `MMG_FRT_DATA`: the 3 m model rows are left out)\n")
+    doc(table(model_rows, ["run", "U0", "advance_L", "transfer_L", "tactical_diameter_L", "steady_diameter_L", "speed_loss"],
                 ["run", "approach", "advance (L)", "transfer (L)", "tactical D (L)", "steady D (L)", "speed loss"]))
-    print("""
+    doc("""
 Expected differences: the 3 m model runs start from a still-accelerating approach at n = 10 rps
 (Fn about 0.07, full-scale equivalent 7-9 kn) in an outdoor pond with wind, and at model-scale
 Reynolds number (thicker boundary layer, larger wake fraction, relatively stronger propeller
@@ -146,7 +206,7 @@ model's measured ones. No full-scale Crane (1979) numbers were available to us.
 """)
 
 
-def st35_variants_section(ship):
+def st35_variants_section(doc, ship):
     """ST35 heading change after 3000 s under the alternatives to the fact sheet's assumptions.
 
     Rhee & Kim chose t_f = 3000 s "to make the ship turn 560 deg"; this shows how far each
@@ -154,7 +214,7 @@ def st35_variants_section(ship):
     """
     from dataclasses import replace
 
-    print("### ST35: heading change after 3000 s (paper: 560 deg) under alternative assumptions\n")
+    doc("### ST35: heading change after 3000 s (paper: 560 deg) under alternative assumptions\n")
     variants = [
         ("as configured (fact sheet)", ship),
         ("no wake change in the turn (C_wake = 0)", replace(ship, propeller=replace(ship.propeller, C_wake=0.0))),
@@ -170,13 +230,13 @@ def st35_variants_section(ship):
         m = turning_metrics(r.t, r.x, r.y, r.psi, r.U, sh.particulars.L, t_execute=0.0)
         rows.append({"variant": label, "heading": float(r.psi[-1] / DEG), "TD": m["tactical_diameter_L"],
                      "U": float(r.U[-1] / r.U[0])})
-    print(table(rows, ["variant", "heading", "TD", "U"],
+    doc(table(rows, ["variant", "heading", "TD", "U"],
                 ["variant", "heading change at 3000 s (deg)", "tactical D (L)", "final U / U0"]))
-    print()
+    doc()
 
 
-def checks_section(ship):
-    print("## 5. Numerical checks\n")
+def checks_section(doc, ship):
+    doc("## 5. Numerical checks\n")
     L = ship.particulars.L
     tds = []
     for dt in (0.2, 0.1, 0.05):
@@ -188,103 +248,139 @@ def checks_section(ship):
     mirror = np.array([1, -1, -1, 1, -1, -1, -1, 1])
     rel = max(np.max(np.abs(a.states[:, j] - mirror[j] * b.states[:, j])) / (np.max(np.abs(a.states[:, j])) or 1)
               for j in range(8))
-    print(table([
+    doc(table([
         {"check": "tactical diameter, dt 0.2 / 0.1 / 0.05 s (L)", "value": " / ".join(f"{v:.7f}" for v in tds)},
         {"check": "relative change halving dt 0.1 -> 0.05 s", "value": f"{abs(tds[2] - tds[1]) / tds[2]:.2e}"},
         {"check": "port/starboard mirror (Y_0 = N_0 = 0), max relative difference", "value": f"{rel:.2e}"},
     ], ["check", "value"]))
-    print()
+    doc()
 
 
-def nomoto_section(out: Path, full: bool):
+def nomoto_section(doc, out: Path, full: bool):
     from . import artyszuk
 
-    print("## 6. Nomoto models: Artyszuk (2018) Tables 1-8\n")
+    doc("## 6. Nomoto models: Artyszuk (2018) Tables 1-8\n")
     if not full:
-        print("(the extended Table 8 without its output-error column and with 2 noise seeds: "
+        doc("(the extended Table 8 without its output-error column and with 2 noise seeds: "
               "`mmg reproduce --full` or `mmg nomoto-paper` runs all of it, about 5 minutes)\n")
     t0 = time.perf_counter()
     tables = artyszuk.reproduce(fast=not full)
     artyszuk.write_tables(tables, out / "nomoto")
     for key, title in artyszuk.TITLES.items():
         if key in tables:
-            print(f"### {title}\n")
-            print(artyszuk.to_markdown(tables[key]))
-            print()
-    print(f"(tables in {out / 'nomoto'}; {time.perf_counter() - t0:.1f} s)\n")
+            doc(f"### {title}\n")
+            doc(artyszuk.to_markdown(tables[key]))
+            doc()
+    doc("(every table also as CSV in `nomoto/`)\n")
+    progress(f"Nomoto tables {time.perf_counter() - t0:.1f} s")
 
 
-def ekf_section(out: Path):
-    from ekf.reproduce import reproduce_rhee_kim
+def ekf_section(doc, out: Path):
+    from .rhee_kim import reproduce_rhee_kim
 
-    print("## 7. EKF: Rhee & Kim (1999) Tables 9-10\n")
+    doc("## 7. EKF: Rhee & Kim (1999) Tables 9-10\n")
     t0 = time.perf_counter()
     reproduce_rhee_kim(out / "ekf", verbose=False)
-    print((out / "ekf" / "comparison.md").read_text())
-    print(f"\n(outputs in {out / 'ekf'}; {time.perf_counter() - t0:.1f} s)\n")
+    doc((out / "ekf" / "comparison.md").read_text())
+    doc("\nThe estimates, the Table-10 error table and the free-run check are in `ekf/` "
+        "([estimates.json](ekf/estimates.json), [error_table.md](ekf/error_table.md), "
+        "[free_run.json](ekf/free_run.json)); convergence figures, one per derivative, e.g. "
+        "[Y_beta](ekf/convergence_Y_beta.png) and [N_r](ekf/convergence_N_r.png) (cf. Rhee & Kim Figs 15-26); "
+        "recovered measurements against the truth (Figs 4-5): [ZZ20](ekf/preprocessing_ZZ20.png).\n")
+    progress(f"EKF reproduction {time.perf_counter() - t0:.1f} s")
 
 
-def sensitivity_section(out: Path):
-    from .sensitivity_cli import paper_figures
+def sensitivity_section(doc, out: Path):
+    from .sensitivity_report import paper_figures
 
-    print("## 8. Derivative sensitivity: Rhee & Kim Figs 2, 8-9, 12, 13, 14, 28\n")
+    doc("## 8. Derivative sensitivity: Rhee & Kim Figs 2, 8-9, 12, 13, 14, 28\n")
     t0 = time.perf_counter()
     cmp_ = out / "ekf" / "comparison.csv"
-    paper_figures(out / "sensitivity", ekf_comparison=cmp_ if cmp_.exists() else None, verbose=True)
-    print(f"\n(figures and CSVs in {out / 'sensitivity'}; {time.perf_counter() - t0:.1f} s)\n")
+    paper_figures(out / "sensitivity", ekf_comparison=cmp_ if cmp_.exists() else None, verbose=False)
+    doc(demote((out / "sensitivity" / "sensitivity_figures.md").read_text(), drop_title=True))
+    doc("\nFigures: [Fig. 2](sensitivity/fig02_conventional.png), [Figs 8-9](sensitivity/fig08_09_sine_sawtooth.png), "
+        "[Fig. 12](sensitivity/fig12_stype.png), [Fig. 13](sensitivity/fig13_conventional_vs_stype120.png), "
+        "[Fig. 14](sensitivity/fig14_sums.png), [Fig. 28](sensitivity/fig28_efficiency.png); CSVs beside them.\n")
+    progress(f"sensitivity figures {time.perf_counter() - t0:.1f} s")
 
 
-def best_estimator_section(out: Path, full: bool):
-    from .cli import main as mmg_main
+def best_estimator_section(doc, out: Path, full: bool):
+    from ekf.estimate import load_config
 
-    print("## 9. Beyond the paper: joint output-error estimate over ST35, ZZ10, ZZ20, S-type 120\n")
-    print("(the EKF of section 7 jointly over the four trials, then an output-error fit of the raw logs; "
+    from .estimation import estimate_and_report, load_inputs, to_markdown
+
+    doc("## 9. Beyond the paper: joint output-error estimate over ST35, ZZ10, ZZ20, S-type 120\n")
+    doc("(the EKF of section 7 jointly over the four trials, then an output-error fit of the raw logs; "
           "one noise seed: the trial files' own)\n")
     t0 = time.perf_counter()
-    trials = [str(CONFIGS / "trials" / f"{n}.yaml") for n in ("st35", "zz10", "zz20", "stype120")]
-    mmg_main(["estimate", *trials, "--method", "output-error", "--no-plots", "--out", str(out / "best_estimator")])
-    print(f"\n({time.perf_counter() - t0:.1f} s)\n")
+    cfg = load_config()
+    datas = load_inputs([str(trial_path(n)) for n in ("st35", "zz10", "zz20", "stype120")], cfg)
+    with StagedOutput(out / "best_estimator") as stage:
+        rep = estimate_and_report(datas, cfg, stage, method="output-error", plots=False, verbose=False)
+    fit = rep["fit"]
+    doc(f"Output-error fit over {', '.join(fit['trials'])}: chi2/dof {fit['chi2_per_dof']:.3f} "
+        f"({fit['residuals']} residuals, {fit['nfev']} evaluations). Coefficients, standard errors from "
+        f"(J^T W J)^-1 and the EKF start ([estimates.json](best_estimator/estimates.json), "
+        f"[oe_fit.json](best_estimator/oe_fit.json)):\n")
+    doc(to_markdown(rep["table"]))
+    for w in rep["warnings"]:
+        doc(f"Warning: {w}\n")
+    progress(f"output-error estimate {time.perf_counter() - t0:.1f} s")
     if full:
-        from ekf.montecarlo import monte_carlo
-        from ekf.output_error import monte_carlo as oe_monte_carlo, summarise
+        from .montecarlo import log_filter_monte_carlo, monte_carlo, output_error_monte_carlo, summarise
 
-        print("## 10. Monte Carlo over 20 noise seeds: plain EKF per trial, and the joint output-error fit\n")
-        monte_carlo(out / "ekf_montecarlo", 20)
-        print((out / "ekf_montecarlo" / "summary.md").read_text())
-        oe_monte_carlo(out / "oe_montecarlo", 20)
-        summarise(out / "oe_montecarlo", ekf_summary=out / "ekf_montecarlo" / "summary.csv")
-        from ekf.log_filter import monte_carlo as log_monte_carlo
+        doc("## 10. Monte Carlo over 20 noise seeds: plain EKF per trial, and the joint output-error fit\n")
+        monte_carlo(out / "ekf_montecarlo", 20, verbose=False)
+        doc((out / "ekf_montecarlo" / "summary.md").read_text())
+        output_error_monte_carlo(out / "oe_montecarlo", 20, verbose=False)
+        summarise(out / "oe_montecarlo", ekf_summary=out / "ekf_montecarlo" / "summary.csv", verbose=False)
+        doc((out / "oe_montecarlo" / "summary.md").read_text())
+        from .sensitivity_report import crb_table
 
-        from .sensitivity_cli import crb_table
-
-        print("\n## 11. The raw-log EKF over 20 noise seeds beside the Cramer-Rao bound\n")
-        log_monte_carlo(out / "ekf_log_montecarlo", 20)
+        doc("\n## 11. The raw-log EKF over 20 noise seeds beside the Cramer-Rao bound\n")
+        log_filter_monte_carlo(out / "ekf_log_montecarlo", 20)
         (out / "crb_vs_mc").mkdir(exist_ok=True)
-        crb_table(out / "ekf_log_montecarlo", out / "crb_vs_mc")
+        crb_table(out / "ekf_log_montecarlo", out / "crb_vs_mc", verbose=False)
+        doc((out / "crb_vs_mc" / "crb_vs_mc.txt").read_text() if (out / "crb_vs_mc" / "crb_vs_mc.txt").exists() else "")
 
 
-def reproduce(args) -> int:
-    out = Path(args.out)
+def reproduce(out, full: bool = False) -> Path:
+    """Run the main job into the folder ``out``; returns the path of ``report.md``.
+
+    Parameters
+    ----------
+    out : str or Path
+        Output folder (created); the report and every file it links to are written there.
+    full : bool
+        Also the Monte Carlo runs (about 25 minutes on 2 cores).
+    """
+    out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    report = open(out / "report.md", "w")
-    old = sys.stdout
-    sys.stdout = Tee(old, report)
-    try:
-        t0 = time.perf_counter()
-        ship = load_trial(CONFIGS / "trials" / "st35.yaml").ship
-        print("# Esso Osaka MMG: paper reproduction\n")
-        straight_run_section(ship)
-        kijima_section(ship)
-        runs = trials_section(out)
-        plausibility_section(runs, ship)
-        st35_variants_section(ship)
-        checks_section(ship)
-        nomoto_section(out, args.full)
-        ekf_section(out)
-        sensitivity_section(out)
-        best_estimator_section(out, args.full)
-        print(f"Total {time.perf_counter() - t0:.1f} s. Report: {out / 'report.md'}")
-    finally:
-        sys.stdout = old
-        report.close()
-    return 0
+    doc = Report()
+    t0 = time.perf_counter()
+    ship = load_trial(trial_path("st35")).ship
+    doc("# Esso Osaka MMG: paper reproduction\n")
+    doc("Rhee & Kim (1999) and Artyszuk (2018) reproduced with this toolkit on its default configs "
+        f"(`mmg reproduce{' --full' if full else ''}`). Our values stand beside the papers' wherever they print one.\n")
+    doc(GLOSSARY)
+    steps = [("straight run", lambda: straight_run_section(doc, ship)), ("Kijima", lambda: kijima_section(doc, ship))]
+    for label, f in steps:
+        f()
+        progress(f"{label} done ({time.perf_counter() - t0:.1f} s)")
+    runs = trials_section(doc, out)
+    progress(f"default trials done ({time.perf_counter() - t0:.1f} s)")
+    for label, f in [("plausibility", lambda: plausibility_section(doc, runs, ship)),
+                     ("ST35 variants", lambda: st35_variants_section(doc, ship)),
+                     ("numerical checks", lambda: checks_section(doc, ship)),
+                     ("Nomoto", lambda: nomoto_section(doc, out, full)),
+                     ("EKF", lambda: ekf_section(doc, out)),
+                     ("sensitivity", lambda: sensitivity_section(doc, out)),
+                     ("output error", lambda: best_estimator_section(doc, out, full))]:
+        f()
+        progress(f"{label} done ({time.perf_counter() - t0:.1f} s)")
+    doc(f"\n---\nTotal {time.perf_counter() - t0:.1f} s.")
+    path = out / "report.md"
+    tmp = out / ".report.md.tmp"
+    tmp.write_text(doc.text())
+    os.replace(tmp, path)
+    return path

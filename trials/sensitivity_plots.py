@@ -7,12 +7,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from mmg.terms import latex_label
+
 from .sensitivity import DERIVATIVES
 
-LABELS = {"Y_beta": r"$Y'_\beta$", "Y_r": r"$Y'_r$", "Y_bb": r"$Y'_{\beta|\beta|}$", "Y_rr": r"$Y'_{r|r|}$",
-          "Y_bbr": r"$Y'_{\beta\beta r}$", "Y_brr": r"$Y'_{\beta rr}$", "N_beta": r"$N'_\beta$", "N_r": r"$N'_r$",
-          "N_bb": r"$N'_{\beta|\beta|}$", "N_rr": r"$N'_{r|r|}$", "N_bbr": r"$N'_{\beta\beta r}$",
-          "N_brr": r"$N'_{\beta rr}$"}
+LABELS = {n: latex_label(n) for n in DERIVATIVES}
 
 
 def _plt():

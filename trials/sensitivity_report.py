@@ -1,16 +1,17 @@
-"""``mmg sensitivity``: derivative sensitivities (Rhee & Kim eqs. 21-22), the paper's figures,
-Fisher information / Cramer-Rao bounds and the trial-design search.
+"""Sensitivity studies as written reports: derivative sensitivities of given trials (Rhee & Kim
+eqs. 21-22), the paper's figures, Cramer-Rao bounds beside a Monte Carlo, the trial-design search.
+
+Each function writes into ``out`` (a folder or a staging object with ``.path(name)``, see
+:class:`trials.output.StagedOutput`) and returns its table.  ``mmg sensitivity`` is the command
+line over them:
 
     mmg sensitivity TRIAL.yaml [TRIAL.yaml ...] --out DIR [--fisher]
     mmg sensitivity --paper-figures --out DIR [--ekf-comparison comparison.csv]
     mmg sensitivity --crb-vs-mc MC_DIR [MC_DIR ...] --out DIR [--mc-seeds N] [--rudder-timing S]
     mmg sensitivity --design --out DIR
-
-Everything is written into a staging folder and moved to ``--out`` only on success.
 """
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
@@ -19,8 +20,9 @@ import pandas as pd
 
 from mmg.errors import InputError
 
-REPO = Path(__file__).resolve().parents[1]
-TRIALS_DIR = REPO / "configs" / "trials"
+from mmg.resources import trial_path
+
+from .output import out_path
 
 # Rhee & Kim's figure groups: (file stem, title, trial files)
 FIGURES = [
@@ -61,16 +63,19 @@ def _wide(df: pd.DataFrame) -> pd.DataFrame:
 
 # --------------------------------------------------------------------------- trials given on the command line
 
-def cmd_trials(args, stage) -> None:
+def trial_sensitivities(trial_files, out, fisher_bounds: bool = False, backend: str = "loky", n_jobs=None) -> pd.DataFrame:
+    """Sensitivities of the given trials, normalised together (sensitivity.csv/.md/.png,
+    group_sums.csv/.png; with ``fisher_bounds`` crb_std.csv); returns the long table."""
     from .sensitivity import group_sums, sensitivity
     from .sensitivity_plots import plot_groups, plot_sensitivity
 
-    trials = _load(args.trials)
+    stage = out_path(out)
+    trials = _load(trial_files)
     names = [t.name for t in trials]
     if len(set(names)) != len(names):
-        raise InputError(" ".join(args.trials), "name", f"two trials share a name ({', '.join(names)}); "
-                                                        "the sensitivities are per trial name")
-    df = sensitivity(trials, backend=args.backend, n_jobs=args.jobs)
+        raise InputError(" ".join(map(str, trial_files)), "name", f"two trials share a name ({', '.join(names)}); "
+                                                                  "the sensitivities are per trial name")
+    df = sensitivity(trials, backend=backend, n_jobs=n_jobs)
     df.to_csv(stage.path("sensitivity.csv"), index=False, float_format="%.6g")
     w = _wide(df)
     stage.path("sensitivity.md").write_text(
@@ -84,7 +89,7 @@ def cmd_trials(args, stage) -> None:
     print(f"sensitivity [%] (eq. 22, absolute differences summed over the record; group total 100 %):")
     print(w.round(2).to_string())
     print(gs.round(2).to_string())
-    if args.fisher:
+    if fisher_bounds:
         from .fisher import crb, fisher, tangent
 
         rows = []
@@ -96,6 +101,7 @@ def cmd_trials(args, stage) -> None:
         cr.to_csv(stage.path("crb_std.csv"), float_format="%.6g")
         print("Cramer-Rao bound on the standard deviation (log noise model):")
         print(cr.T.to_string(float_format=lambda v: f"{v:.3g}"))
+    return df
 
 
 # --------------------------------------------------------------------------- the paper's figures
@@ -123,7 +129,7 @@ def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, 
 
     Each distinct trial is simulated once (13 runs), then each figure's group is normalised
     by eqs. (21)-(22) on its own.  Fig. 28 needs the EKF's final % errors: ``ekf_comparison``
-    (comparison.csv of :func:`ekf.reproduce.reproduce_rhee_kim`, columns trial, coeff,
+    (comparison.csv of :func:`trials.rhee_kim.reproduce_rhee_kim`, columns trial, coeff,
     our_err_pct, paper_err_pct), or None to run that reproduction here (one noise seed per trial).
     """
     from .sensitivity import efficiency, group_differences, group_sums, normalise
@@ -133,7 +139,7 @@ def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, 
     if not hasattr(out, "path"):
         Path(out).mkdir(parents=True, exist_ok=True)
     stems = list(dict.fromkeys(s for _, _, group in FIGURES for s in group))
-    trials = _load([TRIALS_DIR / f"{s}.yaml" for s in stems])
+    trials = _load([trial_path(s) for s in stems])
     t0 = time.perf_counter()
     diffs = dict(zip(stems, group_differences(trials, backend=backend, n_jobs=n_jobs, progress=verbose)))
     if verbose:
@@ -156,7 +162,7 @@ def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, 
     md += ["## Fig. 14 - sums of linear, nonlinear and all sensitivities [%] (group of Fig. 13)\n", _md(gs, "{:.2f}")]
     # Fig. 28 from the EKF's % errors
     if ekf_comparison is None:
-        from ekf.reproduce import reproduce_rhee_kim
+        from .rhee_kim import reproduce_rhee_kim
 
         if verbose:
             print("running the EKF on ST35, ZZ10, ZZ20, S-type 120 for Fig. 28 ...", flush=True)
@@ -182,10 +188,6 @@ def paper_figures(out, ekf_comparison=None, backend: str = "loky", n_jobs=None, 
     return tables
 
 
-def cmd_paper(args, stage) -> None:
-    paper_figures(stage, args.ekf_comparison, backend=args.backend, n_jobs=args.jobs)
-
-
 # --------------------------------------------------------------------------- CRB vs Monte Carlo
 
 def _read_runs(mc_dirs, n_seeds: int, verbose: bool) -> tuple[pd.DataFrame, str]:
@@ -193,7 +195,7 @@ def _read_runs(mc_dirs, n_seeds: int, verbose: bool) -> tuple[pd.DataFrame, str]
     dirs = [mc_dirs] if isinstance(mc_dirs, (str, Path)) else list(mc_dirs)
     csvs = [Path(d) / "runs.csv" for d in dirs]
     if len(csvs) == 1 and not csvs[0].exists():
-        from ekf.montecarlo import monte_carlo
+        from .montecarlo import monte_carlo
 
         if verbose:
             print(f"no {csvs[0]}: running the EKF Monte Carlo ({n_seeds} seeds per trial) ...", flush=True)
@@ -204,7 +206,7 @@ def _read_runs(mc_dirs, n_seeds: int, verbose: bool) -> tuple[pd.DataFrame, str]
             raise InputError(str(c), "", "file not found (a Monte Carlo folder holds runs.csv)")
         r = pd.read_csv(c, keep_default_na=False, na_values=[""])
         if "trial" not in r or "seed" not in r or not any(k.startswith("final_") for k in r.columns):
-            raise InputError(str(c), "final_*", "not an EKF Monte Carlo runs.csv (ekf.montecarlo, ekf.log_filter)")
+            raise InputError(str(c), "final_*", "not an EKF Monte Carlo runs.csv (mmg montecarlo, mmg log-filter)")
         parts.append(r)
     runs = pd.concat(parts, ignore_index=True)
     dup = runs[runs.duplicated(["trial", "seed"])]
@@ -256,7 +258,7 @@ def crb_table(mc_dir, out, n_seeds: int = 20, verbose: bool = True, rudder_timin
 
     P = out.path if hasattr(out, "path") else (lambda n: Path(out) / n)
     runs, src = _read_runs(mc_dir, n_seeds, verbose)
-    files = {k: TRIALS_DIR / f"{v}.yaml" for k, v in EKF_TRIALS.items()}
+    files = {k: trial_path(v) for k, v in EKF_TRIALS.items()}
     if "trial_file" in runs:
         files.update({t: Path(f) for t, f in runs.dropna(subset=["trial_file"]).groupby("trial")["trial_file"]
                       .first().items()})
@@ -291,10 +293,6 @@ def crb_table(mc_dir, out, n_seeds: int = 20, verbose: bool = True, rudder_timin
     return tab
 
 
-def cmd_crb(args, stage) -> None:
-    crb_table(args.crb_vs_mc, stage, n_seeds=args.mc_seeds, rudder_timing=args.rudder_timing)
-
-
 # --------------------------------------------------------------------------- design search
 
 def design(out, backend: str = "loky", n_jobs=None, verbose: bool = True, grid=None,
@@ -304,7 +302,7 @@ def design(out, backend: str = "loky", n_jobs=None, verbose: bool = True, grid=N
     from .sensitivity_plots import plot_design
 
     P = out.path if hasattr(out, "path") else (lambda n: Path(out) / n)
-    base, *refs = _load([TRIALS_DIR / f"{s}.yaml" for s in ("stype120", "st35", "zz10", "zz20", "sine", "sawtooth")])
+    base, *refs = _load([trial_path(s) for s in ("stype120", "st35", "zz10", "zz20", "sine", "sawtooth")])
     df = search(base, grid, references=[base] + refs, rudder_timing=rudder_timing, backend=backend, n_jobs=n_jobs,
                 progress=verbose)
     df.to_csv(P("design.csv"), index=False, float_format="%.6g")
@@ -351,98 +349,3 @@ def design(out, backend: str = "loky", n_jobs=None, verbose: bool = True, grid=N
     if verbose:
         print(text)
     return df
-
-
-def cmd_design(args, stage) -> None:
-    design(stage, backend=args.backend, n_jobs=args.jobs, rudder_timing=args.rudder_timing)
-
-
-def _rudder_timing(text: str) -> float | None:
-    """--rudder-timing: a prior std [s] > 0, 'inf' (no prior) or 'none' (no timing nuisances)."""
-    import argparse
-
-    if text.strip().lower() == "none":
-        return None
-    try:
-        v = float(text)
-    except ValueError:
-        v = float("nan")
-    if not v > 0:
-        raise argparse.ArgumentTypeError(f"expected a prior std in seconds > 0, 'inf' or 'none', got {text!r}")
-    return v
-
-
-# --------------------------------------------------------------------------- registration
-
-def cmd_sensitivity(args) -> int:
-    from .cli import StagedOutput
-
-    modes = [bool(args.trials), args.paper_figures, args.crb_vs_mc is not None, args.design]
-    if sum(modes) != 1:
-        raise InputError("mmg sensitivity", "arguments", "give trial YAMLs, or exactly one of --paper-figures, "
-                                                          "--crb-vs-mc DIR, --design")
-    if args.jobs is not None and args.jobs < 1:
-        raise InputError("--jobs", str(args.jobs), "must be at least 1")
-    if args.ekf_comparison is not None:
-        read_comparison(args.ekf_comparison)
-    for p in args.trials:
-        if not Path(p).is_file():
-            raise InputError(p, "", "file not found")
-    if args.backend == "dask":
-        try:
-            from distributed import Client, LocalCluster  # noqa: F401
-        except ImportError:
-            raise InputError("--backend", "dask", "needs the optional extra: pip install 'mmg-toolkit[dask]'") from None
-    t0 = time.perf_counter()
-    cluster = client = None
-    if args.backend == "dask":
-        from distributed import Client, LocalCluster
-
-        cluster = LocalCluster(n_workers=args.jobs or 2, processes=True, threads_per_worker=1)
-        client = Client(cluster)
-    try:
-        with StagedOutput(args.out) as stage:
-            if args.trials:
-                cmd_trials(args, stage)
-            elif args.paper_figures:
-                cmd_paper(args, stage)
-            elif args.crb_vs_mc is not None:
-                cmd_crb(args, stage)
-            else:
-                cmd_design(args, stage)
-    finally:
-        if client is not None:
-            client.close()
-            cluster.close()
-    print(f"wrote {args.out} ({time.perf_counter() - t0:.1f} s)")
-    return 0
-
-
-def register(sub) -> None:
-    p = sub.add_parser("sensitivity", help="derivative sensitivities (Rhee & Kim eqs. 21-22), Fisher information, "
-                                           "trial design")
-    p.add_argument("trials", nargs="*", help="trial YAMLs to compare (their sensitivities are normalised together)")
-    p.add_argument("--out", required=True, help="output folder")
-    p.add_argument("--paper-figures", action="store_true",
-                   help="Rhee & Kim Figs 2, 8-9, 12, 13, 14 and 28 in one go")
-    p.add_argument("--ekf-comparison", help="comparison.csv of the EKF reproduction for Fig. 28 (default: run it)")
-    p.add_argument("--fisher", action="store_true", help="also write the Cramer-Rao bounds of the given trials")
-    p.add_argument("--crb-vs-mc", metavar="MC_DIR", nargs="+",
-                   help="CRB vs the EKF Monte Carlo in MC_DIR (runs.csv; run there when a single folder is missing); "
-                        "several folders are pooled per trial")
-    p.add_argument("--mc-seeds", type=int, default=20, help="seeds per trial when the Monte Carlo must be run")
-    p.add_argument("--rudder-timing", type=_rudder_timing, default=0.15, metavar="SIGMA_S",
-                   help="with --crb-vs-mc or --design: prior std [s] of the per-movement rudder-timing nuisances of the "
-                        "second log bound (default 0.15, the raw-log EKF's; 'inf' no prior; 'none' leaves that "
-                        "bound out)")
-    p.add_argument("--design", action="store_true", help="trial-design search (S-type psi_S, zigzag angles)")
-    p.add_argument("--backend", choices=["serial", "loky", "threads", "dask"], default="loky",
-                   help="parallel backend of the sweeps (dask: a local distributed cluster; optional extra)")
-    p.add_argument("--jobs", type=int, default=None, help="workers (default: all cores)")
-    p.set_defaults(func=cmd_sensitivity)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    from .cli import main
-
-    sys.exit(main(["sensitivity", *sys.argv[1:]]))

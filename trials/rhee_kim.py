@@ -18,8 +18,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .estimate import REPO, data_from_trial, estimate, joint_estimate, load_config, write_reports
-from .filter import DERIVATIVES
+from ekf.data import PAPER_DERIVATIVES as DERIVATIVES
+from ekf.estimate import estimate, joint_estimate, load_config
+from mmg.resources import trial_path
+
+from .estimation import data_from_trial, write_reports
 
 TRIALS = {"ST35": "st35.yaml", "ZZ10": "zz10.yaml", "ZZ20": "zz20.yaml", "S-type 120": "stype120.yaml"}
 
@@ -71,11 +74,11 @@ def reproduce_rhee_kim(out_dir, seed: int | None = None, config=None, trials=Non
                        verbose: bool = True, joint: bool = True) -> pd.DataFrame:
     """Run ST35, ZZ10, ZZ20 and S-type 120 and compare with Table 10; returns the comparison table.
 
-    Writes into ``out_dir``: comparison.csv/.md, the estimation reports (estimates.json,
-    error_table.csv/.md, convergence_*.png, preprocessing figures) and per-trial logs.
+    Writes into ``out_dir``: comparison.csv/.md and the estimation reports (estimates.json,
+    error_table.csv/.md, convergence_*.png, preprocessing figures, free_run.json).
     ``seed`` replaces every trial's noise seed (None keeps each trial file's own).
     ``joint`` adds rows for trial "joint": one filter run through all the trials in turn
-    (:func:`ekf.estimate.joint_estimate`), the paper has no such column.
+    (:func:`ekf.estimate.joint_estimate`); the paper has no such column.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -84,8 +87,7 @@ def reproduce_rhee_kim(out_dir, seed: int | None = None, config=None, trials=Non
     datas = []
     t0 = time.perf_counter()
     for name in trials or TRIALS:
-        path = REPO / "configs" / "trials" / TRIALS[name]
-        data = data_from_trial(path, cfg, seed=seed, workdir=out / "trials" / TRIALS[name].removesuffix(".yaml"))
+        data = data_from_trial(trial_path(TRIALS[name].removesuffix(".yaml")), cfg, seed=seed)
         datas.append(data)
         ests.append(estimate(data, cfg))
         if verbose:
@@ -109,9 +111,3 @@ def reproduce_rhee_kim(out_dir, seed: int | None = None, config=None, trials=Non
     if verbose:
         print(df.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     return df
-
-
-if __name__ == "__main__":
-    import sys
-
-    reproduce_rhee_kim(sys.argv[1] if len(sys.argv) > 1 else "out/rhee_kim_ekf")

@@ -1,0 +1,79 @@
+"""Nomoto identification of a record file as a report: the text table and the JSON + plot files (``mmg nomoto``)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from mmg.errors import InputError
+
+
+def _f(v, fmt="{:.4g}"):
+    return "n/a" if v is None or not np.isfinite(v) else fmt.format(v)
+
+
+def report(ident) -> str:
+    """Plain-text report of a :class:`trials.nomoto.NomotoIdentification`."""
+    z = ident.zigzag
+    d = ident.to_dict()
+    lines = [f"record {z.name}: L = {z.L:g} m, U = {z.U:.4g} m/s, execute at t = {z.t_execute:.4g} s "
+             f"to {d['first_execute_to']}, rudder {np.degrees(z.delta0):.3g} deg, yaw rate {z.yaw_rate_source}",
+             "points (s' [-], eps' [-], omega' [-], Delta [rad], delta [rad], psi [deg]):"]
+    for nm_, v in ident.points.to_dict().items():
+        lines.append(f"  {nm_:4s} {v['s']:8.4f} {v['eps']:9.5f} {v['omega']:9.5f} {v['Delta']:9.5f} "
+                     f"{v['delta']:9.5f} {v['psi_deg']:9.3f}")
+    lines.append("")
+    lines.append(f"{'method':34s} {'K':>8s} {'T / T1':>8s} {'T2':>8s} {'T3':>8s} {'psi RMS [deg]':>14s}")
+    for _, r in ident.to_pandas().iterrows():
+        lines.append(f"{r['method']:34s} {_f(r['K']):>8s} {_f(r['T1']):>8s} {_f(r['T2']):>8s} {_f(r['T3']):>8s} "
+                     f"{_f(r['rms_deg'], '{:.3f}'):>14s}")
+    for fit in (ident.least_squares, ident.output_error):
+        if fit is None:
+            continue
+        ci = "  ".join(f"{k} [{_f(lo)}, {_f(hi)}]" for k, (lo, hi) in fit.ci95.items() if k != "delta_bias")
+        lines.append(f"95 % intervals, {fit.method.replace('_', ' ')}: {ci}")
+    note = ident.four_point.note()
+    if note:
+        lines.append(f"four-point: {note}")
+    for fit in (ident.least_squares, ident.output_error):
+        if fit is not None and fit.note:
+            lines.append(f"{fit.method}: {fit.note}")
+    return "\n".join(lines)
+
+
+def identify_log(path, length: float, speed: float | None = None, output_error: bool = True):
+    """Nomoto identification of a zigzag record file (:func:`trials.nomoto.identify`); a project log
+    without rudder channel gets its rudder rebuilt from the trial logic of its header.
+
+    Returns
+    -------
+    (NomotoIdentification, str or None)
+        The identification and a note when the rudder was rebuilt.
+    """
+    from trials import nomoto as nm
+    from trials.logio import read_record
+
+    if length is None or not np.isfinite(length) or length <= 0:
+        raise InputError("--length", "", f"ship length must be a positive number of metres, got {length}")
+    if speed is not None and (not np.isfinite(speed) or speed <= 0):
+        raise InputError("--speed", "", f"speed must be a positive number of m/s, got {speed}")
+    rec = read_record(path)
+    note = None
+    if rec.delta is None and rec.meta.get("format") == "log":
+        from trials.rudder import with_rebuilt_rudder
+
+        rec = with_rebuilt_rudder(rec)
+        note = f"{rec.name}: no rudder channel in the log; rudder rebuilt from the {rec.meta.get('kind')} logic in its header"
+    return nm.identify(rec, length, speed, output_error=output_error), note
+
+
+def write_identification(ident, json_path) -> None:
+    """The identification's JSON and its plot (same stem, .png) written together or not at all."""
+    from trials.nomoto_plot import plot_identification
+    from trials.output import StagedOutput
+
+    out = Path(json_path)
+    with StagedOutput(out.parent) as stage:
+        stage.path(out.name).write_text(json.dumps(ident.to_dict(), indent=2))
+        plot_identification(ident, stage.path(out.with_suffix(".png").name))
