@@ -394,17 +394,65 @@ def initial_state(data: TrialData, cfg: dict) -> np.ndarray:
     return np.r_[m.u[0], m.v[0], m.r[0], m.n[0], der]
 
 
-def estimate(data: TrialData, cfg: dict) -> Estimate:
-    """Run the augmented EKF on one trial (raises FilterDivergence naming the trial and time)."""
+def estimate(data: TrialData, cfg: dict, engine: str = "compiled") -> Estimate:
+    """Run the augmented EKF on one trial.
+
+    Parameters
+    ----------
+    data : TrialData
+    cfg : dict
+        Estimation config (:func:`load_config`).
+    engine : {"compiled", "filterpy"}
+        ``"compiled"`` (default): :func:`ekf.filter.run_filter`, the numba loop (about a second
+        for 3000 s).  ``"filterpy"``: :class:`ekf.filter.AugmentedEKF` stepped in Python, the
+        same predict and filterpy's Joseph-form update (about 100 x slower; the same numbers
+        to rounding, ``tests/test_ekf.py``), for users who want to step or modify the filter.
+
+    Returns
+    -------
+    Estimate
+
+    Raises
+    ------
+    FilterDivergence
+        Naming the trial and the time.
+    """
     z0 = initial_state(data, cfg)
     R = R_for(cfg, data.name)
     P0 = P0_for(cfg, data.names, data.reference)
     q = float(cfg.get("Q", 0.0))
     dv = cfg.get("divergence", {})
+    if engine == "filterpy":
+        res = _filterpy_pass(data, z0, P0, R, q)
+        return Estimate(data, res, dict(zip(data.names, z0[NS:])), R)
+    if engine != "compiled":
+        raise ValueError(f"engine must be 'compiled' or 'filterpy', not {engine!r}")
     res = run_filter(data.packed, data.slots, data.meas.t, data.meas.z(), data.meas.delta, z0, P0, R,
                      trial=data.name, q=q, nis_window_s=float(dv.get("nis_window_s", 60.0)),
                      nis_max=float(dv.get("nis_max", 20.0)), names=data.names)
     return Estimate(data, res, dict(zip(data.names, z0[NS:])), R)
+
+
+def _filterpy_pass(data: TrialData, z0, P0, R, q: float) -> FilterResult:
+    """The pass of :func:`run_filter` stepped with filterpy (:class:`ekf.filter.AugmentedEKF`)."""
+    from .filter import AugmentedEKF, FilterDivergence, is_pd
+
+    m = data.meas
+    t = np.asarray(m.t, float)
+    meas, delta = m.z(), np.asarray(m.delta, float)
+    f = AugmentedEKF(data.packed, data.slots, float(t[1] - t[0]))
+    f.x, f.P, f.R = np.asarray(z0, float).copy(), np.asarray(P0, float).copy(), np.asarray(R, float)
+    f.Q = q * np.eye(len(z0))
+    zs = np.empty((len(t), len(z0)))
+    pd_ = np.empty_like(zs)
+    zs[0], pd_[0] = f.x, np.diag(f.P)
+    for k in range(1, len(t)):
+        f.predict((delta[k - 1], delta[k]))
+        f.update_uvrn(meas[k])
+        if not (np.all(np.isfinite(f.x)) and f.x[0] > 0 and is_pd(f.P)):
+            raise FilterDivergence(data.name, t[k], "the state left the valid range or P is no longer positive definite")
+        zs[k], pd_[k] = f.x, np.diag(f.P)
+    return FilterResult(t, zs, pd_, f.P.copy(), tuple(data.names))
 
 
 # --------------------------------------------------------------------------- summaries

@@ -40,8 +40,6 @@ TERMS: dict[str, int] = {
 }
 """Term expression -> integer id (beta [rad], v = v', r = r', all dimensionless)."""
 
-TERM_NAMES = {i: k for k, i in TERMS.items()}
-
 AXES = {"X": 0, "Y": 1, "N": 2}
 
 
@@ -102,11 +100,6 @@ def term_id(key: str) -> int:
         return TERMS[key]
     except KeyError:
         raise KeyError(f"unknown hull term {key!r}; known terms: {', '.join(TERMS)}") from None
-
-
-def evaluate_terms(term_ids, beta, vp, rp) -> np.ndarray:
-    """Values of several terms at one point, as an array (Python convenience)."""
-    return np.array([term_value(int(t), beta, vp, rp) for t in term_ids])
 
 
 _LATEX = {"Y_beta": r"$Y'_\beta$", "Y_r": r"$Y'_r$", "Y_bb": r"$Y'_{\beta|\beta|}$", "Y_rr": r"$Y'_{r|r|}$",

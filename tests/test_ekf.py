@@ -237,3 +237,20 @@ def test_free_run_judges_heading_not_a_current_drifted_track(tmp_path):
     assert fr.position_rms_m > 20.0            # the current carried the ship off the still-water track
     assert fr.ok and fr.heading_rms_deg < 0.5
     assert json.dumps(fr.to_dict())
+
+
+def test_estimate_filterpy_engine_gives_the_compiled_numbers(short_zz):
+    """The filterpy class a user can step is the same filter as the compiled fast path."""
+    from ekf.estimate import estimate, load_config
+    from trials.estimation import data_from_log
+
+    _, d = short_zz
+    cfg = load_config(None, ["divergence.nis_max=0"])
+    data = data_from_log(d / "log.csv", cfg)
+    data.meas = replace(data.meas, **{c: getattr(data.meas, c)[:1200] for c in ("t", "u", "v", "r", "delta", "n", "psi", "x", "y")})
+    a = estimate(data, cfg)
+    b = estimate(data, cfg, engine="filterpy")
+    assert a.final.keys() == b.final.keys()
+    for n in a.final:
+        assert b.final[n] == pytest.approx(a.final[n], rel=1e-8, abs=1e-14)
+    np.testing.assert_allclose(b.result.pdiag[-1], a.result.pdiag[-1], rtol=1e-6, atol=1e-15)

@@ -257,7 +257,7 @@ def to_markdown(df: pd.DataFrame) -> str:
             v = r[c]
             if isinstance(v, str):
                 cells.append(v)
-            elif "err" in c:
+            elif c.endswith("(%)"):
                 cells.append("" if not np.isfinite(v) else f"{v:.2f}")
             else:
                 cells.append("" if not np.isfinite(v) else f"{v:+.4e}")

@@ -75,7 +75,6 @@ NZ = NS + len(DERIVATIVES)              # the paper filter's state: u, v, r, n a
 LOG_NZ = LOG_ND + len(DERIVATIVES)      # the raw-log filter's
 
 NOISE_MODELS = ("log", "filter", "thinned")
-OUTPUTS = ("u", "v", "r", "n")
 
 
 @njit(cache=True)
