@@ -386,9 +386,27 @@ def ship_from_dict(data: dict, source: str = "<dict>") -> Ship:
     )
 
 
-def load_ship(path: str | Path) -> Ship:
-    """Read and validate a ship YAML file."""
-    path = Path(path)
+def load_ship(name_or_path: str | Path) -> Ship:
+    """Read and validate a ship YAML file.
+
+    Parameters
+    ----------
+    name_or_path : str or os.PathLike
+        A bundled ship name (``"esso_osaka"``, ``"kvlcc2_l7"``: the stem of a file in
+        ``configs/ships``) or a path to a ship YAML file.
+
+    Returns
+    -------
+    Ship
+
+    Raises
+    ------
+    mmg.errors.InputError
+        An unknown name, a missing file, malformed YAML or an invalid field.
+    """
+    from .resources import ship_path
+
+    path = ship_path(name_or_path)
     data = read_yaml(path)
     return ship_from_dict(data, str(path))
 

@@ -1,0 +1,8 @@
+"""Sea trials: trial definitions (:mod:`trials.trial`), runs (:mod:`trials.run`), logs,
+metrics, figures and the ``mmg`` command line (:mod:`trials.cli`).
+
+The everyday entry points are re-exported by the :mod:`mmg` facade
+(``mmg.load_trial``, ``mmg.zigzag``, ``mmg.simulate``, ...).
+"""
+
+__all__: list[str] = []

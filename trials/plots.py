@@ -1,15 +1,32 @@
-"""Figures users look at: tracks with ship outlines and time histories (PNG)."""
+"""Figures users look at: tracks with ship outlines and time histories.
+
+:func:`track_figure` and :func:`histories_figure` draw into a new figure (or into axes
+you give) and return the :class:`matplotlib.figure.Figure`; :func:`plot_track` and
+:func:`plot_histories` also write it to a PNG (the CLI).  Importing this module does
+not choose a matplotlib backend: figures that are only saved are drawn without pyplot
+(no window, no global figure state), so the CLI also works without a display.
+"""
 from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from mmg.units import DEG, KNOT
 
-from mmg.units import DEG, KNOT  # noqa: E402
+
+def _figure(figsize, pyplot: bool):
+    """A new figure: pyplot-managed (can be shown) or a bare Agg figure (only saved)."""
+    if pyplot:
+        import matplotlib.pyplot as plt
+
+        return plt.figure(figsize=figsize)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig
 
 
 def ship_outline(x, y, psi, L, B):
@@ -20,9 +37,31 @@ def ship_outline(x, y, psi, L, B):
     return x + s * c - b * sn, y + s * sn + b * c
 
 
-def plot_track(t, x, y, psi, L, B, title, path, every_s=None, show=False):
-    """Track (east right, north up) in ship lengths with outlines every ``every_s`` seconds."""
-    fig, ax = plt.subplots(figsize=(7, 7))
+def track_figure(t, x, y, psi, L, B, title, every_s=None, ax=None, pyplot: bool = True):
+    """Track (east right, north up) in ship lengths with outlines every ``every_s`` seconds.
+
+    Parameters
+    ----------
+    t, x, y, psi : ndarray
+        Time [s], position north, east [m], heading [rad].
+    L, B : float
+        Ship length and beam [m] (the outlines; the axes are in ship lengths).
+    title : str
+    every_s : float, optional
+        Time between outlines [s]; default a 25th of the run, at least 60 s.
+    ax : matplotlib.axes.Axes, optional
+        Draw into these axes; default a new figure.
+    pyplot : bool, default True
+        Make the new figure with pyplot (so ``plt.show()`` shows it).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if ax is None:
+        fig = _figure((7, 7), pyplot)
+        ax = fig.add_subplot()
+    fig = ax.figure
     ax.plot(y / L, x / L, "b-", lw=1, label="midship track")
     every_s = every_s or max(60.0, (t[-1] - t[0]) / 25)
     for tk in np.arange(t[0], t[-1] + 1e-9, every_s):
@@ -35,12 +74,39 @@ def plot_track(t, x, y, psi, L, B, title, path, every_s=None, show=False):
     ax.set_title(f"{title}: track (L = {L:g} m)")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best")
-    _save(fig, path, show)
+    return fig
 
 
-def plot_histories(t, psi, delta, r, U, n, title, path, delta_order=None, show=False):
-    """Heading, rudder, yaw rate, speed and rpm against time."""
-    fig, axs = plt.subplots(5, 1, figsize=(9, 11), sharex=True)
+def histories_figure(t, psi, delta, r, U, n, title, delta_order=None, ax=None, pyplot: bool = True):
+    """Heading, rudder, yaw rate, speed and rpm against time (five panels).
+
+    Parameters
+    ----------
+    t, psi, delta, r, U, n : ndarray
+        Time [s], heading [rad], rudder angle [rad], yaw rate [rad/s], speed [m/s],
+        propeller speed [rps].
+    title : str
+    delta_order : ndarray, optional
+        Rudder order [rad], drawn dashed with the rudder angle.
+    ax : sequence of 5 matplotlib.axes.Axes, optional
+        Draw into these axes; default a new figure with five panels sharing the time axis.
+    pyplot : bool, default True
+        Make the new figure with pyplot.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if ax is None:
+        fig = _figure((9, 11), pyplot)
+        axs = fig.subplots(5, 1, sharex=True)
+        new = True
+    else:
+        axs = list(np.ravel(ax))
+        if len(axs) != 5:
+            raise ValueError(f"histories need 5 axes, got {len(axs)}")
+        fig = axs[0].figure
+        new = False
     axs[0].plot(t, psi / DEG, "b")
     axs[0].set_ylabel("heading ψ (deg)")
     axs[1].plot(t, delta / DEG, "r", label="rudder δ")
@@ -58,12 +124,25 @@ def plot_histories(t, psi, delta, r, U, n, title, path, delta_order=None, show=F
     for a in axs:
         a.grid(True, alpha=0.3)
     axs[0].set_title(f"{title}: time histories")
-    fig.tight_layout()
-    _save(fig, path, show)
+    if new:
+        fig.tight_layout()
+    return fig
+
+
+def plot_track(t, x, y, psi, L, B, title, path, every_s=None, show=False):
+    """:func:`track_figure`, written to the PNG ``path`` (and shown if ``show``)."""
+    _save(track_figure(t, x, y, psi, L, B, title, every_s=every_s, pyplot=show), path, show)
+
+
+def plot_histories(t, psi, delta, r, U, n, title, path, delta_order=None, show=False):
+    """:func:`histories_figure`, written to the PNG ``path`` (and shown if ``show``)."""
+    _save(histories_figure(t, psi, delta, r, U, n, title, delta_order=delta_order, pyplot=show), path, show)
 
 
 def _save(fig, path, show):
     fig.savefig(Path(path), dpi=110)
     if show:
+        import matplotlib.pyplot as plt
+
         plt.show()
-    plt.close(fig)
+        plt.close(fig)

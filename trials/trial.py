@@ -1,6 +1,7 @@
 """Trial definitions from YAML: the manoeuvre, the approach, the log to record.
 
-A trial file (``configs/trials/*.yaml``) names its ship file (relative to itself),
+A trial file (``configs/trials/*.yaml``) names its ship (a bundled name such as
+``esso_osaka``, or a ship YAML path relative to the trial file),
 the approach condition, the manoeuvre, the integration step and duration, the
 sea-trial log to write and optional disturbances.  Every dimensional value carries
 its unit (``"10 kn"``, ``"35 deg"``, ``"0.1 s"``); unknown keys, wrong units,
@@ -22,6 +23,8 @@ schedule  table of [time_s, rudder_deg] or [time_s, rudder_deg, rpm] rows, inlin
 """
 from __future__ import annotations
 
+import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Literal, Optional, Union
@@ -186,7 +189,40 @@ class LogSpec:
 
 @dataclass(frozen=True)
 class Trial:
-    """A validated trial (SI units). ``manoeuvre`` keeps the kind and its parameters."""
+    """A validated trial, in SI units.
+
+    Build one with :func:`load_trial` (a bundled name, a YAML file or a mapping) or with
+    the builders :func:`zigzag`, :func:`turning`, :func:`stype`, :func:`schedule`,
+    :func:`make_trial`; run it with ``mmg.simulate(trial)`` (:func:`trials.run.run_trial`).
+
+    Attributes
+    ----------
+    name, description : str
+        From the trial file.
+    path : str
+        Where the trial came from (a file path, ``"<dict>"`` or ``"<zigzag>"`` etc.).
+    ship : mmg.ship.Ship
+        The ship.
+    ship_path : str
+        The ship YAML it was read from ("" when the builder was given a Ship object).
+    u0 : float
+        Approach speed [m/s].
+    n0 : float or None
+        Approach propeller speed [rps]; None: solved for the approach speed.
+    trim : bool
+        Start from the trim rudder and drift that cancel the ship's Y_0, N_0.
+    duration, dt : float
+        Simulated time and integration step [s].
+    kind : str
+        ``"turning"``, ``"zigzag"``, ``"stype"``, ``"sine"``, ``"sawtooth"`` or ``"schedule"``.
+    manoeuvre : dict
+        The manoeuvre's parameters in SI (angles in rad, times in s; a schedule's
+        ``table`` as rows of [s, rad(, rps)]).
+    log : LogSpec
+        How the sea-trial log is recorded.
+    disturbances : tuple
+        Current and rudder offset (:mod:`mmg.disturbances`).
+    """
 
     name: str
     path: str
@@ -226,6 +262,20 @@ class Trial:
         tab = m["table"]
         n = tab[:, 2] if tab.shape[1] > 2 else None
         return CommandLaw.schedule(tab[:, 0], tab[:, 1], n)
+
+    def __repr__(self) -> str:
+        man = []
+        for k, v in self.manoeuvre.items():
+            if k in ("rudder", "heading", "switch_heading", "amplitude"):
+                man.append(f"{k}={v / DEG:g} deg")
+            elif k in ("period", "execute"):
+                man.append(f"{k}={v:g} s")
+            elif k == "table":
+                man.append(f"table={len(v)} rows")
+            elif k == "first":
+                man.append(f"first={v}")
+        return (f"Trial({self.name!r}, {self.kind}: {', '.join(man)}; ship={self.ship.name!r}, "
+                f"speed={self.u0 * 3600 / 1852:.4g} kn, duration={self.duration:g} s, dt={self.dt:g} s)")
 
     def summary(self) -> dict:
         """Trial parameters for a log header (degrees and knots, as at the edges)."""
@@ -272,21 +322,118 @@ def _read_table(path: Path, source: str) -> np.ndarray:
     return df[cols].to_numpy(dtype=float)
 
 
-def load_trial(path: str | Path) -> Trial:
-    """Read and validate a trial YAML (and the ship file it names)."""
-    path = Path(path)
-    src = str(path)
-    data = read_yaml(path)
+_UNIT_HINT = {
+    "rudder": "deg", "heading": "deg", "switch_heading": "deg", "amplitude": "deg", "direction": "deg",
+    "rudder_offset": "deg", "lat": "deg", "lon": "deg", "start_lat": "deg", "start_lon": "deg",
+    "speed": "kn", "rpm": "rpm", "duration": "s", "dt": "s", "period": "s", "execute": "s", "interval": "s",
+}
+
+
+def _message(err) -> str:
+    """Pydantic's message, made plain; a number where a quantity is expected names the unit to add."""
+    loc = err.get("loc", ())
+    field = str(loc[-1]) if loc else ""
+    value = err.get("input")
+    if err.get("type") == "string_type" and isinstance(value, (int, float)) and not isinstance(value, bool) \
+            and field in _UNIT_HINT:
+        return (f"{value!r} has no unit; write it with one, e.g. '{value} {_UNIT_HINT[field]}' "
+                "(plain numbers are refused)")
+    return err["msg"].removeprefix("Value error, ")
+
+
+def _resolve_ship(spec: str, base: Path, src: str) -> Path:
+    """A trial's ``ship:`` entry: a bundled ship name, or a path relative to ``base``."""
+    from mmg.resources import _looks_like_path, bundled, config_dir
+
+    if _looks_like_path(spec):
+        p = Path(spec).expanduser()
+        p = (p if p.is_absolute() else base / p).resolve()
+        if not p.is_file():
+            raise InputError(src, "ship", f"ship file {spec} not found (looked in {p})")
+        return p
+    p = config_dir() / "ships" / f"{spec}.yaml"
+    if p.is_file():
+        return p
+    if (base / spec).is_file():
+        return (base / spec).resolve()
+    raise InputError(src, "ship", f"no bundled ship {spec!r} (bundled: {', '.join(bundled('ships'))}); "
+                                  "or give a path to a ship YAML, relative to the trial file")
+
+
+def load_trial(source: str | Path | Mapping) -> Trial:
+    """Read and validate a trial (and the ship it names).
+
+    Parameters
+    ----------
+    source : str, os.PathLike or mapping
+        A bundled trial name (``"zz20"``, ``"st35"``: the stem of a file in
+        ``configs/trials``), a path to a trial YAML, or a mapping with a trial YAML's
+        content.  The trial's ``ship:`` is a bundled ship name (``esso_osaka``) or a path,
+        relative to the trial file (for a mapping: to the working directory).
+
+    Returns
+    -------
+    Trial
+
+    Raises
+    ------
+    mmg.errors.InputError
+        An unknown name, a missing file, or an invalid field (one line naming the file
+        and the field).
+    """
+    if isinstance(source, Mapping):
+        return trial_from_dict(source)
+    from mmg.resources import trial_path
+
+    path = trial_path(source)
+    return trial_from_dict(read_yaml(path), source=str(path), base=path.parent)
+
+
+def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | None = None,
+                    ship: Ship | None = None) -> Trial:
+    """Validate a trial mapping (a trial YAML's content) and build the :class:`Trial`.
+
+    Parameters
+    ----------
+    data : mapping
+        The trial's fields, as in a trial YAML.
+    source : str
+        Names the trial in error messages and in :attr:`Trial.path`.
+    base : path, optional
+        Folder that relative paths (``ship:``, ``manoeuvre.file``) are relative to;
+        default the working directory.
+    ship : Ship, optional
+        Use this ship instead of the one ``data["ship"]`` names (which may then be omitted).
+
+    Returns
+    -------
+    Trial
+
+    Raises
+    ------
+    mmg.errors.InputError
+        One line naming ``source`` and the field at fault.
+    """
+    src = str(source)
+    base = Path.cwd() if base is None else Path(base)
+    if not isinstance(data, Mapping):
+        raise InputError(src, "", f"expected a mapping of trial fields, got {type(data).__name__}")
+    data = dict(data)
+    if ship is not None:
+        if not isinstance(ship, Ship):
+            raise InputError(src, "ship", f"expected a Ship, got {type(ship).__name__}")
+        data["ship"] = data.get("ship") or ship.name
     try:
         f = _TrialFile.model_validate(data)
     except ValidationError as e:
         err = e.errors()[0]
-        msg = err["msg"].removeprefix("Value error, ")
-        raise InputError(src, _loc(err), msg) from None
-    ship_path = (path.parent / f.ship).resolve()
-    if not ship_path.exists():
-        raise InputError(src, "ship", f"ship file {f.ship} not found (looked in {ship_path})")
-    ship = load_ship(ship_path)
+        raise InputError(src, _loc(err), _message(err)) from None
+    if ship is None:
+        ship_path = _resolve_ship(f.ship, base, src)
+        ship = load_ship(ship_path)
+        ship_path = str(ship_path)
+    else:
+        ship_path = ""
     dmax = ship.steering.delta_max
     man = f.manoeuvre.model_dump()
     kind = man.pop("kind")
@@ -309,7 +456,7 @@ def load_trial(path: str | Path) -> Trial:
         if (conv.get("table") is None) == (conv.get("file") is None):
             raise InputError(src, "manoeuvre", "a schedule needs exactly one of 'table' or 'file'")
         tab = np.asarray(conv["table"], dtype=float) if conv.get("table") is not None else \
-            _read_table(path.parent / conv["file"], src)
+            _read_table(base / conv["file"], src)
         if tab.ndim != 2 or tab.shape[1] not in (2, 3) or len(tab) < 2:
             raise InputError(src, "manoeuvre.table", "needs at least two rows of [time_s, rudder_deg(, rpm)]")
         if not np.all(np.isfinite(tab)):
@@ -347,12 +494,197 @@ def load_trial(path: str | Path) -> Trial:
     if off != 0.0:
         dist.append(RudderOffset(off))
     return Trial(
-        name=f.name, path=src, ship=ship, ship_path=str(ship_path), description=f.description,
+        name=f.name, path=src, ship=ship, ship_path=ship_path, description=f.description,
         u0=to_si(f.approach.speed, "speed"),
         n0=None if f.approach.rpm == "solve" else to_si(f.approach.rpm, "revolutions"),
         trim=f.approach.trim, duration=duration, dt=dt, kind=kind, manoeuvre=conv, log=log,
         disturbances=tuple(dist),
     )
+
+
+# --------------------------------------------------------------------------- builders
+
+def make_trial(ship: Ship | str | Path, manoeuvre: Mapping, *, speed: str, duration: str, dt: str = "0.1 s",
+               rpm: str = "solve", trim: bool = True, log: Mapping | None = None,
+               disturbances: Mapping | None = None, name: str | None = None, description: str = "") -> Trial:
+    """Build a trial in code, through the same validation as a trial YAML.
+
+    Every dimensional value is a string with its unit, as in the YAML (``"10 kn"``,
+    ``"20 deg"``, ``"3000 s"``).  Plain numbers are refused (is ``20`` degrees or
+    radians?) with :class:`mmg.errors.InputError`, and so are units of the wrong kind
+    (``rudder="20 m"``).
+
+    Parameters
+    ----------
+    ship : Ship, str or os.PathLike
+        A :class:`mmg.ship.Ship`, a bundled ship name (``"esso_osaka"``) or a ship YAML path
+        (relative to the working directory).
+    manoeuvre : mapping
+        The YAML's ``manoeuvre:`` section, e.g. ``{"kind": "sine", "amplitude": "35 deg",
+        "period": "600 s"}``.
+    speed : str
+        Approach speed, e.g. ``"10 kn"``.
+    duration : str
+        Simulated time, e.g. ``"3000 s"``.
+    dt : str, default "0.1 s"
+        Integration step.
+    rpm : str, default "solve"
+        Approach propeller speed (``"54 rpm"``) or ``"solve"``: the rpm that holds ``speed``.
+    trim : bool, default True
+        Start from the trim rudder and drift that cancel the ship's Y_0, N_0.
+    log : mapping, optional
+        The YAML's ``log:`` section (``interval``, ``seed``, ``start_lat``, ``noise``, ``bias``).
+    disturbances : mapping, optional
+        The YAML's ``disturbances:`` section (``current``, ``rudder_offset``).
+    name : str, optional
+        The trial's name; default from the manoeuvre.
+    description : str, default ""
+
+    Returns
+    -------
+    Trial
+
+    Raises
+    ------
+    mmg.errors.InputError
+        A missing or invalid field, a wrong unit, a rudder beyond the steering gear limit.
+    """
+    if not isinstance(manoeuvre, Mapping) or "kind" not in manoeuvre:
+        raise InputError("make_trial", "manoeuvre", "expected a mapping with a 'kind'")
+    kind = str(manoeuvre["kind"])
+    data = {"name": name or _default_name(manoeuvre), "description": description,
+            "approach": {"speed": speed, "rpm": rpm, "trim": trim},
+            "duration": duration, "dt": dt, "manoeuvre": dict(manoeuvre)}
+    if log is not None:
+        data["log"] = dict(log)
+    if disturbances is not None:
+        data["disturbances"] = dict(disturbances)
+    if isinstance(ship, Ship):
+        return trial_from_dict(data, source=f"<{kind}>", ship=ship)
+    if not isinstance(ship, (str, os.PathLike)):
+        raise InputError(f"<{kind}>", "ship", f"expected a Ship, a bundled ship name or a path, got {type(ship).__name__}")
+    data["ship"] = os.fspath(ship)
+    return trial_from_dict(data, source=f"<{kind}>")
+
+
+def _default_name(m: Mapping) -> str:
+    k = m.get("kind")
+    if k == "zigzag":
+        return f"zigzag {m.get('rudder')}/{m.get('heading')}"
+    if k == "turning":
+        return f"turning {m.get('rudder')}"
+    if k == "stype":
+        return f"S-type {m.get('switch_heading')}"
+    if k in ("sine", "sawtooth"):
+        return f"{k} {m.get('amplitude')}, {m.get('period')}"
+    return str(k)
+
+
+def zigzag(ship: Ship | str | Path, *, rudder: str, heading: str | None = None, speed: str, duration: str,
+           first: str = "starboard", **kw) -> Trial:
+    """A zigzag trial: rudder to ``rudder`` until the heading has changed by ``heading``, reverse.
+
+    Parameters
+    ----------
+    ship : Ship, str or os.PathLike
+        A Ship, a bundled ship name or a ship YAML path.
+    rudder : str
+        Rudder angle, e.g. ``"20 deg"``.
+    heading : str, optional
+        Heading change at which the rudder is reversed; default ``rudder`` (a 20/20 zigzag).
+    speed, duration : str
+        Approach speed (``"10 kn"``) and simulated time (``"3000 s"``).
+    first : {"starboard", "port"}, default "starboard"
+        The side of the first rudder order.
+    **kw
+        ``dt``, ``rpm``, ``trim``, ``log``, ``disturbances``, ``name``, ``description`` of
+        :func:`make_trial`.
+
+    Returns
+    -------
+    Trial
+
+    Examples
+    --------
+    >>> zz = zigzag("esso_osaka", rudder="20 deg", heading="20 deg", speed="10 kn", duration="3000 s")
+    """
+    man = {"kind": "zigzag", "rudder": rudder, "heading": rudder if heading is None else heading, "first": first}
+    return make_trial(ship, man, speed=speed, duration=duration, **kw)
+
+
+def turning(ship: Ship | str | Path, *, rudder: str, speed: str, duration: str, execute: str = "0 s",
+            **kw) -> Trial:
+    """A turning circle: hold ``rudder`` (signed, + starboard) from ``execute`` on.
+
+    Parameters
+    ----------
+    ship : Ship, str or os.PathLike
+        A Ship, a bundled ship name or a ship YAML path.
+    rudder : str
+        Rudder angle, + starboard, e.g. ``"35 deg"`` or ``"-35 deg"``.
+    speed, duration : str
+        Approach speed and simulated time.
+    execute : str, default "0 s"
+        When the rudder order is given.
+    **kw
+        See :func:`make_trial`.
+
+    Returns
+    -------
+    Trial
+    """
+    return make_trial(ship, {"kind": "turning", "rudder": rudder, "execute": execute},
+                      speed=speed, duration=duration, **kw)
+
+
+def stype(ship: Ship | str | Path, *, rudder: str, switch_heading: str, speed: str, duration: str,
+          first: str = "starboard", **kw) -> Trial:
+    """An S-type trial (Rhee & Kim section 6.1): reverse at ``switch_heading`` and back at 0.
+
+    Parameters
+    ----------
+    ship : Ship, str or os.PathLike
+    rudder, switch_heading : str
+        Rudder angle and switching heading change psi_S, e.g. ``"35 deg"``, ``"120 deg"``.
+    speed, duration : str
+    first : {"starboard", "port"}, default "starboard"
+    **kw
+        See :func:`make_trial`.
+
+    Returns
+    -------
+    Trial
+    """
+    man = {"kind": "stype", "rudder": rudder, "switch_heading": switch_heading, "first": first}
+    return make_trial(ship, man, speed=speed, duration=duration, **kw)
+
+
+def schedule(ship: Ship | str | Path, *, table=None, file: str | Path | None = None, speed: str,
+             duration: str, **kw) -> Trial:
+    """A scheduled rudder (and rpm) order, linearly interpolated.
+
+    Parameters
+    ----------
+    ship : Ship, str or os.PathLike
+    table : array_like, optional
+        Rows of ``[time_s, rudder_deg]`` or ``[time_s, rudder_deg, rpm]`` (plain numbers in the
+        units the column names say, as in the YAML).
+    file : path, optional
+        A CSV with columns ``time_s, rudder_deg[, rpm]`` instead of ``table``.
+    speed, duration : str
+    **kw
+        See :func:`make_trial`.
+
+    Returns
+    -------
+    Trial
+    """
+    man: dict = {"kind": "schedule"}
+    if table is not None:
+        man["table"] = np.asarray(table, dtype=float).tolist()
+    if file is not None:
+        man["file"] = os.fspath(file)
+    return make_trial(ship, man, speed=speed, duration=duration, **kw)
 
 
 def degrees(x: float) -> float:
