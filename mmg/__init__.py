@@ -8,6 +8,8 @@ The public API, in one namespace::
     res = mmg.simulate(trial)                           # or mmg.simulate("zz20")
     res.metrics()["overshoots_deg"]
     res.to_pandas(); res.plot("track"); res.log(seed=1)
+    est = mmg.estimate("zz20")                          # the augmented EKF on the simulated log
+    est.to_pandas(); est.plot()
 
 Values with a dimension are strings with their unit, as in the YAML configs
 (``"20 deg"``, ``"10 kn"``, ``"3000 s"``); plain numbers and wrong units are refused
@@ -41,6 +43,7 @@ _LAZY = {
     "schedule": ("trials.trial", "schedule"),
     "simulate": ("trials.run", "run_trial"),
     "TrialRun": ("trials.run", "TrialRun"),
+    "estimate": ("trials.estimation", "estimate"),
     "config_dir": ("mmg.resources", "config_dir"),
     "config_path": ("mmg.resources", "config_path"),
     "ship_path": ("mmg.resources", "ship_path"),

@@ -418,3 +418,68 @@ def _paths(out):
     from .output import out_path
 
     return out_path(out)
+
+
+def estimate(source, ship=None, config=None, seed: int | None = None, truth=None, method: str = "ekf",
+             names=None, engine: str = "compiled"):
+    """Estimate the hull coefficients of one record: the everyday entry point (``mmg.estimate``).
+
+    Parameters
+    ----------
+    source : str, Path, Trial or TrialRun
+        A project log file, a trial (bundled name, YAML path or :class:`trials.trial.Trial`:
+        simulated first with noise seed ``seed``) or a simulated :class:`trials.run.TrialRun`
+        (its log taken with ``seed``).
+    ship : Ship, str or Path, optional
+        The model to estimate with, for a log file (default: the log's own ship file, else the
+        bundled Esso Osaka).  Trials bring their own ship.
+    config : str, Path or dict, optional
+        Estimation settings over the bundled Rhee & Kim ones (:func:`ekf.estimate.load_config`).
+    truth : str or Path, optional
+        The truth file of a simulated log (enables errors against the true values).
+    method : {"ekf", "output-error"}
+        The augmented EKF (default) or the EKF followed by the output-error fit of the raw log.
+    names : sequence of str, optional
+        Coefficients to estimate (default: every sway/yaw coefficient of the ship's table).
+    engine : {"compiled", "filterpy"}
+        For ``method="ekf"``: the numba loop or the filterpy class (same numbers).
+
+    Returns
+    -------
+    ekf.estimate.Estimate or ekf.output_error.OEEstimate
+        ``.final``, ``.to_pandas()`` (estimates, std, true values and % errors where known),
+        ``.plot()`` (EKF convergence), ``.warnings()`` (EKF).
+
+    Examples
+    --------
+    >>> import mmg
+    >>> est = mmg.estimate("zz20")                     # doctest: +SKIP
+    >>> est.to_pandas()[["estimate", "true", "error_pct"]]  # doctest: +SKIP
+    """
+    from ekf.estimate import estimate as ekf_estimate
+    from ekf.estimate import load_config
+    from ekf.output_error import OEEstimate, refine
+
+    from .run import TrialRun
+    from .trial import Trial
+
+    cfg = load_config(config)
+    if isinstance(source, TrialRun):
+        run = source
+        if seed is not None:
+            run = TrialRun(replace(run.trial, log=replace(run.trial.log, seed=int(seed))), run.result)
+        meta = run.log_meta()
+        src = str(run.trial.path or run.trial.name)
+        data = data_from_record(record_from_frame(as_written(run.log()), meta, src), cfg, run.trial.ship,
+                                record_from_frame(run.truth(), meta, src), run.trial.ship.hull.as_dict(), names)
+    elif isinstance(source, Trial) or Path(str(source)).suffix.lower() in (".yaml", ".yml") \
+            or not Path(str(source)).exists():
+        data = data_from_trial(source, cfg, seed=seed, names=names)
+    else:
+        data = data_from_log(source, cfg, ship_path=ship, truth_path=truth, names=names)
+    if method == "output-error":
+        _, res = refine([data], cfg)
+        return OEEstimate(data, res, "output-error")
+    if method != "ekf":
+        raise InputError("method", str(method), "must be 'ekf' or 'output-error'")
+    return ekf_estimate(data, cfg, engine=engine)
