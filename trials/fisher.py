@@ -358,8 +358,8 @@ def crb_vs_montecarlo(runs: "pd.DataFrame", trial_files: dict, noises=("log", "f
                       rudder_timing: float | None = 0.15) -> "pd.DataFrame":
     """CRB std beside the Monte Carlo std of the EKF's final estimates, per trial and derivative.
 
-    runs: the EKF Monte Carlo's runs.csv (:func:`ekf.montecarlo.monte_carlo` or
-        :func:`ekf.log_filter.monte_carlo`: one row per trial and seed with ``final_<derivative>``,
+    runs: the EKF Monte Carlo's runs.csv (:func:`trials.montecarlo.monte_carlo` or
+        :func:`trials.montecarlo.log_filter_monte_carlo`: one row per trial and seed with ``final_<derivative>``,
         diverged runs flagged).
     trial_files: maps the trial names in it to trial YAML paths.
     noises: noise models of the bounds with the rudder known (columns ``crb_std_<noise>``).
