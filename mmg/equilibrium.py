@@ -14,7 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import fsolve
 
 from .model import POLY_KQ, N_, PackedShip, forces, pack, polyval, rhs
 from .ship import Ship
@@ -54,6 +53,48 @@ def _accels(pk: PackedShip, u, v, delta, n):
     return out
 
 
+def _newton(fun, z0, tol: float = 1e-13, max_iter: int = 50) -> np.ndarray:
+    """Newton's method with a central-difference Jacobian and step halving, for the few smooth
+    unknowns of the straight run (rpm, sway, trim rudder); converges to rounding in a handful of
+    steps.  (A small solver here instead of scipy.optimize.fsolve: ``import scipy.optimize`` costs
+    more than a simulation.)
+
+    Raises
+    ------
+    ValueError
+        When it does not converge (no straight run at this speed).
+    """
+    z = np.asarray(z0, float).copy()
+    f = np.asarray(fun(z), float)
+    for _ in range(max_iter):
+        if not np.all(np.isfinite(f)):
+            break
+        J = np.empty((len(f), len(z)))
+        for j in range(len(z)):
+            h = 1e-6 * max(abs(z[j]), 1e-3)
+            zp, zm = z.copy(), z.copy()
+            zp[j] += h
+            zm[j] -= h
+            J[:, j] = (np.asarray(fun(zp)) - np.asarray(fun(zm))) / (2 * h)
+        try:
+            step = np.linalg.solve(J, -f)
+        except np.linalg.LinAlgError:
+            break
+        lam, n0 = 1.0, np.linalg.norm(f)
+        while lam > 1e-4:
+            zn = z + lam * step
+            fn = np.asarray(fun(zn), float)
+            if np.all(np.isfinite(fn)) and np.linalg.norm(fn) <= n0:
+                break
+            lam *= 0.5
+        z, f = zn, fn
+        if np.all(np.abs(lam * step) <= tol * np.maximum(np.abs(z), 1e-3)) or np.linalg.norm(f) == 0.0:
+            return z
+    if np.all(np.isfinite(f)) and np.max(np.abs(f)) < 1e-10:
+        return z
+    raise ValueError("the straight-run equations did not converge (no steady straight run at this speed)")
+
+
 def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = True,
                  disturbance_slots: dict | None = None) -> Equilibrium:
     """Solve the steady straight run at surge speed ``u0`` [m/s].
@@ -90,10 +131,7 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
         return out
 
     z0 = ([n_guess] if n is None else []) + ([0.0, 0.0] if trim else [])
-    if z0:
-        z = fsolve(resid, z0, xtol=1e-13, full_output=False)
-    else:
-        z = []
+    z = _newton(resid, z0) if z0 else []
     nn, vv, dd = unpack(z)
     scale = 1.0
     if ship.engine.mode == "constant_power":

@@ -226,17 +226,23 @@ def _check_truth(rec, truth, src: str) -> None:
 def data_from_trial(trial, cfg: dict, seed: int | None = None, names=None) -> TrialData:
     """Simulate a trial (a :class:`trials.trial.Trial`, a bundled name or a trial YAML) with noise seed
     ``seed`` and build its :class:`TrialData` in memory: the log and the truth as the files would hold
-    them, the true values the trial ship's coefficients."""
-    from .run import run_trial
+    them, the true values the trial ship's coefficients.
+
+    ``trial`` may also be a simulated :class:`trials.run.TrialRun`: the simulation is then reused and
+    only the log is drawn again with ``seed`` (the trajectory does not depend on the log's noise), so
+    a Monte Carlo over noise seeds simulates each trial once.
+    """
+    from .run import TrialRun, run_trial
     from .trial import Trial, load_trial
 
-    tr = trial if isinstance(trial, Trial) else load_trial(trial)
+    run = trial if isinstance(trial, TrialRun) else None
+    tr = run.trial if run is not None else (trial if isinstance(trial, Trial) else load_trial(trial))
     if tr.kind not in REBUILT_KINDS:
         raise InputError(str(tr.path or tr.name), "manoeuvre.kind", f"the estimator rebuilds the rudder of turning, "
                                                                     f"zigzag and S-type trials only, not {tr.kind}")
     if seed is not None:
         tr = replace(tr, log=replace(tr.log, seed=int(seed)))
-    run = run_trial(tr)
+    run = run_trial(tr) if run is None else TrialRun(tr, run.result)
     meta = run.log_meta()
     src = str(tr.path or tr.name)
     rec = record_from_frame(as_written(run.log()), meta, src)    # as the log file holds it
@@ -350,14 +356,15 @@ def load_inputs(inputs, cfg: dict, seed: int | None = None, ship=None, truth=Non
 
 
 def estimate_and_report(datas: list[TrialData], cfg: dict, out, joint: bool = False, plots: bool = True,
-                        method: str = "ekf", verbose: bool = True) -> dict:
+                        method: str = "ekf", verbose: bool = True, n_jobs: int = 2, ekf_start: dict | None = None) -> dict:
     """Estimate (``method`` "ekf": the augmented EKF per input, ``joint`` adding one run through all
-    of them; "output-error": the joint EKF then the joint output-error fit) and write the reports
+    of them; "output-error": the joint EKF then the joint output-error fit, its Jacobian's simulations
+    on ``n_jobs`` workers, the EKF skipped when ``ekf_start`` gives its result) and write the reports
     into ``out``.  Returns the report dict (``table``, ``estimates``, ``warnings``, ...)."""
     from ekf.estimate import estimate, joint_estimate
 
     if method == "output-error":
-        return _output_error_report(datas, cfg, out, verbose)
+        return _output_error_report(datas, cfg, out, verbose, n_jobs, ekf_start)
     ests = [estimate(d, cfg) for d in datas]
     warns = [w for e in ests for w in e.warnings()]
     if joint and len(datas) > 1:
@@ -367,13 +374,13 @@ def estimate_and_report(datas: list[TrialData], cfg: dict, out, joint: bool = Fa
     return rep
 
 
-def _output_error_report(datas, cfg, out, verbose: bool) -> dict:
+def _output_error_report(datas, cfg, out, verbose: bool, n_jobs: int = 2, ekf_start=None) -> dict:
     from ekf.output_error import OEEstimate, refine
 
     from .output import dump_json
 
     out = _paths(out)
-    ekf, res = refine(datas, cfg, verbose=verbose)
+    ekf, res = refine(datas, cfg, verbose=verbose, n_jobs=n_jobs, ekf_start=ekf_start)
     name = "output-error" if len(datas) == 1 else "output-error joint"
     est = OEEstimate(datas[0], res, name)
     js = estimates_json([est])

@@ -9,6 +9,7 @@ diverges is counted and left out of the statistics.
 """
 from __future__ import annotations
 
+import functools
 import time
 from pathlib import Path
 
@@ -37,8 +38,16 @@ def paper_trial_file(name: str) -> str:
     return str(trial_path(TRIALS[name].removesuffix(".yaml")))
 
 
+@functools.lru_cache(maxsize=16)
+def _run_of(trial_file: str):
+    """The trial simulated once per worker process: the seeds change only the log's noise."""
+    from .run import run_trial
+
+    return run_trial(load_trial(trial_file))
+
+
 def _one(trial_file: str, seed: int, cfg: dict) -> dict:
-    data = data_from_trial(trial_file, cfg, seed=seed)
+    data = data_from_trial(_run_of(trial_file), cfg, seed=seed)
     try:
         e = estimate(data, cfg)
     except FilterDivergence as exc:
@@ -131,7 +140,7 @@ def _timing_error(data) -> dict:
 
 
 def _log_one(trial_file: str, seed: int, cfg: dict, q, sigma_tau: float = 0.15, rudder: str = "rebuilt") -> dict:
-    data = data_from_trial(trial_file, cfg, seed=seed)
+    data = data_from_trial(_run_of(trial_file), cfg, seed=seed)
     try:
         res = run_log_filter(data, data.record, cfg, q=q, sigma_tau=sigma_tau, rudder=rudder)
     except FilterDivergence as exc:
@@ -182,7 +191,7 @@ def log_filter_monte_carlo(out_dir, n_seeds: int = 20, trials=None, n_jobs: int 
 
 
 def _oe_one(seed: int, trials, cfg, rudder: str) -> dict:
-    datas = [data_from_trial(paper_trial_file(t), cfg, seed=seed) for t in trials]
+    datas = [data_from_trial(_run_of(paper_trial_file(t)), cfg, seed=seed) for t in trials]
     tv = datas[0].true_values
     try:
         ekf, res = refine(datas, cfg, rudder=rudder)

@@ -275,12 +275,15 @@ def nomoto_section(doc, out: Path, full: bool):
     progress(f"Nomoto tables {time.perf_counter() - t0:.1f} s")
 
 
-def ekf_section(doc, out: Path):
+def ekf_section(doc, out: Path, runs: dict) -> dict:
     from .rhee_kim import reproduce_rhee_kim
 
     doc("## 7. EKF: Rhee & Kim (1999) Tables 9-10\n")
     t0 = time.perf_counter()
-    reproduce_rhee_kim(out / "ekf", verbose=False)
+    keep = {}
+    stems = {"ST35": "st35", "ZZ10": "zz10", "ZZ20": "zz20", "S-type 120": "stype120"}
+    reproduce_rhee_kim(out / "ekf", verbose=False, runs={k: runs[s][0] for k, s in stems.items() if s in runs},
+                       keep=keep)
     doc((out / "ekf" / "comparison.md").read_text())
     doc("\nThe estimates, the Table-10 error table and the free-run check are in `ekf/` "
         "([estimates.json](ekf/estimates.json), [error_table.md](ekf/error_table.md), "
@@ -288,6 +291,7 @@ def ekf_section(doc, out: Path):
         "[Y_beta](ekf/convergence_Y_beta.png) and [N_r](ekf/convergence_N_r.png) (cf. Rhee & Kim Figs 15-26); "
         "recovered measurements against the truth (Figs 4-5): [ZZ20](ekf/preprocessing_ZZ20.png).\n")
     progress(f"EKF reproduction {time.perf_counter() - t0:.1f} s")
+    return keep
 
 
 def sensitivity_section(doc, out: Path):
@@ -304,19 +308,21 @@ def sensitivity_section(doc, out: Path):
     progress(f"sensitivity figures {time.perf_counter() - t0:.1f} s")
 
 
-def best_estimator_section(doc, out: Path, full: bool):
+def best_estimator_section(doc, out: Path, full: bool, ekf: dict):
     from ekf.estimate import load_config
 
-    from .estimation import estimate_and_report, load_inputs, to_markdown
+    from .estimation import estimate_and_report, to_markdown
 
     doc("## 9. Beyond the paper: joint output-error estimate over ST35, ZZ10, ZZ20, S-type 120\n")
     doc("(the EKF of section 7 jointly over the four trials, then an output-error fit of the raw logs; "
           "one noise seed: the trial files' own)\n")
     t0 = time.perf_counter()
     cfg = load_config()
-    datas = load_inputs([str(trial_path(n)) for n in ("st35", "zz10", "zz20", "stype120")], cfg)
+    datas = ekf["datas"]                                 # section 7's data (same trials, same seeds)
+    joint = next(e for e in ekf["estimates"] if e.name == "joint")
     with StagedOutput(out / "best_estimator") as stage:
-        rep = estimate_and_report(datas, cfg, stage, method="output-error", plots=False, verbose=False)
+        rep = estimate_and_report(datas, cfg, stage, method="output-error", plots=False, verbose=False,
+                                  n_jobs=2, ekf_start=joint.final)
     fit = rep["fit"]
     doc(f"Output-error fit over {', '.join(fit['trials'])}: chi2/dof {fit['chi2_per_dof']:.3f} "
         f"({fit['residuals']} residuals, {fit['nfev']} evaluations). Coefficients, standard errors from "
@@ -368,14 +374,15 @@ def reproduce(out, full: bool = False) -> Path:
         f()
         progress(f"{label} done ({time.perf_counter() - t0:.1f} s)")
     runs = trials_section(doc, out)
+    keep: dict = {}
     progress(f"default trials done ({time.perf_counter() - t0:.1f} s)")
     for label, f in [("plausibility", lambda: plausibility_section(doc, runs, ship)),
                      ("ST35 variants", lambda: st35_variants_section(doc, ship)),
                      ("numerical checks", lambda: checks_section(doc, ship)),
                      ("Nomoto", lambda: nomoto_section(doc, out, full)),
-                     ("EKF", lambda: ekf_section(doc, out)),
+                     ("EKF", lambda: keep.update(ekf_section(doc, out, runs))),
                      ("sensitivity", lambda: sensitivity_section(doc, out)),
-                     ("output error", lambda: best_estimator_section(doc, out, full))]:
+                     ("output error", lambda: best_estimator_section(doc, out, full, keep))]:
         f()
         progress(f"{label} done ({time.perf_counter() - t0:.1f} s)")
     doc(f"\n---\nTotal {time.perf_counter() - t0:.1f} s.")

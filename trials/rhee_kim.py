@@ -64,7 +64,8 @@ def comparison(ests) -> pd.DataFrame:
 
 
 def reproduce_rhee_kim(out_dir, seed: int | None = None, config=None, trials=None, plots: bool = True,
-                       verbose: bool = True, joint: bool = True) -> pd.DataFrame:
+                       verbose: bool = True, joint: bool = True, runs: dict | None = None,
+                       keep: dict | None = None) -> pd.DataFrame:
     """Run ST35, ZZ10, ZZ20 and S-type 120 and compare with Table 10; returns the comparison table.
 
     Writes into ``out_dir``: comparison.csv/.md and the estimation reports (estimates.json,
@@ -72,6 +73,9 @@ def reproduce_rhee_kim(out_dir, seed: int | None = None, config=None, trials=Non
     ``seed`` replaces every trial's noise seed (None keeps each trial file's own).
     ``joint`` adds rows for trial "joint": one filter run through all the trials in turn
     (:func:`ekf.estimate.joint_estimate`); the paper has no such column.
+    ``runs``: already simulated trials by name (``{"ST35": TrialRun, ...}``), reused instead of
+    simulating them again; ``keep``: a dict that receives the ``datas`` and ``estimates`` for
+    callers that go on from them (the main job's output-error section).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -80,7 +84,8 @@ def reproduce_rhee_kim(out_dir, seed: int | None = None, config=None, trials=Non
     datas = []
     t0 = time.perf_counter()
     for name in trials or TRIALS:
-        data = data_from_trial(trial_path(TRIALS[name].removesuffix(".yaml")), cfg, seed=seed)
+        src = (runs or {}).get(name) or trial_path(TRIALS[name].removesuffix(".yaml"))
+        data = data_from_trial(src, cfg, seed=seed)
         datas.append(data)
         ests.append(estimate(data, cfg))
         if verbose:
@@ -88,6 +93,8 @@ def reproduce_rhee_kim(out_dir, seed: int | None = None, config=None, trials=Non
     if joint and len(datas) > 1:
         ests.append(joint_estimate(datas, cfg, name="joint"))
     write_reports(ests, out, plots=plots)
+    if keep is not None:
+        keep.update(datas=datas, estimates=ests)
     df = comparison(ests)
     df.to_csv(out / "comparison.csv", index=False, float_format="%.6g")
     wide = df.pivot(index="coeff", columns="trial", values=["paper_err_pct", "our_err_pct"]).reindex(DERIVATIVES)

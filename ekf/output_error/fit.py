@@ -269,14 +269,21 @@ def information(trials: list[OETrial], theta) -> tuple[np.ndarray, np.ndarray]:
 
 
 def refine(datas, cfg, rudder: str = "ramp", n_jobs: int = 1, verbose: bool = False, start: str = "ekf",
-           stages=None):
-    """EKF (joint over ``datas``) then the joint output-error fit. Returns (ekf_final dict, OEResult)."""
+           stages=None, ekf_start: dict | None = None):
+    """EKF (joint over ``datas``) then the joint output-error fit. Returns (ekf_final dict, OEResult).
+
+    ``ekf_start``: the EKF's final values when the caller already has them (the joint estimate of
+    the same data), so the filter is not run twice; ``n_jobs``: workers for the Jacobian's simulations.
+    """
     from ..estimate import estimate, initial_state, joint_estimate
 
     names = tuple(datas[0].names)
     theta_start = initial_state(datas[0], cfg)[4:]
     ekf = None
-    if start == "ekf":
+    if ekf_start is not None:
+        ekf = {n: float(ekf_start[n]) for n in names}
+        theta_start = np.array([ekf[n] for n in names])
+    elif start == "ekf":
         try:
             e = joint_estimate(datas, cfg) if len(datas) > 1 else estimate(datas[0], cfg)
             ekf = e.final
