@@ -1,7 +1,6 @@
-"""Nomoto models and zigzag identification (trials/nomoto.py, artyszuk.py, nomoto_cli.py)."""
+"""Nomoto models and zigzag identification (trials/nomoto/, artyszuk.py, the ``mmg nomoto`` commands)."""
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import json
 from pathlib import Path
@@ -10,10 +9,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from mmg.errors import InputError
 from trials import artyszuk as a
 from trials import nomoto as nm
-from trials.errors import InputError
-from trials.records import TrialRecord
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "frt-ds-esso"
 CONFIGS = Path(__file__).resolve().parents[1] / "configs" / "nomoto"
@@ -185,15 +183,9 @@ def test_port_first_execute_gives_same_parameters(sim2):
 
 
 # ---- acceptance 6: bad input ----------------------------------------------------------
-def _args(tmp_path, log, **kw):
-    from trials import nomoto_cli
-
-    ap = argparse.ArgumentParser()
-    sub = ap.add_subparsers()
-    nomoto_cli.register(sub)
-    argv = ["nomoto", str(log), "--length", str(kw.get("length", 100.0)), "--speed", "5",
+def _nomoto_argv(tmp_path, log):
+    return ["nomoto", str(log), "--length", "100", "--speed", "5",
             "--json", str(tmp_path / "out.json"), "--no-output-error"]
-    return ap.parse_args(argv)
 
 
 def _write_log(path, rec):
@@ -210,8 +202,9 @@ def test_cli_on_simulated_log_writes_json_and_png(tmp_path, sim2, capsys):
     pytest.importorskip("trials.logio")
     log = tmp_path / "zz.csv"
     _write_log(log, a.sim_record(sim2, ds=0.02))
-    args = _args(tmp_path, log)
-    assert args.func(args) == 0
+    from trials.cli import main
+
+    assert main(_nomoto_argv(tmp_path, log)) == 0
     d = json.loads((tmp_path / "out.json").read_text())
     # 0.4 s sampling: eps' from the spline is ~2 % off at the counter-rudder kinks
     assert abs(d["second_order_four_point"]["K"] - 4.89577) / 4.89577 < 0.03
@@ -265,10 +258,7 @@ def test_real_zigzag_identifies_without_error():
 
 @pytest.mark.slow
 def test_nomoto_paper_command_writes_tables(tmp_path):
-    from trials import nomoto_cli
+    from trials.cli import main
 
-    ap = argparse.ArgumentParser()
-    nomoto_cli.register(ap.add_subparsers())
-    args = ap.parse_args(["nomoto-paper", "--out", str(tmp_path), "--fast"])
-    assert args.func(args) == 0
+    assert main(["nomoto-paper", "--out", str(tmp_path), "--fast"]) == 0
     assert (tmp_path / "artyszuk_tables.md").exists() and (tmp_path / "table8.csv").exists()

@@ -8,7 +8,7 @@ from 5, 7, 8), by running :func:`trials.nomoto.four_point` on those inputs.
 
 Beyond the paper, :func:`table8_robust` repeats the Table 8 perturbations on a
 whole simulated record and adds heading noise, comparing the four-point
-method with the least-squares (eq. 15) and output-error fits.
+method with the least-squares (eq. 15 integrated twice) and output-error fits.
 """
 from __future__ import annotations
 
@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from mmg.resources import config_path
 from trials import nomoto as nm
 
-CONFIG_DIR = Path(__file__).resolve().parents[1] / "configs" / "nomoto"
 PI18 = np.pi / 18.0
 POINTS = ("CR1", "OS1", "CR2", "OS2")
 DELTA_SIGN = {"CR1": 1.0, "OS1": -1.0, "CR2": -1.0, "OS2": 1.0}  # eq. (18), fourth column
@@ -139,7 +139,7 @@ def simulate_config(name: str, **overrides) -> nm.ZigzagSimulation:
     **overrides
         Replace zigzag settings (delta0_deg, psi0_deg, rudder_rate_deg_per_L, s_max, ds).
     """
-    path = Path(name) if str(name).endswith(".yaml") else CONFIG_DIR / f"{name}.yaml"
+    path = Path(name) if str(name).endswith(".yaml") else config_path("nomoto", f"{name}.yaml")
     model = nm.load_model(path)
     z = nm.zigzag_spec(path)
     z.update(overrides)
