@@ -67,18 +67,27 @@ def _set(cfg: dict, assignment: str) -> None:
     if "=" not in assignment:
         raise InputError("--set", assignment, "expected key.path=value")
     key, val = assignment.split("=", 1)
-    parts = key.strip().split(".")
+    key = key.strip()
+    parts = key.split(".")
+    if any(not p for p in parts):
+        raise InputError("--set", key, "expected key.path=value with no empty part")
     if parts[0] not in CONFIG_KEYS:
         raise InputError("--set", key, f"unknown key {parts[0]!r}; known: {', '.join(CONFIG_KEYS)}")
     d = cfg
-    for p in parts[:-1]:
-        if not isinstance(d.get(p), dict):
+    for i, p in enumerate(parts[:-1]):
+        if d.get(p) is None:
             d[p] = {}
+        elif not isinstance(d[p], dict):
+            raise InputError("--set", key, f"{'.'.join(parts[:i + 1])} is a value, not a mapping")
         d = d[p]
     try:
         d[parts[-1]] = float(val)
     except ValueError:
-        d[parts[-1]] = yaml.safe_load(val)
+        try:
+            d[parts[-1]] = yaml.safe_load(val)
+        except yaml.YAMLError as e:
+            problem = getattr(e, "problem", None) or e
+            raise InputError("--set", key, f"cannot read the value {val!r} ({' '.join(str(problem).split())})") from None
 
 
 def default_config_path() -> Path:
@@ -104,11 +113,14 @@ def load_config(path: str | Path | dict | None = None, sets=()) -> dict:
     Raises
     ------
     InputError
-        Naming the file and the field: unknown keys, non-positive covariances, a bad step.
+        Naming the file and the field: unknown keys, duplicate keys, a file that is not YAML
+        text, non-positive or absurd covariances (see :data:`P0_VARIANCE_RANGE`,
+        :data:`R_VARIANCE_RANGE`), a bad step.
     """
+    from mmg.ship import read_yaml
+
     default = default_config_path()
-    with open(default) as fh:
-        cfg = yaml.safe_load(fh)
+    cfg = read_yaml(default)
     src = str(default)
     if isinstance(path, dict):
         src = "<config dict>"
@@ -116,17 +128,7 @@ def load_config(path: str | Path | dict | None = None, sets=()) -> dict:
         cfg = _merge(cfg, path)
     elif path is not None:
         src = str(path)
-        try:
-            with open(path) as fh:
-                over = yaml.safe_load(fh) or {}
-        except FileNotFoundError:
-            raise InputError(src, "", "file not found") from None
-        except (IsADirectoryError, UnicodeDecodeError) as e:
-            raise InputError(src, "", f"cannot read as a YAML text file ({e.__class__.__name__})") from None
-        except yaml.YAMLError as e:
-            raise InputError(src, "", f"not valid YAML ({str(e).splitlines()[0]})") from None
-        if not isinstance(over, dict):
-            raise InputError(src, "", "expected a mapping")
+        over = read_yaml(path, empty_ok=True)
         _check_keys(over, src)
         cfg = _merge(cfg, over)
     for s in sets:
@@ -137,44 +139,101 @@ def load_config(path: str | Path | dict | None = None, sets=()) -> dict:
     return cfg
 
 
+P0_VARIANCE_RANGE = (1e-20, 1e6)
+"""Each initial variance (after squaring when ``P0_is: std``): 1e-20 to 1e6 in SI and primes.  The
+paper's are 2e-4 to 0.5; outside this range the first covariance update is singular or overflows."""
+
+R_VARIANCE_RANGE = (1e-20, 1e10)
+"""Each measurement variance of R: 1e-20 to 1e10 (the paper's are 2e-4 to 0.5)."""
+
+DT_RANGE = (1e-4, 60.0)
+"""The filter step [s]: 0.1 ms to 60 s (the paper's is 0.1 s)."""
+
+
+def _number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and bool(np.isfinite(v))
+
+
 def _positive(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and bool(np.isfinite(v)) and v > 0
+    return _number(v) and v > 0
+
+
+def _sub(cfg: dict, key: str, src: str) -> dict:
+    v = cfg.get(key)
+    if v is None:
+        return {}
+    if not isinstance(v, dict):
+        raise InputError(src, key, f"expected a mapping, got {v!r}")
+    return v
+
+
+def _variance(x: float, is_std: bool, src: str, field: str, what: str = "P0") -> float:
+    v = x * x if is_std else x
+    lo, hi = P0_VARIANCE_RANGE if what == "P0" else R_VARIANCE_RANGE
+    if not (np.isfinite(v) and lo <= v <= hi):
+        how = f"{x:g} squared" if is_std else f"{x:g}"
+        raise InputError(src, field, f"a variance of {how} is outside {lo:g} to {hi:g}: the covariance would be "
+                                     "singular or overflow")
+    return v
 
 
 def _validate(cfg: dict, src: str) -> None:
     try:
-        cfg["dt_s"] = to_si(str(cfg["dt"]), "time")
+        cfg["dt_s"] = to_si(cfg.get("dt"), "time", *DT_RANGE)
     except Exception as e:  # noqa: BLE001 - any bad dt is an input error
         raise InputError(src, "dt", f"bad time step ({e})") from None
-    if not (cfg["dt_s"] > 0 and np.isfinite(cfg["dt_s"])):
-        raise InputError(src, "dt", "must be positive")
     if cfg.get("P0_is") not in ("variance", "std"):
-        raise InputError(src, "P0_is", "must be 'variance' or 'std'")
-    P0 = cfg.get("P0") or {}
+        raise InputError(src, "P0_is", f"must be 'variance' or 'std', got {cfg.get('P0_is')!r}")
+    is_std = cfg["P0_is"] == "std"
+    P0 = _sub(cfg, "P0", src)
     for name in STATES:
         if not _positive(P0.get(name)):
             raise InputError(src, f"P0.{name}", f"must be a positive number, got {P0.get(name)!r}")
     for name, v in P0.items():
         if not _positive(v):
             raise InputError(src, f"P0.{name}", f"must be a positive number, got {v!r}")
-    if not _positive(cfg.get("P0_default_relative_std", 0.5)):
-        raise InputError(src, "P0_default_relative_std", "must be a positive number")
+        _variance(float(v), is_std, src, f"P0.{name}")
+    rel = cfg.get("P0_default_relative_std", 0.5)
+    if not (_positive(rel) and rel <= 10):
+        raise InputError(src, "P0_default_relative_std", f"must be a positive number at most 10, got {rel!r}")
     q = cfg.get("Q", 0.0)
-    if not isinstance(q, (int, float)) or not np.isfinite(q) or q < 0:
-        raise InputError(src, "Q", "must be a non-negative number")
-    sc = cfg.get("initial", {}).get("scale", 1.2)
-    if not isinstance(sc, (int, float)) or not np.isfinite(sc):
-        raise InputError(src, "initial.scale", "must be a number")
-    for k, v in (cfg.get("initial", {}).get("values") or {}).items():
-        if not isinstance(v, (int, float)) or not np.isfinite(v):
-            raise InputError(src, f"initial.values.{k}", "must be a finite number")
-    if "default" not in cfg.get("R", {}):
+    if not (_number(q) and 0 <= q <= P0_VARIANCE_RANGE[1]):
+        raise InputError(src, "Q", f"must be a number from 0 to {P0_VARIANCE_RANGE[1]:g}, got {q!r}")
+    initial = _sub(cfg, "initial", src)
+    sc = initial.get("scale", 1.2)
+    if not _number(sc):
+        raise InputError(src, "initial.scale", f"must be a finite number, got {sc!r}")
+    values = initial.get("values") or {}
+    if not isinstance(values, dict):
+        raise InputError(src, "initial.values", f"expected a mapping of derivative name to value, got {values!r}")
+    for k, v in values.items():
+        if not _number(v):
+            raise InputError(src, f"initial.values.{k}", f"must be a finite number, got {v!r}")
+    R = _sub(cfg, "R", src)
+    if "default" not in R:
         raise InputError(src, "R.default", "missing")
-    for trial, row in cfg["R"].items():
+    for trial, row in R.items():
+        if not isinstance(row, dict):
+            raise InputError(src, f"R.{trial}", f"expected a mapping of u, v, r, n, got {row!r}")
+        for ch in row:
+            if ch not in STATES:
+                raise InputError(src, f"R.{trial}.{ch}", f"unknown channel; known: {', '.join(STATES)}")
         for ch in STATES:
-            v = (row or {}).get(ch)
+            v = row.get(ch)
             if not _positive(v):
                 raise InputError(src, f"R.{trial}.{ch}", f"must be a positive number, got {v!r}")
+            _variance(float(v), False, src, f"R.{trial}.{ch}", "R")
+    fc = _sub(cfg, "fit_checks", src)
+    for k in ("froude_min", "froude_max", "rpm_mismatch", "length_mismatch"):
+        if k in fc and not (_number(fc[k]) and fc[k] >= 0):
+            raise InputError(src, f"fit_checks.{k}", f"must be a number 0 or more, got {fc[k]!r}")
+    if _number(fc.get("froude_min")) and _number(fc.get("froude_max")) and fc["froude_min"] >= fc["froude_max"]:
+        raise InputError(src, "fit_checks.froude_max", "must be above froude_min")
+    dv = _sub(cfg, "divergence", src)
+    if "nis_window_s" in dv and not _positive(dv["nis_window_s"]):
+        raise InputError(src, "divergence.nis_window_s", f"must be a positive number, got {dv['nis_window_s']!r}")
+    if "nis_max" in dv and not (_number(dv["nis_max"]) and dv["nis_max"] >= 0):
+        raise InputError(src, "divergence.nis_max", f"must be a number 0 or more (0 disables), got {dv['nis_max']!r}")
 
 
 def R_for(cfg: dict, trial: str) -> np.ndarray:
@@ -193,17 +252,23 @@ def P0_for(cfg: dict, names=PAPER_DERIVATIVES, reference: dict | None = None) ->
     Raises
     ------
     InputError
-        When a name is neither listed nor has a nonzero reference value.
+        When a name is neither listed nor has a nonzero reference value, or when a variance
+        falls outside :data:`P0_VARIANCE_RANGE` (the covariance would be singular).
     """
     P0 = cfg["P0"]
     rel = float(cfg.get("P0_default_relative_std", 0.5))
     v = []
     for n in tuple(STATES) + tuple(names):
         if n in P0:
-            x = float(P0[n])
-            v.append(x if cfg["P0_is"] == "variance" else x * x)
+            v.append(_variance(float(P0[n]), cfg["P0_is"] == "std", "estimation config", f"P0.{n}"))
         elif reference is not None and reference.get(n):
-            v.append((rel * float(reference[n])) ** 2)
+            try:
+                v.append(_variance(rel * float(reference[n]), True, "estimation config", f"P0.{n}"))
+            except InputError:
+                raise InputError("estimation config", f"P0.{n}",
+                                 f"not given, and {rel:g} x the reference value {float(reference[n]):g} is not a "
+                                 f"usable std (variance outside {P0_VARIANCE_RANGE[0]:g} to "
+                                 f"{P0_VARIANCE_RANGE[1]:g}): give P0.{n}") from None
         else:
             raise InputError("estimation config", f"P0.{n}", "not given, and no nonzero reference value to scale a default from")
     return np.diag(np.asarray(v, float))

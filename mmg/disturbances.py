@@ -8,13 +8,33 @@ effects (sensor biases) act on logs instead, through :meth:`SensorBias.apply`.
 
 Conventions: directions are the direction a flow goes *towards*, clockwise from
 north [rad]; forces in N and moments in N m about midship.
+
+Every component checks its values when it is built: they must be finite, a current's speed
+0 to 20 kn (:data:`mmg.units.MAX_CURRENT`) and a rudder offset within +-10 deg
+(:data:`mmg.units.MAX_RUDDER_OFFSET`); anything else raises :class:`mmg.errors.InputError`
+naming the component and the field, so a NaN never reaches the solver.
 """
 from __future__ import annotations
 
 import abc
-from dataclasses import dataclass
+import math
+import numbers
+from dataclasses import dataclass, fields
 
 from . import model as M
+from .errors import InputError
+from .units import MAX_CURRENT, MAX_RUDDER_OFFSET
+
+
+def _check(obj, bounds: dict | None = None) -> None:
+    """InputError unless every field of ``obj`` is a finite number within ``bounds`` (name -> (lo, hi), SI)."""
+    for f in fields(obj):
+        v = getattr(obj, f.name)
+        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+            raise InputError(type(obj).__name__, f.name, f"must be a finite number, got {v!r}")
+        lo, hi = (bounds or {}).get(f.name, (-math.inf, math.inf))
+        if not lo <= v <= hi:
+            raise InputError(type(obj).__name__, f.name, f"{v!r} is outside {lo:g} to {hi:g} (SI)")
 
 
 class Disturbance(abc.ABC):
@@ -36,6 +56,9 @@ class UniformCurrent(Disturbance):
     speed: float
     direction: float
 
+    def __post_init__(self):
+        _check(self, {"speed": (0.0, MAX_CURRENT)})
+
     def slots(self):
         return {M.P_CUR_SPEED: self.speed, M.P_CUR_DIR: self.direction}
 
@@ -45,6 +68,9 @@ class RudderOffset(Disturbance):
     """A rudder indicator zero error [rad]: the effective angle is delta + offset."""
 
     offset: float
+
+    def __post_init__(self):
+        _check(self, {"offset": (-MAX_RUDDER_OFFSET, MAX_RUDDER_OFFSET)})
 
     def slots(self):
         return {M.P_RUDDER_OFFSET: self.offset}
@@ -58,6 +84,9 @@ class ConstantForce(Disturbance):
     Y: float = 0.0
     N: float = 0.0
 
+    def __post_init__(self):
+        _check(self)
+
     def slots(self):
         return {M.P_EXT_X: self.X, M.P_EXT_Y: self.Y, M.P_EXT_N: self.N}
 
@@ -69,6 +98,9 @@ class SensorBias:
     heading: float = 0.0
     speed: float = 0.0
     rpm: float = 0.0
+
+    def __post_init__(self):
+        _check(self)
 
 
 def combine(disturbances) -> dict[int, float]:

@@ -24,6 +24,8 @@ Symbols follow the MMG literature (Yasukawa & Yoshimura 2015; Rhee & Kim 1999):
 """
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal, Optional
@@ -33,7 +35,8 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from .errors import InputError
 from .terms import AXES, TERMS
-from .units import to_si
+from .units import (DENSITY_RANGE, MAX_RUDDER, MAX_STEERING_RATE, MAX_STEERING_TIME_CONSTANT, SHIP_LENGTH_RANGE,
+                    check_range, to_si)
 
 # --------------------------------------------------------------------------- dataclasses (SI)
 
@@ -188,46 +191,53 @@ class Ship:
 
 
 # --------------------------------------------------------------------------- YAML schema
+#
+# The schema checks types and keys (strict: a number is an int or a float, never a bool or a
+# string; NaN and inf are refused); _build then converts units and checks every value against
+# bounds a naval architect would accept for any displacement ship modelled with MMG, from a
+# 0.5 m model to a 500 m tanker (SI bounds; primes as in mmg.nondim):
+#
+#   particulars  L 0.5-500 m; 1 < L/B <= 30 (B <= L); 0 < T <= B; C_b 0.3-1;
+#                S_wetted 0.3-1.5 x L (B + 2T); |x_G| <= 0.1 L; rho 950-1100 kg/m^3
+#   mass         m' within 25 % of 2 C_b B / L (its definition with the same L, B, T);
+#                0 <= m_x' <= m'; 0 <= m_y' <= 3 m'; I_zG' = m' (k_zz/L)^2 with k_zz/L 0.1-0.5;
+#                0 <= J_z' <= 3 I_zG'
+#   hull         at least one X_, Y_ and N_ coefficient; |value| <= 20
+#   propeller    0 < D <= 1.5 T; 0 < P <= 3 D; K_T(0) in (0, 1); K_Q(0) in (0, 0.2] for a
+#                constant-power engine; t_P(0), w_P0(0) in [0, 1); polynomial coefficients
+#                |c| <= 10; |x_P'| <= 1; C_wake, C_1 0-50; C_2 0-10
+#   rudder       A_R 0.002-0.1 L T; 0 < H_R <= 1.5 T; f_alpha 0-10; epsilon 0-3; kappa 0-2;
+#                eta 0-1.5; t_R in [0, 1); a_H 0-3; |x_H'|, |x_R'| <= 1; gamma_R 0-2; |l_R'| <= 3
+#   steering     0 < T_E <= 60 s; 0 < rate_max <= 60 deg/s; 0 < delta_max <= 90 deg
+#   engine       constant power: SHP_0 not all zero; watts_per_hp 700-800;
+#                0 < shaft_inertia_coefficient <= 100
+#
+# A value outside them is refused with one line naming the ship file and the field.
 
 Length = str
 Quantity = str
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
 class _Particulars(_Strict):
     L: Quantity
     B: Quantity
     T: Quantity
-    C_b: float = Field(gt=0, le=1)
+    C_b: float
     S_wetted: Quantity
     x_G: Quantity = "0 m"
     rho: Quantity = "1025 kg/m^3"
 
-    def build(self) -> Particulars:
-        out = Particulars(
-            L=to_si(self.L, "length"),
-            B=to_si(self.B, "length"),
-            T=to_si(self.T, "length"),
-            C_b=self.C_b,
-            S_wetted=to_si(self.S_wetted, "area"),
-            x_G=to_si(self.x_G, "length"),
-            rho=to_si(self.rho, "density"),
-        )
-        for k in ("L", "B", "T", "S_wetted", "rho"):
-            if getattr(out, k) <= 0:
-                raise ValueError(f"{k} must be positive")
-        return out
-
 
 class _Mass(_Strict):
-    m_prime: float = Field(gt=0)
-    m_x_prime: float = Field(ge=0)
-    m_y_prime: float = Field(ge=0)
-    I_zG_prime: float = Field(gt=0)
-    J_z_prime: float = Field(ge=0)
+    m_prime: float
+    m_x_prime: float
+    m_y_prime: float
+    I_zG_prime: float
+    J_z_prime: float
 
 
 class _Coefficient(_Strict):
@@ -245,18 +255,6 @@ class _Coefficient(_Strict):
 class _Hull(_Strict):
     form: str = ""
     coefficients: dict[str, _Coefficient]
-
-    def build(self) -> HullModel:
-        names, axes, terms, values = [], [], [], []
-        for name, c in self.coefficients.items():
-            axis = name.split("_", 1)[0]
-            if axis not in AXES:
-                raise ValueError(f"coefficient {name!r} must start with X_, Y_ or N_")
-            names.append(name)
-            axes.append(axis)
-            terms.append(c.term)
-            values.append(c.value)
-        return HullModel(tuple(names), tuple(axes), tuple(terms), tuple(values))
 
 
 class _Wake(_Strict):
@@ -277,29 +275,14 @@ class _Propeller(_Strict):
     w_P0: list[float] = Field(min_length=1, max_length=6)
     wake: _Wake
 
-    def build(self) -> Propeller:
-        return Propeller(
-            D=to_si(self.D, "length"),
-            K_T=tuple(self.K_T),
-            K_Q=tuple(self.K_Q),
-            t_P=tuple(self.t_P),
-            w_P0=tuple(self.w_P0),
-            x_P_prime=self.wake.x_P_prime,
-            wake_model=self.wake.model,
-            C_wake=self.wake.C_wake,
-            C_1=self.wake.C_1,
-            C_2_pos=self.wake.C_2_pos,
-            C_2_neg=self.wake.C_2_neg,
-        )
-
 
 class _Rudder(_Strict):
     A_R: Quantity
     H_R: Quantity
-    f_alpha: float = Field(gt=0)
-    epsilon: float = Field(gt=0)
+    f_alpha: float
+    epsilon: float
     kappa: float
-    eta: float = Field(gt=0, le=1.5)
+    eta: float
     t_R: float
     a_H: float
     x_H_prime: float
@@ -308,35 +291,22 @@ class _Rudder(_Strict):
     gamma_R_neg: float
     l_R_prime: float
 
-    def build(self) -> Rudder:
-        d = self.model_dump()
-        d["A_R"] = to_si(self.A_R, "area")
-        d["H_R"] = to_si(self.H_R, "length")
-        return Rudder(**d)
-
 
 class _Steering(_Strict):
     T_E: Quantity
     rate_max: Quantity
     delta_max: Quantity
 
-    def build(self) -> SteeringGear:
-        return SteeringGear(
-            T_E=to_si(self.T_E, "time"),
-            rate_max=to_si(self.rate_max, "angular_rate"),
-            delta_max=to_si(self.delta_max, "angle"),
-        )
-
 
 class _Engine(_Strict):
     mode: Literal["constant_power", "constant_rpm"]
     SHP_0: list[float] = Field(default=[0.0], min_length=1, max_length=6)
     watts_per_hp: float = 745.0
-    shaft_inertia_coefficient: float = Field(default=2.0, gt=0)
+    shaft_inertia_coefficient: float = 2.0
 
 
 class _ShipFile(_Strict):
-    name: str
+    name: str = Field(min_length=1)
     source: str = ""
     particulars: _Particulars
     mass: _Mass
@@ -347,43 +317,212 @@ class _ShipFile(_Strict):
     engine: _Engine
 
 
+_UNIT_HINT = {"L": "m", "B": "m", "T": "m", "S_wetted": "m^2", "x_G": "m", "rho": "kg/m^3", "D": "m", "P": "m",
+              "A_R": "m^2", "H_R": "m", "T_E": "s", "rate_max": "deg/s", "delta_max": "deg"}
+
+
+def one_line(text) -> str:
+    """``text`` with its whitespace runs (newlines included) collapsed to single spaces."""
+    return " ".join(str(text).split())
+
+
+def field_path(loc) -> str:
+    """A pydantic ``loc`` (or any sequence of keys) as ``a.b.c``, one line."""
+    return ".".join(one_line(p) if isinstance(p, str) and p.isprintable() else
+                    (str(p) if isinstance(p, int) else repr(p)) for p in loc)
+
+
 def _loc(err: dict) -> str:
-    return ".".join(str(p) for p in err.get("loc", ()))
+    return field_path(err.get("loc", ()))
 
 
-def ship_from_dict(data: dict, source: str = "<dict>") -> Ship:
+def pydantic_message(err: dict, hints: dict[str, str]) -> str:
+    """Pydantic's message, made plain; a number where a quantity is expected names the unit to add."""
+    loc = err.get("loc", ())
+    field = str(loc[-1]) if loc else ""
+    value = err.get("input")
+    typ = str(err.get("type", ""))
+    if typ == "string_type" and isinstance(value, (int, float)) and not isinstance(value, bool) and field in hints:
+        if not math.isfinite(value):
+            return f"{value!r} is not a finite number with a unit, e.g. '1.0 {hints[field]}'"
+        return (f"{value!r} has no unit; write it with one, e.g. '{value} {hints[field]}' "
+                "(plain numbers are refused)")
+    msg = one_line(err.get("msg", "invalid")).removeprefix("Value error, ")
+    if typ.endswith("_type") or typ.startswith(("greater_than", "less_than", "too_", "string_too")) \
+            or typ in ("finite_number", "literal_error", "int_from_float", "enum"):
+        msg += f", got {_short(value)}"
+    return msg
+
+
+def _short(value) -> str:
+    r = repr(value)
+    return one_line(r if len(r) <= 60 else r[:57] + "...")
+
+
+def _num(src: str, field: str, x: float, lo=None, hi=None, *, lo_open=False, hi_open=False, why="") -> float:
+    try:
+        return check_range(x, lo, hi, lo_open=lo_open, hi_open=hi_open, why=why)
+    except ValueError as e:
+        raise InputError(src, field, str(e)) from None
+
+
+def _qty(src: str, field: str, value: str, dimension: str, lo=None, hi=None, *, lo_open=False, hi_open=False,
+         why="") -> float:
+    try:
+        return to_si(value, dimension, lo, hi, lo_open=lo_open, hi_open=hi_open, why=why)
+    except ValueError as e:
+        raise InputError(src, field, str(e)) from None
+
+
+def _poly(src: str, field: str, c: list[float], bound: float) -> tuple[float, ...]:
+    for i, v in enumerate(c):
+        _num(src, f"{field}.{i}", v, -bound, bound, why=f"a polynomial coefficient of magnitude at most {bound:g}")
+    return tuple(float(v) for v in c)
+
+
+def _build(f: _ShipFile, src: str) -> Ship:
+    """Units to SI and every value checked against the bounds above (InputError naming the field)."""
+    pa = f.particulars
+    L = _qty(src, "particulars.L", pa.L, "length", *SHIP_LENGTH_RANGE)
+    B = _qty(src, "particulars.B", pa.B, "length", L / 30, L, why=f"1 < L/B <= 30 with L = {L:g} m")
+    T = _qty(src, "particulars.T", pa.T, "length", 0.0, B, lo_open=True,
+             why=f"the draught cannot exceed the breadth B = {B:g} m")
+    C_b = _num(src, "particulars.C_b", pa.C_b, 0.3, 1.0)
+    box = L * (B + 2 * T)
+    S = _qty(src, "particulars.S_wetted", pa.S_wetted, "area", 0.3 * box, 1.5 * box,
+             why=f"0.3-1.5 x L (B + 2T) = {box:.6g} m^2")
+    x_G = _qty(src, "particulars.x_G", pa.x_G, "length", -0.1 * L, 0.1 * L, why=f"|x_G| <= 0.1 L = {0.1 * L:g} m")
+    rho = _qty(src, "particulars.rho", pa.rho, "density", *DENSITY_RANGE)
+    particulars = Particulars(L=L, B=B, T=T, C_b=C_b, S_wetted=S, x_G=x_G, rho=rho)
+
+    ms = f.mass
+    m0 = 2 * C_b * B / L
+    m = _num(src, "mass.m_prime", ms.m_prime, 0.75 * m0, 1.25 * m0,
+             why=f"within 25 % of 2 C_b B / L = {m0:.4g}, the primed mass of these particulars")
+    mass = MassProperties(
+        m_prime=m,
+        m_x_prime=_num(src, "mass.m_x_prime", ms.m_x_prime, 0.0, m, why=f"0 to m' = {m:.4g}"),
+        m_y_prime=_num(src, "mass.m_y_prime", ms.m_y_prime, 0.0, 3 * m, why=f"0 to 3 m' = {3 * m:.4g}"),
+        I_zG_prime=_num(src, "mass.I_zG_prime", ms.I_zG_prime, 0.01 * m, 0.25 * m,
+                        why="m' (k_zz/L)^2 with a radius of gyration k_zz of 0.1-0.5 L"),
+        J_z_prime=0.0,
+    )
+    mass = replace(mass, J_z_prime=_num(src, "mass.J_z_prime", ms.J_z_prime, 0.0, 3 * mass.I_zG_prime,
+                                        why=f"0 to 3 I_zG' = {3 * mass.I_zG_prime:.4g}"))
+
+    names, axes, terms, values = [], [], [], []
+    for name, c in f.hull.coefficients.items():
+        field = f"hull.coefficients.{field_path([name])}"
+        axis = name.split("_", 1)[0]
+        if axis not in AXES or "_" not in name:
+            raise InputError(src, field, "a coefficient name must start with X_, Y_ or N_")
+        names.append(name)
+        axes.append(axis)
+        terms.append(c.term)
+        values.append(_num(src, f"{field}.value", c.value, -20.0, 20.0,
+                           why="a primed hull coefficient of magnitude at most 20; is it primed?"))
+    for axis in AXES:
+        if axis not in axes:
+            raise InputError(src, "hull.coefficients", f"no {axis}_ coefficient: the hull model needs at least one "
+                                                       "force term on each of X, Y and N")
+    hull = HullModel(tuple(names), tuple(axes), tuple(terms), tuple(values))
+
+    pr = f.propeller
+    D = _qty(src, "propeller.D", pr.D, "length", 0.0, 1.5 * T, lo_open=True,
+             why=f"0 < D <= 1.5 T = {1.5 * T:g} m: the propeller works under water")
+    if pr.P is not None:
+        _qty(src, "propeller.P", pr.P, "length", 0.0, 3 * D, lo_open=True, why=f"0 < P <= 3 D = {3 * D:g} m")
+    K_T = _poly(src, "propeller.K_T", pr.K_T, 10.0)
+    _num(src, "propeller.K_T.0", K_T[0], 0.0, 1.0, lo_open=True, hi_open=True, why="the bollard K_T(0) is 0-1")
+    K_Q = _poly(src, "propeller.K_Q", pr.K_Q, 10.0)
+    if f.engine.mode == "constant_power":
+        _num(src, "propeller.K_Q.0", K_Q[0], 0.0, 0.2, lo_open=True,
+             why="a constant-power engine balances the shaft with K_Q: K_Q(0) is 0-0.2")
+    t_P = _poly(src, "propeller.t_P", pr.t_P, 10.0)
+    _num(src, "propeller.t_P.0", t_P[0], 0.0, 1.0, hi_open=True, why="a thrust deduction t_P is 0 to below 1")
+    w_P0 = _poly(src, "propeller.w_P0", pr.w_P0, 10.0)
+    _num(src, "propeller.w_P0.0", w_P0[0], 0.0, 1.0, hi_open=True, why="a wake fraction w_P0 is 0 to below 1")
+    wk = pr.wake
+    propeller = Propeller(
+        D=D, K_T=K_T, K_Q=K_Q, t_P=t_P, w_P0=w_P0,
+        x_P_prime=_num(src, "propeller.wake.x_P_prime", wk.x_P_prime, -1.0, 1.0, why="a position within +-1 L"),
+        wake_model=wk.model,
+        C_wake=_num(src, "propeller.wake.C_wake", wk.C_wake, 0.0, 50.0),
+        C_1=_num(src, "propeller.wake.C_1", wk.C_1, 0.0, 50.0),
+        C_2_pos=_num(src, "propeller.wake.C_2_pos", wk.C_2_pos, 0.0, 10.0, lo_open=True),
+        C_2_neg=_num(src, "propeller.wake.C_2_neg", wk.C_2_neg, 0.0, 10.0, lo_open=True),
+    )
+
+    ru = f.rudder
+    LT = L * T
+    rudder = Rudder(
+        A_R=_qty(src, "rudder.A_R", ru.A_R, "area", 0.002 * LT, 0.1 * LT,
+                 why=f"0.002-0.1 L T = {0.002 * LT:.4g}-{0.1 * LT:.4g} m^2 (ships: 1/70-1/30 L T)"),
+        H_R=_qty(src, "rudder.H_R", ru.H_R, "length", 0.0, 1.5 * T, lo_open=True, why=f"0 < H_R <= 1.5 T = {1.5 * T:g} m"),
+        f_alpha=_num(src, "rudder.f_alpha", ru.f_alpha, 0.0, 10.0, lo_open=True),
+        epsilon=_num(src, "rudder.epsilon", ru.epsilon, 0.0, 3.0, lo_open=True),
+        kappa=_num(src, "rudder.kappa", ru.kappa, 0.0, 2.0),
+        eta=_num(src, "rudder.eta", ru.eta, 0.0, 1.5, lo_open=True),
+        t_R=_num(src, "rudder.t_R", ru.t_R, 0.0, 1.0, hi_open=True),
+        a_H=_num(src, "rudder.a_H", ru.a_H, 0.0, 3.0),
+        x_H_prime=_num(src, "rudder.x_H_prime", ru.x_H_prime, -1.0, 1.0, why="a position within +-1 L"),
+        x_R_prime=_num(src, "rudder.x_R_prime", ru.x_R_prime, -1.0, 1.0, why="a position within +-1 L"),
+        gamma_R_pos=_num(src, "rudder.gamma_R_pos", ru.gamma_R_pos, 0.0, 2.0),
+        gamma_R_neg=_num(src, "rudder.gamma_R_neg", ru.gamma_R_neg, 0.0, 2.0),
+        l_R_prime=_num(src, "rudder.l_R_prime", ru.l_R_prime, -3.0, 3.0),
+    )
+
+    st = f.steering
+    steering = SteeringGear(
+        T_E=_qty(src, "steering.T_E", st.T_E, "time", 0.0, MAX_STEERING_TIME_CONSTANT, lo_open=True),
+        rate_max=_qty(src, "steering.rate_max", st.rate_max, "angular_rate", 0.0, MAX_STEERING_RATE, lo_open=True),
+        delta_max=_qty(src, "steering.delta_max", st.delta_max, "angle", 0.0, MAX_RUDDER, lo_open=True),
+    )
+
+    en = f.engine
+    SHP_0 = tuple(float(v) for v in en.SHP_0)
+    if en.mode == "constant_power" and not any(SHP_0):
+        raise InputError(src, "engine.SHP_0", "a constant-power engine needs its power curve SHP_0(u) [hp], "
+                                              "lowest power of u [m/s] first (all zero here)")
+    engine = Engine(
+        mode=en.mode, SHP_0=SHP_0,
+        watts_per_hp=_num(src, "engine.watts_per_hp", en.watts_per_hp, 700.0, 800.0, why="one horse power is 735.5-745.7 W"),
+        shaft_inertia_coefficient=_num(src, "engine.shaft_inertia_coefficient", en.shaft_inertia_coefficient,
+                                       0.0, 100.0, lo_open=True),
+    )
+    return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
+                steering=steering, engine=engine, source=f.source)
+
+
+def ship_from_dict(data: Mapping, source: str = "<dict>") -> Ship:
     """Validate a ship mapping (as read from YAML) and build the :class:`Ship`.
 
-    Raises :class:`trials.errors.InputError`-compatible ``ConfigError`` naming the field.
+    Parameters
+    ----------
+    data : mapping
+        A ship YAML's content.
+    source : str
+        Names the ship in error messages (the ship file's path).
+
+    Returns
+    -------
+    Ship
+
+    Raises
+    ------
+    mmg.errors.InputError
+        One line naming ``source`` and the field: an unknown or missing key, a wrong type or
+        unit, a NaN or infinite number, a value outside the bounds listed in this module.
     """
+    src = str(source)
+    if not isinstance(data, Mapping):
+        raise InputError(src, "", f"expected a mapping of ship fields, got {type(data).__name__}")
     try:
-        f = _ShipFile.model_validate(data)
+        f = _ShipFile.model_validate(dict(data))
     except ValidationError as e:
         err = e.errors()[0]
-        raise ConfigError(source, _loc(err), err["msg"]) from None
-    parts = {}
-    for key, build in (
-        ("particulars", f.particulars.build),
-        ("hull", f.hull.build),
-        ("propeller", f.propeller.build),
-        ("rudder", f.rudder.build),
-        ("steering", f.steering.build),
-    ):
-        try:
-            parts[key] = build()
-        except ValueError as e:
-            raise ConfigError(source, key, str(e)) from None
-    return Ship(
-        name=f.name,
-        particulars=parts["particulars"],
-        mass=MassProperties(**f.mass.model_dump()),
-        hull=parts["hull"],
-        propeller=parts["propeller"],
-        rudder=parts["rudder"],
-        steering=parts["steering"],
-        engine=Engine(**{**f.engine.model_dump(), "SHP_0": tuple(f.engine.SHP_0)}),
-        source=f.source,
-    )
+        raise ConfigError(src, _loc(err), pydantic_message(err, _UNIT_HINT)) from None
+    return _build(f, src)
 
 
 def load_ship(name_or_path: str | Path) -> Ship:
@@ -402,7 +541,8 @@ def load_ship(name_or_path: str | Path) -> Ship:
     Raises
     ------
     mmg.errors.InputError
-        An unknown name, a missing file, malformed YAML or an invalid field.
+        An unknown name, a missing file, malformed YAML or an invalid field (naming the ship
+        file, never a trial that names it).
     """
     from .resources import ship_path
 
@@ -411,19 +551,118 @@ def load_ship(name_or_path: str | Path) -> Ship:
     return ship_from_dict(data, str(path))
 
 
-def read_yaml(path: Path) -> dict:
-    """Read a YAML mapping; ConfigError on a missing file or malformed YAML."""
+# --------------------------------------------------------------------------- YAML files
+
+MAX_CONFIG_BYTES = 16 * 2**20
+"""A config file larger than this (16 MiB) is refused unread: it is not a config."""
+
+_MERGE_TAG = "tag:yaml.org,2002:merge"
+
+
+def _no_duplicate_keys(loader: yaml.SafeLoader, root: yaml.Node, src: str) -> None:
+    """InputError naming the key path when a mapping repeats a key (YAML would keep the last silently)."""
+    stack = [(root, ())]
+    done: set[int] = set()
+    while stack:
+        node, path = stack.pop()
+        if id(node) in done:
+            continue
+        done.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            first: dict = {}
+            for k, v in node.value:
+                if not isinstance(k, yaml.ScalarNode):  # a complex key: the constructor refuses it
+                    stack.append((v, path + ("?",)))
+                    continue
+                if k.tag == _MERGE_TAG:
+                    stack.append((v, path))
+                    continue
+                key = loader.construct_object(k, deep=True)
+                try:
+                    line = first.get(key)
+                except TypeError:  # unhashable: the constructor refuses it
+                    line = None
+                if line is not None:
+                    raise InputError(src, field_path(path + (key,)),
+                                     f"duplicate key (lines {line + 1} and {k.start_mark.line + 1}); "
+                                     "YAML would silently keep the last")
+                try:
+                    first[key] = k.start_mark.line
+                except TypeError:
+                    pass
+                stack.append((v, path + (key,)))
+        elif isinstance(node, yaml.SequenceNode):
+            for i, v in enumerate(node.value):
+                stack.append((v, path + (i,)))
+
+
+def parse_yaml(text: str, source: str = "<text>"):
+    """Parse one YAML document with the safe loader, refusing duplicate keys; InputError when malformed."""
+    src = str(source)
+    loader = None
     try:
-        with open(path) as fh:
-            data = yaml.safe_load(fh)
-    except FileNotFoundError:
-        raise ConfigError(str(path), "", "file not found") from None
+        loader = yaml.SafeLoader(text)
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _no_duplicate_keys(loader, node, src)
+        return loader.construct_document(node)
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f"line {mark.line + 1}" if mark is not None else ""
-        raise ConfigError(str(path), where, f"malformed YAML ({getattr(e, 'problem', e)})") from None
+        problem = getattr(e, "problem", None) or e
+        raise ConfigError(src, where, f"malformed YAML ({one_line(problem)})") from None
+    except RecursionError:
+        raise ConfigError(src, "", "malformed YAML (nested too deeply)") from None
+    except (ValueError, TypeError, OverflowError) as e:  # a constructor's: a date 2020-13-45, '!!int 1.5'
+        raise ConfigError(src, "", f"malformed YAML (a value cannot be read: {one_line(e)})") from None
+    finally:
+        if loader is not None:
+            loader.dispose()
+
+
+def read_yaml(path: str | Path, empty_ok: bool = False) -> dict:
+    """Read a YAML mapping from a file.
+
+    Duplicate keys are refused (YAML's "the last wins" would hide a typo), and so are a
+    missing file, a directory, a file that is not UTF-8 text, malformed YAML and a file over
+    :data:`MAX_CONFIG_BYTES`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    empty_ok : bool, default False
+        An empty file gives ``{}`` instead of an error.
+
+    Raises
+    ------
+    mmg.errors.InputError
+        One line naming the file (and the line or key at fault).
+    """
+    src = str(path)
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_CONFIG_BYTES + 1)
+    except FileNotFoundError:
+        raise ConfigError(src, "", "file not found") from None
+    except IsADirectoryError:
+        raise ConfigError(src, "", "is a directory, not a YAML file") from None
+    except PermissionError:
+        raise ConfigError(src, "", "cannot be read (permission denied)") from None
+    except (OSError, ValueError) as e:
+        raise ConfigError(src, "", f"cannot be read ({one_line(getattr(e, 'strerror', None) or e)})") from None
+    if len(raw) > MAX_CONFIG_BYTES:
+        raise ConfigError(src, "", f"larger than {MAX_CONFIG_BYTES // 2**20} MiB: not a config file")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ConfigError(src, "", f"not a UTF-8 text file (byte 0x{raw[e.start]:02x} at offset {e.start}): "
+                                   "is it binary?") from None
+    data = parse_yaml(text, src)
+    if data is None and empty_ok:
+        return {}
     if not isinstance(data, dict):
-        raise ConfigError(str(path), "", "expected a mapping at the top level")
+        raise ConfigError(src, "", "expected a mapping at the top level")
     return data
 
 

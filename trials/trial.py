@@ -35,8 +35,10 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from mmg.disturbances import RudderOffset, SensorBias, UniformCurrent
 from mmg.errors import InputError
 from mmg.integrate import CommandLaw
-from mmg.ship import Ship, load_ship, read_yaml
-from mmg.units import DEG, to_si
+from mmg.limits import MAX_SAMPLES, check_steps
+from mmg.ship import Ship, field_path, load_ship, one_line, pydantic_message, read_yaml
+from mmg.units import (DEG, KNOT, LONGITUDE_RANGE, MAX_CURRENT, MAX_FROUDE, MAX_HEADING_CHANGE, MAX_LATITUDE,
+                       MAX_RPM, MAX_RUDDER, MAX_RUDDER_OFFSET, MAX_SHIP_SPEED, to_si)
 
 
 def _q(dimension):
@@ -48,7 +50,7 @@ def _q(dimension):
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
 class _Approach(_Strict):
@@ -59,15 +61,14 @@ class _Approach(_Strict):
     @field_validator("speed")
     @classmethod
     def _speed(cls, v):
-        if to_si(v, "speed") <= 0:
-            raise ValueError(f"approach speed must be positive, got {v!r}")
+        to_si(v, "speed", 0.0, MAX_SHIP_SPEED, lo_open=True)
         return v
 
     @field_validator("rpm")
     @classmethod
     def _rpm(cls, v):
-        if v != "solve" and to_si(v, "revolutions") <= 0:
-            raise ValueError(f"rpm must be positive or 'solve', got {v!r}")
+        if v != "solve":
+            to_si(v, "revolutions", 0.0, MAX_RPM, lo_open=True)
         return v
 
 
@@ -136,7 +137,7 @@ class _Bias(_Strict):
 
 class _Log(_Strict):
     interval: str = "5 s"
-    seed: int = 0
+    seed: int = Field(default=0, ge=0, le=2**63 - 1)
     start_lat: str = "35.0 deg"
     start_lon: str = "129.0 deg"
     noise: _Noise = _Noise()
@@ -239,6 +240,10 @@ class Trial:
     log: LogSpec
     disturbances: tuple
 
+    def __post_init__(self):
+        # also for dataclasses.replace(trial, duration=...): refuse a run too big to allocate
+        check_steps(self.duration, self.dt, self.path or "Trial", "duration")
+
     def command_law(self, trim_rudder: float = 0.0, psi0: float = 0.0) -> CommandLaw:
         """The compiled-loop command law for this manoeuvre (see :mod:`mmg.integrate`)."""
         m = self.manoeuvre
@@ -300,26 +305,86 @@ def periodic_order(kind: str, t: np.ndarray, amplitude: float, period: float) ->
 
 
 def _loc(err) -> str:
-    loc = [str(p) for p in err.get("loc", ())]
+    loc = list(err.get("loc", ()))
     # drop pydantic's union-tag element (e.g. manoeuvre.turning.rudder -> manoeuvre.rudder)
     if len(loc) > 1 and loc[0] == "manoeuvre" and loc[1] in ("turning", "zigzag", "stype", "sine", "sawtooth", "schedule"):
         loc.pop(1)
-    return ".".join(loc)
+    return field_path(loc)
+
+
+MAX_SCHEDULE_BYTES = 64 * 2**20
+"""A schedule CSV larger than this (64 MiB, some two million rows) is refused unread."""
+
+_TABLE_COLUMNS = ("time_s", "rudder_deg", "rpm")
 
 
 def _read_table(path: Path, source: str) -> np.ndarray:
+    """The schedule CSV's time_s, rudder_deg[, rpm] as floats; InputError naming the CSV and its column."""
     import pandas as pd
 
+    csv = str(path)
     try:
-        df = pd.read_csv(path, comment="#")
+        size = path.stat().st_size
     except FileNotFoundError:
         raise InputError(source, "manoeuvre.file", f"schedule file {path} not found") from None
-    need = ["time_s", "rudder_deg"]
-    for c in need:
-        if c not in df.columns:
-            raise InputError(str(path), c, "missing column")
-    cols = need + (["rpm"] if "rpm" in df.columns else [])
-    return df[cols].to_numpy(dtype=float)
+    except (OSError, ValueError) as e:
+        raise InputError(source, "manoeuvre.file", f"schedule file {path} cannot be read ({one_line(e)})") from None
+    if path.is_dir():
+        raise InputError(source, "manoeuvre.file", f"schedule file {path} is a directory, not a CSV file")
+    if size > MAX_SCHEDULE_BYTES:
+        raise InputError(csv, "", f"{size / 2**20:.0f} MiB is larger than the {MAX_SCHEDULE_BYTES // 2**20} MiB "
+                                  "a schedule may have")
+    try:
+        df = pd.read_csv(path, comment="#", encoding="utf-8", skipinitialspace=True)
+    except UnicodeDecodeError:
+        raise InputError(csv, "", "not a UTF-8 text file: is it binary?") from None
+    except pd.errors.EmptyDataError:
+        raise InputError(csv, "", "empty: expected columns time_s, rudder_deg[, rpm]") from None
+    except pd.errors.ParserError as e:
+        raise InputError(csv, "", f"not a regular CSV table ({one_line(e)})") from None
+    except (OSError, ValueError) as e:
+        raise InputError(csv, "", f"cannot be read ({one_line(e)})") from None
+    cols = [str(c) for c in df.columns]
+    for c in cols:
+        if c not in _TABLE_COLUMNS:
+            raise InputError(csv, c, f"unknown column; known: {', '.join(_TABLE_COLUMNS)}")
+    if len(set(cols)) != len(cols):
+        raise InputError(csv, "", "a column is repeated")
+    for c in ("time_s", "rudder_deg"):
+        if c not in cols:
+            raise InputError(csv, c, "missing column")
+    use = [c for c in _TABLE_COLUMNS if c in cols]
+    out = np.empty((len(df), len(use)))
+    for j, c in enumerate(use):
+        col = df[c]
+        vals = None
+        if col.dtype != bool:
+            try:
+                vals = col.to_numpy(dtype=float)
+            except (ValueError, TypeError, OverflowError):
+                pass
+        if vals is None:  # find the first cell that is not a number (a word, True, a number beyond float)
+            for i, cell in enumerate(col):
+                try:
+                    ok = not isinstance(cell, (bool, np.bool_)) and np.isfinite(float(cell))
+                except (ValueError, TypeError, OverflowError):
+                    ok = False
+                if not ok:
+                    raise InputError(csv, c, f"data row {i + 1}: {_short(cell)} is not a finite number")
+            raise InputError(csv, c, "not a column of numbers")
+        bad = ~np.isfinite(vals)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            cell = col.iloc[i]
+            what = "is empty" if pd.isna(cell) else f"{_short(cell)} is not a finite number"
+            raise InputError(csv, c, f"data row {i + 1} {what}")
+        out[:, j] = vals
+    return out
+
+
+def _short(value) -> str:
+    r = repr(value)
+    return one_line(r if len(r) <= 40 else r[:37] + "...")
 
 
 _UNIT_HINT = {
@@ -331,31 +396,29 @@ _UNIT_HINT = {
 
 def _message(err) -> str:
     """Pydantic's message, made plain; a number where a quantity is expected names the unit to add."""
-    loc = err.get("loc", ())
-    field = str(loc[-1]) if loc else ""
-    value = err.get("input")
-    if err.get("type") == "string_type" and isinstance(value, (int, float)) and not isinstance(value, bool) \
-            and field in _UNIT_HINT:
-        return (f"{value!r} has no unit; write it with one, e.g. '{value} {_UNIT_HINT[field]}' "
-                "(plain numbers are refused)")
-    return err["msg"].removeprefix("Value error, ")
+    return pydantic_message(err, _UNIT_HINT)
 
 
 def _resolve_ship(spec: str, base: Path, src: str) -> Path:
     """A trial's ``ship:`` entry: a bundled ship name, or a path relative to ``base``."""
     from mmg.resources import _looks_like_path, bundled, config_dir
 
-    if _looks_like_path(spec):
-        p = Path(spec).expanduser()
-        p = (p if p.is_absolute() else base / p).resolve()
-        if not p.is_file():
-            raise InputError(src, "ship", f"ship file {spec} not found (looked in {p})")
-        return p
-    p = config_dir() / "ships" / f"{spec}.yaml"
-    if p.is_file():
-        return p
-    if (base / spec).is_file():
-        return (base / spec).resolve()
+    try:
+        if _looks_like_path(spec):
+            p = Path(spec).expanduser()
+            p = (p if p.is_absolute() else base / p).resolve()
+            if p.is_dir():
+                raise InputError(src, "ship", f"ship file {spec} is a directory, not a ship YAML (looked in {p})")
+            if not p.is_file():
+                raise InputError(src, "ship", f"ship file {spec} not found (looked in {p})")
+            return p
+        p = config_dir() / "ships" / f"{spec}.yaml"
+        if p.is_file():
+            return p
+        if (base / spec).is_file():
+            return (base / spec).resolve()
+    except (OSError, ValueError, RuntimeError) as e:  # a name too long, a NUL byte, '~nosuchuser'
+        raise InputError(src, "ship", f"{_short(spec)} is not a usable ship name or path ({one_line(e)})") from None
     raise InputError(src, "ship", f"no bundled ship {spec!r} (bundled: {', '.join(bundled('ships'))}); "
                                   "or give a path to a ship YAML, relative to the trial file")
 
@@ -379,7 +442,7 @@ def load_trial(source: str | Path | Mapping) -> Trial:
     ------
     mmg.errors.InputError
         An unknown name, a missing file, or an invalid field (one line naming the file
-        and the field).
+        and the field; an error in the ship file names the ship file).
     """
     if isinstance(source, Mapping):
         return trial_from_dict(source)
@@ -389,9 +452,45 @@ def load_trial(source: str | Path | Mapping) -> Trial:
     return trial_from_dict(read_yaml(path), source=str(path), base=path.parent)
 
 
+MIN_DT = 1e-4
+"""Smallest integration step [s] (0.1 ms); the largest is the ship's steering-gear time constant T_E."""
+
+MIN_STEPS_PER_PERIOD = 10
+"""A sine or sawtooth period must span at least this many integration steps."""
+
+NOISE_MAX = {"lat": 0.01 * DEG, "lon": 0.01 * DEG, "heading": 10 * DEG, "speed": 5 * KNOT, "rpm": 100 / 60}
+"""Largest log noise amplitude per channel (SI): lat, lon 0.01 deg (1.1 km), heading 10 deg, speed 5 kn,
+rpm 100 rpm; the same bounds apply to |bias|."""
+
+_DIM = {"lat": "angle", "lon": "angle", "heading": "angle", "speed": "speed", "rpm": "revolutions"}
+
+
+def _polyval(c, x: float) -> float:
+    return float(np.polyval(np.asarray(c, float)[::-1], x))
+
+
 def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | None = None,
                     ship: Ship | None = None) -> Trial:
     """Validate a trial mapping (a trial YAML's content) and build the :class:`Trial`.
+
+    Besides types, keys and units, every value is checked against plausible bounds (a value
+    outside them is refused as probably the wrong unit), and against the ship:
+
+    * approach speed 0-60 kn, Froude number U/sqrt(gL) at most 1, the ship's t_P(u) and
+      w_P0(u) within [0, 1) and (constant power) SHP_0(u) > 0 at that speed; rpm 0-6000 rpm;
+    * dt 0.1 ms to the ship's steering-gear time constant T_E (RK4 on the gear's first-order
+      lag is unstable beyond 2.8 T_E); dt <= duration; at most :data:`mmg.limits.MAX_STEPS`
+      steps (refused before anything is allocated, saying how much it would need);
+    * rudder and amplitude within the steering-gear limit (and 90 deg); a zigzag or S-type
+      rudder and switching heading positive (the side is ``first``), the heading at most
+      360 deg; a period of at least 10 steps; execute in [0, duration);
+    * a schedule: at least two rows, all of 2 or all of 3 numbers, finite, times strictly
+      increasing from 0 or later and starting before the end; an rpm column (0-6000 rpm) only
+      for a constant-rpm engine (a constant-power engine would ignore it);
+    * log: interval a multiple of dt, at most the duration; seed 0 or more; start latitude
+      within +-90 deg, longitude -180 to 360 deg; noise 0 or more and |bias| at most
+      :data:`NOISE_MAX`;
+    * current 0-20 kn towards a direction within +-360 deg; rudder offset within +-10 deg.
 
     Parameters
     ----------
@@ -412,7 +511,8 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
     Raises
     ------
     mmg.errors.InputError
-        One line naming ``source`` and the field at fault.
+        One line naming ``source`` and the field at fault (the ship file and its field when
+        the ship file is at fault; a schedule CSV and its column when that is).
     """
     src = str(source)
     base = Path.cwd() if base is None else Path(base)
@@ -428,78 +528,166 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
     except ValidationError as e:
         err = e.errors()[0]
         raise InputError(src, _loc(err), _message(err)) from None
+
+    def q(field, value, dimension, lo=None, hi=None, **kw) -> float:
+        try:
+            return to_si(value, dimension, lo, hi, **kw)
+        except ValueError as e:
+            raise InputError(src, field, str(e)) from None
+
+    # the size of the run first: refused before the ship is read or anything allocated
+    duration = q("duration", f.duration, "time", 0.0, None, lo_open=True)
+    dt = q("dt", f.dt, "time", MIN_DT, None)
+    if dt > duration:
+        raise InputError(src, "dt", f"{f.dt} is longer than the duration ({f.duration})")
+    check_steps(duration, dt, src, "duration")
+
     if ship is None:
         ship_path = _resolve_ship(f.ship, base, src)
         ship = load_ship(ship_path)
         ship_path = str(ship_path)
     else:
         ship_path = ""
+    label = f"{ship.name} ({ship_path})" if ship_path else ship.name
+    T_E = ship.steering.T_E
+    if dt > T_E * (1 + 1e-9):
+        raise InputError(src, "dt", f"{f.dt} is longer than the steering gear's time constant T_E = {T_E:g} s of "
+                                    f"{label}: the step must resolve it (RK4 is unstable beyond 2.8 T_E)")
+
+    # approach, against the ship
+    u0 = q("approach.speed", f.approach.speed, "speed", 0.0, MAX_SHIP_SPEED, lo_open=True)
+    L = ship.particulars.L
+    fn = u0 / np.sqrt(9.81 * L)
+    if fn > MAX_FROUDE:
+        raise InputError(src, "approach.speed", f"{f.approach.speed} is a Froude number of {fn:.3g} for the {L:g} m "
+                                                f"{label}; above {MAX_FROUDE:g} no displacement ship sails "
+                                                "(probably the wrong unit)")
+    pr = ship.propeller
+    for name, poly in (("t_P", pr.t_P), ("w_P0", pr.w_P0)):
+        v = _polyval(poly, u0)
+        if not 0.0 <= v < 1.0:
+            raise InputError(src, "approach.speed", f"at {f.approach.speed} the ship's {name}(u) polynomial gives "
+                                                    f"{v:.4g}, outside [0, 1): the speed is outside the range of "
+                                                    f"the propeller data of {label}")
+    if ship.engine.mode == "constant_power":
+        shp = _polyval(ship.engine.SHP_0, u0)
+        if not shp > 0.0:
+            raise InputError(src, "approach.speed", f"at {f.approach.speed} the constant-power engine's SHP_0(u) "
+                                                    f"gives {shp:.4g} hp; it needs positive power (the speed is "
+                                                    f"outside the engine data of {label})")
+    n0 = None if f.approach.rpm == "solve" else q("approach.rpm", f.approach.rpm, "revolutions", 0.0, MAX_RPM,
+                                                  lo_open=True)
+
+    # the manoeuvre
     dmax = ship.steering.delta_max
     man = f.manoeuvre.model_dump()
     kind = man.pop("kind")
-    conv = {}
+    conv: dict = {}
     for k, v in man.items():
-        if k in ("rudder", "heading", "switch_heading", "amplitude"):
-            conv[k] = to_si(v, "angle")
-        elif k in ("period", "execute"):
-            conv[k] = to_si(v, "time")
+        field = f"manoeuvre.{k}"
+        if k in ("rudder", "amplitude"):
+            x = q(field, v, "angle", -MAX_RUDDER, MAX_RUDDER)
+            if abs(x) > dmax + 1e-12:
+                raise InputError(src, field, f"{v} exceeds the steering gear limit of {dmax / DEG:g} deg of {label}")
+            if k == "rudder" and kind in ("zigzag", "stype") and not x > 0:
+                raise InputError(src, field, f"must be positive, got {v!r} (the first side is set by 'first')")
+            conv[k] = x
+        elif k in ("heading", "switch_heading"):
+            conv[k] = q(field, v, "angle", 0.0, MAX_HEADING_CHANGE, lo_open=True)
+        elif k == "period":
+            conv[k] = q(field, v, "time", MIN_STEPS_PER_PERIOD * dt, None,
+                        why=f"at least {MIN_STEPS_PER_PERIOD} steps of dt = {dt:g} s, so the order is resolved")
+        elif k == "execute":
+            conv[k] = q(field, v, "time", 0.0, duration, hi_open=True,
+                        why=f"the execute time must lie in [0, {duration:g} s), within the run")
         else:
             conv[k] = v
-    for k in ("rudder", "amplitude"):
-        if k in conv and abs(conv[k]) > dmax + 1e-12:
-            raise InputError(src, f"manoeuvre.{k}",
-                             f"{man[k]} exceeds the steering gear limit of {dmax / DEG:g} deg of {ship.name}")
-    for k in ("heading", "switch_heading", "period"):
-        if k in conv and conv[k] <= 0:
-            raise InputError(src, f"manoeuvre.{k}", f"must be positive, got {man[k]}")
     if kind == "schedule":
-        if (conv.get("table") is None) == (conv.get("file") is None):
-            raise InputError(src, "manoeuvre", "a schedule needs exactly one of 'table' or 'file'")
-        tab = np.asarray(conv["table"], dtype=float) if conv.get("table") is not None else \
-            _read_table(base / conv["file"], src)
-        if tab.ndim != 2 or tab.shape[1] not in (2, 3) or len(tab) < 2:
-            raise InputError(src, "manoeuvre.table", "needs at least two rows of [time_s, rudder_deg(, rpm)]")
-        if not np.all(np.isfinite(tab)):
-            raise InputError(src, "manoeuvre.table", "contains NaN or infinite values")
-        if np.any(np.diff(tab[:, 0]) <= 0):
-            raise InputError(src, "manoeuvre.table", "time_s must be strictly increasing")
-        if np.any(np.abs(tab[:, 1]) > dmax / DEG + 1e-9):
-            raise InputError(src, "manoeuvre.table", f"rudder beyond the steering gear limit of {dmax / DEG:g} deg")
-        tab = tab.copy()
-        tab[:, 1] *= DEG
-        if tab.shape[1] > 2:
-            tab[:, 2] /= 60.0
-        conv = {"table": tab}
-    duration, dt = to_si(f.duration, "time"), to_si(f.dt, "time")
-    if dt <= 0 or duration <= 0:
-        raise InputError(src, "dt" if dt <= 0 else "duration", "must be positive")
-    if dt > duration:
-        raise InputError(src, "dt", "is longer than the duration")
+        conv = {"table": _schedule(conv, ship, label, duration, base, src)}
+
+    # the log
     lg = f.log
-    interval = to_si(lg.interval, "time")
+    interval = q("log.interval", lg.interval, "time", 0.0, duration, lo_open=True,
+                 why=f"a positive interval at most the duration {f.duration}")
     ratio = interval / dt
-    if interval <= 0 or abs(ratio - round(ratio)) > 1e-6:
-        raise InputError(src, "log.interval", f"must be a positive multiple of dt ({f.dt})")
-    nz = lg.noise
-    log = LogSpec(interval, lg.seed, to_si(lg.start_lat, "angle"), to_si(lg.start_lon, "angle"),
-                  to_si(nz.lat, "angle"), to_si(nz.lon, "angle"), to_si(nz.heading, "angle"),
-                  to_si(nz.speed, "speed"), to_si(nz.rpm, "revolutions"),
-                  SensorBias(to_si(lg.bias.heading, "angle"), to_si(lg.bias.speed, "speed"),
-                             to_si(lg.bias.rpm, "revolutions")))
+    if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-6:
+        raise InputError(src, "log.interval", f"must be a positive multiple of dt ({f.dt}), got {lg.interval!r}")
+    start_lat = q("log.start_lat", lg.start_lat, "angle", -MAX_LATITUDE, MAX_LATITUDE,
+                  why="a latitude is within +-90 deg")
+    start_lon = q("log.start_lon", lg.start_lon, "angle", *LONGITUDE_RANGE, why="a longitude is -180 to 360 deg")
+    noise = {c: q(f"log.noise.{c}", getattr(lg.noise, c), _DIM[c], 0.0, NOISE_MAX[c]) for c in _DIM}
+    bias = {c: q(f"log.bias.{c}", getattr(lg.bias, c), _DIM[c], -NOISE_MAX[c], NOISE_MAX[c])
+            for c in ("heading", "speed", "rpm")}
+    log = LogSpec(interval, lg.seed, start_lat, start_lon, noise["lat"], noise["lon"], noise["heading"],
+                  noise["speed"], noise["rpm"], SensorBias(bias["heading"], bias["speed"], bias["rpm"]))
+
+    # disturbances
     dist = []
     d = f.disturbances
     if d.current is not None:
-        dist.append(UniformCurrent(to_si(d.current.speed, "speed"), to_si(d.current.direction, "angle")))
-    off = to_si(d.rudder_offset, "angle")
+        dist.append(UniformCurrent(
+            q("disturbances.current.speed", d.current.speed, "speed", 0.0, MAX_CURRENT,
+              why="a current runs at 0-20 kn (its sense is the direction)"),
+            q("disturbances.current.direction", d.current.direction, "angle", -2 * np.pi, 2 * np.pi)))
+    off = q("disturbances.rudder_offset", d.rudder_offset, "angle", -MAX_RUDDER_OFFSET, MAX_RUDDER_OFFSET)
     if off != 0.0:
         dist.append(RudderOffset(off))
     return Trial(
         name=f.name, path=src, ship=ship, ship_path=ship_path, description=f.description,
-        u0=to_si(f.approach.speed, "speed"),
-        n0=None if f.approach.rpm == "solve" else to_si(f.approach.rpm, "revolutions"),
-        trim=f.approach.trim, duration=duration, dt=dt, kind=kind, manoeuvre=conv, log=log,
+        u0=u0, n0=n0, trim=f.approach.trim, duration=duration, dt=dt, kind=kind, manoeuvre=conv, log=log,
         disturbances=tuple(dist),
     )
+
+
+def _schedule(man: dict, ship: Ship, label: str, duration: float, base: Path, src: str) -> np.ndarray:
+    """A schedule's table in SI (rows of s, rad(, rps)), from ``table`` or ``file``, checked."""
+    if (man.get("table") is None) == (man.get("file") is None):
+        raise InputError(src, "manoeuvre", "a schedule needs exactly one of 'table' or 'file'")
+    if man.get("table") is not None:
+        rows = man["table"]
+        where, cols = src, ("manoeuvre.table",) * 3
+        if len(rows) < 2:
+            raise InputError(src, "manoeuvre.table", "needs at least two rows of [time_s, rudder_deg(, rpm)]")
+        if len(rows) > MAX_SAMPLES:
+            raise InputError(src, "manoeuvre.table", f"{len(rows):,} rows; at most {MAX_SAMPLES:,}")
+        width = len(rows[0])
+        for i, r in enumerate(rows):
+            if len(r) not in (2, 3) or len(r) != width:
+                raise InputError(src, f"manoeuvre.table.{i}", f"row of {len(r)} values; every row must be "
+                                                              "[time_s, rudder_deg] or every row [time_s, rudder_deg, rpm]")
+        tab = np.asarray(rows, dtype=float)
+    else:
+        try:
+            path = base / man["file"]
+        except (TypeError, ValueError) as e:
+            raise InputError(src, "manoeuvre.file", f"not a usable path ({one_line(e)})") from None
+        tab = _read_table(path, src)
+        where, cols = str(path), _TABLE_COLUMNS
+        if len(tab) < 2:
+            raise InputError(where, "", "needs at least two rows of time_s, rudder_deg(, rpm)")
+    if not np.all(np.isfinite(tab)):
+        raise InputError(where, cols[0], "contains NaN or infinite values")
+    t = tab[:, 0]
+    if np.any(np.diff(t) <= 0):
+        i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
+        raise InputError(where, cols[0], f"time_s must be strictly increasing ({t[i - 1]:g} then {t[i]:g})")
+    if t[0] < 0 or t[0] >= duration:
+        raise InputError(where, cols[0], f"the first time {t[0]:g} s must lie in [0, {duration:g} s), within the run")
+    dmax = ship.steering.delta_max
+    if np.any(np.abs(tab[:, 1]) > dmax / DEG + 1e-9):
+        raise InputError(where, cols[1], f"rudder beyond the steering gear limit of {dmax / DEG:g} deg of {label}")
+    tab = tab.copy()
+    tab[:, 1] *= DEG
+    if tab.shape[1] > 2:
+        if ship.engine.mode != "constant_rpm":
+            raise InputError(where, cols[2], f"an rpm order, but the {ship.engine.mode.replace('_', '-')} engine of "
+                                             f"{label} would ignore it: drop the rpm column or use a constant-rpm ship")
+        rpm = tab[:, 2]
+        if np.any(rpm <= 0) or np.any(rpm > MAX_RPM * 60):
+            raise InputError(where, cols[2], f"rpm must be positive and at most {MAX_RPM * 60:g} rpm "
+                                             f"(got {rpm.min():g} to {rpm.max():g})")
+        tab[:, 2] /= 60.0
+    return tab
 
 
 # --------------------------------------------------------------------------- builders
