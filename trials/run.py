@@ -9,16 +9,14 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 
 from mmg.errors import InputError
 from mmg.integrate import integrate
 from mmg.model import STATE_NAMES
 from mmg.simulation import SimulationResult, prepare
-from mmg.units import DEG, KNOT
+from mmg.units import DEG, KNOT, M_PER_DEG_LAT, M_PER_DEG_LON
 
 from . import metrics as MET
-from .logio import M_PER_DEG_LAT, M_PER_DEG_LON, log_frame, truth_frame
 from .trial import Trial
 
 
@@ -109,7 +107,7 @@ class TrialRun:
             return self.result.U
         return np.hypot(np.gradient(x, t), np.gradient(y, t))
 
-    def to_pandas(self) -> pd.DataFrame:
+    def to_pandas(self) -> "pd.DataFrame":
         """The time history as a DataFrame indexed by time ``t`` [s].
 
         Returns
@@ -125,6 +123,8 @@ class TrialRun:
             name, kind and ship.
         """
         r = self.result
+        import pandas as pd
+
         df = pd.DataFrame(r.states, columns=list(STATE_NAMES), index=pd.Index(r.t, name="t"))
         df["delta_order"] = r.orders
         df["U"] = r.U
@@ -189,7 +189,7 @@ class TrialRun:
             plt.show()
         return fig
 
-    def log(self, seed: int | None = None) -> pd.DataFrame:
+    def log(self, seed: int | None = None) -> "pd.DataFrame":
         """The sea-trial log: the track sampled at the log interval, with sensor noise and bias.
 
         Parameters
@@ -206,6 +206,8 @@ class TrialRun:
         """
         r = self.result
         spec = self.trial.log if seed is None else dataclasses.replace(self.trial.log, seed=int(seed))
+        from .logio import log_frame      # pandas only when a log is asked for
+
         return log_frame(r.t, r.x, r.y, r.psi, self.sog, r.n, spec)
 
     def log_meta(self) -> dict:
@@ -226,7 +228,7 @@ class TrialRun:
                 "bias": f"heading {np.degrees(lg.bias.heading):g} deg, speed {lg.bias.speed / 0.514444:g} kn, "
                         f"rpm {lg.bias.rpm * 60:g} rpm"}
 
-    def truth(self) -> pd.DataFrame:
+    def truth(self) -> "pd.DataFrame":
         """The truth file's table: states at every integration step (SI).
 
         Returns
@@ -236,6 +238,8 @@ class TrialRun:
             ``delta_order_rad``, ``x_m``, ``y_m``, ``psi_rad``, ``n_rps`` (a plain index).
         """
         r = self.result
+        from .logio import truth_frame
+
         return truth_frame(r.t, r.states, r.orders)
 
     def metrics(self) -> dict:
