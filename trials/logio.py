@@ -15,18 +15,45 @@ Formats
   (wrapped), r_angvelo [rad/s], n_prop [rps], delta_rudder [rad], wind...``.
 
 :func:`read_record` recognises the format from the header and returns a
-:class:`~trials.records.TrialRecord`; malformed files (missing columns, NaN, gaps,
-time not increasing) raise :class:`~mmg.errors.InputError` naming the file and field.
+:class:`~trials.records.TrialRecord`.  Anything else raises :class:`~mmg.errors.InputError`
+(one line naming the file and the field; the CLI exits 2), never another exception and never a
+silently wrong record:
+
+* the file: missing, a directory, binary (NUL bytes), not UTF-8, larger than
+  ``256 * mmg.limits.MAX_SAMPLES`` bytes;
+* the table: rows with more or fewer cells than the header, a column twice, missing columns,
+  cells that are not finite numbers (named by file line);
+* time: not strictly increasing, a gap (a step over 1.5 sampling steps), a sampling step that is
+  not the format's (the header's ``interval_s`` for a log, ``dt_s`` for a truth file, 10 Hz for
+  FRT-DS-ESSO, or a resampled copy of it at 0.02 to 1 s; "time in milliseconds?" when it is 1000
+  times), a step other than the header's (logs, truth files), a record spanning more than
+  ``mmg.limits.MAX_STEPS`` steps of 0.1 s (what the estimators would integrate); any number
+  beyond 1e12;
+* units (plausibility): a rudder beyond 45 deg or a wrapped heading beyond 2 pi in a radian
+  column ("degrees?"), a yaw rate beyond 1 rad/s ("deg/s?") or disagreeing with the heading's
+  change (one of them in degrees), a heading jumping more than 1 rad/s sample after sample,
+  speeds or the track beyond Froude number 1 for the ship's length, a logged speed that is not
+  the speed along the track (a log with ``interval_s``), positions far from the header's start,
+  propeller speeds beyond 100 rps ("rpm?").
+
+Rows whose cells are all empty (e.g. the ~300 rows after the end of a real zigzag) carry no
+sample: they are ignored and said so (``rec.meta["notes"]`` and a warning on the
+``trials.logio`` logger); a gap they leave in time is refused as a gap.
 """
 from __future__ import annotations
 
+import csv
 import io
+import logging
+import math
+import stat
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from mmg.errors import InputError
+from mmg.limits import MAX_SAMPLES, MAX_STEPS
 from mmg.units import DEG, KNOT, M_PER_DEG_LAT, M_PER_DEG_LON
 
 from .records import TrialRecord
@@ -110,10 +137,39 @@ def truth_frame(t, states, orders) -> pd.DataFrame:
 
 # --------------------------------------------------------------------------- reading
 
+_log = logging.getLogger(__name__)
+
+MAX_SPAN_S = MAX_STEPS * 0.1
+"""Longest record [s] a reader accepts: :data:`mmg.limits.MAX_STEPS` steps of 0.1 s (the analysis step)."""
+MAX_FILE_BYTES = 256 * MAX_SAMPLES
+"""Largest file [bytes] a reader opens: :data:`mmg.limits.MAX_SAMPLES` rows of 256 bytes."""
+FRT_INTERVAL_S = 0.1
+"""FRT-DS-ESSO sampling step [s] (10 Hz)."""
+FRT_STEP_RANGE = (0.02, 1.0, FRT_INTERVAL_S)
+"""Sampling steps [s] accepted in the FRT-DS-ESSO layout (copies resampled between 50 Hz and 1 Hz)."""
+FRT_LENGTH_M = 3.0
+MAX_RUDDER = 45.0 * DEG
+"""Largest plausible rudder angle [rad]; a larger value in a radian column is a unit error."""
+MAX_YAW_RATE = 1.0
+"""Largest plausible yaw rate [rad/s] (57 deg/s) for any ship or model."""
+MAX_FROUDE = 1.0
+"""Largest plausible Froude number U / sqrt(g L) of a displacement ship or model."""
+MAX_RPS = 100.0
+"""Largest plausible propeller speed [rps]."""
+MAX_MAGNITUDE = 1e12
+"""Largest magnitude of any number in a record (seconds, metres, ...): beyond it arithmetic on the
+channels overflows and no unit makes sense."""
+G = 9.80665
+
+_POSITIVE_META = ("interval_s", "dt_s", "length_m", "m_per_deg_lat", "m_per_deg_lon")
+_FINITE_META = ("start_lat_deg", "start_lon_deg", "execute_s", "rudder_deg", "heading_deg", "switch_heading_deg",
+                "trim_rudder_deg", "steering_T_E_s", "steering_rate_deg_s", "steering_delta_max_deg")
+
+
 def _parse_meta(lines: list[str]) -> dict:
     meta = {}
     for ln in lines:
-        body = ln[1:].strip()
+        body = ln.lstrip()[1:].strip()
         if ":" in body:
             k, v = body.split(":", 1)
             v = v.strip()
@@ -125,27 +181,17 @@ def _parse_meta(lines: list[str]) -> dict:
     return meta
 
 
-def _check(df: pd.DataFrame, cols, source: str, time_col: str, max_gap: float | None = None):
-    for c in cols:
-        if c not in df.columns:
-            raise InputError(source, c, "missing column")
-    for c in cols:
-        vals = pd.to_numeric(df[c], errors="coerce").to_numpy(dtype=float)
-        bad = np.flatnonzero(~np.isfinite(vals))
-        if bad.size:
-            raise InputError(source, c, f"non-numeric or NaN value at data row {bad[0] + 1}")
-    t = df[time_col].to_numpy(dtype=float)
-    if len(t) < 2:
-        raise InputError(source, time_col, "fewer than two samples")
-    dt = np.diff(t)
-    bad = np.flatnonzero(dt <= 0)
-    if bad.size:
-        raise InputError(source, time_col, f"time is not strictly increasing at data row {bad[0] + 2} (t = {t[bad[0] + 1]:g} s)")
-    med = float(np.median(dt))
-    limit = max_gap if max_gap is not None else 3.0 * med
-    gap = np.flatnonzero(dt > limit + 1e-9)
-    if gap.size:
-        raise InputError(source, time_col, f"gap of {dt[gap[0]]:g} s at t = {t[gap[0]]:g} s (sampling {med:g} s)")
+def _check_meta(meta: dict, src: str) -> None:
+    """Header values the readers and analyses use must be numbers (positive where they are sizes)."""
+    for k in _POSITIVE_META + _FINITE_META:
+        if k not in meta:
+            continue
+        v = meta[k]
+        ok = (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+              and (v > 0 or k not in _POSITIVE_META))
+        if not ok:
+            need = "a positive number" if k in _POSITIVE_META else "a finite number"
+            raise InputError(src, k, f"header value {v!r} is not {need}")
 
 
 def unwrap_heading(psi_wrapped: np.ndarray) -> np.ndarray:
@@ -154,74 +200,439 @@ def unwrap_heading(psi_wrapped: np.ndarray) -> np.ndarray:
     return psi - 2 * np.pi * np.round(psi[0] / (2 * np.pi))
 
 
-def read_record(path: str | Path) -> TrialRecord:
-    """Read a project log, a project truth file or an FRT-DS-ESSO CSV into a TrialRecord."""
-    path = Path(path)
-    src = str(path)
+def _read_text(path: Path, src: str) -> str:
     try:
-        text = path.read_text()
+        st = path.stat()
     except FileNotFoundError:
         raise InputError(src, "", "file not found") from None
-    except (UnicodeDecodeError, IsADirectoryError) as e:
-        raise InputError(src, "", f"cannot read as text ({e.__class__.__name__})") from None
-    lines = text.splitlines()
-    head = [ln for ln in lines if ln.startswith("#")]
-    meta = _parse_meta(head)
-    body = "\n".join(ln for ln in lines if not ln.startswith("#"))
-    if not body.strip():
-        raise InputError(src, "", "no data")
+    except OSError as e:
+        raise InputError(src, "", f"cannot read ({e.strerror or e.__class__.__name__})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError(src, "", "is a directory, not a log file")
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(src, "", "is not a regular file")
+    if st.st_size > MAX_FILE_BYTES:
+        raise InputError(src, "", f"file of {st.st_size / 1e6:.4g} MB is larger than any record the readers accept "
+                                  f"({MAX_FILE_BYTES / 1e6:.4g} MB: mmg.limits.MAX_SAMPLES rows)")
     try:
-        df = pd.read_csv(io.StringIO(body))
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as e:
-        raise InputError(src, "", f"not a readable CSV ({str(e).splitlines()[0]})") from None
-    return record_from_frame(df, meta, src, default_name=path.stem)
+        data = path.read_bytes()
+    except OSError as e:
+        raise InputError(src, "", f"cannot read ({e.strerror or e.__class__.__name__})") from None
+    nul = data.find(b"\x00")
+    if nul >= 0:
+        raise InputError(src, "", f"binary file (NUL byte at offset {nul}), not a CSV text")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        raise InputError(src, "", f"not UTF-8 text (byte 0x{data[e.start]:02x} at offset {e.start})") from None
 
 
-def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", default_name: str = "") -> TrialRecord:
+def _cells(line: str, lineno: int, src: str) -> list[str]:
+    if '"' not in line:
+        return line.split(",")
+    try:
+        return next(csv.reader([line], strict=True))
+    except (csv.Error, StopIteration) as e:
+        raise InputError(src, f"line {lineno}", f"not a readable CSV row ({e})") from None
+
+
+def _parse_table(numbered: list[tuple[int, str]], src: str) -> tuple[pd.DataFrame, np.ndarray, list[str]]:
+    """The CSV table of the non-comment lines: (frame of the data rows, their file line numbers, notes).
+
+    Rows with a different number of cells than the header are refused; rows whose cells are
+    all empty carry no sample and are dropped (and reported in the notes), so that a gap they
+    leave shows as a gap in time, and trailing empty rows (a logger that stopped) are harmless.
+    """
+    rows = [(n, ln) for n, ln in numbered if ln.strip()]
+    if not rows:
+        raise InputError(src, "", "no data (no header line and no rows)")
+    hno, hline = rows[0]
+    names = [c.strip() for c in _cells(hline, hno, src)]
+    seen = set()
+    for c in names:
+        if c and c in seen:
+            raise InputError(src, c, f"column appears twice in the header (line {hno})")
+        seen.add(c)
+    ncol = len(names)
+    keep, lines, empty = [], [], []
+    for n, ln in rows[1:]:
+        if '"' in ln:
+            cells = _cells(ln, n, src)
+            k, blank = len(cells), all(not c.strip() for c in cells)
+        else:
+            k, blank = ln.count(",") + 1, not ln.replace(",", "").strip()
+        if blank:
+            empty.append(len(lines))       # position among the data rows
+            continue
+        if k != ncol:
+            raise InputError(src, f"line {n}", f"{k} cells, but the header (line {hno}) has {ncol} columns")
+        keep.append(ln)
+        lines.append(n)
+    if not keep:
+        raise InputError(src, "", "no data rows after the header")
+    notes = []
+    if empty:
+        trailing = sum(1 for k in empty if k == len(lines))
+        leading = sum(1 for k in empty if k == 0)
+        inner = len(empty) - trailing - leading
+        for count, where in ((leading, "leading"), (inner, "interior"), (trailing, "trailing")):
+            if count:
+                notes.append(f"ignored {count} {where} empty row{'s' if count > 1 else ''} (no values)")
+    text = "\n".join([hline] + keep)
+    try:
+        df = pd.read_csv(io.StringIO(text), keep_default_na=False, skip_blank_lines=False, low_memory=False)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, OverflowError, csv.Error) as e:
+        raise InputError(src, "", f"not a readable CSV ({str(e).splitlines()[0] if str(e) else e.__class__.__name__})") from None
+    if len(df) != len(keep) or df.shape[1] != ncol:
+        raise InputError(src, "", "not a readable CSV (quoted cells spanning lines)")
+    df.columns = names
+    return df, np.asarray(lines), notes
+
+
+def read_record(path: str | Path) -> TrialRecord:
+    """Read a project log, a project truth file or an FRT-DS-ESSO CSV into a TrialRecord.
+
+    Anything that is not such a file, or is one with wrong-looking content, raises
+    :class:`~mmg.errors.InputError` naming the file and the field (column, header key or line):
+    a directory, a binary or non-UTF-8 file, rows with the wrong number of cells, cells that are
+    not numbers, NaN, time that does not increase, gaps, a sampling step that is not the format's
+    (the header's ``interval_s`` / ``dt_s``, 10 Hz for FRT-DS-ESSO), a record longer than
+    ``mmg.limits.MAX_STEPS`` steps of 0.1 s, and channels in a wrong unit (see
+    :func:`record_from_frame`).  Empty rows (all cells empty) are ignored and said so in
+    ``rec.meta["notes"]`` and on the ``trials.logio`` logger.
+    """
+    path = Path(path)
+    src = str(path)
+    text = _read_text(path, src)
+    lines = text.splitlines()
+    meta = _parse_meta([ln for ln in lines if ln.lstrip().startswith("#")])
+    numbered = [(i + 1, ln) for i, ln in enumerate(lines) if not ln.lstrip().startswith("#")]
+    df, rows, notes = _parse_table(numbered, src)
+    return record_from_frame(df, meta, src, default_name=path.stem, notes=notes, lines=rows)
+
+
+class _Table:
+    """A table being checked: numeric columns with messages that point at the file line."""
+
+    def __init__(self, df: pd.DataFrame, src: str, lines=None):
+        self.df, self.src, self.lines = df, src, lines
+
+    def where(self, i: int) -> str:
+        return f"line {int(self.lines[i])}" if self.lines is not None else f"data row {i + 1}"
+
+    def require(self, cols) -> None:
+        for c in cols:
+            if c not in self.df.columns:
+                raise InputError(self.src, c, "missing column")
+
+    def numeric(self, c: str) -> np.ndarray:
+        col = self.df[c]
+        if col.dtype.kind in "fiu":
+            vals = col.to_numpy(dtype=float)
+        else:
+            vals = pd.to_numeric(col.astype(str).str.strip(), errors="coerce").to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(vals))
+        if bad.size:
+            i = int(bad[0])
+            raw = str(col.iloc[i]).strip()
+            what = "empty cell" if raw == "" else (f"value {raw[:20]!r} is not a finite number")
+            raise InputError(self.src, c, f"{what} at {self.where(i)}" + (f" ({bad.size} such cells)" if bad.size > 1 else ""))
+        huge = np.flatnonzero(np.abs(vals) > MAX_MAGNITUDE)
+        if huge.size:
+            i = int(huge[0])
+            raise InputError(self.src, c, f"value {vals[i]:.4g} at {self.where(i)} is beyond any plausible value of a "
+                                          f"channel (|v| > {MAX_MAGNITUDE:g})")
+        return vals
+
+
+_TIME_UNITS = ((1e3, "time in milliseconds?"), (1e6, "time in microseconds?"), (1 / 60, "time in minutes?"),
+               (1 / 3600, "time in hours?"))
+
+
+def _time_hint(ratio: float, step: float, nominal: float) -> str:
+    for factor, text in _TIME_UNITS:
+        if abs(ratio / factor - 1) < 0.05:
+            return f" ({text})"
+    if abs(step - 1.0) < 1e-9 and abs(nominal - 1.0) > 1e-6:
+        return " (sample numbers rather than seconds?)"
+    return ""
+
+
+def _check_time(tab: _Table, col: str, t: np.ndarray, nominal: float | None, what: str, tol: float,
+                step_range: tuple | None = None) -> None:
+    """Time strictly increasing, sampled at ``nominal`` (within relative ``tol``; else a gap or a wrong
+    step) or, with ``step_range`` (lo, hi, format step), at a uniform step within it, spanning no more
+    than :data:`MAX_SPAN_S`."""
+    src = tab.src
+    if len(t) < 2:
+        raise InputError(src, col, "fewer than two samples")
+    if len(t) > MAX_SAMPLES:
+        raise InputError(src, col, f"{len(t):,} samples; a record may have at most {MAX_SAMPLES:,} (mmg.limits.MAX_SAMPLES)")
+    dt = np.diff(t)
+    bad = np.flatnonzero(~(dt > 0))
+    if bad.size:
+        i = int(bad[0]) + 1
+        raise InputError(src, col, f"time is not strictly increasing at {tab.where(i)} (t = {t[i]:g} s after {t[i - 1]:g} s)")
+    med = float(np.median(dt))
+    if nominal is not None:
+        ratio = med / nominal
+        if abs(ratio - 1.0) > tol:
+            raise InputError(src, col, f"sampling step {med:g} s, but {what} is {nominal:g} s{_time_hint(ratio, med, nominal)}")
+    if step_range is not None:
+        lo, hi, fmt = step_range
+        if not lo <= med <= hi:
+            raise InputError(src, col, f"sampling step {med:g} s, but {what} is {fmt:g} s (resampled copies "
+                                       f"{lo:g} to {hi:g} s){_time_hint(med / fmt, med, fmt)}")
+    span = float(t[-1] - t[0])
+    if span > MAX_SPAN_S:
+        ref = nominal or (step_range[2] if step_range else None)
+        hint = _time_hint(med / ref, med, ref) if ref else ""
+        raise InputError(src, col, f"the record spans {span:.4g} s ({t[0]:g} to {t[-1]:g} s, step {med:g} s); a record may span "
+                                   f"at most {MAX_SPAN_S:,.0f} s (mmg.limits.MAX_STEPS steps of 0.1 s){hint}")
+    step = nominal if nominal is not None else med
+    gap_limit = 1.5 * step if (nominal is not None or step_range is not None) else 3.0 * med
+    gap = np.flatnonzero(dt > gap_limit * (1 + 1e-9))
+    if gap.size:
+        i = int(gap[0])
+        missing = int(round(dt[i] / step)) - 1
+        raise InputError(src, col, f"gap of {dt[i]:g} s after t = {t[i]:g} s ({tab.where(i + 1)}; about {max(missing, 1)} "
+                                   f"sample{'s' if missing > 1 else ''} missing at the sampling step of {step:g} s)")
+    if nominal is not None:
+        odd = np.flatnonzero(np.abs(dt - nominal) > tol * nominal)
+        if odd.size:
+            i = int(odd[0])
+            raise InputError(src, col, f"step of {dt[i]:g} s after t = {t[i]:g} s ({tab.where(i + 1)}) differs from {what} "
+                                       f"({nominal:g} s)")
+
+
+def _angle_hint(vmax_abs: float, limit_deg: float) -> str:
+    return " (degrees?)" if vmax_abs <= 1.01 * max(limit_deg, 360.0) else ""
+
+
+def _check_rudder(tab: _Table, col: str, d: np.ndarray) -> None:
+    m = float(np.max(np.abs(d)))
+    if m > MAX_RUDDER:
+        i = int(np.argmax(np.abs(d)))
+        raise InputError(tab.src, col, f"rudder angle {d[i]:.4g} rad ({float(d[i]) / DEG:.4g} deg) at {tab.where(i)} is beyond the "
+                                       f"+/-45 deg of any rudder{_angle_hint(m, 45)}")
+
+
+def _check_rudder_deg(tab: _Table, col: str, d: np.ndarray) -> None:
+    m = float(np.max(np.abs(d)))
+    if m > MAX_RUDDER / DEG:
+        i = int(np.argmax(np.abs(d)))
+        raise InputError(tab.src, col, f"rudder angle {d[i]:.4g} deg at {tab.where(i)} is beyond the +/-45 deg of any rudder")
+
+
+def _check_yaw_rate(tab: _Table, col: str, r: np.ndarray) -> None:
+    m = float(np.max(np.abs(r)))
+    if m > MAX_YAW_RATE:
+        i = int(np.argmax(np.abs(r)))
+        hint = " (deg/s?)" if m <= 60 else ""
+        raise InputError(tab.src, col, f"yaw rate {r[i]:.4g} rad/s ({float(r[i]) / DEG:.4g} deg/s) at {tab.where(i)} is impossible for a "
+                                       f"ship (at most {MAX_YAW_RATE:g} rad/s){hint}")
+
+
+def _check_heading_rate(tab: _Table, col: str, t: np.ndarray, psi: np.ndarray) -> None:
+    """On a dense record (step <= 1 s) the heading cannot change faster than MAX_YAW_RATE sample after sample."""
+    dt = np.diff(t)
+    if len(dt) < 10 or np.median(dt) > 1.0:
+        return
+    rate = np.abs(np.diff(psi)) / dt
+    p99 = float(np.percentile(rate, 99))
+    if p99 > MAX_YAW_RATE:
+        raise InputError(tab.src, col, f"the heading changes by up to {p99 / DEG * np.median(dt):.3g} deg from sample to sample "
+                                       f"({p99:.3g} rad/s in 1 % of the samples): not a heading in radians")
+
+
+def _check_heading_vs_yaw_rate(tab: _Table, psi_col: str, r_col: str, t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> None:
+    """Heading and yaw rate of a dense record must agree: the least-squares slope of the heading change
+    over ~1 s blocks against the integrated yaw rate is 1 (57 when one of them is in degrees)."""
+    dt = np.diff(t)
+    if len(dt) < 10:
+        return
+    med = float(np.median(dt))
+    if med > 1.0:
+        return
+    k = max(1, int(round(1.0 / med)))
+    idx = np.arange(0, len(t), k)
+    if len(idx) < 3:
+        return
+    rint = np.concatenate([[0.0], np.cumsum(0.5 * (r[1:] + r[:-1]) * dt)])
+    a, b = np.diff(psi[idx]), np.diff(rint[idx])
+    sb = float(np.dot(b, b))
+    if not np.isfinite(sb) or np.sqrt(sb) < 5 * DEG:       # too little turning to compare
+        return
+    slope = float(np.dot(a, b) / sb)
+    if 0.5 <= slope <= 2.0:
+        return
+    r2d = 180 / np.pi
+    if abs(slope / r2d - 1) < 0.3:
+        raise InputError(tab.src, psi_col, f"the heading changes {slope:.3g} times as fast as the yaw rate {r_col} integrates "
+                                           f"(heading in degrees?)")
+    if abs(slope * r2d - 1) < 0.3:
+        raise InputError(tab.src, r_col, f"the yaw rate integrates to {1 / slope:.3g} times the change of {psi_col} "
+                                         f"(yaw rate in deg/s?)")
+    if -2.0 <= slope <= -0.5:
+        raise InputError(tab.src, r_col, f"the yaw rate has the opposite sign of the change of {psi_col}")
+    raise InputError(tab.src, psi_col, f"the heading and the yaw rate {r_col} disagree: the heading changes {slope:.3g} times "
+                                       f"what the yaw rate integrates to")
+
+
+def _check_speed(tab: _Table, col: str, U: np.ndarray, L: float | None, unit: str = "m/s", factor: float = 1.0) -> None:
+    """Speed against the ship: at most Froude number MAX_FROUDE (50 m/s without a length)."""
+    limit = MAX_FROUDE * np.sqrt(G * L) if L else 50.0
+    m = float(np.max(np.abs(U))) * factor
+    if m > limit:
+        i = int(np.argmax(np.abs(U)))
+        what = f"Froude number {m / np.sqrt(G * L):.3g} for a {L:g} m ship" if L else "beyond any ship"
+        raise InputError(tab.src, col, f"speed {U[i]:.4g} {unit} at {tab.where(i)} is {what} (not {unit}?)")
+
+
+def _check_track(tab: _Table, cols: str, t, x, y, L: float | None, U=None, ratio_range=None, ucol: str = "") -> None:
+    """Positions against the ship: the median speed along the track at most Froude MAX_FROUDE for a ship of
+    known length ``L`` and, with ``U`` and ``ratio_range``, within that range of the median logged speed."""
+    dt = np.diff(t)
+    if len(dt) < 3:
+        return
+    trk = np.hypot(np.diff(x), np.diff(y)) / dt
+    med = float(np.median(trk))
+    if L and med > MAX_FROUDE * np.sqrt(G * L):
+        raise InputError(tab.src, cols, f"the positions move {med:.4g} m/s along the track (median), Froude number "
+                                        f"{med / np.sqrt(G * L):.3g} for the {L:g} m ship: not the unit the format says?")
+    if U is not None and ratio_range is not None and len(dt) >= 5:
+        mu = float(np.median(np.abs(U)))
+        if mu > 0.5 and med > 0.25:
+            q = med / mu
+            if not ratio_range[0] <= q <= ratio_range[1]:
+                raise InputError(tab.src, ucol, f"the logged speed is {1 / q:.3g} times the speed along the track "
+                                                f"{cols} ({mu:.3g} vs {med:.3g} m/s, medians): wrong speed unit?")
+
+
+def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", default_name: str = "",
+                      notes=None, lines=None) -> TrialRecord:
     """A TrialRecord from a table in one of the supported column layouts and its header ``meta``.
 
     The one conversion behind :func:`read_record`; the estimators' in-memory path
     (:func:`trials.estimation.data_from_trial`) uses it on a simulated log and truth table
     directly, so a simulated record and the same record read back from its files agree.
+
+    Besides the table's form (columns, numbers, time) it checks that the channels look like
+    their units: angles in radian columns within the radian range (a rudder beyond 45 deg or a
+    heading beyond 2 pi is in degrees), yaw rate within 1 rad/s and agreeing with the heading,
+    the sampling step equal to the header's (``interval_s`` for logs, ``dt_s`` for truth files,
+    0.1 s for FRT-DS-ESSO), speeds and track below Froude number 1 for the ship.  Each refusal
+    is an :class:`~mmg.errors.InputError` naming the channel and the likely unit.
     """
     src = source
+    _check_meta(meta, src)
+    df = df.copy()
+    df.columns = [str(c).strip() for c in df.columns]
+    tab = _Table(df, src, lines)
     cols = set(df.columns)
+    notes = list(notes or [])
+    for nt in notes:
+        _log.warning("note: %s: %s", src, nt)
     name = str(meta.get("trial", default_name))
     ship = str(meta.get("ship", ""))
+    L = float(meta["length_m"]) if "length_m" in meta else None
     if "t [s]" in cols or "psi_hat [rad]" in cols:
-        return _read_frt(df, src, Path(src))
+        return _read_frt(tab, src, Path(src), notes)
     if "u_mps" in cols or "psi_rad" in cols:
-        _check(df, TRUTH_COLUMNS, src, "time_s")
-        a = {c: df[c].to_numpy(dtype=float) for c in TRUTH_COLUMNS}
+        tab.require(TRUTH_COLUMNS)
+        a = {c: tab.numeric(c) for c in TRUTH_COLUMNS}
+        _check_time(tab, "time_s", a["time_s"], meta.get("dt_s"), "the header's dt_s", 1e-3)
+        _check_rudder(tab, "delta_rad", a["delta_rad"])
+        _check_rudder(tab, "delta_order_rad", a["delta_order_rad"])
+        _check_yaw_rate(tab, "r_radps", a["r_radps"])
+        _check_heading_rate(tab, "psi_rad", a["time_s"], a["psi_rad"])
+        _check_heading_vs_yaw_rate(tab, "psi_rad", "r_radps", a["time_s"], a["psi_rad"], a["r_radps"])
+        U = np.hypot(a["u_mps"], a["v_mps"])
+        _check_speed(tab, "u_mps", U, L)
+        _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L, U, (0.2, 5.0), "u_mps")
+        _check_rps(tab, "n_rps", a["n_rps"])
         return TrialRecord(t=a["time_s"], name=name, ship=ship, source=src, x=a["x_m"], y=a["y_m"],
-                           psi=a["psi_rad"], U=np.hypot(a["u_mps"], a["v_mps"]), u=a["u_mps"],
+                           psi=a["psi_rad"], U=U, u=a["u_mps"],
                            v=a["v_mps"], r=a["r_radps"], delta=a["delta_rad"], n=a["n_rps"],
-                           meta={**meta, "format": "truth", "delta_order": a["delta_order_rad"]})
+                           meta={**meta, "format": "truth", "delta_order": a["delta_order_rad"], "notes": notes})
     if "lat_deg" in cols or "heading_deg" in cols or "time_s" in cols:
-        _check(df, LOG_COLUMNS, src, "time_s")
-        a = {c: df[c].to_numpy(dtype=float) for c in LOG_COLUMNS}
+        tab.require(LOG_COLUMNS)
+        a = {c: tab.numeric(c) for c in LOG_COLUMNS}
+        t = a["time_s"]
+        _check_time(tab, "time_s", t, meta.get("interval_s"), "the header's interval_s", 1e-3)
+        _check_range(tab, "lat_deg", a["lat_deg"], -90.0, 90.0, "a latitude in degrees")
+        _check_range(tab, "lon_deg", a["lon_deg"], -180.0, 360.0, "a longitude in degrees")
+        _check_range(tab, "heading_deg", a["heading_deg"], -360.0, 360.0, "a heading in degrees (a gyro prints 0-360)")
+        _check_rps(tab, "rpm", a["rpm"] / 60.0, "rpm", 60.0)
         lat0 = float(meta.get("start_lat_deg", a["lat_deg"][0]))
         lon0 = float(meta.get("start_lon_deg", a["lon_deg"][0]))
+        for col, key, v0 in (("lat_deg", "start_lat_deg", lat0), ("lon_deg", "start_lon_deg", lon0)):
+            if key in meta and abs(a[col][0] - v0) > 1.0:
+                raise InputError(src, col, f"the first position {a[col][0]:.6g} is {abs(a[col][0] - v0):.3g} deg from the "
+                                           f"header's {key} {v0:g}: not degrees?")
         mlat = float(meta.get("m_per_deg_lat", M_PER_DEG_LAT))
         mlon = float(meta.get("m_per_deg_lon", M_PER_DEG_LON))
+        x, y, U = (a["lat_deg"] - lat0) * mlat, (a["lon_deg"] - lon0) * mlon, a["speed_kn"] * KNOT
+        _check_speed(tab, "speed_kn", a["speed_kn"], L, "kn", KNOT)
+        # the track against the logged speed over ground, for a log that says it is a project log
+        _check_track(tab, "lat_deg, lon_deg", t, x, y, L, U, (0.7, 1.4) if "interval_s" in meta else None, "speed_kn")
         extra = {}
         if "rudder_deg" in cols:
-            extra["delta"] = df["rudder_deg"].to_numpy(dtype=float) * DEG
-        return TrialRecord(t=a["time_s"], name=name, ship=ship, source=src,
-                           x=(a["lat_deg"] - lat0) * mlat, y=(a["lon_deg"] - lon0) * mlon,
-                           psi=unwrap_heading(np.radians(a["heading_deg"])), U=a["speed_kn"] * KNOT,
-                           n=a["rpm"] / 60.0, meta={**meta, "format": "log"}, **extra)
+            d = tab.numeric("rudder_deg")
+            _check_rudder_deg(tab, "rudder_deg", d)
+            extra["delta"] = d * DEG
+        return TrialRecord(t=t, name=name, ship=ship, source=src, x=x, y=y,
+                           psi=unwrap_heading(np.radians(a["heading_deg"])), U=U,
+                           n=a["rpm"] / 60.0, meta={**meta, "format": "log", "notes": notes}, **extra)
     missing = sorted(set(LOG_COLUMNS) - cols)
     raise InputError(src, missing[0] if missing else "", "missing column (not a project log, truth file or FRT-DS-ESSO CSV)")
 
 
-def _read_frt(df: pd.DataFrame, src: str, path: Path) -> TrialRecord:
+def _check_range(tab: _Table, col: str, v: np.ndarray, lo: float, hi: float, what: str) -> None:
+    bad = np.flatnonzero((v < lo) | (v > hi))
+    if bad.size:
+        i = int(bad[0])
+        raise InputError(tab.src, col, f"{v[i]:.6g} at {tab.where(i)} is not {what} (range {lo:g} to {hi:g})")
+
+
+def _check_rps(tab: _Table, col: str, n: np.ndarray, unit: str = "rps", factor: float = 1.0) -> None:
+    m = float(np.max(np.abs(n)))
+    if m > MAX_RPS:
+        i = int(np.argmax(np.abs(n)))
+        hint = " (rpm where rps is expected?)" if unit == "rps" else ""
+        raise InputError(tab.src, col, f"propeller speed {n[i] * factor:.4g} {unit} at {tab.where(i)} is beyond any ship "
+                                       f"(at most {MAX_RPS * factor:g} {unit}){hint}")
+
+
+def _read_frt(tab: _Table, src: str, path: Path, notes: list) -> TrialRecord:
+    df = tab.df
+    tab.require(FRT_REQUIRED)
     present = [c for c in FRT_COLUMNS if c in df.columns]
-    _check(df, list(FRT_REQUIRED) + [c for c in present if c not in FRT_REQUIRED], src, "t [s]")
-    a = {FRT_COLUMNS[c]: df[c].to_numpy(dtype=float) for c in present}
-    psi = unwrap_heading(a.pop("psi"))
+    a = {FRT_COLUMNS[c]: tab.numeric(c) for c in present}
+    L = FRT_LENGTH_M
+    t = a["t"]
+    _check_time(tab, "t [s]", t, None, "the FRT-DS-ESSO sampling step (10 Hz)", 0.0, FRT_STEP_RANGE)
+    raw = a.pop("psi")
+    lo, hi = float(raw.min()), float(raw.max())
+    if lo < -np.pi - 0.01 or hi > 2 * np.pi + 0.01:
+        raise InputError(src, "psi_hat [rad]", f"heading values from {lo:.4g} to {hi:.4g} are not radians wrapped to "
+                                               f"(-pi, pi] or [0, 2 pi){_angle_hint(max(abs(lo), abs(hi)), 360)}")
+    psi = unwrap_heading(raw)
+    _check_heading_rate(tab, "psi_hat [rad]", t, psi)
+    if "delta" in a:
+        _check_rudder(tab, "delta_rudder [rad]", a["delta"])
+    if "r" in a:
+        _check_yaw_rate(tab, "r_angvelo [rad/s]", a["r"])
+        _check_heading_vs_yaw_rate(tab, "psi_hat [rad]", "r_angvelo [rad/s]", t, psi, a["r"])
+    for key, col in (("u", "u_velo [m/s]"), ("v", "vm_velo [m/s]")):
+        if key in a:
+            _check_speed(tab, col, a[key], L)
+    if "n" in a:
+        _check_rps(tab, "n_prop [rps]", a["n"])
     u, v = a.get("u"), a.get("v")
     U = np.hypot(u, v) if u is not None and v is not None else None
-    meta = {"format": "frt-ds-esso", "ship": "Esso Osaka 3 m model", "length_m": 3.0}
+    _check_track(tab, "x_position_mid [m], y_position_mid [m]", t, a["x"], a["y"], L)
+    meta = {"format": "frt-ds-esso", "ship": "Esso Osaka 3 m model", "length_m": L,
+            "interval_s": float(np.median(np.diff(t))), "notes": notes}
     return TrialRecord(t=a.pop("t"), name=path.stem, ship="Esso Osaka 3 m model", source=src,
                        psi=psi, U=U, meta=meta, **a)
