@@ -6,6 +6,15 @@ or option and the field; nothing written) or bad arguments; 3 a diverging filter
 interrupted by SIGINT / SIGTERM (one line, nothing left behind).  Library code never calls
 :func:`main`.
 
+Outputs: every command that writes checks its target first (``--out`` a folder that exists
+or can be created, ``--json`` a file whose folder can be written; :func:`trials.output.check_output_dir`,
+:func:`trials.output.check_output_file`) and refuses an unusable one in one line before any
+computation; it then writes through :class:`trials.output.StagedOutput` (a staging folder
+inside the target, moved in at the end), so an error, a full disk, a read-only filesystem,
+SIGINT or SIGTERM leaves nothing behind: no staging folder, no partial file, no folder it
+created.  A write failure (no space, read-only, no permission) is one line naming the path,
+exit 2.
+
 Subcommands
 -----------
 simulate      a trial from its YAML                    (:func:`trials.run.run_trial`)
@@ -22,6 +31,7 @@ output-error  joint output-error Monte Carlo            (:func:`trials.montecarl
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import signal
 import sys
@@ -42,8 +52,11 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
 
 
-class Interrupted(Exception):
-    """SIGTERM arrived (SIGINT arrives as KeyboardInterrupt)."""
+class Interrupted(BaseException):
+    """SIGTERM arrived (SIGINT arrives as KeyboardInterrupt).
+
+    A BaseException, like KeyboardInterrupt, so that library code catching ``Exception`` does
+    not swallow it; ``with`` blocks (the output staging) clean up as it passes."""
 
 
 def _version() -> str:
@@ -112,13 +125,14 @@ def print_metrics(m: dict, out=None) -> None:
 
 
 def cmd_simulate(args) -> int:
-    from .output import StagedOutput, write_trial_outputs
+    from .output import StagedOutput, check_output_dir, write_trial_outputs
     from .run import run_trial
     from .trial import load_trial
 
+    check_output_dir(args.out)
     trial = load_trial(args.config)
-    run = run_trial(trial)
     with StagedOutput(args.out) as stage:
+        run = run_trial(trial)
         m = write_trial_outputs(run, stage, show=args.show)
     print(f"{trial.name}: wrote log.csv, truth.csv, metrics.json, track.png, histories.png to {args.out}")
     print_metrics(m)
@@ -132,23 +146,27 @@ def cmd_metrics(args) -> int:
 
     from .logio import read_record
     from .metrics import record_metrics
-    from .output import StagedOutput, dump_json
+    from .output import check_output_file, dump_json
 
+    if args.json:
+        check_output_file(args.json)
     rec = read_record(args.log)
     ang = None if args.zigzag_angle is None else np.radians(args.zigzag_angle)
     m = record_metrics(rec, args.kind, args.length, ang)
     print(f"{rec.name} ({m['kind']}, {rec.source})")
     print_metrics(m)
     if args.json:
-        with StagedOutput(Path(args.json).parent or ".") as stage:
-            dump_json(m, stage.path(Path(args.json).name))
+        dump_json(m, args.json)               # a temporary file beside it, renamed
     return 0
 
 
 def cmd_reproduce(args) -> int:
+    from .output import StagedOutput, check_output_dir
     from .reproduce import reproduce
 
-    rep = reproduce(args.out, full=args.full)
+    check_output_dir(args.out)
+    with StagedOutput(args.out) as stage:         # the whole report or nothing
+        rep = stage.final(reproduce(stage.dir, full=args.full))
     print(f"report: {rep}")
     return 0
 
@@ -157,14 +175,28 @@ def cmd_reproduce(args) -> int:
 
 
 def cmd_nomoto(args) -> int:
-    from .nomoto_report import identify_log, report, write_identification
+    from contextlib import nullcontext
 
-    ident, note = identify_log(args.log, args.length, args.speed, output_error=not args.no_output_error)
-    if note:
-        print(note)
-    print(report(ident))
+    import json
+
+    from .nomoto_report import identify_log, report, write_identification
+    from .output import StagedOutput, check_output_file, dump_json
+
     if args.json:
-        write_identification(ident, args.json)
+        if Path(args.json).suffix.lower() == ".png":
+            raise InputError("--json", args.json, "ends in .png, the name of the plot written beside it")
+        check_output_file(args.json, also=[Path(args.json).with_suffix(".png")])
+    with StagedOutput(Path(args.json).parent) if args.json else nullcontext() as stage:
+        ident, note = identify_log(args.log, args.length, args.speed, output_error=not args.no_output_error)
+        if note:
+            print(note)
+        print(report(ident))
+        if args.json:
+            staged = stage.path(Path(args.json).name)
+            write_identification(ident, staged)
+            # rewritten through dump_json: NaN / Infinity as null (write_identification uses json.dumps)
+            dump_json(json.loads(staged.read_text()), staged)
+    if args.json:
         print(f"wrote {args.json} and {Path(args.json).with_suffix('.png')}")
     return 0
 
@@ -173,8 +205,12 @@ def cmd_nomoto_paper(args) -> int:
     import pandas as pd
 
     from . import artyszuk as a
+    from .output import StagedOutput, check_output_dir
 
-    tables = a.reproduce(fast=args.fast)
+    check_output_dir(args.out)
+    with StagedOutput(args.out) as stage:
+        tables = a.reproduce(fast=args.fast)
+        paths = a.write_tables(tables, stage.dir)
     with pd.option_context("display.width", 200, "display.max_columns", 40, "display.float_format", "{:.5g}".format):
         for key, title in a.TITLES.items():
             print(f"\n{title}")
@@ -182,7 +218,6 @@ def cmd_nomoto_paper(args) -> int:
             note = tables.get("notes", {}).get(key)
             if note:
                 print(f"note: {note}")
-    paths = a.write_tables(tables, args.out)
     print(f"\nwrote {len(paths)} files to {args.out}")
     return 0
 
@@ -194,21 +229,20 @@ def cmd_estimate(args) -> int:
     from ekf.estimate import load_config
 
     from .estimation import estimate_and_report, load_inputs
-    from .output import StagedOutput
+    from .output import StagedOutput, check_output_dir
 
+    check_output_dir(args.out)
     cfg = load_config(args.config, args.set or ())
-    datas = load_inputs(args.inputs, cfg, seed=args.seed, ship=args.ship, truth=args.truth)
     with StagedOutput(args.out) as out:
+        datas = load_inputs(args.inputs, cfg, seed=args.seed, ship=args.ship, truth=args.truth)
         rep = estimate_and_report(datas, cfg, out, joint=args.joint, plots=not args.no_plots, method=args.method)
     for w in rep["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     tab = rep["table"]
+    print(f"wrote {_listing(out.written)} to {args.out}")   # the files actually written (no PNG with --no-plots)
     if rep["method"] == "output-error":
-        print(f"wrote {args.out}/estimates.json, oe_fit.json, error_table.csv/.md, free_run.json")
         print(tab.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
         return 0
-    figs = ", convergence_*.png" if rep["figures"] else ""
-    print(f"wrote {args.out}/estimates.json, error_table.csv/.md, final_estimates.csv{figs}")
     for n, r in rep["rms"].items():
         print(f"  preprocessing RMS {n}: " + ", ".join(f"{k} {v:.3g}" for k, v in r.items()))
     cols = [c for c in tab.columns if c in ("coeff", "real") or c.endswith("final") or c.endswith("err(%)")]
@@ -220,13 +254,21 @@ def cmd_estimate(args) -> int:
 
 
 def cmd_sensitivity(args) -> int:
+    from contextlib import ExitStack
+
     from . import sensitivity_report as sr
-    from .output import StagedOutput
+    from .output import StagedOutput, check_output_dir
 
     modes = [bool(args.trials), args.paper_figures, args.crb_vs_mc is not None, args.design]
     if sum(modes) != 1:
         raise InputError("mmg sensitivity", "arguments", "give trial YAMLs, or exactly one of --paper-figures, "
                                                           "--crb-vs-mc DIR, --design")
+    check_output_dir(args.out)
+    # a single --crb-vs-mc folder without runs.csv is where the Monte Carlo is run (written): staged too
+    mc_run_dir = (args.crb_vs_mc[0] if args.crb_vs_mc and len(args.crb_vs_mc) == 1
+                  and not (Path(args.crb_vs_mc[0]) / "runs.csv").exists() else None)
+    if mc_run_dir is not None:
+        check_output_dir(mc_run_dir, "--crb-vs-mc")
     if args.ekf_comparison is not None:
         sr.read_comparison(args.ekf_comparison)
     for p in args.trials:
@@ -240,17 +282,22 @@ def cmd_sensitivity(args) -> int:
     t0 = time.perf_counter()
     cluster = client = None
     if args.backend == "dask":
-        cluster = LocalCluster(n_workers=args.jobs or 2, processes=True, threads_per_worker=1)
-        client = Client(cluster)
+        from .output import children_ignore_sigint
+
+        with children_ignore_sigint():     # a terminal's Ctrl-C reaches this process only, which closes them
+            cluster = LocalCluster(n_workers=args.jobs or 2, processes=True, threads_per_worker=1)
+            client = Client(cluster)
     try:
-        with StagedOutput(args.out) as stage:
+        with ExitStack() as stack:
+            stage = stack.enter_context(StagedOutput(args.out))
             if args.trials:
                 sr.trial_sensitivities(args.trials, stage, fisher_bounds=args.fisher, backend=args.backend,
                                        n_jobs=args.jobs)
             elif args.paper_figures:
                 sr.paper_figures(stage, args.ekf_comparison, backend=args.backend, n_jobs=args.jobs)
             elif args.crb_vs_mc is not None:
-                sr.crb_table(args.crb_vs_mc, stage, n_seeds=args.mc_seeds, rudder_timing=args.rudder_timing)
+                mc = args.crb_vs_mc if mc_run_dir is None else stack.enter_context(StagedOutput(mc_run_dir)).dir
+                sr.crb_table(mc, stage, n_seeds=args.mc_seeds, rudder_timing=args.rudder_timing)
             else:
                 sr.design(stage, backend=args.backend, n_jobs=args.jobs, rudder_timing=args.rudder_timing)
     finally:
@@ -266,37 +313,57 @@ def cmd_sensitivity(args) -> int:
 
 def cmd_montecarlo(args) -> int:
     from .montecarlo import group_table, monte_carlo
+    from .output import StagedOutput, check_output_dir
 
-    if args.summarise_only:
+    if args.summarise_only:              # reads only
         import pandas as pd
 
-        print("\n".join(group_table(pd.read_csv(Path(args.out) / "summary.csv"))))
+        summary = Path(args.out) / "summary.csv"
+        if not summary.is_file():
+            raise InputError(str(summary), "", "file not found (mmg montecarlo OUT writes it)")
+        print("\n".join(group_table(pd.read_csv(summary))))
         return 0
-    monte_carlo(args.out, n_seeds=args.seeds, n_jobs=args.jobs, first_seed=args.first_seed, config=args.config)
+    check_output_dir(args.out, "OUT")
+    with StagedOutput(args.out) as stage:
+        monte_carlo(stage.dir, n_seeds=args.seeds, n_jobs=args.jobs, first_seed=args.first_seed, config=args.config)
     return 0
 
 
 def cmd_log_filter(args) -> int:
     from .montecarlo import log_filter_monte_carlo
+    from .output import StagedOutput, check_output_dir
 
+    check_output_dir(args.out, "OUT")
     sigma = args.sigma_tau if args.sigma_tau is not None else (1e-4 if args.true_rudder else 0.15)
-    log_filter_monte_carlo(args.out, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=sigma,
-                           first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt",
-                           config=args.config)
+    with StagedOutput(args.out) as stage:
+        log_filter_monte_carlo(stage.dir, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=sigma,
+                               first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt",
+                               config=args.config)
     return 0
 
 
 def cmd_output_error(args) -> int:
+    import shutil
+
     from .montecarlo import PAPER_TRIALS, output_error_monte_carlo, summarise
+    from .output import StagedOutput, check_output_dir
 
     for t in args.trials:
         if t not in PAPER_TRIALS:
             raise InputError("--trials", t, f"not one of {', '.join(PAPER_TRIALS)}")
-    if args.summarise_only:
-        summarise(args.out, tuple(args.trials), args.rudder, args.ekf_summary)
-    else:
-        output_error_monte_carlo(args.out, args.seeds, tuple(args.trials), n_jobs=args.jobs, first_seed=args.first_seed,
-                                 rudder=args.rudder, ekf_summary=args.ekf_summary, config=args.config)
+    runs = Path(args.out) / "runs.csv"
+    if args.summarise_only and not runs.is_file():
+        raise InputError(str(runs), "", "file not found (mmg output-error OUT writes it)")
+    check_output_dir(args.out, "OUT")
+    ekf_summary = args.ekf_summary
+    with StagedOutput(args.out) as stage:
+        if args.summarise_only:          # the summary from a copy of runs.csv, moved in with it
+            shutil.copy2(runs, stage.path("runs.csv"))
+            summarise(stage.dir, tuple(args.trials), args.rudder, ekf_summary)
+        else:
+            output_error_monte_carlo(stage.dir, args.seeds, tuple(args.trials), n_jobs=args.jobs,
+                                     first_seed=args.first_seed, rudder=args.rudder, ekf_summary=ekf_summary,
+                                     config=args.config)
     return 0
 
 
@@ -417,12 +484,121 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _on_sigterm(signum, frame):
+def _listing(names) -> str:
+    """File names for a 'wrote ...' line; 3 or more of one pattern (convergence_*.png) as one."""
+    groups: dict = {}
+    for n in names:
+        stem, suffix = os.path.splitext(n)
+        key = (stem.split("_", 1)[0] + "_*" if "_" in stem else stem, suffix)
+        groups.setdefault(key, []).append(n)
+    out = []
+    for (pat, suffix), ns in groups.items():
+        out += [f"{pat}{suffix} ({len(ns)})"] if len(ns) >= 3 else ns
+    return ", ".join(out) or "nothing"
+
+
+_signal_state = {"signum": None, "unwinding": False}
+
+
+def _on_signal(signum, frame):
+    """SIGINT -> KeyboardInterrupt, SIGTERM -> Interrupted.  While that exception unwinds (and the
+    staging cleans up) a further signal is ignored, so the clean-up is never cut short."""
+    if _signal_state["unwinding"]:
+        return
+    _signal_state.update(signum=signum, unwinding=True)
+    import logging
+    import warnings
+
+    # from here on only "interrupted": no joblib "tasks executed but not used" warning, no logged
+    # "exception calling callback" of a worker pool being shut down
+    warnings.simplefilter("ignore")
+    logging.disable(logging.CRITICAL)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
     raise Interrupted()
+
+
+def _unraisable(u, _default=sys.unraisablehook):
+    """The interrupt's exception raised where Python cannot propagate it (a weakref callback, a
+    ``__del__``: "Exception ignored in ...") is not lost: the signal is sent again, so it is
+    raised at the next ordinary line instead; other unraisable exceptions as usual."""
+    if (u.exc_type is not None and issubclass(u.exc_type, (Interrupted, KeyboardInterrupt))
+            and _signal_state["signum"] is not None):
+        import threading
+
+        _signal_state["unwinding"] = False
+        # sent a moment later, from another thread: sent here, its handler would run (and raise) in this hook
+        t = threading.Timer(0.02, os.kill, (os.getpid(), _signal_state["signum"]))
+        t.daemon = True
+        t.start()
+        return
+    _default(u)
+
+
+def _install_handlers() -> dict:
+    """Our handler for SIGINT and SIGTERM where they have their default one (main thread only);
+    returns the old handlers to restore."""
+    import logging
+    import threading
+
+    old = {}
+    _signal_state.update(signum=None, unwinding=False)
+    if threading.current_thread() is not threading.main_thread():
+        return old
+    old["logging"] = logging.root.manager.disable      # _on_signal silences logging: put back after main()
+    defaults = {signal.SIGINT: (signal.default_int_handler,), signal.SIGTERM: (signal.SIG_DFL, None)}
+    for sig, dflt in defaults.items():
+        if signal.getsignal(sig) in dflt:
+            old[sig] = signal.signal(sig, _on_signal)
+    if signal.SIGINT in old or signal.SIGTERM in old:
+        old["unraisablehook"] = sys.unraisablehook
+        sys.unraisablehook = lambda u, _d=sys.unraisablehook: _unraisable(u, _d)
+    return old
+
+
+def _interrupted(code: int) -> int:
+    print("interrupted", file=sys.stderr)
+    return code
 
 
 def main(argv=None) -> int:
     """Run the ``mmg`` command; returns the exit status (see the module docstring)."""
+    import warnings
+
+    old = _install_handlers()          # first: an early signal is already one line, 130 / 143
+    try:
+        with warnings.catch_warnings():    # _on_signal silences warnings: only for this run
+            try:
+                return _run(argv)
+            except KeyboardInterrupt:      # a signal during the last lines of _run's own handling
+                return _interrupted(130)
+            except Interrupted:
+                return _interrupted(143)
+    finally:
+        hook = old.pop("unraisablehook", None)
+        level = old.pop("logging", None)
+        for sig, h in old.items():
+            signal.signal(sig, h)
+        if hook is not None:
+            sys.unraisablehook = hook
+        if level is not None:
+            import logging
+
+            logging.disable(level)
+        if argv is None and signal.SIGINT in old and _is_command_line():
+            # the run is over (its outputs are in place or gone): a Ctrl-C while Python shuts down
+            # (joining the worker pool's threads) would only print a KeyboardInterrupt traceback
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _is_command_line() -> bool:
+    """This process is the ``mmg`` command (console script or ``python -m trials.cli``)."""
+    main_mod = sys.modules.get("__main__")
+    spec = getattr(main_mod, "__spec__", None)
+    return Path(sys.argv[0]).name in ("mmg", "mmg.exe") or (spec is not None and spec.name == "trials.cli")
+
+
+def _run(argv) -> int:
     ap = build_parser()
     try:
         args = ap.parse_args(argv)
@@ -430,28 +606,62 @@ def main(argv=None) -> int:
         return int(e.code or 0)
     if not getattr(args, "show", False):
         os.environ.setdefault("MPLBACKEND", "Agg")   # files only; no display needed (cheap: nothing imported)
-    old = signal.signal(signal.SIGTERM, _on_sigterm) if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None) else None
     try:
         return int(args.func(args) or 0)
-    except InputError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
-    except Interrupted:
-        print("interrupted", file=sys.stderr)
-        return 143
-    except Exception as e:  # a diverging filter is a result, not a crash
+    except (Exception, KeyboardInterrupt, Interrupted) as e:
+        code = _interrupt_code(e)
+        if code:
+            return _interrupted(code)
+        if isinstance(e, InputError):
+            print(f"error: {e}", file=sys.stderr)
+            return 2
+        if isinstance(e, BrokenPipeError):    # stdout's reader left (mmg ... | head): quiet, as SIGPIPE would be
+            try:
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            except (OSError, ValueError):
+                pass
+            return 141
+        if isinstance(e, OSError) and e.errno in _WRITE_ERRNOS():
+            # writing (or reading) a file failed: no space, read-only filesystem, no permission
+            from .output import write_error
+
+            print(f"error: {write_error(e) if e.errno in _FULL_OR_READ_ONLY else _os_error_line(e)}", file=sys.stderr)
+            return 2
         from ekf.filter import FilterDivergence
 
-        if isinstance(e, FilterDivergence):
+        if isinstance(e, FilterDivergence):   # a diverging filter is a result, not a crash
             print(f"error: {e}", file=sys.stderr)
             return 3
         raise
-    finally:
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
+
+
+def _interrupt_code(e: BaseException) -> int:
+    """130 / 143 when ``e`` is, or was caused by, the interrupt (numba, for one, turns an exception
+    raised in a callback into a SystemError), or when any error follows a signal; else 0."""
+    seen, x = set(), e
+    while x is not None and id(x) not in seen:
+        if isinstance(x, KeyboardInterrupt):
+            return 130
+        if isinstance(x, Interrupted):
+            return 143
+        seen.add(id(x))
+        x = x.__cause__ or x.__context__
+    if _signal_state["unwinding"] and _signal_state["signum"] is not None:
+        return 130 if _signal_state["signum"] == signal.SIGINT else 143
+    return 0
+
+
+def _WRITE_ERRNOS():
+    from .output import WRITE_ERRNOS
+
+    return WRITE_ERRNOS
+
+
+_FULL_OR_READ_ONLY = {getattr(errno, n) for n in ("ENOSPC", "EROFS", "EDQUOT", "EFBIG") if hasattr(errno, n)}
+
+
+def _os_error_line(e: OSError) -> str:
+    return f"{e.filename or '?'}: {e.strerror or e}"
 
 
 if __name__ == "__main__":

@@ -1,62 +1,536 @@
-"""Output folders written all-or-nothing, and JSON that understands numpy."""
+"""Outputs written all-or-nothing, checked before any work, and JSON without NaN.
+
+* :func:`check_output_dir` / :func:`check_output_file` refuse an unusable ``--out`` folder or
+  ``--json`` file in one :class:`~mmg.errors.InputError` line (an existing file where a folder is
+  wanted and the reverse, a path under a file, a place nothing can be created in: read-only,
+  no permission) *before* any computation.  They create nothing and leave nothing.
+* :class:`StagedOutput` stages a folder's files *inside the target itself*
+  (``out/.staging-XXXX``: the same filesystem, so a mount point or a folder under a read-only
+  parent works), moves them into ``out`` on success and, on any failure, SIGINT or SIGTERM,
+  removes the staging folder, every file it had already moved (the files they replaced are put
+  back) and every folder it created (``out`` itself and missing parents).
+* :class:`StagedFile` does the same for one file: a temporary file beside the target, renamed
+  onto it.  :func:`dump_json` writes through it.
+* An ``OSError`` while writing (no space left, read-only filesystem, no permission) comes out as
+  one :class:`~mmg.errors.InputError` naming the final path (never the staging one).
+
+JSON: :func:`dump_json` writes NaN and +-Infinity as ``null`` (JSON has no NaN; a value is NaN
+here when it is undefined, e.g. an overshoot that never happened or a fit that failed), so
+every file parses with ``json.loads(text, parse_constant=<refuse>)``; numpy scalars and arrays
+become numbers and lists.
+
+Signals: the moves of a commit and the removals of a clean-up run with SIGINT and SIGTERM
+blocked (they are delivered right after), so an interrupt never leaves half a commit or half a
+clean-up behind; an interrupt that arrives while a commit runs undoes that commit.
+"""
 from __future__ import annotations
 
+import errno
 import json
+import math
 import os
 import shutil
+import signal
+import stat
 import tempfile
+import threading
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
+from mmg.errors import InputError
+
+#: errno values of a target that cannot be written (reported as one InputError line, exit 2).
+WRITE_ERRNOS = frozenset(getattr(errno, n) for n in ("ENOSPC", "EROFS", "EACCES", "EPERM", "EDQUOT", "EFBIG",
+                                                      "EXDEV", "ENAMETOOLONG", "ENOTDIR", "EISDIR", "EMLINK", "EIO")
+                         if hasattr(errno, n))
+
+_SIGNALS = tuple(s for s in (getattr(signal, "SIGINT", None), getattr(signal, "SIGTERM", None)) if s is not None)
+
+
+# --------------------------------------------------------------------------- signals held
+
+
+def _can_hold() -> bool:
+    return hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+
+
+@contextmanager
+def signals_held(signals=None):
+    """SIGINT and SIGTERM (or the ``signals`` given) blocked inside the block and delivered (their
+    handlers run) on leaving it.  Processes started inside the block inherit the mask: started with
+    ``signals_held([signal.SIGINT])``, pool workers never see a terminal's Ctrl-C (the main process
+    gets it and stops them).
+
+    A signal whose handler was already due when the block starts is raised here, before the
+    block runs (never inside it).  A no-op outside the main thread and where the platform has
+    no ``pthread_sigmask``.
+    """
+    if not _can_hold():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, [])        # the mask now (runs any handler due)
+    try:
+        signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS if signals is None else signals)
+    except BaseException:                                     # a handler due raised: nothing blocked stays blocked
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        raise
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+@contextmanager
+def children_ignore_sigint():
+    """Processes started inside the block (pool workers: joblib's loky, dask) start with SIGINT
+    blocked and keep it so, so a terminal's Ctrl-C, sent to the whole process group, reaches only
+    this process, which stops them (no traceback from each starting worker).
+
+    SIGINT is blocked in this thread only for the block (a mask is inherited by child processes
+    and kept across ``exec``); a Ctrl-C meanwhile still reaches this process (another thread takes
+    it, or it waits until the block ends).  A no-op outside the main thread.
+    """
+    if not _can_hold():
+        yield
+        return
+    try:      # started now: starting it inside the block would unblock SIGINT (3.11's ensure_running does)
+        from multiprocessing import resource_tracker
+
+        resource_tracker.ensure_running()
+    except Exception:                               # pragma: no cover - platform without it
+        pass
+    with signals_held([signal.SIGINT]):
+        yield
+
+
+def _signal_pending() -> bool:
+    """A SIGINT or SIGTERM is waiting (blocked by :func:`signals_held`)."""
+    return _can_hold() and bool(set(signal.sigpending()) & set(_SIGNALS))
+
+
+# --------------------------------------------------------------------------- checks before any work
+
+
+def _shown(path) -> str:
+    return os.fspath(path)
+
+
+def _abs(path) -> Path:
+    return Path(os.path.abspath(os.fspath(path)))
+
+
+def _nearest_existing(p: Path) -> Path:
+    while not os.path.lexists(p):
+        p = p.parent
+    return p
+
+
+def _check_can_create_in(folder: Path, option: str, shown: str) -> None:
+    """``folder`` exists, or can be created: its nearest existing ancestor is a folder we can write in."""
+    a = _nearest_existing(folder)
+    if not a.is_dir():
+        what = "a file" if a.exists() else "a broken link"
+        raise InputError(option, shown, f"{a} is {what}, not a folder")
+    try:
+        with signals_held():
+            os.rmdir(tempfile.mkdtemp(prefix=".mmg-write-check-", dir=a))
+    except OSError as e:
+        raise InputError(option, shown, f"cannot write in {a} ({e.strerror or e})") from None
+
+
+def check_output_dir(path, option: str = "--out") -> Path:
+    """Refuse an output folder that cannot be written, before any work; returns it as an absolute path.
+
+    Refused (one :class:`InputError`, ``option: path: why``): an empty path, an existing file
+    or broken link, a path under a file, a folder (or its nearest existing parent) that nothing
+    can be created in (read-only filesystem, no permission; tested by creating and removing
+    a folder there, so it holds for root too).  An existing folder is fine (files of the same
+    name are replaced when the run succeeds).  Nothing is created or left behind.
+    """
+    shown = _shown(path)
+    if not shown.strip():
+        raise InputError(option, repr(shown), "empty path")
+    p = _abs(path)
+    if os.path.lexists(p) and not p.is_dir():
+        raise InputError(option, shown, "is a file, not a folder" if p.exists() else "is a broken link")
+    _check_can_create_in(p, option, shown)
+    return p
+
+
+def check_output_file(path, option: str = "--json", also=()) -> Path:
+    """Refuse an output file that cannot be written, before any work; returns it as an absolute path.
+
+    Refused: an empty path or one ending in a path separator, an existing folder or other
+    non-regular file (a device, a FIFO), a path under a file, a folder nothing can be created
+    in (the file is written beside itself and renamed, so its folder must be writable).
+    ``also``: further files written beside it (e.g. the plot ``x.png`` of ``x.json``), checked
+    the same way.  An existing regular file is fine (replaced when the run succeeds).
+    """
+    shown = _shown(path)
+    if not shown.strip():
+        raise InputError(option, repr(shown), "empty path")
+    if shown.endswith(("/", os.sep)):
+        raise InputError(option, shown, "names a folder; give a file name")
+    p = _abs(path)
+    for q in (p, *(_abs(a) for a in also)):
+        if q.is_dir():
+            raise InputError(option, shown, f"{q} is a folder, not a file" if q != p else "is a folder, not a file")
+        if os.path.lexists(q) and not q.is_file():
+            raise InputError(option, shown, f"{q} is not a regular file" if q != p else "is not a regular file")
+    _check_can_create_in(p.parent, option, shown)
+    return p
+
+
+# --------------------------------------------------------------------------- staging
+
+
+def _make_dirs(d: Path) -> list[Path]:
+    """Create ``d`` and its missing parents; returns the folders created (outermost first).
+    On an error the ones created are removed again before it propagates."""
+    d = _abs(d)
+    missing = []
+    p = d
+    while not os.path.lexists(p):
+        missing.append(p)
+        p = p.parent
+    created = []
+    try:
+        for q in reversed(missing):
+            try:
+                os.mkdir(q)
+            except FileExistsError:
+                if not q.is_dir():
+                    raise
+                continue                     # made by someone else meanwhile: not ours to remove
+            created.append(q)
+    except BaseException:
+        _remove_dirs(created)
+        raise
+    return created
+
+
+def _remove_dirs(created) -> None:
+    """Remove the folders we created, innermost first, where they are (still) empty."""
+    for q in reversed(list(created)):
+        try:
+            os.rmdir(q)
+        except OSError:
+            pass
+
+
+def _umask_mode() -> int:
+    m = os.umask(0)
+    os.umask(m)
+    return 0o666 & ~m
+
+
+def _move(src: Path, dst: Path) -> None:
+    """Rename ``src`` onto ``dst``; across filesystems (a mount point inside the target) copy it to a
+    temporary file beside ``dst`` and rename that."""
+    try:
+        os.replace(src, dst)
+    except OSError as e:
+        if e.errno != errno.EXDEV:
+            raise
+        fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
+        os.close(fd)
+        try:
+            shutil.copy2(src, tmp)
+            os.replace(tmp, dst)
+        except BaseException:
+            _unlink(tmp)
+            raise
+        _unlink(src)
+
+
+def _unlink(p) -> None:
+    try:
+        os.unlink(p)
+    except OSError:
+        pass
+
+
+def write_error(exc: OSError, shown=None) -> InputError:
+    """The one-line :class:`InputError` of an ``OSError`` met while writing: the path and the reason."""
+    where = shown or exc.filename or "output"
+    reason = exc.strerror or str(exc)
+    return InputError(str(where), "", f"cannot write ({reason}); nothing was written")
+
 
 class StagedOutput:
-    """Write files into a temporary folder and move them into ``out`` only on success."""
+    """An output folder written all-or-nothing.
+
+    Files are written through :meth:`path` (or into :attr:`dir`) into a staging folder
+    ``out/.staging-XXXX`` inside the target (created with any missing parents when the block
+    is entered), and moved into ``out`` when the ``with`` block ends without an exception.
+    On an exception (an error, KeyboardInterrupt, the CLI's SIGTERM exception), a failed move
+    or a signal during the moves, everything is undone: the staging folder is removed, files
+    already moved are removed (files they replaced are restored) and so are the folders it
+    created, ``out`` included.  An ``OSError`` of writing comes out as one :class:`InputError`
+    naming the final path.  Stagings nest (a StagedOutput on a path inside another's staging
+    folder commits into it).
+
+    Use it as a context manager; :meth:`path` outside a ``with`` block opens the staging
+    folder, and then :meth:`commit` or :meth:`abort` must follow.
+    """
+
+    check = staticmethod(check_output_dir)
 
     def __init__(self, out: str | Path):
         self.out = Path(out)
-        self.out.parent.mkdir(parents=True, exist_ok=True) if self.out.parent != Path("") else None
-        self.tmp = Path(tempfile.mkdtemp(prefix=".staging-", dir=self.out.parent if str(self.out.parent) else "."))
+        self.tmp: Path | None = None
+        self.written: list[str] = []           # relative paths moved into ``out`` by the commit
+        self._created: list[Path] = []
+        self._done = False
+
+    # ----------------------------------------------------------------- staging folder
+    def open(self) -> "StagedOutput":
+        """Create ``out`` (and missing parents) and the staging folder in it; idempotent."""
+        if self.tmp is not None:
+            return self
+        if os.path.lexists(self.out) and not self.out.is_dir():
+            raise InputError(str(self.out), "", "is a file, not a folder")
+        with signals_held():
+            try:
+                self._created = _make_dirs(self.out)
+                try:
+                    self.tmp = _abs(tempfile.mkdtemp(prefix=".staging-", dir=self.out))
+                except BaseException:
+                    _remove_dirs(self._created)
+                    self._created = []
+                    raise
+            except NotADirectoryError:
+                raise InputError(str(self.out), "", "a part of this path is a file, not a folder") from None
+            except FileExistsError:
+                raise InputError(str(self.out), "", "is a file, not a folder") from None
+            except OSError as e:
+                raise write_error(e, self.out) from None
+        return self
+
+    @property
+    def dir(self) -> Path:
+        """The staging folder (write there directly, or through :meth:`path`)."""
+        return self.open().tmp
 
     def path(self, name: str) -> Path:
-        p = self.tmp / name
+        """Where to write the output file ``name`` (may contain folders: ``"ekf/comparison.csv"``)."""
+        p = self.dir / name
         p.parent.mkdir(parents=True, exist_ok=True)
         return p
 
+    def final(self, p) -> Path:
+        """The final path of a staged path (``out/.staging-XXXX/a/b`` -> ``out/a/b``)."""
+        p = Path(os.fsdecode(p)) if isinstance(p, bytes) else Path(p)
+        if self.tmp is not None:
+            try:
+                return self.out / _abs(p).relative_to(self.tmp)
+            except ValueError:
+                pass
+        return p
+
+    # ----------------------------------------------------------------- commit / abort
     def commit(self) -> None:
-        self.out.mkdir(parents=True, exist_ok=True)
-        for p in sorted(self.tmp.rglob("*")):
-            if p.is_file():
-                dst = self.out / p.relative_to(self.tmp)
-                dst.parent.mkdir(parents=True, exist_ok=True)
-                os.replace(p, dst)
-        shutil.rmtree(self.tmp, ignore_errors=True)
+        """Move every staged file into ``out`` (all or none; see the class)."""
+        if self._done:
+            return
+        self.open()
+        journal: list[tuple] = []                # ("dir", path) | ("file", dst, backup or None)
+        with signals_held():
+            try:
+                if _signal_pending():
+                    raise _Pending()
+                entries = sorted(self.tmp.rglob("*"))
+                backups = Path(tempfile.mkdtemp(prefix=".replaced-", dir=self.tmp))
+                for src in entries:
+                    rel = src.relative_to(self.tmp)
+                    dst = self.out / rel
+                    if src.is_dir() and not src.is_symlink():
+                        if not os.path.lexists(dst):
+                            os.mkdir(dst)
+                            journal.append(("dir", dst))
+                        elif not dst.is_dir():
+                            raise InputError(str(dst), "", "is a file; cannot write a folder there")
+                        continue
+                    if dst.is_dir() and not dst.is_symlink():
+                        raise InputError(str(dst), "", "is a folder; cannot replace it with a file")
+                    backup = None
+                    if os.path.lexists(dst):
+                        backup = backups / f"{len(journal)}"
+                        os.replace(dst, backup)
+                    journal.append(("file", dst, backup))
+                    _move(src, dst)
+                    self.written.append(rel.as_posix())
+                if _signal_pending():              # interrupted while moving: undo, then the signal acts
+                    raise _Pending()
+            except BaseException as e:
+                self._rollback(journal)
+                self.written = []
+                self._cleanup(remove_created=True)
+                if not isinstance(e, _Pending):
+                    if isinstance(e, OSError):
+                        raise write_error(e, self.final(e.filename) if e.filename else self.out) from None
+                    raise
+                interrupted = True              # leaving the held block delivers the signal
+            else:
+                interrupted = False
+                self._cleanup(remove_created=False)
+        if interrupted:                         # the signal's handler did not raise: say so all the same
+            raise InputError(str(self.out), "", "interrupted while moving the files in; nothing was written")
 
     def abort(self) -> None:
-        shutil.rmtree(self.tmp, ignore_errors=True)
+        """Remove the staging folder and every folder this staging created (nothing is left)."""
+        if self._done:
+            return
+        with signals_held():
+            self._cleanup(remove_created=True)
+
+    def _rollback(self, journal) -> None:
+        for entry in reversed(journal):
+            try:
+                if entry[0] == "dir":
+                    os.rmdir(entry[1])
+                elif entry[2] is not None:
+                    os.replace(entry[2], entry[1])
+                else:
+                    _unlink(entry[1])
+            except OSError:
+                pass
+
+    def _cleanup(self, remove_created: bool) -> None:
+        if self.tmp is not None:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+        if remove_created:
+            _remove_dirs(self._created)
+        self._done = True
 
     def __enter__(self):
-        return self
+        return self.open()
 
     def __exit__(self, exc_type, exc, tb):
-        if exc_type is None:
-            self.commit()
-        else:
+        try:
+            if exc_type is None:
+                self.commit()
+            else:
+                self.abort()
+        except BaseException:
             self.abort()
+            raise
+        if isinstance(exc, OSError) and not isinstance(exc, InputError) and _is_write_error(exc, self):
+            raise write_error(exc, self.final(exc.filename) if exc.filename else self.out) from None
         return False
 
 
+class _Pending(BaseException):
+    """A signal arrived during a commit (internal)."""
+
+
+def _is_write_error(exc: OSError, stage: StagedOutput | None = None) -> bool:
+    if exc.errno in WRITE_ERRNOS:
+        return True
+    if stage is not None and stage.tmp is not None and exc.filename:
+        try:
+            _abs(os.fsdecode(exc.filename)).relative_to(stage.tmp)
+            return True
+        except (ValueError, TypeError):
+            return False
+    return False
+
+
+class StagedFile:
+    """One file written all-or-nothing: ``with StagedFile(target) as tmp: write tmp`` writes a
+    temporary file beside ``target`` (its missing folders created) and renames it onto
+    ``target`` on success; on any failure or interrupt the temporary file and the folders
+    created are removed.  An existing target keeps its permission bits."""
+
+    def __init__(self, target: str | Path):
+        self.target = Path(target)
+        self.tmp: Path | None = None
+        self._created: list[Path] = []
+
+    def __enter__(self) -> Path:
+        with signals_held():
+            try:
+                self._created = _make_dirs(self.target.parent)
+                try:
+                    fd, tmp = tempfile.mkstemp(prefix=f".{self.target.name}.", suffix=".tmp", dir=self.target.parent)
+                except BaseException:
+                    _remove_dirs(self._created)
+                    raise
+            except OSError as e:
+                raise write_error(e, self.target) from None
+            os.close(fd)
+            self.tmp = Path(tmp)
+            try:
+                mode = stat.S_IMODE(os.stat(self.target).st_mode) if self.target.is_file() else _umask_mode()
+                os.chmod(self.tmp, mode)
+            except OSError:
+                pass
+        return self.tmp
+
+    def __exit__(self, exc_type, exc, tb):
+        with signals_held():
+            interrupted = exc_type is None and _signal_pending()
+            if exc_type is None and not interrupted:
+                try:
+                    os.replace(self.tmp, self.target)
+                except OSError as e:
+                    self._abort()
+                    raise write_error(e, self.target) from None
+            else:
+                self._abort()
+        if interrupted:                          # the signal's handler did not raise: say so all the same
+            raise InputError(str(self.target), "", "interrupted before it was renamed into place; nothing was written")
+        if isinstance(exc, OSError) and not isinstance(exc, InputError) and (
+                exc.errno in WRITE_ERRNOS or exc.filename in (str(self.tmp), self.tmp)):
+            raise write_error(exc, self.target) from None
+        return False
+
+    def _abort(self) -> None:
+        _unlink(self.tmp)
+        _remove_dirs(self._created)
+
+
+# --------------------------------------------------------------------------- JSON
+
+
+def json_safe(o):
+    """``o`` with numpy scalars/arrays as Python numbers/lists, tuples as lists and NaN, +-Infinity
+    as None (JSON null)."""
+    if isinstance(o, dict):
+        return {(k.item() if isinstance(k, np.generic) else k): json_safe(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [json_safe(v) for v in o]
+    if isinstance(o, np.ndarray):
+        return json_safe(o.tolist())
+    if isinstance(o, np.generic):
+        o = o.item()
+    if isinstance(o, float) and not math.isfinite(o):
+        return None
+    return o
+
+
 def _json_default(o):
-    if isinstance(o, (np.floating, np.integer)):
+    if isinstance(o, (np.floating, np.integer, np.bool_)):
         return o.item()
     if isinstance(o, np.ndarray):
         return o.tolist()
-    raise TypeError(type(o))
+    raise TypeError(f"{type(o).__name__} is not JSON serialisable")
+
+
+def dumps_json(obj) -> str:
+    """``obj`` as indented JSON text; NaN and +-Infinity written as null (never as NaN/Infinity)."""
+    return json.dumps(json_safe(obj), indent=2, default=_json_default, allow_nan=False) + "\n"
 
 
 def dump_json(obj, path: Path) -> None:
-    with open(path, "w") as fh:
-        json.dump(obj, fh, indent=2, default=_json_default)
+    """Write ``obj`` as JSON to ``path`` (a temporary file beside it, renamed): numpy values as
+    numbers and lists, NaN and +-Infinity as null, so the file parses with a strict
+    ``json.loads(text, parse_constant=...)``."""
+    text = dumps_json(obj)                 # serialise first: a TypeError leaves no file
+    with StagedFile(path) as tmp:
+        tmp.write_text(text)
 
 
 class Folder:
