@@ -226,8 +226,6 @@ def test_pool_workers_started_in_children_ignore_sigint_miss_ctrl_c():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="trials/sweep.py must start its loky pool inside trials.output.children_ignore_sigint()",
-                   strict=False)
 def test_montecarlo_ctrl_c_to_the_process_group(tmp_path):
     """Ctrl-C in a terminal (SIGINT to the whole group, workers included): one line, 130, nothing left."""
     base = tmp_path / "base"

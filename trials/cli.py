@@ -177,10 +177,8 @@ def cmd_reproduce(args) -> int:
 def cmd_nomoto(args) -> int:
     from contextlib import nullcontext
 
-    import json
-
     from .nomoto_report import identify_log, report, write_identification
-    from .output import StagedOutput, check_output_file, dump_json
+    from .output import StagedOutput, check_output_file
 
     if args.json:
         if Path(args.json).suffix.lower() == ".png":
@@ -192,10 +190,7 @@ def cmd_nomoto(args) -> int:
             print(note)
         print(report(ident))
         if args.json:
-            staged = stage.path(Path(args.json).name)
-            write_identification(ident, staged)
-            # rewritten through dump_json: NaN / Infinity as null (write_identification uses json.dumps)
-            dump_json(json.loads(staged.read_text()), staged)
+            write_identification(ident, stage.path(Path(args.json).name))
     if args.json:
         print(f"wrote {args.json} and {Path(args.json).with_suffix('.png')}")
     return 0

@@ -1,7 +1,6 @@
 """Nomoto identification of a record file as a report: the text table and the JSON + plot files (``mmg nomoto``)."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -71,9 +70,9 @@ def identify_log(path, length: float, speed: float | None = None, output_error: 
 def write_identification(ident, json_path) -> None:
     """The identification's JSON and its plot (same stem, .png) written together or not at all."""
     from trials.nomoto_plot import plot_identification
-    from trials.output import StagedOutput
+    from trials.output import StagedOutput, dump_json
 
     out = Path(json_path)
     with StagedOutput(out.parent) as stage:
-        stage.path(out.name).write_text(json.dumps(ident.to_dict(), indent=2))
+        dump_json(ident.to_dict(), stage.path(out.name))        # NaN / Infinity written as null
         plot_identification(ident, stage.path(out.with_suffix(".png").name))

@@ -88,7 +88,9 @@ def run_sweep(func: Callable, tasks: Sequence, *, backend: str = "loky", n_jobs:
     else:
         ctx = parallel_backend("loky", n_jobs=jobs)
     out: list = [None] * n
-    with ctx:
+    from .output import children_ignore_sigint
+
+    with ctx, children_ignore_sigint():      # workers leave Ctrl-C to the main process (it cleans up)
         gen = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=batch_size)(
             delayed(_indexed)(func, i, task) for i, task in enumerate(tasks))
         for done, (i, res) in enumerate(gen, 1):
