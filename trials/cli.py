@@ -40,7 +40,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-METRIC_KEYS = ["trial", "kind", "approach_speed_kn", "approach_rpm", "trim_rudder_deg", "advance_L", "transfer_L",
+METRIC_KEYS = ["trial", "kind", "execute_s", "approach_speed_mps", "rudder_deg", "approach_speed_kn", "approach_rpm", "trim_rudder_deg", "advance_L", "transfer_L",
                "tactical_diameter_L", "steady_diameter_L", "speed_loss", "overshoots_deg", "initial_turning_time_s",
                "period_s", "final_heading_change_deg"]
 
@@ -155,6 +155,8 @@ def cmd_metrics(args) -> int:
     m = record_metrics(rec, args.kind, args.length, ang)
     print(f"{rec.name} ({m['kind']}, {rec.source})")
     print_metrics(m)
+    for note in m.get("notes", []):
+        print(f"note: {note}", file=sys.stderr)
     if args.json:
         dump_json(m, args.json)               # a temporary file beside it, renamed
     return 0
