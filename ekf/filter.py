@@ -41,7 +41,8 @@ from numba import njit
 
 from mmg.model import N_, R_, U_, V_, PackedShip
 
-from .kernels import CSTEP, fpft, jacobian_step, make_workspace, symmetrise  # noqa: F401 (CSTEP re-exported)
+from .kernels import (CSTEP, fpft, jacobian_step, jacobian_step_reference, joseph_update_ws,  # noqa: F401 (CSTEP re-exported)
+                      make_update_workspace, make_workspace, symmetrise)
 
 STATES = ("u", "v", "r", "n")
 NS = 4
@@ -78,6 +79,9 @@ def workspace(nz, hull_coef):
 def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
     """One RK4 step of the augmented state z (nz,) and its exact Jacobian into ``ws`` (z_next = ws[8], F = ws[9]).
 
+    F by the tangent-linear RK4 of :func:`ekf.kernels.jacobian_step` (state columns by complex
+    step of each stage, derivative columns analytic: 16 complex model evaluations a step).
+
     d0, d1 rudder angle [rad] at the start and end of the step (an input, linear over it), dt [s];
     idx the derivatives' slots in ``hull_coef``; ws from :func:`workspace`."""
     jacobian_step(z, d0, d1, 0.0, 0.0, -1, SLOTS, NS, dt, p, poly, hull_axis, hull_term, idx, ws)
@@ -89,8 +93,8 @@ def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, 
 
     z (nz,) real; d0, d1 rudder angle [rad] at the start and end of the step; dt [s];
     hull_coef the packed ship's coefficients (the derivative slots ``idx`` are overwritten
-    by z[4:] in a complex copy); z_next (nz,) and F (nz, nz) are written.  Column j of F is
-    Im(step(z + i h e_j)) / h with h = 1e-30: exact to rounding, no truncation error.
+    by z[4:] in a complex copy); z_next (nz,) and F (nz, nz) are written.  F is exact to
+    rounding (:func:`propagate_step`; no truncation error).
     """
     ws = workspace(z.shape[0], hull_coef)
     propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws)
@@ -184,11 +188,17 @@ def _check(z, P):
 
 
 @njit(cache=True)
-def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag):
-    """The whole pass: predict (RK4 + complex-step F), P = F P F^T, Joseph update, checks.
+def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag,
+                  reference=None):
+    """The whole pass: predict (RK4 + exact F), P = F P F^T, Joseph update, checks.
 
     meas (N, 4) u, v, r, n at times k*dt; delta (N,); zs (N, nz) and pdiag (N, nz) are filled
     (row 0 the initial values); q: Q = q I (0 in the paper). Returns (status, step index, final P).
+    reference: the previous implementation, for tests and ``bench/bench_ekf.py``: F by the
+    brute-force complex step (:func:`ekf.kernels.jacobian_step_reference`, one complex RK4 step
+    per column) instead of the tangent-linear RK4 of :func:`propagate_step`, and the update by
+    :func:`joseph_update` instead of its allocation-free form :func:`ekf.kernels.joseph_update_ws`;
+    the same numbers to rounding.  Left out (None), that path is not compiled at all.
     """
     nz = z0.shape[0]
     N = meas.shape[0]
@@ -197,13 +207,18 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
     FP = np.empty((nz, nz))
     ws = workspace(nz, hull_coef)
     zn, F = ws[8], ws[9]
+    uw = make_update_workspace(nz, meas.shape[1])
     for i in range(nz):
         zs[0, i] = z[i]
         pdiag[0, i] = P[i, i]
     ring = np.zeros(max(nis_window, 1))
     nis_sum = 0.0
     for k in range(1, N):
-        propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
+        if reference is not None and reference:
+            jacobian_step_reference(z, delta[k - 1], delta[k], 0.0, 0.0, -1, SLOTS, NS, dt, p, poly, hull_axis,
+                                    hull_term, idx, ws)
+        else:
+            propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
         z[:] = zn
         fpft(F, P, NS, FP, P)
         if q > 0.0:
@@ -212,7 +227,10 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
         st = _check(z, P)
         if st != OK:
             return st, k, P
-        nis = joseph_update(z, P, meas[k], R)
+        if reference is not None and reference:
+            nis = joseph_update(z, P, meas[k], R)
+        else:
+            nis = joseph_update_ws(z, P, meas[k], R, uw)
         st = _check(z, P)
         if nis_window > 0:
             slot = k % nis_window

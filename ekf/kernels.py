@@ -9,15 +9,19 @@ estimated hull derivatives sit in their state z:
   ``[X_, Y_, PSI_, N_, U_, V_, R_]``, derivatives from z[8] (tau, the rudder-timing offset, is
   held like the derivatives and enters through the rudder angle, see :func:`jacobian_step`).
 
-So one RK4 step (:func:`rk4_step`), one complex-step Jacobian (:func:`jacobian_step`) and one
-covariance propagation (:func:`fpft`) serve both; the only physics is :func:`mmg.model.rhs`.
+So one RK4 step (:func:`rk4_step`), one exact Jacobian of it (:func:`jacobian_step`: the
+tangent-linear RK4, state columns by complex step of each stage, derivative columns analytic), one
+covariance propagation (:func:`fpft`) and one measurement update (:func:`joseph_update_ws`) serve
+both; the only physics is :func:`mmg.model` (:func:`~mmg.model.rhs` and the parts it is made of).
+:func:`jacobian_step_reference` keeps the brute-force complex step (one complex RK4 step per
+column of F, 4 x slower for the paper filter) as the reference for tests and ``bench/bench_ekf.py``.
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-from mmg.model import DELTA_, rhs
+from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_, dynamics, inverse_mass, rhs, rhs_hull_jacobian, track
 
 CSTEP = 1e-30               # complex-step size: F = Im(step(z + i h e_j)) / h, exact to rounding
 
@@ -64,27 +68,221 @@ def rk4_step(z, slots, c0, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx,
 
 @njit(cache=True)
 def make_workspace(nz, ns, hull_coef):
-    """Work arrays of :func:`jacobian_step` for nz states of which ns are propagated:
-    (zc, coef, xs, k1, k2, k3, k4, out, z_next, F); coef is a complex copy of ``hull_coef``."""
+    """Work arrays of :func:`jacobian_step` (and :func:`jacobian_step_reference`) for nz states of
+    which ns are propagated: (zc, coef, xs, k1, k2, k3, k4, out, z_next, F, hc, xr, kc, kr, ks, A, dK,
+    dKn, B, w); coef a complex and hc a real copy of ``hull_coef``.  ws[0:8] are the complex work
+    arrays of :func:`rk4_step`, z_next = ws[8], F = ws[9]; ws[10:] those of the tangent-linear RK4."""
     coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
     for i in range(hull_coef.shape[0]):
         coef[i] = hull_coef[i]
     return (np.empty(nz, dtype=np.complex128), coef, np.zeros(8, dtype=np.complex128),
             np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
-            np.empty(8, dtype=np.complex128), np.empty(ns, dtype=np.complex128), np.empty(nz), np.empty((nz, nz)))
+            np.empty(8, dtype=np.complex128), np.empty(ns, dtype=np.complex128), np.empty(nz), np.empty((nz, nz)),
+            hull_coef.copy(), np.zeros(8), np.zeros(8, dtype=np.complex128), np.empty(ns), np.empty(ns),
+            np.zeros((ns, ns + 1)), np.zeros((ns, nz)), np.zeros((ns, nz)), np.empty((3, max(nz - ns, 0))),
+            np.empty(8))
 
 
 @njit(cache=True)
-def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hull_term, idx, ws):
-    """One RK4 step of the real state z (:func:`rk4_step`) and its exact Jacobian F = d z_next / d z.
+def _held_rows(z, ns, z_next, F):
+    """z_next = z and F = identity on the held states (rows ns..)."""
+    nz = z.shape[0]
+    for i in range(ns, nz):
+        z_next[i] = z[i]
+        for j in range(nz):
+            F[i, j] = 1.0 if i == j else 0.0
 
-    Column j of F is Im(step(z + i h e_j)) / h with h = 1e-30 (complex step: exact to rounding).
-    The states from len(slots) on are held (their rows of F are the identity).
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _dynamics_column(k, u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef, out):
+    """:func:`mmg.model.dynamics` with a complex step in state ``k`` (U_, V_, R_, N_ or DELTA_)."""
+    h = 1j * CSTEP
+    if k == U_ or k == V_ or k == R_:
+        dynamics(u + (h if k == U_ else 0j), v + (h if k == V_ else 0j), r + (h if k == R_ else 0j), delta, n,
+                 p, poly, hull_axis, hull_term, hull_coef, out)
+    elif k == N_:
+        dynamics(u, v, r, delta, n + h, p, poly, hull_axis, hull_term, hull_coef, out)
+    else:
+        dynamics(u, v, r, delta + h, n, p, poly, hull_axis, hull_term, hull_coef, out)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _track_column(k, u, v, r, psi, p, out):
+    """:func:`mmg.model.track` with a complex step in state ``k`` (U_, V_, R_ or PSI_)."""
+    h = 1j * CSTEP
+    if k == U_:
+        track(u + h, v, r, psi, p, out)
+    elif k == V_:
+        track(u, v + h, r, psi, p, out)
+    elif k == R_:
+        track(u, v, r + h, psi, p, out)
+    else:
+        track(u, v, r, psi + h, p, out)
+
+
+@njit(cache=True, error_model="numpy")
+def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hull_term, idx, ws):
+    """One RK4 step of the real state z and its exact Jacobian F = d z_next / d z (tangent-linear RK4).
+
+    Same step as :func:`rk4_step` and the same F as :func:`jacobian_step_reference` (to
+    rounding), differentiating the RK4 stages instead of the whole step.  With
+    x_s = z + a_s dt k_{s-1} (a = 0, 1/2, 1/2, 1) the stage state, k_s = f(x_s) and
+    theta = z, for every stage
+
+        d k_s / d theta = A_s (E + a_s dt d k_{s-1} / d theta) + a_delta,s d delta_s / d theta + B_s,
+
+    F = E + dt/6 (dk_1 + 2 dk_2 + 2 dk_3 + dk_4) on the propagated rows (E = [I 0]).
+
+    * A_s = d f / d x over the propagated slots, by complex step of the two parts of
+      :func:`mmg.model.rhs`, each along its own arguments only: :func:`mmg.model.dynamics`
+      (u, v, r, n rows; in u, v, r, n) and, when x0, y0 or psi are propagated,
+      :func:`mmg.model.track` (x0, y0, psi rows; in u, v, r, psi).  One complex evaluation per
+      argument, the others left real (so e.g. the hull force stays real under a step in n);
+      the real parts give k_s.  Nothing depends on x0, y0: their columns are zero.
+    * a_delta,s = d f / d delta (with itau >= 0 only; one more evaluation of the dynamics): the
+      rudder at stage s is d_s + z[itau] g_s, so d delta_s / d z[itau] = g_s.
+    * B_s = d f / d c for the coefficients z[c0 + j] = hull_coef[idx[j]]: analytic
+      (:func:`mmg.model.rhs_hull_jacobian`; the hull forces are linear in them).
+
+    Paper filter: 16 complex evaluations of the dynamics a step instead of 64 of rhs; raw-log
+    filter 20 (and 16 cheap ones of the track) instead of 80.
+    Arguments and outputs as :func:`jacobian_step_reference`: rudder [rad] d0 -> d1 over the
+    step, with itau >= 0 it is d + z[itau] g (g0 -> g1 [rad/s]); slots from U_, V_, R_, N_, X_,
+    Y_, PSI_; the states from len(slots) on are held (rows of F the identity).  ws from
+    :func:`make_workspace`: z_next = ws[8], F = ws[9].
+    """
+    z_next, F, hc, xr, kc, kr, ks, A, dK, dKn, B, w = ws[8], ws[9], ws[10], ws[11], ws[12], ws[13], ws[14], \
+        ws[15], ws[16], ws[17], ws[18], ws[19]
+    nz = z.shape[0]
+    ns = slots.shape[0]
+    m = idx.shape[0]
+    for j in range(m):
+        hc[idx[j]] = z[c0 + j]
+    iu = -1
+    iv = -1
+    ir = -1
+    tmask = 0                   # bit i: row i is a track state (x0, y0, psi)
+    dmask = 0                   # bit i: row i is a dynamic state (u, v, r, n)
+    for i in range(ns):
+        sl = slots[i]
+        if sl == U_:
+            iu = i
+        elif sl == V_:
+            iv = i
+        elif sl == R_:
+            ir = i
+        if sl == X_ or sl == Y_ or sl == PSI_:
+            tmask |= 1 << i
+        elif sl == U_ or sl == V_ or sl == R_ or sl == N_:
+            dmask |= 1 << i
+        else:
+            raise ValueError("slots: the rudder angle is an input, not a propagated state")
+    minv = inverse_mass(p, w)
+    tau = z[itau] if itau >= 0 else 0.0
+    e0 = d0 + tau * g0
+    e1 = d1 + tau * g1
+    for i in range(8):
+        xr[i] = 0.0
+    c6 = dt / 6.0
+    for i in range(ns):
+        ks[i] = 0.0
+        for j in range(nz):
+            F[i, j] = 1.0 if i == j else 0.0
+    for st in range(4):
+        if st == 0:
+            a, wst, e, ge = 0.0, 1.0, e0, g0
+        elif st == 3:
+            a, wst, e, ge = dt, 1.0, e1, g1
+        else:
+            a, wst, e, ge = 0.5 * dt, 2.0, 0.5 * (e0 + e1), 0.5 * (g0 + g1)
+        # stage state x_s = z + a k_{s-1} (a = a_s dt; its tangent E + a dk_{s-1} enters below)
+        for i in range(ns):
+            xr[slots[i]] = z[i] + a * kr[i] if st > 0 else z[i]
+        xr[DELTA_] = e
+        u, v, r, psi, n = xr[U_], xr[V_], xr[R_], xr[PSI_], xr[N_]
+        # A_s (column ns: d f / d delta) by complex step; the first evaluations' real parts are k_s
+        dyn_real = dmask == 0
+        trk_real = tmask == 0
+        for c in range(ns + 1):
+            if c < ns:
+                k = slots[c]
+            elif itau >= 0:
+                k = DELTA_
+            else:
+                break
+            for i in range(ns):
+                A[i, c] = 0.0
+            if dmask != 0 and (k == U_ or k == V_ or k == R_ or k == N_ or k == DELTA_):
+                _dynamics_column(k, u, v, r, e, n, p, poly, hull_axis, hull_term, hc, kc)
+                for i in range(ns):
+                    if (dmask >> i) & 1:
+                        A[i, c] = kc[slots[i]].imag / CSTEP
+                        if not dyn_real:
+                            kr[i] = kc[slots[i]].real
+                dyn_real = True
+            if tmask != 0 and (k == U_ or k == V_ or k == R_ or k == PSI_):
+                _track_column(k, u, v, r, psi, p, kc)
+                for i in range(ns):
+                    if (tmask >> i) & 1:
+                        A[i, c] = kc[slots[i]].imag / CSTEP
+                        if not trk_real:
+                            kr[i] = kc[slots[i]].real
+                trk_real = True
+        if not dyn_real:                # no dynamic state to differentiate in: k_s alone
+            dynamics(u, v, r, e, n, p, poly, hull_axis, hull_term, hc, w)
+            for i in range(ns):
+                if (dmask >> i) & 1:
+                    kr[i] = w[slots[i]]
+        if not trk_real:
+            track(u, v, r, psi, p, w)
+            for i in range(ns):
+                if (tmask >> i) & 1:
+                    kr[i] = w[slots[i]]
+        # B_s, analytic
+        rhs_hull_jacobian(xr, p, hull_axis, hull_term, idx, minv, B)
+        # dk_s = A_s (E + a dt dk_{s-1}) + a_delta g_s e_tau + B_s (into dKn; rows of dK contiguous)
+        for i in range(ns):
+            for j in range(nz):
+                dKn[i, j] = 0.0
+            if st > 0:
+                for c in range(ns):
+                    aic = a * A[i, c]
+                    for j in range(nz):
+                        dKn[i, j] += aic * dK[c, j]
+            for j in range(ns):
+                dKn[i, j] += A[i, j]
+            if itau >= 0:
+                dKn[i, itau] += A[i, ns] * ge
+        dK, dKn = dKn, dK
+        for j in range(m):
+            if iu >= 0:
+                dK[iu, c0 + j] += B[0, j]
+            if iv >= 0:
+                dK[iv, c0 + j] += B[1, j]
+            if ir >= 0:
+                dK[ir, c0 + j] += B[2, j]
+        cw = c6 * wst
+        for i in range(ns):
+            ks[i] += wst * kr[i]
+            for j in range(nz):
+                F[i, j] += cw * dK[i, j]
+    for i in range(ns):
+        z_next[i] = z[i] + c6 * ks[i]
+    _held_rows(z, ns, z_next, F)
+
+
+@njit(cache=True)
+def jacobian_step_reference(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hull_term, idx, ws):
+    """:func:`jacobian_step` by brute force: column j of F is Im(step(z + i h e_j)) / h, h = 1e-30.
+
+    One complex RK4 step (:func:`rk4_step`) per column of F (4 nz complex evaluations of f a
+    step; complex step: exact to rounding).  The reference for :func:`jacobian_step` (tests,
+    ``bench/bench_ekf.py``); same arguments and outputs.
     Rudder [rad] d0 -> d1 over the step; with itau >= 0 it is d + z[itau] g (g0 -> g1 [rad/s]),
     z[itau] a timing offset [s] (g = -d(delta)/dt: the rudder moved by -tau in time); itau < 0:
     the rudder is d alone (g ignored).  ws from :func:`make_workspace`: z_next = ws[8], F = ws[9].
     """
-    zc, coef, xs, k1, k2, k3, k4, out, z_next, F = ws
+    zc, coef, xs, k1, k2, k3, k4, out, z_next, F = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7], ws[8], ws[9]
     nz = z.shape[0]
     ns = slots.shape[0]
     for j in range(nz):
@@ -103,15 +301,12 @@ def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hu
         if j == 0:
             for i in range(ns):
                 z_next[i] = out[i].real
-    for i in range(ns, nz):
-        z_next[i] = z[i]
-        for j in range(nz):
-            F[i, j] = 1.0 if i == j else 0.0
+    _held_rows(z, ns, z_next, F)
 
 
 @njit(cache=True)
 def _dot(a, b):
-    """sum_k a[k] b[k], k ascending (the summation order every caller relies on)."""
+    """sum_k a[k] b[k], k ascending."""
     acc = 0.0
     for k in range(a.shape[0]):
         acc += a[k] * b[k]
@@ -127,7 +322,11 @@ def fpft(F, P, ns, FP, out):
     nz = P.shape[0]
     for i in range(ns):
         for j in range(nz):
-            FP[i, j] = _dot(F[i], P[:, j])
+            FP[i, j] = 0.0
+        for k in range(nz):
+            f = F[i, k]
+            for j in range(nz):
+                FP[i, j] += f * P[k, j]
     for i in range(ns, nz):
         for j in range(nz):
             FP[i, j] = P[i, j]
@@ -136,6 +335,104 @@ def fpft(F, P, ns, FP, out):
             out[i, j] = _dot(FP[i], F[j])
         for j in range(ns, nz):
             out[i, j] = FP[i, j]
+
+
+@njit(cache=True)
+def make_update_workspace(nz, m):
+    """Work arrays of :func:`joseph_update_ws` for nz states of which the first m are measured:
+    (S, SI, K, KT, KR, y, A)."""
+    return (np.empty((m, m)), np.empty((m, m)), np.empty((nz, m)), np.empty((m, nz)), np.empty((nz, m)),
+            np.empty(m), np.empty((nz, nz)))
+
+
+@njit(cache=True)
+def _inverse(S, out):
+    """out = S^-1 (Gauss-Jordan with partial pivoting; S is overwritten).  Small m only."""
+    m = S.shape[0]
+    for i in range(m):
+        for j in range(m):
+            out[i, j] = 1.0 if i == j else 0.0
+    for c in range(m):
+        piv = c
+        for i in range(c + 1, m):
+            if abs(S[i, c]) > abs(S[piv, c]):
+                piv = i
+        if piv != c:
+            for j in range(m):
+                S[c, j], S[piv, j] = S[piv, j], S[c, j]
+                out[c, j], out[piv, j] = out[piv, j], out[c, j]
+        d = S[c, c]
+        for j in range(m):
+            S[c, j] /= d
+            out[c, j] /= d
+        for i in range(m):
+            if i != c:
+                f = S[i, c]
+                if f != 0.0:
+                    for j in range(m):
+                        S[i, j] -= f * S[c, j]
+                        out[i, j] -= f * out[c, j]
+
+
+@njit(cache=True)
+def joseph_update_ws(z, P, meas, R, uw):
+    """Measurement update of z, P with H = [I_m 0] (the first m states measured), Joseph form
+    P <- (I - K H) P (I - K H)^T + K R K^T, then P symmetrised; in place.  Returns the NIS y^T S^-1 y.
+
+    The update of :func:`ekf.filter.joseph_update` (same formulas, equal to rounding) without
+    its allocations and 16 x 16 matrix products: with H = [I 0], (I - K H) P = P - K P[:m] and
+    (I - K H) P (I - K H)^T + K R K^T = A + (K R - A[:, :m]) K^T with A = (I - K H) P.
+    uw from :func:`make_update_workspace` (nz, m).
+    """
+    S, SI, K, KT, KR, y, A = uw
+    nz = z.shape[0]
+    m = meas.shape[0]
+    for i in range(m):
+        for j in range(m):
+            S[i, j] = P[i, j] + R[i, j]
+    _inverse(S, SI)
+    for i in range(nz):
+        for j in range(m):
+            acc = 0.0
+            for k in range(m):
+                acc += P[i, k] * SI[k, j]
+            K[i, j] = acc
+            KT[j, i] = acc
+    for i in range(m):
+        y[i] = meas[i] - z[i]
+    nis = 0.0
+    for i in range(m):
+        for j in range(m):
+            nis += y[i] * SI[i, j] * y[j]
+    for i in range(nz):
+        acc = 0.0
+        for j in range(m):
+            acc += K[i, j] * y[j]
+        z[i] += acc
+    # A = P - K P[:m]
+    for i in range(nz):
+        for j in range(nz):
+            A[i, j] = P[i, j]
+        for k in range(m):
+            kik = K[i, k]
+            for j in range(nz):
+                A[i, j] -= kik * P[k, j]
+    # W = K R - A[:, :m] (into KR), P = A + W K^T, symmetrised
+    for i in range(nz):
+        for j in range(m):
+            acc = 0.0
+            for k in range(m):
+                acc += K[i, k] * R[k, j]
+            KR[i, j] = acc - A[i, j]
+    for i in range(nz):
+        for j in range(nz):
+            P[i, j] = A[i, j]
+        for k in range(m):
+            wik = KR[i, k]
+            for j in range(nz):
+                P[i, j] += wik * KT[k, j]
+    symmetrise(P, P)
+    return nis
 
 
 @njit(cache=True)

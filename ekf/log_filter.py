@@ -60,7 +60,8 @@ from mmg.errors import InputError
 from mmg.model import N_, PSI_, R_, U_, V_, X_, Y_
 
 from .filter import NEG_SPEED, NONFINITE, NOT_PD, OK, FilterDivergence, is_pd, joseph_update
-from .kernels import fpft, jacobian_step, make_workspace, symmetrise
+from .kernels import (fpft, jacobian_step, jacobian_step_reference, joseph_update_ws, make_update_workspace,
+                      make_workspace, symmetrise)
 
 STATES = ("x", "y", "psi", "n", "u", "v", "r", "tau")
 NS = 7                      # dynamic states (propagated by RK4)
@@ -81,7 +82,8 @@ _REASON = {NONFINITE: "a state or covariance became non-finite",
 
 @njit(cache=True)
 def propagate_log(z, d0, d1, g0, g1, dt, p, poly, hull_axis, hull_term, idx, ws):
-    """One RK4 step of z (nz,) and its exact (complex-step) Jacobian: z_next = ws[8], F = ws[9].
+    """One RK4 step of z (nz,) and its exact Jacobian: z_next = ws[8], F = ws[9] (the tangent-linear
+    RK4 of :func:`ekf.kernels.jacobian_step`: 24 complex model evaluations a step, not 80).
 
     The rudder [rad] over the step (dt [s]) is d + tau g (d0 -> d1, g0 -> g1 [rad/s]): the
     rebuilt rudder moved by -tau in time, g = -d(delta)/dt, so the timing offset tau [s] is
@@ -108,13 +110,18 @@ def _check_log(z, P):
 
 @njit(cache=True)
 def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q, p, poly, hull_axis, hull_term,
-                      hull_coef, idx, zs, pdiag, nis):
+                      hull_coef, idx, zs, pdiag, nis, reference=None):
     """The whole pass on the 0.1 s grid of ``delta`` (N,): predict every step, update at steps ``meas_k``.
 
     meas (M, 4) x, y, psi, n at grid steps meas_k (M,) (increasing; a sample at step 0 is taken
     to be in z0, P0); g (N,) = -d(delta)/dt; at the steps reset_k (before each rudder movement)
     tau is marginalised out (its effect already lives in the other states) and restarted at 0
     with variance var_tau; q (nz,) diagonal of Q per step; zs, pdiag (N, nz) filled; nis (M,).
+    reference: the previous implementation (tests): F by the brute-force complex step
+    (:func:`ekf.kernels.jacobian_step_reference`) instead of the tangent-linear RK4 of
+    :func:`propagate_log`, the update by :func:`ekf.filter.joseph_update` instead of
+    :func:`ekf.kernels.joseph_update_ws`; the same numbers to rounding.  Left out (None), that path
+    is not compiled at all.
     Returns (status, step index, final P).
     """
     N = delta.shape[0]
@@ -125,6 +132,7 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
     FP = np.empty((NZ, NZ))
     ws = make_workspace(NZ, NS, hull_coef)
     zn, F = ws[8], ws[9]
+    uw = make_update_workspace(NZ, meas.shape[1])
     j = 0
     while j < M and meas_k[j] < 1:
         j += 1
@@ -140,7 +148,11 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
                 P[i, TAU] = 0.0
             P[TAU, TAU] = var_tau
             r += 1
-        propagate_log(z, delta[k - 1], delta[k], g[k - 1], g[k], dt, p, poly, hull_axis, hull_term, idx, ws)
+        if reference is not None and reference:
+            jacobian_step_reference(z, delta[k - 1], delta[k], g[k - 1], g[k], TAU, SLOTS, ND, dt, p, poly,
+                                    hull_axis, hull_term, idx, ws)
+        else:
+            propagate_log(z, delta[k - 1], delta[k], g[k - 1], g[k], dt, p, poly, hull_axis, hull_term, idx, ws)
         for i in range(NZ):
             z[i] = zn[i]
         fpft(F, P, NS, FP, P)
@@ -151,7 +163,10 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
         if st != OK:
             return st, k, P
         while j < M and meas_k[j] == k:
-            nis[j] = joseph_update(z, P, meas[j], R)
+            if reference is not None and reference:
+                nis[j] = joseph_update(z, P, meas[j], R)
+            else:
+                nis[j] = joseph_update_ws(z, P, meas[j], R, uw)
             j += 1
             st = _check_log(z, P)
             if st != OK:

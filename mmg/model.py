@@ -218,34 +218,46 @@ def shaft_acceleration(u, n, J, p, poly):
     return (QP + QE) / (2.0 * np.pi * p[P_SHAFT_I])
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def hull_scales(U, p):
+    """Dimensional scales of the primed hull forces (X_H', Y_H', N_H') at speed U [m/s]:
+    (1/2 rho L T U^2, 1/2 rho L T U^2, 1/2 rho L^2 T U^2) [N, N, N m]."""
+    fs = force_scale(p[P_RHO], p[P_L], p[P_T], U)
+    ms = moment_scale(p[P_RHO], p[P_L], p[P_T], U)
+    return fs, fs, ms
+
+
 @njit(cache=True, error_model="numpy")
 def forces(x, p, poly, hull_axis, hull_term, hull_coef):
     """Total surge and sway force [N] and yaw moment [N m] about midship, and J_P."""
-    u, v, r, delta, n = x[U_], x[V_], x[R_], x[DELTA_], x[N_]
+    return forces_of(x[U_], x[V_], x[R_], x[DELTA_], x[N_], p, poly, hull_axis, hull_term, hull_coef)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef):
+    """:func:`forces` of the states u, v [m/s], r [rad/s], delta [rad], n [rps] as scalars, each
+    real or complex (a complex step in one of them leaves the parts that do not depend on it real)."""
     L = p[P_L]
     U, beta, vp, rp = kinematics(u, v, r, L)
     XHp, YHp, NHp = hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef)
-    fs = force_scale(p[P_RHO], L, p[P_T], U)
-    ms = moment_scale(p[P_RHO], L, p[P_T], U)
+    sX, sY, sN = hull_scales(U, p)
     owp = one_minus_wake(u, beta, rp, p, poly)
     J, KT, XP = propeller(u, n, owp, p, poly)
     XR, YR, NR, FN = rudder(u, U, beta, rp, delta, owp, J, KT, p)
-    X = XHp * fs + XP + XR + p[P_EXT_X]
-    Y = YHp * fs + YR + p[P_EXT_Y]
-    N = NHp * ms + NR + p[P_EXT_N]
+    X = XHp * sX + XP + XR + p[P_EXT_X]
+    Y = YHp * sY + YR + p[P_EXT_Y]
+    N = NHp * sN + NR + p[P_EXT_N]
     return X, Y, N, J
 
 
-@njit(cache=True, error_model="numpy")
-def rhs(x, delta_cmd, p, poly, hull_axis, hull_term, hull_coef, out):
-    """Time derivative of the state, written into ``out`` (MMG equations of motion).
+@njit(cache=True, error_model="numpy", inline="always")
+def accelerations(X, Y, N, u, v, r, p, out):
+    """The equations of motion about midship: du/dt, dv/dt, dr/dt into out[U_], out[V_], out[R_].
 
-    (m+m_x) du/dt - (m+m_y) v r - x_G m r^2 = X
-    (m+m_y) dv/dt + x_G m dr/dt + (m+m_x) u r = Y
-    (I_zG + x_G^2 m + J_z) dr/dt + x_G m (dv/dt + u r) = N
+    X, Y [N], N [N m] the total forces (:func:`forces`), u, v [m/s], r [rad/s]; see :func:`rhs`.
+    Affine in (X, Y, N): with u = v = r = 0 it is the force-to-acceleration map (the inverse
+    mass matrix, :func:`inverse_mass`).
     """
-    u, v, r, psi = x[U_], x[V_], x[R_], x[PSI_]
-    X, Y, N, J = forces(x, p, poly, hull_axis, hull_term, hull_coef)
     m, mx, my, xG = p[P_M], p[P_MX], p[P_MY], p[P_XG]
     a11 = m + my
     a12 = xG * m
@@ -256,9 +268,93 @@ def rhs(x, delta_cmd, p, poly, hull_axis, hull_term, hull_coef, out):
     out[V_] = (b1 * a22 - a12 * b2) / det
     out[R_] = (a11 * b2 - a12 * b1) / det
     out[U_] = (X + (m + my) * v * r + xG * m * r * r) / (m + mx)
+
+
+@njit(cache=True, error_model="numpy")
+def rhs(x, delta_cmd, p, poly, hull_axis, hull_term, hull_coef, out):
+    """Time derivative of the state, written into ``out`` (MMG equations of motion).
+
+    (m+m_x) du/dt - (m+m_y) v r - x_G m r^2 = X
+    (m+m_y) dv/dt + x_G m dr/dt + (m+m_x) u r = Y
+    (I_zG + x_G^2 m + J_z) dr/dt + x_G m (dv/dt + u r) = N
+
+    Made of three parts, each a function of only the states it is given:
+    :func:`dynamics` (u, v, r, n from u, v, r, delta, n), :func:`track` (x0, y0, psi from u, v,
+    r, psi) and the steering gear (delta from delta and the order); nothing depends on x0, y0.
+    """
+    u, v, r, psi = x[U_], x[V_], x[R_], x[PSI_]
+    dynamics(u, v, r, x[DELTA_], x[N_], p, poly, hull_axis, hull_term, hull_coef, out)
+    track(u, v, r, psi, p, out)
+    out[DELTA_] = steering_rate(delta_cmd, x[DELTA_], p)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def dynamics(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef, out):
+    """du/dt, dv/dt, dr/dt and dn/dt of :func:`rhs` into out[U_], out[V_], out[R_], out[N_].
+
+    The states as scalars (u, v [m/s], r [rad/s], delta [rad], n [rps]), each real or complex.
+    """
+    X, Y, N, J = forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef)
+    accelerations(X, Y, N, u, v, r, p, out)
+    out[N_] = shaft_acceleration(u, n, J, p, poly)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def track(u, v, r, psi, p, out):
+    """dx0/dt, dy0/dt [m/s] (over ground, with the current) and dpsi/dt [rad/s] of :func:`rhs`
+    into out[X_], out[Y_], out[PSI_]; u, v [m/s], r [rad/s], psi [rad] scalars, real or complex."""
     c, s = np.cos(psi), np.sin(psi)
     out[X_] = u * c - v * s + p[P_CUR_SPEED] * np.cos(p[P_CUR_DIR])
     out[Y_] = u * s + v * c + p[P_CUR_SPEED] * np.sin(p[P_CUR_DIR])
     out[PSI_] = r
-    out[DELTA_] = steering_rate(delta_cmd, x[DELTA_], p)
-    out[N_] = shaft_acceleration(u, x[N_], J, p, poly)
+
+
+@njit(cache=True, error_model="numpy")
+def hull_regressors(x, p, hull_axis, hull_term, idx, out):
+    """d(X, Y, N) / d hull_coef[idx[j]] at the (real) state x into out[:, j] (out (3, m)).
+
+    The hull forces are linear in their coefficients (:func:`hull_primed`, :func:`forces`):
+    coefficient i adds its term's value times its axis's scale (:func:`hull_scales`) to that
+    axis [N or N m per unit coefficient] and nothing elsewhere.
+    """
+    U, beta, vp, rp = kinematics(x[U_], x[V_], x[R_], p[P_L])
+    sX, sY, sN = hull_scales(U, p)
+    for j in range(idx.shape[0]):
+        i = idx[j]
+        val = term_value(hull_term[i], beta, vp, rp)
+        a = hull_axis[i]
+        out[0, j] = val * sX if a == 0 else 0.0
+        out[1, j] = val * sY if a == 1 else 0.0
+        out[2, j] = val * sN if a == 2 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def inverse_mass(p, work):
+    """The force-to-acceleration map of :func:`accelerations` (the inverse mass matrix about
+    midship): (du/dX, du/dY, du/dN, dv/dX, dv/dY, dv/dN, dr/dX, dr/dY, dr/dN); work: real (8,) scratch."""
+    accelerations(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, p, work)
+    m0u, m0v, m0r = work[U_], work[V_], work[R_]
+    accelerations(0.0, 1.0, 0.0, 0.0, 0.0, 0.0, p, work)
+    m1u, m1v, m1r = work[U_], work[V_], work[R_]
+    accelerations(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, p, work)
+    m2u, m2v, m2r = work[U_], work[V_], work[R_]
+    return m0u, m1u, m2u, m0v, m1v, m2v, m0r, m1r, m2r
+
+
+@njit(cache=True, error_model="numpy")
+def rhs_hull_jacobian(x, p, hull_axis, hull_term, idx, minv, out):
+    """d(du/dt, dv/dt, dr/dt) / d hull_coef[idx[j]] of :func:`rhs` at the (real) state x, analytically.
+
+    out (3, m): rows u, v, r (no other component of :func:`rhs` depends on the hull
+    coefficients); minv: :func:`inverse_mass` of the ship.  The accelerations are affine in the
+    forces (:func:`accelerations`) and the forces linear in the coefficients
+    (:func:`hull_regressors`), so column j is the force-to-acceleration map applied to
+    coefficient j's regressor.
+    """
+    hull_regressors(x, p, hull_axis, hull_term, idx, out)
+    uX, uY, uN, vX, vY, vN, rX, rY, rN = minv
+    for j in range(idx.shape[0]):
+        fx, fy, fn = out[0, j], out[1, j], out[2, j]
+        out[0, j] = uX * fx + uY * fy + uN * fn
+        out[1, j] = vX * fx + vY * fy + vN * fn
+        out[2, j] = rX * fx + rY * fy + rN * fn
