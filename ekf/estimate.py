@@ -21,7 +21,7 @@ import yaml
 
 from mmg.errors import InputError
 from mmg.resources import config_path
-from mmg.units import to_si
+from mmg.units import is_finite_number, to_si
 
 from .data import PAPER_DERIVATIVES, TrialData
 from .filter import NS, STATES, FilterResult, run_filter
@@ -151,7 +151,7 @@ DT_RANGE = (1e-4, 60.0)
 
 
 def _number(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and bool(np.isfinite(v))
+    return isinstance(v, (int, float)) and is_finite_number(v)
 
 
 def _positive(v) -> bool:

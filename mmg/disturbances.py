@@ -18,20 +18,19 @@ from __future__ import annotations
 
 import abc
 import math
-import numbers
 from dataclasses import dataclass, fields
 
 from . import model as M
 from .errors import InputError
-from .units import MAX_CURRENT, MAX_RUDDER_OFFSET
+from .units import MAX_CURRENT, MAX_RUDDER_OFFSET, is_finite_number
 
 
 def _check(obj, bounds: dict | None = None) -> None:
     """InputError unless every field of ``obj`` is a finite number within ``bounds`` (name -> (lo, hi), SI)."""
     for f in fields(obj):
         v = getattr(obj, f.name)
-        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
-            raise InputError(type(obj).__name__, f.name, f"must be a finite number, got {v!r}")
+        if not is_finite_number(v):
+            raise InputError(type(obj).__name__, f.name, f"must be a finite number, got {v!r:.40}")
         lo, hi = (bounds or {}).get(f.name, (-math.inf, math.inf))
         if not lo <= v <= hi:
             raise InputError(type(obj).__name__, f.name, f"{v!r} is outside {lo:g} to {hi:g} (SI)")

@@ -343,7 +343,7 @@ def pydantic_message(err: dict, hints: dict[str, str]) -> str:
     value = err.get("input")
     typ = str(err.get("type", ""))
     if typ == "string_type" and isinstance(value, (int, float)) and not isinstance(value, bool) and field in hints:
-        if not math.isfinite(value):
+        if isinstance(value, float) and not math.isfinite(value):     # (an int is finite however large)
             return f"{value!r} is not a finite number with a unit, e.g. '1.0 {hints[field]}'"
         return (f"{value!r} has no unit; write it with one, e.g. '{value} {hints[field]}' "
                 "(plain numbers are refused)")

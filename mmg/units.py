@@ -165,6 +165,16 @@ def to_si(value: str, dimension: str, lo: float | None = None, hi: float | None 
     return x
 
 
+def is_finite_number(x) -> bool:
+    """True for a real, finite number that fits a float (not a bool; an int of 400 digits is not)."""
+    if isinstance(x, bool) or not isinstance(x, numbers.Real):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except OverflowError:
+        return False
+
+
 def check_range(x: float, lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
                 hi_open: bool = False, shown=None, unit: str = "", scale: float = 1.0, why: str = "") -> float:
     """``x`` when it is finite and within ``[lo, hi]`` (open ends as flagged); else ValueError.
@@ -173,8 +183,8 @@ def check_range(x: float, lo: float | None = None, hi: float | None = None, *, l
     ``scale`` (SI per unit) express the bounds in the value's unit, ``why`` replaces "probably the
     wrong unit" in an out-of-range message.  The message is one line.
     """
-    if isinstance(x, bool) or not isinstance(x, numbers.Real) or not math.isfinite(x):
-        raise ValueError(f"{x!r} is not a finite number")
+    if not is_finite_number(x):
+        raise ValueError(f"{x!r:.40} is not a finite number")
     shown = _fmt(x / scale) + (f" {unit}" if unit else "") if shown is None else shown
     below = lo is not None and (x < lo or (lo_open and x == lo))
     above = hi is not None and (x > hi or (hi_open and x == hi))
