@@ -4,6 +4,8 @@ import errno
 import json
 import os
 import signal
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -348,7 +350,8 @@ def test_file_where_a_folder_is_staged(tmp_path, capsys):
 
 def test_signal_during_commit_undoes_it(tmp_path, monkeypatch):
     """SIGINT arriving while the files are moved in: the commit is undone (old files back), then the
-    interrupt is raised."""
+    interrupt is raised.  (Sent to this thread: ``os.kill`` may hand it to another thread, which
+    can run its handler after the commit has ended; the next test covers that case.)"""
     out = tmp_path / "out"
     out.mkdir()
     (out / "a.txt").write_text("old a")
@@ -358,7 +361,7 @@ def test_signal_during_commit_undoes_it(tmp_path, monkeypatch):
     def move(src, dst):
         if not sent:
             sent.append(1)
-            os.kill(os.getpid(), signal.SIGINT)    # held until the commit ends
+            signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)    # held until the commit ends
         return real(src, dst)
 
     monkeypatch.setattr(output, "_move", move)
@@ -369,6 +372,47 @@ def test_signal_during_commit_undoes_it(tmp_path, monkeypatch):
             st.path("b.txt").write_text("new b")
     assert sent
     assert tree(out) == ["a.txt"] and (out / "a.txt").read_text() == "old a"
+
+
+@pytest.mark.parametrize("where", ["other thread", "this thread"])
+def test_signal_during_commit_undoes_it_whichever_thread_gets_it(tmp_path, monkeypatch, where):
+    """The kernel gives a process-directed SIGINT to any thread that does not block it (numba, BLAS
+    and pool threads do not); Python then runs the handler in the main thread at an arbitrary
+    point.  Here it lands just after an old file was moved aside, before the undo journal notes it:
+    raised there, the old file would be lost.  It must not raise mid-commit: the commit is undone
+    (old file back) and the interrupt raised after."""
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait, daemon=True)
+    other.start()                                  # started with SIGINT unblocked
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "a.txt").write_text("old a")
+    real = os.replace
+    sent = []
+
+    def replace(src, dst, *a, **k):
+        real(src, dst, *a, **k)
+        if not sent and Path(src) == out / "a.txt":          # the old a.txt moved aside
+            sent.append(1)
+            target = other.ident if where == "other thread" else threading.main_thread().ident
+            signal.pthread_kill(target, signal.SIGINT)
+            deadline = time.monotonic() + 5.0      # until its handler has run in this thread
+            while where == "other thread" and not getattr(output, "_noted", None) and time.monotonic() < deadline:
+                time.sleep(0.001)
+
+    monkeypatch.setattr(os, "replace", replace)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            with StagedOutput(out) as st:
+                st.path("a.txt").write_text("new a")
+                st.path("b.txt").write_text("new b")
+    finally:
+        monkeypatch.undo()
+        stop.set()
+        other.join()
+    assert sent
+    assert tree(out) == ["a.txt"] and (out / "a.txt").read_text() == "old a"
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_staged_file_failure_leaves_nothing(tmp_path):

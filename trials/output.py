@@ -105,9 +105,38 @@ def children_ignore_sigint():
         yield
 
 
+_noted: list[int] = []          # signals caught by the deferring handler of :func:`_critical`
+
+
+@contextmanager
+def _critical():
+    """A section that must not be cut: :func:`signals_held`, and for the same time SIGINT/SIGTERM
+    handlers that only note the signal.  The mask holds a signal sent to this thread; the noting
+    handler catches one the kernel gave to another thread (numba, BLAS or pool threads do not block
+    it), whose Python handler would otherwise run in the middle of the section.  On leaving, a noted
+    signal is raised again in this thread, so the original handler runs when the mask is lifted."""
+    with signals_held():
+        if not _can_hold():
+            yield
+            return
+        old = {s: h for s in _SIGNALS if (h := signal.getsignal(s)) is not None}   # None: set outside Python
+        start = len(_noted)
+        try:
+            for s in old:
+                signal.signal(s, lambda signum, frame: _noted.append(signum))
+            yield
+        finally:
+            for s, h in old.items():
+                signal.signal(s, h)
+            again = _noted[start:]
+            del _noted[start:]
+            for s in dict.fromkeys(again):
+                signal.raise_signal(s)           # pending in this thread until the mask is lifted
+
+
 def _signal_pending() -> bool:
-    """A SIGINT or SIGTERM is waiting (blocked by :func:`signals_held`)."""
-    return _can_hold() and bool(set(signal.sigpending()) & set(_SIGNALS))
+    """A SIGINT or SIGTERM is waiting (held by :func:`_critical` or :func:`signals_held`)."""
+    return _can_hold() and (bool(_noted) or bool(set(signal.sigpending()) & set(_SIGNALS)))
 
 
 # --------------------------------------------------------------------------- checks before any work
@@ -134,7 +163,7 @@ def _check_can_create_in(folder: Path, option: str, shown: str) -> None:
         what = "a file" if a.exists() else "a broken link"
         raise InputError(option, shown, f"{a} is {what}, not a folder")
     try:
-        with signals_held():
+        with _critical():
             os.rmdir(tempfile.mkdtemp(prefix=".mmg-write-check-", dir=a))
     except OSError as e:
         raise InputError(option, shown, f"cannot write in {a} ({e.strerror or e})") from None
@@ -292,7 +321,7 @@ class StagedOutput:
             return self
         if os.path.lexists(self.out) and not self.out.is_dir():
             raise InputError(str(self.out), "", "is a file, not a folder")
-        with signals_held():
+        with _critical():
             try:
                 self._created = _make_dirs(self.out)
                 try:
@@ -337,7 +366,7 @@ class StagedOutput:
             return
         self.open()
         journal: list[tuple] = []                # ("dir", path) | ("file", dst, backup or None)
-        with signals_held():
+        with _critical():
             try:
                 if _signal_pending():
                     raise _Pending()
@@ -383,7 +412,7 @@ class StagedOutput:
         """Remove the staging folder and every folder this staging created (nothing is left)."""
         if self._done:
             return
-        with signals_held():
+        with _critical():
             self._cleanup(remove_created=True)
 
     def _rollback(self, journal) -> None:
@@ -450,7 +479,7 @@ class StagedFile:
         self._created: list[Path] = []
 
     def __enter__(self) -> Path:
-        with signals_held():
+        with _critical():
             try:
                 self._created = _make_dirs(self.target.parent)
                 try:
@@ -470,7 +499,7 @@ class StagedFile:
         return self.tmp
 
     def __exit__(self, exc_type, exc, tb):
-        with signals_held():
+        with _critical():
             interrupted = exc_type is None and _signal_pending()
             if exc_type is None and not interrupted:
                 try:
