@@ -73,10 +73,11 @@ def timed_jacobians(res, data, reference: bool) -> float:
 
 
 def timed_pass(args, name: str, reference: bool):
+    """(wall-clock [s], CPU time of this process [s], result) of one pass."""
     with previous_path(reference):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         res = run_filter(*args, trial=name)
-        return time.perf_counter() - t0, res
+        return time.perf_counter() - t0, time.process_time() - c0, res
 
 
 def main() -> None:
@@ -91,12 +92,15 @@ def main() -> None:
                 P0_for(cfg, data.names, data.reference), R_for(cfg, data.name))
         first = {ref: timed_pass(args, data.name, ref)[0] for ref in (True, False)}
         times = {True: [], False: []}
+        cpu = {True: [], False: []}
         res = {}
         for _ in range(REPEATS):
             for ref in (True, False):
-                dt, res[ref] = timed_pass(args, data.name, ref)
+                dt, dc, res[ref] = timed_pass(args, data.name, ref)
                 times[ref].append(dt)
+                cpu[ref].append(dc)
         old, new = statistics.median(times[True]), statistics.median(times[False])
+        cold, cnew = statistics.median(cpu[True]), statistics.median(cpu[False])
         for ref in (True, False):
             timed_jacobians(res[ref], data, ref)                  # compile
         jac = {True: [], False: []}
@@ -110,7 +114,8 @@ def main() -> None:
               f"{old:.3f} s (min {min(times[True]):.3f} s; first {first[True]:.2f} s)")
         print(f"  current path (tangent-linear RK4 F, 16 complex evaluations of the dynamics a step):    "
               f"{new:.3f} s (min {min(times[False]):.3f} s; first {first[False]:.2f} s)")
-        print(f"  ratio previous / current: {old / new:.2f} (of the minima {min(times[True]) / min(times[False]):.2f})")
+        print(f"  ratio previous / current: {old / new:.2f} (of the minima {min(times[True]) / min(times[False]):.2f}; "
+              f"of the median CPU times {cold:.3f} s / {cnew:.3f} s: {cold / cnew:.2f})")
         print(f"  F alone at the pass's {len(m.t) - 1} states: previous {jo:.3f} s ({100 * jo / old:.0f} % of its pass), "
               f"current {jn:.3f} s ({100 * jn / new:.0f} % of its pass), ratio {jo / jn:.2f}")
         zo, zn = res[True].z, res[False].z

@@ -52,6 +52,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -243,6 +244,46 @@ def snapshot(dest: Path) -> int:
     return len(files)
 
 
+_CHILDREN: set = set()
+_STOP = threading.Event()
+_CHILDREN_LOCK = threading.Lock()
+
+
+def _run(cmd, cwd, env, timeout) -> subprocess.CompletedProcess:
+    """subprocess.run that remembers the child (its own process group) so a SIGTERM of this script ends it."""
+    if _STOP.is_set():
+        raise RuntimeError("stopped by SIGTERM")
+    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    with _CHILDREN_LOCK:
+        _CHILDREN.add(proc)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        _kill(proc)
+        proc.communicate()
+        raise
+    finally:
+        with _CHILDREN_LOCK:
+            _CHILDREN.discard(proc)
+    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
+
+
+def _kill(proc) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGTERM)     # the pytest run and its workers (joblib, dask), by group id
+    except ProcessLookupError:
+        pass
+
+
+def _on_sigterm(signum, frame):
+    _STOP.set()
+    with _CHILDREN_LOCK:
+        for proc in list(_CHILDREN):
+            _kill(proc)
+    raise SystemExit(128 + signum)               # runs the finally blocks: temp copies are removed
+
+
 @dataclass
 class Outcome:
     name: str
@@ -259,6 +300,8 @@ _FAIL = re.compile(r"^(FAILED|ERROR) (.+?)( - .*)?$", re.M)   # "FAILED node id 
 def run_copy(base: Path, pristine: Path, mut: Mutation | None, tests: list[str], deselect: list[str],
              timeout: float, keep: bool, exitfirst: bool = True, ignore: tuple = ()) -> tuple[Outcome, list[str]]:
     name = mut.name if mut else "(none: original code)"
+    if _STOP.is_set():
+        return Outcome(name, "error", "", 0.0, "stopped by SIGTERM"), []
     t0 = time.time()
     work = Path(tempfile.mkdtemp(prefix="m-", dir=base))
     main = work / "main"
@@ -282,16 +325,16 @@ def run_copy(base: Path, pristine: Path, mut: Mutation | None, tests: list[str],
         env.update(PYTHONPATH=os.pathsep.join([str(main), str(base / "guard")]),
                    MUTATION_GUARD_ROOT=str(main), MUTATION_GUARD_OUT=str(work / "imports.json"),
                    OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", NUMBA_NUM_THREADS="1",
-                   MPLBACKEND="Agg")
+                   MPLBACKEND="Agg", COLUMNS="400")    # wide terminal: pytest's one-line failure reasons untruncated
         env.pop("NUMBA_CACHE_DIR", None)
         cmd = [sys.executable, "-m", "pytest", "-q", "-m", "not slow"] + (["-x"] if exitfirst else []) + [
-            "-p", "no:cacheprovider", "-p", "mutation_guard", "-rfE"]
+            "-p", "no:cacheprovider", "-p", "mutation_guard", "-rfE", f"--junitxml={work / 'junit.xml'}"]
         for d in deselect:
             cmd += ["--deselect", d]
         cmd += [f"--ignore={p}" for p in ignore]
         cmd += tests
         try:
-            proc = subprocess.run(cmd, cwd=main, env=env, capture_output=True, text=True, timeout=timeout)
+            proc = _run(cmd, main, env, timeout)
         except subprocess.TimeoutExpired:
             return Outcome(name, "yes" if mut else "error", f"(timeout after {timeout:.0f} s)", time.time() - t0), []
         log = proc.stdout + proc.stderr
@@ -304,8 +347,10 @@ def run_copy(base: Path, pristine: Path, mut: Mutation | None, tests: list[str],
         if leaks:
             return Outcome(name, "error", "", time.time() - t0, f"modules imported from outside the copy: {leaks}"), []
         hits = list(_FAIL.finditer(proc.stdout))
-        failures = [m.group(2) for m in hits]
-        why = (hits[0].group(3) or "")[3:][:300] if hits else ""   # pytest's one-line reason of the first failure
+        reasons = {m.group(2): (m.group(3) or "")[3:][:300] for m in hits}   # pytest's one-line reasons
+        # failures in the order the tests ran (the -r summary lists failures before setup errors)
+        failures = _junit_failures(work / "junit.xml") or [m.group(2) for m in hits]
+        why = reasons.get(failures[0], "") if failures else ""
         secs = time.time() - t0
         if proc.returncode == 0:
             return Outcome(name, "no", "", secs), []
@@ -322,6 +367,28 @@ def run_copy(base: Path, pristine: Path, mut: Mutation | None, tests: list[str],
 
 
 NEW_TESTS = ("tests/test_physics_reference.py", "tests/test_steering_engine.py")
+
+
+def _junit_failures(path: Path) -> list[str]:
+    """Node ids of the failed/errored tests in run order, from pytest's JUnit XML."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError):
+        return []
+    out = []
+    for case in root.iter("testcase"):
+        if any(child.tag in ("failure", "error") for child in case):
+            mod, name = case.get("classname", ""), case.get("name", "")
+            parts = mod.split(".")
+            # classname is "tests.test_x" or "tests.test_x.TestClass"
+            k = next((i for i in range(len(parts), 0, -1) if Path(*parts[:i]).with_suffix(".py").name.startswith("test_")),
+                     len(parts))
+            node = "/".join(parts[:k]) + ".py" + "".join("::" + c for c in parts[k:]) + "::" + name
+            if node not in out:
+                out.append(node)
+    return out
 
 
 def table(rows: list[Outcome], counts: bool = False) -> str:
@@ -363,6 +430,7 @@ def main(argv=None) -> int:
     ap.add_argument("--no-baseline", action="store_true", help="skip the run of the unmutated copy")
     ap.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     args = ap.parse_args(argv)
+    signal.signal(signal.SIGTERM, _on_sigterm)
 
     base = Path(tempfile.mkdtemp(prefix="mmg-mutation-"))
     try:

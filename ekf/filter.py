@@ -75,12 +75,13 @@ def workspace(nz, hull_coef):
     return make_workspace(nz, NS, hull_coef)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
     """One RK4 step of the augmented state z (nz,) and its exact Jacobian into ``ws`` (z_next = ws[8], F = ws[9]).
 
     F by the tangent-linear RK4 of :func:`ekf.kernels.jacobian_step` (state columns by complex
-    step of each stage, derivative columns analytic: 16 complex model evaluations a step).
+    step of each stage, derivative columns analytic: 16 complex evaluations of the dynamics a
+    step, not 64 of the whole model).
 
     d0, d1 rudder angle [rad] at the start and end of the step (an input, linear over it), dt [s];
     idx the derivatives' slots in ``hull_coef``; ws from :func:`workspace`."""

@@ -14,7 +14,7 @@ tangent-linear RK4, state columns by complex step of each stage, derivative colu
 covariance propagation (:func:`fpft`) and one measurement update (:func:`joseph_update_ws`) serve
 both; the only physics is :func:`mmg.model` (:func:`~mmg.model.rhs` and the parts it is made of).
 :func:`jacobian_step_reference` keeps the brute-force complex step (one complex RK4 step per
-column of F, 4 x slower for the paper filter) as the reference for tests and ``bench/bench_ekf.py``.
+column of F, ~5 x slower for the paper filter) as the reference for tests and ``bench/bench_ekf.py``.
 """
 from __future__ import annotations
 
@@ -120,7 +120,10 @@ def _track_column(k, u, v, r, psi, p, out):
         track(u, v, r, psi + h, p, out)
 
 
-@njit(cache=True, error_model="numpy")
+# _nrt=False: no reference counting in this kernel (it allocates nothing; the work arrays live in
+# ws).  The inlined model code otherwise increfs / decrefs every array argument at every inlined
+# call, ~20 % of this kernel's time.
+@njit(cache=True, error_model="numpy", _nrt=False)
 def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hull_term, idx, ws):
     """One RK4 step of the real state z and its exact Jacobian F = d z_next / d z (tangent-linear RK4).
 

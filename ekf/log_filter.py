@@ -80,10 +80,11 @@ _REASON = {NONFINITE: "a state or covariance became non-finite",
 # --------------------------------------------------------------------------- compiled kernels
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def propagate_log(z, d0, d1, g0, g1, dt, p, poly, hull_axis, hull_term, idx, ws):
     """One RK4 step of z (nz,) and its exact Jacobian: z_next = ws[8], F = ws[9] (the tangent-linear
-    RK4 of :func:`ekf.kernels.jacobian_step`: 24 complex model evaluations a step, not 80).
+    RK4 of :func:`ekf.kernels.jacobian_step`: 20 complex evaluations of the dynamics and 16 of the
+    track a step, not 80 of the whole model).
 
     The rudder [rad] over the step (dt [s]) is d + tau g (d0 -> d1, g0 -> g1 [rad/s]): the
     rebuilt rudder moved by -tau in time, g = -d(delta)/dt, so the timing offset tau [s] is
