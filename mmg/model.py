@@ -42,8 +42,20 @@ STATE_UNITS = ("m/s", "m/s", "rad/s", "m", "m", "rad", "rad", "rps")
     P_TE, P_RATE, P_DMAX,
     P_ENGINE, P_POWER, P_SHAFT_I,
     P_CUR_SPEED, P_CUR_DIR, P_RUDDER_OFFSET, P_EXT_X, P_EXT_Y, P_EXT_N,
+    P_ULOW,
     N_PARAMS,
-) = range(42)
+) = range(43)
+
+LOW_SPEED_FROUDE = 0.02
+"""Froude number below which the hull's speed scale is floored (:func:`kinematics`): U_low =
+0.02 sqrt(g L), 0.11 m/s for the 3 m model, 1.13 m/s (2.2 kn) for the 325 m ship."""
+J_MAX = 1.2
+"""Largest advance ratio the propeller polynomials are evaluated at (:func:`propeller`); beyond it
+(a propeller barely turning, n -> 0) K_T is held at K_T(J_MAX) so the thrust n^2 K_T fades to 0."""
+ASTERN_KT = 0.6
+"""Bollard thrust astern as a fraction of ahead, K_T = 0.6 K_T(0) for n < 0 (a fixed-pitch propeller
+run astern gives 50-70 % of its ahead thrust); the astern rudder gets no slipstream (:func:`rudder`)."""
+G = 9.80665
 
 # polynomial table rows
 POLY_KT, POLY_KQ, POLY_TP, POLY_WP0 = range(4)
@@ -103,6 +115,7 @@ def pack(ship: Ship, engine_power_W: float = 0.0, disturbance_slots: dict | None
     p[P_ENGINE] = ENGINE_CONSTANT_POWER if en.mode == "constant_power" else ENGINE_CONSTANT_RPM
     p[P_POWER] = engine_power_W
     p[P_SHAFT_I] = en.shaft_inertia_coefficient * pr.D**5
+    p[P_ULOW] = LOW_SPEED_FROUDE * np.sqrt(G * pa.L)
     for k, v in (disturbance_slots or {}).items():
         p[k] = v
     poly = np.vstack([_poly_row(pr.K_T), _poly_row(pr.K_Q), _poly_row(pr.t_P), _poly_row(pr.w_P0)])
@@ -129,11 +142,26 @@ def polyval(c, x):
 
 
 @njit(cache=True, error_model="numpy")
-def kinematics(u, v, r, L):
-    """Speed U [m/s], drift angle beta = atan(-v/u) [rad], v' and r' at midship."""
+def kinematics(u, v, r, p):
+    """Speed U [m/s], the hull's speed scale U_h [m/s], drift angle beta [rad], v' and r' at midship.
+
+    Above U_low = ``p[P_ULOW]`` (:data:`LOW_SPEED_FROUDE` sqrt(g L)) this is the textbook set:
+    U_h = U, beta = atan(-v/u), v' = v/U, r' = r L/U.  Below it, where beta and r' lose their
+    meaning (every measured record starts at rest), the speed scale is floored smoothly,
+    U_h = (U^2 + U_low^2) / (2 U_low) (equal to U, with equal slope, at U_low; U_low/2 at rest),
+    and v' = v/U_h, r' = r L/U_h, beta = atan(-v / sqrt(U_h^2 - v^2)), all bounded at U = 0.  The
+    hull forces are the primed forces times 1/2 rho L T U U_h (:func:`hull_scales`), so they fall
+    to zero at rest, the quadratic resistance turning linear in U below U_low (a laminar-like
+    floor), and the manoeuvring derivatives act as linear damping there, Y = 1/2 rho L T Y_v' v U_h.
+    The choice keeps every result above U_low (all of the full-scale trials) bit for bit.
+    """
     U = np.sqrt(u * u + v * v)
-    beta = np.arctan(-v / u)
-    return U, beta, v / U, r_prime(r, L, U)
+    ul = p[P_ULOW]
+    if U.real >= ul:
+        return U, U, np.arctan(-v / u), v / U, r_prime(r, p[P_L], U)
+    Uh = (U * U + ul * ul) / (2.0 * ul)
+    uh = np.sqrt(Uh * Uh - v * v)
+    return U, Uh, np.arctan(-v / uh), v / Uh, r_prime(r, p[P_L], Uh)
 
 
 @njit(cache=True, error_model="numpy")
@@ -169,24 +197,47 @@ def one_minus_wake(u, beta, rp, p, poly):
 def propeller(u, n, one_minus_wP, p, poly):
     """Advance ratio J_P, thrust coefficient K_T and surge force X_P [N] (eq. 12)."""
     D = p[P_D]
-    J = u * one_minus_wP / (n * D)
-    KT = polyval(poly[POLY_KT], J)
+    uP = u * one_minus_wP
     tP = polyval(poly[POLY_TP], u)
+    if n.real < 0.0:                     # astern: no open-water data; K_T(0) x ASTERN_KT, thrust aft
+        J = 0.0 * uP
+        KT = ASTERN_KT * polyval(poly[POLY_KT], J)
+        return J, KT, -(1.0 - tP) * p[P_RHO] * n * n * D ** 4 * KT
+    if uP.real < 0.0:                    # ahead propeller, ship moving astern: bollard-like, J held at 0
+        J = 0.0 * uP
+    elif (n * D).real * J_MAX > uP.real:
+        J = uP / (n * D)
+    else:
+        J = J_MAX + 0.0 * uP
+    KT = polyval(poly[POLY_KT], J)
     XP = (1.0 - tP) * p[P_RHO] * n * n * D ** 4 * KT
     return J, KT, XP
 
 
 @njit(cache=True, error_model="numpy")
-def rudder(u, U, beta, rp, delta, one_minus_wP, J, KT, p):
-    """MMG rudder forces (X_R, Y_R, N_R) [N, N, N m] and the normal force F_N [N]."""
+def rudder(u, U, beta, rp, delta, n, one_minus_wP, KT, p):
+    """MMG rudder forces (X_R, Y_R, N_R) [N, N, N m] and the normal force F_N [N].
+
+    The slipstream speed u_P sqrt(1 + 8 K_T / (pi J^2)) is written sqrt(u_P^2 + 8 K_T (n D)^2 / pi)
+    (the same for u_P > 0), which stays defined as u_P or n go to zero; beta, r' are those of
+    :func:`kinematics`, so v_R = U gamma_R beta_R stays bounded at rest."""
     d = delta + p[P_RUDDER_OFFSET]
     uP = u * one_minus_wP
-    s = 1.0 + p[P_KAPPA] * (np.sqrt(1.0 + 8.0 * KT / (np.pi * J * J)) - 1.0)
-    uR = p[P_EPS] * uP * np.sqrt(p[P_ETA] * s * s + (1.0 - p[P_ETA]))
+    nD = n * p[P_D]
+    q2 = uP * uP + 8.0 * KT * nD * nD / np.pi
+    if n.real < 0.0:                     # astern: the slipstream goes forward, away from the rudder
+        q = uP
+    else:
+        q = np.sqrt(q2) if q2.real > 0.0 else 0.0 * q2
+    uPs = (1.0 - p[P_KAPPA]) * uP + p[P_KAPPA] * q            # u_P s
+    uR = p[P_EPS] * np.sqrt(p[P_ETA] * uPs * uPs + (1.0 - p[P_ETA]) * uP * uP)
     bR = beta - p[P_LR] * rp
     g = p[P_GPOS] if bR.real >= 0.0 else p[P_GNEG]
     vR = U * g * bR
-    alpha = d - np.arctan(vR / uR)
+    if uR.real > 1e-12:
+        alpha = d - np.arctan(vR / uR)
+    else:                                                       # no inflow along the blade
+        alpha = d - (np.pi / 2 if vR.real > 0.0 else -np.pi / 2 if vR.real < 0.0 else 0.0) + 0.0 * uR
     FN = 0.5 * p[P_RHO] * p[P_AR] * (uR * uR + vR * vR) * p[P_FALPHA] * np.sin(alpha)
     cd = np.cos(d)
     XR = -(1.0 - p[P_TR]) * FN * np.sin(d)
@@ -219,11 +270,13 @@ def shaft_acceleration(u, n, J, p, poly):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def hull_scales(U, p):
-    """Dimensional scales of the primed hull forces (X_H', Y_H', N_H') at speed U [m/s]:
-    (1/2 rho L T U^2, 1/2 rho L T U^2, 1/2 rho L^2 T U^2) [N, N, N m]."""
-    fs = force_scale(p[P_RHO], p[P_L], p[P_T], U)
-    ms = moment_scale(p[P_RHO], p[P_L], p[P_T], U)
+def hull_scales(U, Uh, p):
+    """Dimensional scales of the primed hull forces (X_H', Y_H', N_H') at speed U [m/s] with the
+    hull's speed scale Uh [m/s] (:func:`kinematics`; Uh = U above the low-speed floor):
+    (1/2 rho L T U Uh, 1/2 rho L T U Uh, 1/2 rho L^2 T U Uh) [N, N, N m]."""
+    k = U * Uh
+    fs = force_scale(p[P_RHO], p[P_L], p[P_T], 1.0) * k
+    ms = moment_scale(p[P_RHO], p[P_L], p[P_T], 1.0) * k
     return fs, fs, ms
 
 
@@ -237,13 +290,12 @@ def forces(x, p, poly, hull_axis, hull_term, hull_coef):
 def forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef):
     """:func:`forces` of the states u, v [m/s], r [rad/s], delta [rad], n [rps] as scalars, each
     real or complex (a complex step in one of them leaves the parts that do not depend on it real)."""
-    L = p[P_L]
-    U, beta, vp, rp = kinematics(u, v, r, L)
+    U, Uh, beta, vp, rp = kinematics(u, v, r, p)
     XHp, YHp, NHp = hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef)
-    sX, sY, sN = hull_scales(U, p)
+    sX, sY, sN = hull_scales(U, Uh, p)
     owp = one_minus_wake(u, beta, rp, p, poly)
     J, KT, XP = propeller(u, n, owp, p, poly)
-    XR, YR, NR, FN = rudder(u, U, beta, rp, delta, owp, J, KT, p)
+    XR, YR, NR, FN = rudder(u, U, beta, rp, delta, n, owp, KT, p)
     X = XHp * sX + XP + XR + p[P_EXT_X]
     Y = YHp * sY + YR + p[P_EXT_Y]
     N = NHp * sN + NR + p[P_EXT_N]
@@ -317,8 +369,8 @@ def hull_regressors(x, p, hull_axis, hull_term, idx, out):
     coefficient i adds its term's value times its axis's scale (:func:`hull_scales`) to that
     axis [N or N m per unit coefficient] and nothing elsewhere.
     """
-    U, beta, vp, rp = kinematics(x[U_], x[V_], x[R_], p[P_L])
-    sX, sY, sN = hull_scales(U, p)
+    U, Uh, beta, vp, rp = kinematics(x[U_], x[V_], x[R_], p)
+    sX, sY, sN = hull_scales(U, Uh, p)
     for j in range(idx.shape[0]):
         i = idx[j]
         val = term_value(hull_term[i], beta, vp, rp)
