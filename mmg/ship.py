@@ -172,6 +172,37 @@ class Engine:
 
 
 @dataclass(frozen=True)
+class Wind:
+    """Wind loads from the measured relative wind (:mod:`mmg.wind`).
+
+    enabled: whether the replay, the estimators and ``mmg predict`` apply them; coefficients: the
+    regression (``"fujiwara1998"``: Fujiwara, Ueno & Nimura 1998, J. SNAJ 183); scale: a factor on
+    all three loads (1 = as published); areas [m^2], lengths and heights [m] as in
+    :class:`mmg.wind.WindParticulars` (L_oa the length over all, the moment arm).
+    """
+
+    enabled: bool
+    coefficients: str
+    A_T: float
+    A_L: float
+    L_oa: float
+    B: float
+    A_OD: float
+    H_BR: float
+    x_AL: float
+    z_AL: float
+    x_AOD: float
+    scale: float = 1.0
+
+    def particulars(self):
+        """The :class:`mmg.wind.WindParticulars` of this ship."""
+        from .wind import WindParticulars
+
+        return WindParticulars(A_T=self.A_T, A_L=self.A_L, L=self.L_oa, B=self.B, A_OD=self.A_OD, H_BR=self.H_BR,
+                               x_AL=self.x_AL, z_AL=self.z_AL, x_AOD=self.x_AOD)
+
+
+@dataclass(frozen=True)
 class Ship:
     """A ship: everything the simulator needs, in SI and primes."""
 
@@ -184,6 +215,7 @@ class Ship:
     steering: SteeringGear
     engine: Engine
     source: str = ""
+    wind: Wind | None = None
 
     def with_hull(self, changes: dict[str, float]) -> "Ship":
         """A copy with some hull coefficients changed (e.g. for sensitivity)."""
@@ -305,6 +337,20 @@ class _Engine(_Strict):
     shaft_inertia_coefficient: float = 2.0
 
 
+class _Wind(_Strict):
+    enabled: bool
+    coefficients: Literal["fujiwara1998"] = "fujiwara1998"
+    A_T: Quantity
+    A_L: Quantity
+    L_oa: Optional[Quantity] = None
+    A_OD: Quantity
+    H_BR: Quantity
+    x_AL: Quantity
+    z_AL: Quantity
+    x_AOD: Quantity
+    scale: float = 1.0
+
+
 class _ShipFile(_Strict):
     name: str = Field(min_length=1)
     source: str = ""
@@ -315,6 +361,7 @@ class _ShipFile(_Strict):
     rudder: _Rudder
     steering: _Steering
     engine: _Engine
+    wind: Optional[_Wind] = None
 
 
 _UNIT_HINT = {"L": "m", "B": "m", "T": "m", "S_wetted": "m^2", "x_G": "m", "rho": "kg/m^3", "D": "m", "P": "m",
@@ -490,8 +537,25 @@ def _build(f: _ShipFile, src: str) -> Ship:
         shaft_inertia_coefficient=_num(src, "engine.shaft_inertia_coefficient", en.shaft_inertia_coefficient,
                                        0.0, 100.0, lo_open=True),
     )
+    wind = None
+    if f.wind is not None:
+        w = f.wind
+        area = (0.001 * L * L, 0.5 * L * L)           # a tenth of a per cent of L^2 to half of it
+        wind = Wind(
+            enabled=w.enabled, coefficients=w.coefficients,
+            A_T=_qty(src, "wind.A_T", w.A_T, "area", *area, lo_open=True),
+            A_L=_qty(src, "wind.A_L", w.A_L, "area", *area, lo_open=True),
+            L_oa=_qty(src, "wind.L_oa", w.L_oa, "length", L, 1.3 * L) if w.L_oa is not None else L,
+            B=B,
+            A_OD=_qty(src, "wind.A_OD", w.A_OD, "area", 0.0, 0.5 * L * L, lo_open=True),
+            H_BR=_qty(src, "wind.H_BR", w.H_BR, "length", 0.0, L, lo_open=True),
+            x_AL=_qty(src, "wind.x_AL", w.x_AL, "length", -0.5 * L, 0.5 * L),
+            z_AL=_qty(src, "wind.z_AL", w.z_AL, "length", 0.0, L, lo_open=True),
+            x_AOD=_qty(src, "wind.x_AOD", w.x_AOD, "length", -0.5 * L, 0.5 * L),
+            scale=_num(src, "wind.scale", w.scale, 0.0, 10.0),
+        )
     return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
-                steering=steering, engine=engine, source=f.source)
+                steering=steering, engine=engine, source=f.source, wind=wind)
 
 
 def ship_from_dict(data: Mapping, source: str = "<dict>") -> Ship:

@@ -63,7 +63,11 @@ TRUTH_COLUMNS = ("time_s", "u_mps", "v_mps", "r_radps", "delta_rad", "delta_orde
                  "x_m", "y_m", "psi_rad", "n_rps")
 FRT_COLUMNS = {"t [s]": "t", "x_position_mid [m]": "x", "y_position_mid [m]": "y",
                "u_velo [m/s]": "u", "vm_velo [m/s]": "v", "psi_hat [rad]": "psi",
-               "r_angvelo [rad/s]": "r", "n_prop [rps]": "n", "delta_rudder [rad]": "delta"}
+               "r_angvelo [rad/s]": "r", "n_prop [rps]": "n", "delta_rudder [rad]": "delta",
+               "wind_velo_relative_mid [m/s]": "wind_speed_rel", "wind_dir_relative_mid [rad]": "wind_dir_rel",
+               "wind_velo_true [m/s]": "wind_speed_true", "wind_dir_true [rad]": "wind_dir_true"}
+MAX_WIND_MPS = 60.0
+"""Largest wind speed [m/s] a record may log (a hurricane; beyond it the column is in another unit)."""
 FRT_REQUIRED = ("t [s]", "x_position_mid [m]", "y_position_mid [m]", "psi_hat [rad]")
 
 
@@ -289,7 +293,7 @@ def _parse_table(numbered: list[tuple[int, str]], src: str) -> tuple[pd.DataFram
     return df, np.asarray(lines), notes
 
 
-def read_record(path: str | Path) -> TrialRecord:
+def read_record(path: str | Path, length_m: float | None = None) -> TrialRecord:
     """Read a project log, a project truth file or an FRT-DS-ESSO CSV into a TrialRecord.
 
     Anything that is not such a file, or is one with wrong-looking content, raises
@@ -300,6 +304,9 @@ def read_record(path: str | Path) -> TrialRecord:
     ``mmg.limits.MAX_STEPS`` steps of 0.1 s, and channels in a wrong unit (see
     :func:`record_from_frame`).  Empty rows (all cells empty) are ignored and said so in
     ``rec.meta["notes"]`` and on the ``trials.logio`` logger.
+
+    ``length_m`` [m] is the ship's length where the file does not say it (FRT-DS-ESSO files):
+    speeds and track are checked against it; the 3 m model's when omitted.
     """
     path = Path(path)
     src = str(path)
@@ -308,7 +315,7 @@ def read_record(path: str | Path) -> TrialRecord:
     meta = _parse_meta([ln for ln in lines if ln.lstrip().startswith("#")])
     numbered = [(i + 1, ln) for i, ln in enumerate(lines) if not ln.lstrip().startswith("#")]
     df, rows, notes = _parse_table(numbered, src)
-    return record_from_frame(df, meta, src, default_name=path.stem, notes=notes, lines=rows)
+    return record_from_frame(df, meta, src, default_name=path.stem, notes=notes, lines=rows, length_m=length_m)
 
 
 class _Table:
@@ -510,7 +517,7 @@ def _check_track(tab: _Table, cols: str, t, x, y, L: float | None, U=None, ratio
 
 
 def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", default_name: str = "",
-                      notes=None, lines=None) -> TrialRecord:
+                      notes=None, lines=None, length_m: float | None = None) -> TrialRecord:
     """A TrialRecord from a table in one of the supported column layouts and its header ``meta``.
 
     The one conversion behind :func:`read_record`; the estimators' in-memory path
@@ -537,7 +544,7 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
     ship = str(meta.get("ship", ""))
     L = float(meta["length_m"]) if "length_m" in meta else None
     if "t [s]" in cols or "psi_hat [rad]" in cols:
-        return _read_frt(tab, src, Path(src), notes)
+        return _read_frt(tab, src, Path(src), notes, length_m or FRT_LENGTH_M)
     if "u_mps" in cols or "psi_rad" in cols:
         tab.require(TRUTH_COLUMNS)
         a = {c: tab.numeric(c) for c in TRUTH_COLUMNS}
@@ -604,12 +611,11 @@ def _check_rps(tab: _Table, col: str, n: np.ndarray, unit: str = "rps", factor: 
                                        f"(at most {MAX_RPS * factor:g} {unit}){hint}")
 
 
-def _read_frt(tab: _Table, src: str, path: Path, notes: list) -> TrialRecord:
+def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> TrialRecord:
     df = tab.df
     tab.require(FRT_REQUIRED)
     present = [c for c in FRT_COLUMNS if c in df.columns]
     a = {FRT_COLUMNS[c]: tab.numeric(c) for c in present}
-    L = FRT_LENGTH_M
     t = a["t"]
     _check_time(tab, "t [s]", t, None, "the FRT-DS-ESSO sampling step (10 Hz)", 0.0, FRT_STEP_RANGE)
     raw = a.pop("psi")
@@ -629,10 +635,23 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list) -> TrialRecord:
             _check_speed(tab, col, a[key], L)
     if "n" in a:
         _check_rps(tab, "n_prop [rps]", a["n"])
+    for key, col in (("wind_speed_rel", "wind_velo_relative_mid [m/s]"), ("wind_speed_true", "wind_velo_true [m/s]")):
+        if key in a:
+            w = a[key]
+            if float(np.min(w)) < 0.0 or float(np.max(w)) > MAX_WIND_MPS:
+                i = int(np.argmax(np.abs(w))) if float(np.max(w)) > MAX_WIND_MPS else int(np.argmin(w))
+                raise InputError(src, col, f"wind speed {w[i]:.4g} m/s at {tab.where(i)} is not a wind speed in m/s "
+                                           f"(0 to {MAX_WIND_MPS:g}; knots or km/h?)")
+    for key, col in (("wind_dir_rel", "wind_dir_relative_mid [rad]"), ("wind_dir_true", "wind_dir_true [rad]")):
+        if key in a:
+            w = a[key]
+            m = float(np.max(np.abs(w)))
+            if m > 2 * np.pi + 0.01:
+                raise InputError(src, col, f"wind direction {m:.4g} is not radians (|value| <= 2 pi){_angle_hint(m, 360)}")
     u, v = a.get("u"), a.get("v")
     U = np.hypot(u, v) if u is not None and v is not None else None
     _check_track(tab, "x_position_mid [m], y_position_mid [m]", t, a["x"], a["y"], L)
-    meta = {"format": "frt-ds-esso", "ship": "Esso Osaka 3 m model", "length_m": L,
+    meta = {"format": "frt-ds-esso", "ship": "Esso Osaka 3 m model" if L == FRT_LENGTH_M else "", "length_m": L,
             "interval_s": float(np.median(np.diff(t))), "notes": notes}
-    return TrialRecord(t=a.pop("t"), name=path.stem, ship="Esso Osaka 3 m model", source=src,
+    return TrialRecord(t=a.pop("t"), name=path.stem, ship=meta["ship"], source=src,
                        psi=psi, U=U, meta=meta, **a)

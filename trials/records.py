@@ -24,6 +24,13 @@ delta  rudder angle, positive to starboard [rad]
 n      propeller revolutions [rps]
 """
 
+WIND_CHANNELS = ("wind_speed_rel", "wind_dir_rel", "wind_speed_true", "wind_dir_true")
+"""Optional wind channels, as the FRT-DS-ESSO files log them (:mod:`mmg.wind` for the conventions).
+
+wind_speed_rel, wind_dir_rel     apparent (relative) wind at midship [m/s, rad]
+wind_speed_true, wind_dir_true   true wind [m/s, rad]
+"""
+
 
 @dataclass(frozen=True)
 class TrialRecord:
@@ -41,6 +48,8 @@ class TrialRecord:
         Where it came from (file path, or ``"simulation"``).
     x, y, psi, U, u, v, r, delta, n : ndarray or None
         Channels, see :data:`CHANNELS`.
+    wind_speed_rel, wind_dir_rel, wind_speed_true, wind_dir_true : ndarray or None
+        Wind channels, see :data:`WIND_CHANNELS`.
     meta : dict
         Free-form metadata (seed, start position, trial kind, ...).
     """
@@ -58,11 +67,15 @@ class TrialRecord:
     r: Optional[np.ndarray] = None
     delta: Optional[np.ndarray] = None
     n: Optional[np.ndarray] = None
+    wind_speed_rel: Optional[np.ndarray] = None
+    wind_dir_rel: Optional[np.ndarray] = None
+    wind_speed_true: Optional[np.ndarray] = None
+    wind_dir_true: Optional[np.ndarray] = None
     meta: dict = field(default_factory=dict)
 
     def channels(self) -> tuple[str, ...]:
         """Names of the channels present in this record."""
-        return tuple(c for c in CHANNELS if getattr(self, c) is not None)
+        return tuple(c for c in CHANNELS + WIND_CHANNELS if getattr(self, c) is not None)
 
     def speed(self) -> np.ndarray:
         """Speed [m/s]: ``U`` if recorded, else sqrt(u^2 + v^2), else from the track."""
@@ -95,7 +108,7 @@ class TrialRecord:
         """The part of the record with t0 <= t <= t1."""
         m = (self.t >= t0) & (self.t <= t1)
         kw = {f.name: getattr(self, f.name) for f in fields(self)}
-        for c in ("t",) + CHANNELS:
+        for c in ("t",) + CHANNELS + WIND_CHANNELS:
             if kw[c] is not None:
                 kw[c] = kw[c][m]
         return TrialRecord(**kw)

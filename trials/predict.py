@@ -1,0 +1,230 @@
+"""Replay a measured record against its own rudder and propeller history (``mmg predict``).
+
+:func:`replay_record` simulates one record open-loop from its first measured state (or from a
+start time) with its measured rudder angle and propeller revolutions prescribed
+(:mod:`mmg.replay`: steering gear and engine bypassed) and, when the ship config switches wind
+on and the record has the relative-wind channels, the wind loads of :mod:`mmg.wind` from the
+measured relative wind.  It reads every record :func:`trials.logio.read_record` reads:
+
+* FRT-DS-ESSO files (model or full scale, checked against the ship's length): u, v, r, x, y,
+  heading, rudder, revolutions and wind all logged;
+* project truth files: the same channels, no wind;
+* project sea-trial logs (position, heading, speed, rpm): the rudder is rebuilt from the
+  header's trial logic (:func:`trials.rudder.with_rebuilt_rudder`), the initial yaw rate from
+  the heading and the initial sway velocity taken as zero.
+
+Each run is scored by the RMS differences over the record of heading [deg], yaw rate [deg/s]
+and speed [m/s] and by the final position error [m and ship lengths] (:meth:`Replayed.scores`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from mmg.errors import InputError
+from mmg.model import pack
+from mmg.replay import STATE, ReplayInputs, replay_states
+from mmg.ship import Ship
+
+from .records import TrialRecord
+
+__all__ = ["MeasuredRun", "Replayed", "Prediction", "measured_run", "replay_record", "predict", "SCORE_KEYS"]
+
+SCORE_KEYS = ("heading_rms_deg", "yaw_rate_rms_degps", "speed_rms_mps", "final_position_error_m", "final_position_error_L")
+"""Keys of :meth:`Replayed.scores`, as ``mmg predict`` writes them for each run."""
+
+
+@dataclass(frozen=True)
+class MeasuredRun:
+    """A record made ready for replay: the measured states and the prescribed inputs.
+
+    Parameters
+    ----------
+    name, source : str
+        The record's name and file.
+    meas : ndarray (N, 6)
+        Measured u, v [m/s], r [rad/s], x, y [m], psi [rad] (:data:`mmg.replay.STATE`) at ``inputs.t``.
+    inputs : ReplayInputs
+        Rudder [rad], revolutions [rps], external (wind) loads [N, N, N m].
+    wind : str
+        ``"on"`` (wind loads from the measured relative wind), ``"off"`` (the ship config has it
+        off) or why it is not applied (``"no wind channels"``).
+    notes : list of str
+        How channels the record lacks were made up (rebuilt rudder, zero sway, ...).
+    """
+
+    name: str
+    source: str
+    meas: np.ndarray
+    inputs: ReplayInputs
+    wind: str = "off"
+    notes: list = field(default_factory=list)
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.inputs.t
+
+
+def _wind_loads(ship: Ship, rec: TrialRecord, wind: bool | None) -> tuple[np.ndarray | None, str]:
+    use = (ship.wind is not None and ship.wind.enabled) if wind is None else bool(wind)
+    if not use:
+        return None, "off"
+    if ship.wind is None:
+        raise InputError(ship.source or ship.name, "wind", "wind was asked for but the ship config has no wind section")
+    if rec.wind_speed_rel is None or rec.wind_dir_rel is None:
+        return None, "no wind channels"
+    from mmg.wind import angle_from_dataset, wind_forces
+
+    X, Y, N = wind_forces(rec.wind_speed_rel, angle_from_dataset(rec.wind_dir_rel), ship.wind.particulars(),
+                          scale=ship.wind.scale)
+    return np.column_stack([X, Y, N]), "on"
+
+
+def measured_run(ship: Ship, rec: TrialRecord, start: float | None = None, wind: bool | None = None) -> MeasuredRun:
+    """The record as measured states and prescribed inputs (see the module docstring).
+
+    Parameters
+    ----------
+    ship : Ship
+    rec : TrialRecord
+    start : float, optional
+        Start time [s] of the replay; the record's first sample when omitted.
+    wind : bool, optional
+        Apply the wind loads; default: as the ship config says (``ship.wind.enabled``).
+    """
+    notes = []
+    src = rec.source or rec.name
+    if rec.delta is None:
+        from .rudder import with_rebuilt_rudder
+
+        rec = with_rebuilt_rudder(rec, dt=min(0.5, float(np.median(np.diff(rec.t)))))
+        notes.append("rudder rebuilt from the header's trial logic")
+    if start is not None:
+        if not rec.t[0] <= start < rec.t[-1]:
+            raise InputError(src, "--start", f"{start:g} s is outside the record ({rec.t[0]:g} to {rec.t[-1]:g} s)")
+        rec = rec.slice_time(start, np.inf)
+    if len(rec.t) < 3:
+        raise InputError(src, "t", "fewer than 3 samples to replay")
+    if rec.n is None:
+        raise InputError(src, "n", "no propeller revolutions channel: the replay needs n(t)")
+    for c in ("x", "y", "psi"):
+        if getattr(rec, c) is None:
+            raise InputError(src, c, "missing channel: the replay is scored against the track and heading")
+    r = rec.r if rec.r is not None else np.gradient(rec.psi, rec.t)
+    if rec.r is None:
+        notes.append("yaw rate from the heading")
+    if rec.u is not None and rec.v is not None:
+        u, v = rec.u, rec.v
+    else:
+        u, v = rec.speed(), np.zeros_like(rec.t)
+        notes.append("u taken as the speed over ground, v as zero (the record has no u, v)")
+    meas = np.column_stack([u, v, r, rec.x, rec.y, rec.psi]).astype(float)
+    ext, w = _wind_loads(ship, rec, wind)
+    return MeasuredRun(name=rec.name, source=rec.source, meas=meas,
+                       inputs=ReplayInputs(t=np.asarray(rec.t, float), delta=np.asarray(rec.delta, float),
+                                           n=np.asarray(rec.n, float), ext=ext), wind=w, notes=notes)
+
+
+@dataclass(frozen=True)
+class Replayed:
+    """One record replayed: measured and predicted states.
+
+    Attributes
+    ----------
+    run : MeasuredRun
+    pred : ndarray (N, 6)
+        Predicted u, v, r, x, y, psi (:data:`mmg.replay.STATE`).
+    L, B : float
+        Ship length and beam [m] (scores in ship lengths, outlines in plots).
+    """
+
+    run: MeasuredRun
+    pred: np.ndarray
+    L: float
+    B: float
+
+    def scores(self) -> dict:
+        """RMS over the record of heading [deg], yaw rate [deg/s], speed [m/s]; final position
+        error [m] and [L] (keys :data:`SCORE_KEYS`); NaN where the replay diverged."""
+        m, p = self.run.meas, self.pred
+        dpsi = np.degrees(p[:, 5] - m[:, 5])
+        dr = np.degrees(p[:, 2] - m[:, 2])
+        dU = np.hypot(p[:, 0], p[:, 1]) - np.hypot(m[:, 0], m[:, 1])
+        e = float(np.hypot(p[-1, 3] - m[-1, 3], p[-1, 4] - m[-1, 4]))
+        rms = lambda a: float(np.sqrt(np.mean(a * a)))  # noqa: E731
+        return {"heading_rms_deg": rms(dpsi), "yaw_rate_rms_degps": rms(dr), "speed_rms_mps": rms(dU),
+                "final_position_error_m": e, "final_position_error_L": e / self.L}
+
+    def to_pandas(self):
+        """Measured and predicted states against time [s] (columns ``u_meas``, ``u_pred``, ...; SI)."""
+        import pandas as pd
+
+        d = {"delta": self.run.inputs.delta, "n": self.run.inputs.n}
+        for j, c in enumerate(STATE):
+            d[f"{c}_meas"] = self.run.meas[:, j]
+            d[f"{c}_pred"] = self.pred[:, j]
+        return pd.DataFrame(d, index=pd.Index(self.run.t, name="t"))
+
+    def plot(self, pyplot: bool = True):
+        """Track (ship outlines) and time histories, measured against predicted; returns the figure."""
+        from .predict_plots import replay_figure
+
+        return replay_figure(self, pyplot=pyplot)
+
+
+def replay_record(ship: Ship, rec: TrialRecord | MeasuredRun, start: float | None = None,
+                  wind: bool | None = None, packed=None) -> Replayed:
+    """Replay one record open-loop from its first measured state (see the module docstring).
+
+    Parameters
+    ----------
+    ship : Ship
+    rec : TrialRecord or MeasuredRun
+    start : float, optional
+        Start time [s]; the first sample when omitted.
+    wind : bool, optional
+        Override the ship config's wind switch.
+    packed : PackedShip, optional
+        The ship already packed (a candidate's coefficients); ``pack(ship)`` when omitted.
+
+    Returns
+    -------
+    Replayed
+    """
+    run = rec if isinstance(rec, MeasuredRun) else measured_run(ship, rec, start, wind)
+    packed = packed or pack(ship)
+    pred = replay_states(packed, run.inputs, run.meas[0])
+    return Replayed(run=run, pred=pred, L=ship.particulars.L, B=ship.particulars.B)
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """Several records replayed with one ship: :attr:`runs` in the order given."""
+
+    runs: list
+
+    def to_json(self) -> dict:
+        """``{"runs": [{"file": ..., "heading_rms_deg": ..., ...}, ...]}`` (``mmg predict --json``)."""
+        return {"runs": [{"file": r.run.source, **r.scores()} for r in self.runs]}
+
+    def to_pandas(self):
+        """One row of scores per run, indexed by the record's name."""
+        import pandas as pd
+
+        return pd.DataFrame([{"name": r.run.name, "wind": r.run.wind, **r.scores()} for r in self.runs]).set_index("name")
+
+
+def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = None, progress=None) -> Prediction:
+    """Read and replay each record of ``paths`` (:func:`replay_record`); a bad record raises
+    :class:`~mmg.errors.InputError` naming it."""
+    from .logio import read_record
+
+    runs = []
+    for i, path in enumerate(paths):
+        rec = read_record(path, length_m=ship.particulars.L)
+        runs.append(replay_record(ship, rec, start, wind))
+        if progress:
+            progress(i + 1, len(paths), Path(path).name)
+    return Prediction(runs=runs)
