@@ -27,6 +27,7 @@ sensitivity   sensitivities, CRB, trial design          (:mod:`trials.sensitivit
 montecarlo    EKF Monte Carlo over noise seeds          (:func:`trials.montecarlo.monte_carlo`)
 log-filter    raw-log EKF Monte Carlo                   (:func:`trials.montecarlo.log_filter_monte_carlo`)
 output-error  joint output-error Monte Carlo            (:func:`trials.montecarlo.output_error_monte_carlo`)
+predict       replay records against their own inputs   (:func:`trials.predict.predict`)
 """
 from __future__ import annotations
 
@@ -361,6 +362,57 @@ def cmd_output_error(args) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- predict
+
+
+def _plot_names(runs) -> list[str]:
+    """``<name>.png`` per replayed run; a name met again gets ``_2``, ``_3``, ... (two records of one trial)."""
+    seen: dict = {}
+    out = []
+    for r in runs:
+        base = str(r.run.name or Path(r.run.source).stem).replace(os.sep, "_").replace("/", "_") or "run"
+        k = seen[base] = seen.get(base, 0) + 1
+        out.append(f"{base}.png" if k == 1 else f"{base}_{k}.png")
+    return out
+
+
+def cmd_predict(args) -> int:
+    from contextlib import nullcontext
+
+    from mmg.ship import load_ship
+
+    from .output import StagedFile, StagedOutput, check_output_dir, check_output_file, dumps_json
+    from .predict import predict
+
+    check_output_file(args.json)
+    if args.plots:
+        check_output_dir(args.plots, "--plots")
+    for log in args.logs:                  # every record there before the first is replayed
+        if not Path(log).is_file():
+            raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
+    ship = load_ship(args.ship)
+    wind = None if args.wind is None else args.wind == "on"
+
+    def progress(i, n, name):
+        print(f"replayed {i}/{n}: {name}", file=sys.stderr, flush=True)
+
+    pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)
+    for r in pred.runs:
+        s = r.scores()
+        print(f"{r.run.name}: heading {s['heading_rms_deg']:.4g} deg RMS, yaw rate {s['yaw_rate_rms_degps']:.4g} deg/s RMS, "
+              f"speed {s['speed_rms_mps']:.4g} m/s RMS, final position {s['final_position_error_m']:.4g} m "
+              f"({s['final_position_error_L']:.4g} L), wind {r.run.wind}")
+    text = dumps_json(pred.to_json())
+    names = _plot_names(pred.runs)
+    with StagedFile(args.json) as tmp:     # renamed last, after the plots are in place
+        with StagedOutput(args.plots) if args.plots else nullcontext() as stage:
+            for r, name in zip(pred.runs, names if args.plots else ()):
+                r.plot(pyplot=False).savefig(stage.path(name))
+        tmp.write_text(text)
+    print(f"wrote {args.json}" + (f" and {len(names)} plot{'s' if len(names) != 1 else ''} to {args.plots}" if args.plots else ""))
+    return 0
+
+
 # --------------------------------------------------------------------------- parser
 
 
@@ -475,6 +527,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="summary.csv of 'mmg montecarlo' (per-trial EKF) to show beside the table")
     p.add_argument("--summarise-only", action="store_true", help="rewrite the table from OUT/runs.csv, no runs")
     p.set_defaults(func=cmd_output_error)
+
+    p = sub.add_parser("predict", help="replay records open-loop against their own rudder and propeller history: "
+                                       "heading, yaw-rate, speed RMS and final position error per run")
+    p.add_argument("logs", nargs="+", metavar="LOG", help="FRT-DS-ESSO CSVs, project logs or truth files")
+    p.add_argument("--ship", required=True, help="ship YAML or bundled name (esso_osaka_3m, esso_osaka, ...)")
+    p.add_argument("--json", required=True, help="write the scores of every run to this JSON file")
+    p.add_argument("--plots", default=None, metavar="DIR", help="also one figure per run, DIR/<name>.png")
+    p.add_argument("--start", type=float, default=None, metavar="S",
+                   help="start time [s] of every replay (default: each record's first sample)")
+    p.add_argument("--wind", choices=("on", "off"), default=None,
+                   help="wind loads from the measured relative wind (default: as the ship config says)")
+    p.set_defaults(func=cmd_predict)
     return ap
 
 

@@ -218,13 +218,16 @@ class Prediction:
 
 def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = None, progress=None) -> Prediction:
     """Read and replay each record of ``paths`` (:func:`replay_record`); a bad record raises
-    :class:`~mmg.errors.InputError` naming it."""
+    :class:`~mmg.errors.InputError` naming it.  Every record is read and made ready
+    (:func:`measured_run`: channels, ``start``, wind) before the first is replayed, so a bad one
+    is refused before any work; ``progress(i, n, file name)`` is called after each replay."""
     from .logio import read_record
 
+    measured = [measured_run(ship, read_record(path, length_m=ship.particulars.L), start, wind) for path in paths]
+    packed = pack(ship)
     runs = []
-    for i, path in enumerate(paths):
-        rec = read_record(path, length_m=ship.particulars.L)
-        runs.append(replay_record(ship, rec, start, wind))
+    for i, (path, run) in enumerate(zip(paths, measured)):
+        runs.append(replay_record(ship, run, packed=packed))
         if progress:
             progress(i + 1, len(paths), Path(path).name)
     return Prediction(runs=runs)
