@@ -18,7 +18,7 @@ _LAZY = {
     "estimable_names": ("ekf.data", "estimable_names"),
     "hull_slots": ("ekf.data", "hull_slots"),
     "PAPER_DERIVATIVES": ("ekf.data", "PAPER_DERIVATIVES"),
-    "AugmentedEKF": ("ekf.filter", "AugmentedEKF"),
+    "AugmentedEKF": ("ekf.filterpy_ekf", "AugmentedEKF"),
     "FilterResult": ("ekf.filter", "FilterResult"),
     "FilterDivergence": ("ekf.filter", "FilterDivergence"),
     "run_filter": ("ekf.filter", "run_filter"),

@@ -469,7 +469,7 @@ def estimate(data: TrialData, cfg: dict, engine: str = "compiled") -> Estimate:
         Estimation config (:func:`load_config`).
     engine : {"compiled", "filterpy"}
         ``"compiled"`` (default): :func:`ekf.filter.run_filter`, the numba loop (about a second
-        for 3000 s).  ``"filterpy"``: :class:`ekf.filter.AugmentedEKF` stepped in Python, the
+        for 3000 s).  ``"filterpy"``: :class:`ekf.filterpy_ekf.AugmentedEKF` stepped in Python, the
         same predict and filterpy's Joseph-form update (about 100 x slower; the same numbers
         to rounding, ``tests/test_ekf.py``), for users who want to step or modify the filter.
 
@@ -499,8 +499,9 @@ def estimate(data: TrialData, cfg: dict, engine: str = "compiled") -> Estimate:
 
 
 def _filterpy_pass(data: TrialData, z0, P0, R, q: float) -> FilterResult:
-    """The pass of :func:`run_filter` stepped with filterpy (:class:`ekf.filter.AugmentedEKF`)."""
-    from .filter import AugmentedEKF, FilterDivergence, is_pd
+    """The pass of :func:`run_filter` stepped with filterpy (:class:`ekf.filterpy_ekf.AugmentedEKF`)."""
+    from .filter import FilterDivergence, is_pd
+    from .filterpy_ekf import AugmentedEKF
 
     m = data.meas
     t = np.asarray(m.t, float)

@@ -1,4 +1,4 @@
-"""State-augmented extended Kalman filter (Rhee & Kim 1999 section 4) on filterpy.
+"""State-augmented extended Kalman filter (Rhee & Kim 1999 section 4).
 
 State (4 + m): z = [u, v, r, n, c_1 .. c_m] with c the estimated hull coefficients, named
 from the ship's table (:func:`ekf.data.estimable_names`: for the Esso Osaka Rhee & Kim's 12
@@ -10,24 +10,28 @@ Time update
     simulator's own right-hand side: the derivatives are written into the packed
     ship's ``hull_coef`` slots, heading/position are not needed, delta is the
     input interpolated linearly over the step, dc/dt = 0).  P <- F P F^T with F the
-    exact Jacobian of that RK4 map, obtained by complex-step differentiation of the
-    same compiled code (one complex RK4 step per column, step 1e-30, so F is exact
-    to rounding).  Q = 0 as in the paper.
+    exact Jacobian of that RK4 map: the tangent-linear RK4 of
+    :func:`ekf.kernels.jacobian_step` (state columns by complex step of each stage, step
+    1e-30, coefficient columns analytic as the hull force is linear in them), exact to
+    rounding.  Q = 0 as in the paper.
 Measurement update
     Joseph form P = (I-KH) P (I-KH)^T + K R K^T (filterpy's
     ``ExtendedKalmanFilter.update`` uses exactly this form; checked in
-    ``tests/test_ekf_filter.py``).  P is symmetrised after each step and checked
+    ``tests/test_ekf.py``).  P is symmetrised after each step and checked
     for positive definiteness (Cholesky); a non-PD P, a non-finite state or u <= 0
     raises :class:`FilterDivergence` naming the trial and the time.
 
-The RK4 step, its complex-step Jacobian and F P F^T are the kernels of :mod:`ekf.kernels`,
-shared with the raw-log filter (:mod:`ekf.log_filter`).  Two drivers share them:
+The RK4 step, its exact Jacobian and F P F^T are the kernels of :mod:`ekf.kernels`,
+shared with the raw-log filter (:mod:`ekf.log_filter`); this filter's time update built on them
+(:func:`propagate_step`, :func:`propagate_jacobian`) is :mod:`ekf.propagate`, re-exported here.
+Two drivers share them:
 
-* :class:`AugmentedEKF`, a subclass of filterpy's ``ExtendedKalmanFilter`` whose
-  ``predict`` is the compiled propagation above and whose ``update`` is filterpy's;
-  convenient step by step but ~100 us/step of Python in filterpy's update.
+* :class:`AugmentedEKF` (in :mod:`ekf.filterpy_ekf`, loaded on first use of the name so that
+  this module does not import filterpy and scipy.stats), a subclass of filterpy's
+  ``ExtendedKalmanFilter`` whose ``predict`` is the compiled propagation above and whose
+  ``update`` is filterpy's; convenient step by step but ~100 us/step of Python in filterpy's update.
 * :func:`run_filter`, the hot loop: the same predict kernel and the same Joseph-form
-  update written in numba, so a 3000 s pass (30 000 steps) takes about a second.
+  update written in numba, so a 3000 s pass (30 000 steps) takes about 0.4 s.
   filterpy's update is too slow for the 2 s budget (numpy calls on 16x16 arrays
   dominate), hence this; the two drivers agree to rounding (tested).
 """
@@ -36,17 +40,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from filterpy.kalman import ExtendedKalmanFilter
 from numba import njit
 
-from mmg.model import N_, R_, U_, V_, PackedShip
+from mmg.model import PackedShip
 
-from .kernels import (CSTEP, fpft, jacobian_step, jacobian_step_reference, joseph_update_ws,  # noqa: F401 (CSTEP re-exported)
-                      make_update_workspace, make_workspace, symmetrise)
+from .kernels import (CSTEP, fpft, jacobian_step_reference, joseph_update_ws,  # noqa: F401 (CSTEP re-exported)
+                      make_update_workspace, symmetrise)
+from .propagate import NS, SLOTS, propagate_jacobian, propagate_step, workspace  # noqa: F401 (re-exported)
 
 STATES = ("u", "v", "r", "n")
-NS = 4
-SLOTS = np.array([U_, V_, R_, N_], dtype=np.int64)   # mmg state slot of each dynamic state
 PD_TOL = 1e-9
 
 OK, NONFINITE, NEG_SPEED, NOT_PD, NIS_HIGH = 0, 1, 2, 3, 4
@@ -67,40 +69,6 @@ class FilterDivergence(RuntimeError):
 
 
 # --------------------------------------------------------------------------- compiled kernels
-
-
-@njit(cache=True)
-def workspace(nz, hull_coef):
-    """Work arrays of :func:`propagate_step` (:func:`ekf.kernels.make_workspace`): z_next = ws[8], F = ws[9]."""
-    return make_workspace(nz, NS, hull_coef)
-
-
-@njit(cache=True, inline="always")
-def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
-    """One RK4 step of the augmented state z (nz,) and its exact Jacobian into ``ws`` (z_next = ws[8], F = ws[9]).
-
-    F by the tangent-linear RK4 of :func:`ekf.kernels.jacobian_step` (state columns by complex
-    step of each stage, derivative columns analytic: 16 complex evaluations of the dynamics a
-    step, not 64 of the whole model).
-
-    d0, d1 rudder angle [rad] at the start and end of the step (an input, linear over it), dt [s];
-    idx the derivatives' slots in ``hull_coef``; ws from :func:`workspace`."""
-    jacobian_step(z, d0, d1, 0.0, 0.0, -1, SLOTS, NS, dt, p, poly, hull_axis, hull_term, idx, ws)
-
-
-@njit(cache=True)
-def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, idx, z_next, F):
-    """Propagate z over one step (RK4 on mmg.model.rhs) and fill F = d z_next / d z (complex step).
-
-    z (nz,) real; d0, d1 rudder angle [rad] at the start and end of the step; dt [s];
-    hull_coef the packed ship's coefficients (the derivative slots ``idx`` are overwritten
-    by z[4:] in a complex copy); z_next (nz,) and F (nz, nz) are written.  F is exact to
-    rounding (:func:`propagate_step`; no truncation error).
-    """
-    ws = workspace(z.shape[0], hull_coef)
-    propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws)
-    z_next[:] = ws[8]
-    F[:, :] = ws[9]
 
 
 @njit(cache=True)
@@ -250,52 +218,6 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
 # --------------------------------------------------------------------------- Python side
 
 
-class AugmentedEKF(ExtendedKalmanFilter):
-    """filterpy's EKF with the MMG propagation: ``predict((delta0, delta1))``, then filterpy's ``update``.
-
-    This is the filter a user steps by hand (``x``, ``P``, ``F``, ``Q``, ``R`` explicit, as
-    filterpy has them); :func:`run_filter` is its compiled fast path over a whole record and
-    gives the same numbers (``tests/test_ekf.py``).
-
-    Parameters
-    ----------
-    packed : PackedShip
-        K_Q-calibrated, from :func:`mmg.simulation.prepare`.
-    slots : array of int
-        Indices of the m estimated coefficients in ``packed.hull_coef`` (:func:`ekf.data.hull_slots`).
-    dt : float
-        Filter step [s].
-    """
-
-    def __init__(self, packed: PackedShip, slots, dt: float = 0.1):
-        self.slots = np.asarray(slots, dtype=np.int64)
-        nz = NS + len(self.slots)
-        super().__init__(dim_x=nz, dim_z=NS)
-        self.nz = nz
-        self.H = np.hstack([np.eye(NS), np.zeros((NS, nz - NS))])
-        self.packed = packed
-        self.dt = float(dt)
-        self.Q = np.zeros((nz, nz))
-
-    def predict(self, u=(0.0, 0.0)):
-        d0, d1 = u
-        z = np.asarray(self.x, float).reshape(-1)
-        zn = np.empty(self.nz)
-        F = np.empty((self.nz, self.nz))
-        propagate_jacobian(z, float(d0), float(d1), self.dt, *self.packed.args(), self.slots, zn, F)
-        self.F = F
-        self.x = zn
-        self.P = F @ self.P @ F.T + self.Q
-        self.P = 0.5 * (self.P + self.P.T)
-        self.x_prior = self.x.copy()
-        self.P_prior = self.P.copy()
-
-    def update_uvrn(self, meas):
-        """filterpy's (Joseph-form) update with H = [I_4 0]."""
-        self.update(np.asarray(meas, float), HJacobian=lambda x: self.H, Hx=lambda x: np.asarray(x)[:NS])
-        self.P = 0.5 * (self.P + self.P.T)
-
-
 @dataclass
 class FilterResult:
     """A filter pass.
@@ -358,3 +280,14 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     if st != OK:
         raise FilterDivergence(trial, t[k], _REASON[st])
     return FilterResult(t, zs, pd_, P, tuple(names))
+
+
+def __getattr__(name: str):
+    """``ekf.filter.AugmentedEKF`` (and ``from ekf.filter import AugmentedEKF``) from :mod:`ekf.filterpy_ekf`,
+    imported only then: filterpy pulls scipy.stats (~0.4 s), which the compiled path never needs."""
+    if name == "AugmentedEKF":
+        from .filterpy_ekf import AugmentedEKF
+
+        globals()[name] = AugmentedEKF
+        return AugmentedEKF
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
