@@ -27,6 +27,7 @@ sensitivity   sensitivities, CRB, trial design          (:mod:`trials.sensitivit
 montecarlo    EKF Monte Carlo over noise seeds          (:func:`trials.montecarlo.monte_carlo`)
 log-filter    raw-log EKF Monte Carlo                   (:func:`trials.montecarlo.log_filter_monte_carlo`)
 output-error  joint output-error Monte Carlo            (:func:`trials.montecarlo.output_error_monte_carlo`)
+identify      identify a ship model from records        (:func:`trials.identify.identify`)
 predict       replay records against their own inputs   (:func:`trials.predict.predict`)
 """
 from __future__ import annotations
@@ -413,6 +414,47 @@ def cmd_predict(args) -> int:
     return 0
 
 
+def cmd_identify(args) -> int:
+    import numpy as np
+
+    from mmg.resources import ship_path
+    from mmg.ship import load_ship
+
+    from .identify import cross_validate, identify, load_runs, write_identification
+    from .output import StagedOutput, check_output_dir
+
+    check_output_dir(args.out)
+    for log in args.train:
+        if not Path(log).is_file():
+            raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
+    src = ship_path(args.ship)
+    ship = load_ship(src)
+    wind = None if args.wind is None else args.wind == "on"
+    t0 = time.perf_counter()
+    runs = load_runs(ship, args.train, wind=wind)        # an unusable record: one line, skipped
+    if not runs:
+        raise InputError("--train", "", "no usable training record")
+    print(f"training on {len(runs)} records", file=sys.stderr, flush=True)
+
+    def progress(k, cost):
+        print(f"  iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
+
+    ident = identify(ship, runs, wind=wind, progress=progress)
+    cv = None
+    if args.cv:
+        cv = cross_validate(ship, runs, folds=args.cv, wind=wind,
+                            progress=lambda k, n: print(f"cross-validation fold {k}/{n} ({time.perf_counter() - t0:.0f} s)",
+                                                        file=sys.stderr, flush=True))
+    with StagedOutput(args.out) as stage:
+        write_identification(ident, src, stage.dir, cv)
+    a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
+    b = np.mean([x["heading_rms_deg"] for x in ident.scores()])
+    print(f"identified {len(ident.fit.free)} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
+          f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
+    print(f"wrote {Path(args.out) / 'ship.yaml'} and {Path(args.out) / 'report.md'}")
+    return 0
+
+
 # --------------------------------------------------------------------------- parser
 
 
@@ -539,6 +581,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--wind", choices=("on", "off"), default=None,
                    help="wind loads from the measured relative wind (default: as the ship config says)")
     p.set_defaults(func=cmd_predict)
+
+    p = sub.add_parser("identify", help="identify hull coefficients and model-scale constants jointly over measured "
+                                        "records (segment-wise output error); writes DIR/ship.yaml and DIR/report.md")
+    p.add_argument("--ship", required=True, help="initial ship YAML or bundled name (the prior)")
+    p.add_argument("--train", required=True, nargs="+", metavar="LOG", help="training records")
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--wind", choices=("on", "off"), default=None,
+                   help="wind loads from the measured relative wind (default: as the ship config says)")
+    p.add_argument("--cv", type=_whole(2, "--cv"), default=None, metavar="FOLDS",
+                   help="also cross-validate in FOLDS folds (each record kept out once) and report it")
+    p.set_defaults(func=cmd_identify)
     return ap
 
 

@@ -1,0 +1,48 @@
+"""Cross-validation of ``mmg identify`` on the shared FRT-DS-ESSO turning and zigzag records
+(issue 11, acceptance 1): four folds, each record kept out once, with and without wind; per
+record the open-loop heading RMS of the initial (Froude-scaled) 3 m model and of the model
+identified without it.  Run: ``python bench/identify_cv.py [--wind on|off|both]``."""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import mmg  # noqa: E402
+from trials.identify import cross_validate, load_runs  # noqa: E402
+from trials.reproduce import frt_data_dir  # noqa: E402
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--wind", choices=["on", "off", "both"], default="both")
+    ap.add_argument("--folds", type=int, default=4)
+    a = ap.parse_args()
+    d = frt_data_dir()
+    if d is None:
+        sys.exit("FRT-DS-ESSO data not found (set MMG_FRT_DATA)")
+    files = sorted((d / "turning").glob("*.csv")) + sorted((d / "zigzag").glob("*.csv"))
+    ship = mmg.load_ship("esso_osaka_3m")
+    for wind in ([True, False] if a.wind == "both" else [a.wind == "on"]):
+        runs = load_runs(ship, files, wind=wind)
+        t0 = time.perf_counter()
+        cv = cross_validate(ship, runs, folds=a.folds, wind=wind,
+                            progress=lambda k, n: print(f"  fold {k}/{n} done, {time.perf_counter() - t0:.0f} s", flush=True))
+        print(f"\nwind {'on' if wind else 'off'}: {len(runs)} records, {a.folds} folds, {time.perf_counter() - t0:.0f} s")
+        print(f"{'record':32s} {'initial':>8s} {'identified':>10s} {'ratio':>6s}  (heading RMS, deg)")
+        for c in cv:
+            x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
+            print(f"{c['name']:32s} {x:8.2f} {y:10.2f} {x / y:6.2f}")
+        xa = np.mean([c["initial"]["heading_rms_deg"] for c in cv])
+        xb = np.mean([c["identified"]["heading_rms_deg"] for c in cv])
+        nb = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
+        print(f"{'mean':32s} {xa:8.2f} {xb:10.2f} {xa / xb:6.2f}   better on {nb} of {len(cv)} kept-out records")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,231 @@
+"""Joint identification over measured records: segment-wise output error with a prior.
+
+Each record (its measured states and prescribed inputs, :class:`mmg.replay.ReplayInputs`) is cut
+into segments of ``segment_s`` seconds; every segment is replayed (:func:`mmg.replay.replay_states`
+with ``reset``) from the measured state at its start, so an error in one segment does not carry
+into the next (multiple shooting without continuity constraints).  The residuals are the
+differences of u, v, r and heading between replay and record, each divided by its scale
+(:class:`Scales`), over every segment of every record, plus the prior residuals
+(theta - theta_0) / sigma_0 that keep coefficients the records do not inform at their config
+values (a maximum a posteriori output-error fit).  Levenberg-Marquardt-like trust-region steps
+(:func:`scipy.optimize.least_squares`) with forward-difference Jacobian columns computed on all
+cores (threads; the compiled replay releases the GIL).
+
+The free parameters (:class:`FreeParameter`) are hull coefficients by name and, optionally,
+the ship constants ``"w_P0"`` (the constant term of the wake polynomial: the model-scale wake),
+``"epsilon"`` (rudder inflow ratio) and ``"X_uu"`` is simply a hull name.  The standard errors
+are from the Gauss-Newton covariance at the optimum, scaled by the residual variance per
+degree of freedom; correlated residuals (10 Hz samples are not independent) make them optimistic.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from mmg.model import P_EPS, POLY_WP0, PackedShip
+from mmg.replay import ReplayInputs, replay_states
+
+__all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
+           "segment_resets", "identify_segments", "SHIP_CONSTANTS"]
+
+SHIP_CONSTANTS = ("w_P0", "epsilon")
+"""Ship constants besides the hull coefficients that :func:`free_parameters` can free."""
+
+
+@dataclass(frozen=True)
+class Segmented:
+    """One record for the fit: measured states (N, 6), inputs and the segment starts (bool (N,))."""
+
+    name: str
+    meas: np.ndarray
+    inputs: ReplayInputs
+    reset: np.ndarray
+
+
+@dataclass(frozen=True)
+class Scales:
+    """Residual scales: u, v [m/s], r [rad/s], heading [rad]."""
+
+    u: float
+    v: float
+    r: float
+    psi: float
+
+    def array(self) -> np.ndarray:
+        return np.array([self.u, self.v, self.r, self.psi])
+
+
+@dataclass(frozen=True)
+class FreeParameter:
+    """A parameter being fitted: its name, kind (``"hull"`` index or ship constant), prior value and std."""
+
+    name: str
+    kind: str
+    index: int
+    prior: float
+    sigma: float
+    lower: float = -np.inf
+    upper: float = np.inf
+
+
+def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float = 0.5) -> list[FreeParameter]:
+    """The :class:`FreeParameter` list for ``names`` (hull coefficient names or :data:`SHIP_CONSTANTS`).
+
+    The prior std is ``prior_rel_std`` times the config value (0.5: the value is known to a factor of
+    about 2 either way), at least 0.01 for hull coefficients."""
+    out = []
+    for nm in names:
+        if nm in hull_names:
+            i = list(hull_names).index(nm)
+            v = float(packed.hull_coef[i])
+            lo, hi = (-np.inf, 0.0) if nm == "X_uu" else (-np.inf, np.inf)      # resistance stays a resistance
+            out.append(FreeParameter(nm, "hull", i, v, max(prior_rel_std * abs(v), 0.01), lo, hi))
+        elif nm == "w_P0":
+            v = float(packed.poly[POLY_WP0][0])
+            out.append(FreeParameter(nm, "w_P0", 0, v, 0.15, 0.0, 0.8))           # a wake fraction
+        elif nm == "epsilon":
+            v = float(packed.p[P_EPS])
+            out.append(FreeParameter(nm, "epsilon", P_EPS, v, prior_rel_std * v, 0.3, 3.0))
+        else:
+            raise KeyError(f"unknown parameter {nm!r}: not a hull coefficient of the ship nor one of {SHIP_CONSTANTS}")
+    return out
+
+
+def apply_parameters(packed: PackedShip, free: list[FreeParameter], theta) -> PackedShip:
+    """A copy of ``packed`` with the free parameters set to ``theta``."""
+    coef, p, poly = packed.hull_coef.copy(), packed.p.copy(), packed.poly.copy()
+    for f, v in zip(free, theta):
+        if f.kind == "hull":
+            coef[f.index] = v
+        elif f.kind == "w_P0":
+            poly[POLY_WP0][0] = v
+        else:
+            p[f.index] = v
+    return replace(packed, p=p, poly=poly, hull_coef=coef)
+
+
+def segment_resets(t: np.ndarray, segment_s: float) -> np.ndarray:
+    """Segment starts (bool (N,)): the first sample and every sample ``segment_s`` [s] after the last start."""
+    reset = np.zeros(len(t), dtype=bool)
+    nxt = t[0]
+    for i, ti in enumerate(t):
+        if ti >= nxt - 1e-9:
+            reset[i] = True
+            nxt = ti + segment_s
+    return reset
+
+
+def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int) -> np.ndarray:
+    pred = replay_states(packed, rec.inputs, rec.meas[0], meas=rec.meas, reset=rec.reset)
+    d = (pred[::stride] - rec.meas[::stride])[:, [0, 1, 2, 5]] / sc
+    d[~np.isfinite(d)] = 1e3                          # a diverged segment: a large, finite misfit
+    return d.ravel()
+
+
+@dataclass(frozen=True)
+class IdentifyResult:
+    """The fit: free parameters, values, standard errors, correlation, cost before and after."""
+
+    free: list
+    theta: np.ndarray
+    std: np.ndarray
+    corr: np.ndarray
+    cost_initial: float
+    cost_final: float
+    n_residuals: int
+    iterations: int
+    message: str
+
+    def values(self) -> dict:
+        """Fitted value of each free parameter, by name."""
+        return {f.name: float(v) for f, v in zip(self.free, self.theta)}
+
+    def to_pandas(self):
+        """One row per parameter: prior, estimate, standard error, change from the prior [%]."""
+        import pandas as pd
+
+        rows = [{"name": f.name, "prior": f.prior, "estimate": float(v), "std": float(s),
+                 "change_pct": 100.0 * (float(v) - f.prior) / abs(f.prior) if f.prior else np.nan}
+                for f, v, s in zip(self.free, self.theta, self.std)]
+        return pd.DataFrame(rows).set_index("name")
+
+
+def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
+                      stride: int = 2, n_jobs: int | None = None, max_nfev: int = 40, progress=None,
+                      start=None) -> IdentifyResult:
+    """Fit ``free`` jointly over ``records`` (module docstring).
+
+    Parameters
+    ----------
+    packed : PackedShip
+        The ship with its config values (the prior and the starting point).
+    records : list of Segmented
+    free : list of FreeParameter
+    scales : Scales
+        Residual scales of u, v, r, heading.
+    stride : int
+        Use every ``stride``-th sample in the residuals.
+    n_jobs : int, optional
+        Threads for the Jacobian columns; all cores when omitted.
+    max_nfev : int
+        Most trust-region iterations.
+    start : array_like, optional
+        Starting values (a previous fit's); the priors when omitted.
+    progress : callable, optional
+        ``progress(iteration, cost)`` after each Jacobian.
+    """
+    from scipy.optimize import least_squares
+
+    sc = scales.array()
+    theta0 = np.array([f.prior for f in free])
+    sig0 = np.array([f.sigma for f in free])
+    n_jobs = n_jobs or os.cpu_count() or 1
+    pool = ThreadPoolExecutor(max_workers=n_jobs)
+
+    def resid(theta):
+        pk = apply_parameters(packed, free, theta)
+        parts = list(pool.map(lambda rec: _residual_one(pk, rec, sc, stride), records))
+        return np.concatenate(parts + [(theta - theta0) / sig0])
+
+    count = [0]
+
+    def jac(theta):
+        r0 = resid(theta)
+        h = 1e-6 * np.maximum(np.abs(theta), sig0)
+        cols = []
+        for j in range(len(theta)):
+            th = theta.copy()
+            if th[j] + h[j] > free[j].upper:                 # at an upper bound: step down
+                h[j] = -h[j]
+            th[j] += h[j]
+            cols.append((resid(th) - r0) / h[j])
+        count[0] += 1
+        if progress:
+            progress(count[0], 0.5 * float(r0 @ r0))
+        return np.column_stack(cols)
+
+    try:
+        r_init = resid(theta0)
+        lo = np.array([f.lower for f in free])
+        hi = np.array([f.upper for f in free])
+        x0 = theta0 if start is None else np.asarray(start, float)
+        sol = least_squares(resid, np.clip(x0, lo, hi), jac=jac, method="trf", x_scale=sig0, max_nfev=max_nfev,
+                            bounds=(lo, hi))
+    finally:
+        pool.shutdown()
+    J = sol.jac
+    dof = max(len(sol.fun) - len(theta0), 1)
+    s2 = float(sol.fun @ sol.fun) / dof
+    try:
+        cov = np.linalg.inv(J.T @ J) * s2
+    except np.linalg.LinAlgError:
+        cov = np.full((len(theta0), len(theta0)), np.nan)
+    std = np.sqrt(np.abs(np.diag(cov)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(std, std)
+    return IdentifyResult(free=free, theta=sol.x, std=std, corr=corr, cost_initial=0.5 * float(r_init @ r_init),
+                          cost_final=float(sol.cost), n_residuals=len(sol.fun), iterations=int(sol.nfev),
+                          message=str(sol.message))

@@ -1,0 +1,90 @@
+"""mmg identify: the fit recovers coefficients it did not start from, writes a usable ship config,
+and skips unusable records with one line."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mmg
+from ekf.identify import Scales, Segmented, free_parameters, identify_segments, segment_resets
+from mmg.model import pack
+from mmg.replay import ReplayInputs, replay
+from trials.identify import identify, ship_yaml, write_identification
+from trials.predict import MeasuredRun
+
+SHIP = "esso_osaka_3m"
+
+
+def _zigzag_inputs(t, amp_deg=20.0, period=40.0, n=10.0):
+    delta = np.radians(amp_deg) * np.sign(np.sin(2 * np.pi * t / period))
+    delta = np.convolve(delta, np.ones(5) / 5, mode="same")             # a finite rudder rate
+    return ReplayInputs(t=t, delta=delta, n=np.full_like(t, n))
+
+
+def _synthetic_runs(ship_true, seeds=(0, 1), duration=120.0):
+    """Records made by replaying the *true* ship (coefficients the fit does not know) from a
+    moving start with zigzag-like rudders; measurement noise added."""
+    pk = pack(ship_true)
+    runs = []
+    for k in seeds:
+        rng = np.random.default_rng(k)
+        t = np.arange(0.0, duration + 1e-9, 0.1)
+        inp = _zigzag_inputs(t, amp_deg=15.0 + 10 * k, period=30.0 + 10 * k)
+        s = replay(pk, inp, [0.35, 0.0, 0.0, 0.0, 0.0, 0.0])
+        meas = s + rng.normal(0.0, [0.002, 0.002, 0.0005, 0.01, 0.01, 0.002], s.shape)
+        runs.append(MeasuredRun(name=f"syn{k}", source=f"syn{k}", meas=meas, inputs=inp))
+    return runs
+
+
+def test_fit_recovers_the_coefficients_that_made_the_records():
+    ship = mmg.load_ship(SHIP)
+    true = {"N_r": ship.hull.value("N_r") * 1.3, "N_beta": ship.hull.value("N_beta") * 0.8,
+            "Y_beta": ship.hull.value("Y_beta") * 1.2}
+    runs = _synthetic_runs(ship.with_hull(true))
+    pk = pack(ship)
+    free = free_parameters(pk, ship.hull.names, list(true))
+    segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, 30.0)) for r in runs]
+    fit = identify_segments(pk, segs, free, Scales(0.005, 0.005, 0.001, np.radians(0.5)), n_jobs=2)
+    got = fit.values()
+    for k, v in true.items():                    # from 20-30 % off to within 3 %
+        assert got[k] == pytest.approx(v, rel=0.03), (k, got[k], v)
+    assert fit.cost_final < 0.1 * fit.cost_initial
+    assert np.all(np.isfinite(fit.std)) and np.all(fit.std > 0)
+
+
+def test_identify_improves_the_open_loop_replay_and_writes_a_usable_ship(tmp_path):
+    ship = mmg.load_ship(SHIP)
+    true = {"N_r": ship.hull.value("N_r") * 1.3, "N_beta": ship.hull.value("N_beta") * 0.8}
+    runs = _synthetic_runs(ship.with_hull(true), seeds=(0,), duration=90.0)
+    ident = identify(ship, runs, free=list(true), segment_s=(30.0, np.inf), say=lambda m: None)
+    a = ident.scores(model="initial")[0]["heading_rms_deg"]
+    b = ident.scores()[0]["heading_rms_deg"]
+    assert b < 0.2 * a
+    out = write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)
+    back = mmg.load_ship(out["ship"])                      # a complete, valid ship config
+    for k, v in ident.fit.values().items():
+        assert back.hull.value(k) == pytest.approx(v, rel=1e-5)
+    assert back.wind is not None and back.particulars == ship.particulars
+    rep = out["report"].read_text()
+    assert "| N_r |" in rep and "Training fits" in rep
+
+
+def test_ship_yaml_changes_only_the_fitted_values(tmp_path):
+    src = mmg.config_path("ships", f"{SHIP}.yaml")
+    text = ship_yaml(src, {"N_r": -0.04, "w_P0": 0.5, "epsilon": 1.2}, "test")
+    p = tmp_path / "s.yaml"
+    p.write_text(text)
+    a, b = mmg.load_ship(src), mmg.load_ship(p)
+    assert b.hull.value("N_r") == -0.04 and b.propeller.w_P0[0] == 0.5 and b.rudder.epsilon == 1.2
+    assert b.hull.value("Y_beta") == a.hull.value("Y_beta") and b.mass == a.mass
+
+
+def test_unusable_record_is_skipped_with_one_line(tmp_path, capsys):
+    ship = mmg.load_ship(SHIP)
+    runs = _synthetic_runs(ship, seeds=(0,), duration=40.0)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t [s],x_position_mid [m],y_position_mid [m],psi_hat [rad]\n0,0,0,0\n0.1,nan,0,0\n0.2,0,0,0\n")
+    said = []
+    ident = identify(ship, runs + [bad], free=["N_r"], segment_s=(20.0,), say=said.append)
+    assert len(said) == 1 and "bad.csv" in said[0] and "\n" not in said[0]
+    assert len(ident.runs) == 1

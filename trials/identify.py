@@ -1,0 +1,229 @@
+"""Identify a ship model from measured records (``mmg identify``) and cross-validate it.
+
+:func:`identify` reads the training records (every layout :func:`trials.logio.read_record`
+reads, checked against the ship's length), skips a record it cannot use with one line naming it
+and why, and fits the hull coefficients and the model-scale constants jointly over all of them
+with their measured inputs (:func:`ekf.identify.identify_segments`: segment-wise output error with
+a prior).  :func:`write_identification` writes ``ship.yaml`` (the ship config with the fitted
+values: usable by every other command) and ``report.md`` (values, standard errors, correlations,
+training fits).  :func:`cross_validate` keeps each record out once (k folds) and compares the
+open-loop replay of the kept-out records with the initial and the identified model.
+
+Freed by default (:data:`DEFAULT_FREE`): every hull coefficient except the constants Y_0, N_0
+(asymmetries the records cannot separate from wind and a rudder offset), the wake fraction's
+constant term ``w_P0`` (the model-scale wake is the largest scale effect, see the 3 m config)
+and the rudder inflow ratio ``epsilon`` (follows the wake).  The propeller curve, masses and
+rudder geometry stay at the config values: the records (n constant over most of each run) cannot
+separate them from the freed ones.
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mmg.errors import InputError
+from mmg.model import pack
+from mmg.ship import Ship
+
+from .predict import MeasuredRun, measured_run, replay_record
+
+__all__ = ["identify", "cross_validate", "write_identification", "load_runs", "ship_yaml", "Identification",
+           "DEFAULT_FREE"]
+
+DEFAULT_FREE = ("hull-except-constants", "w_P0", "epsilon")
+DEFAULT_SEGMENTS_L = (52.0, np.inf)
+"""Segment lengths of the successive fits, in units of sqrt(L/g): 29 s for a 3 m model, 300 s at
+325 m (about one zigzag half-period: short enough that a poor start does not diverge), then the
+whole record open-loop from the first fit's values (the objective the replay is judged by)."""
+
+
+def _log(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
+def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log) -> list[MeasuredRun]:
+    """Read and prepare each record; one that cannot be used is skipped with one line saying why."""
+    from .logio import read_record
+
+    runs = []
+    for p in paths:
+        try:
+            rec = read_record(p, length_m=ship.particulars.L)
+            runs.append(measured_run(ship, rec, wind=wind))
+        except InputError as e:
+            say(f"skipped: {e}")
+    return runs
+
+
+def _free_names(ship: Ship, free) -> list[str]:
+    names = []
+    for f in free:
+        if f == "hull-except-constants":
+            names += [n for n, t in zip(ship.hull.names, ship.hull.terms) if t != "1"]
+        else:
+            names.append(f)
+    return names
+
+
+def _scales(runs: list[MeasuredRun], L: float):
+    from ekf.identify import Scales
+
+    U = float(np.median(np.concatenate([np.hypot(r.meas[:, 0], r.meas[:, 1]) for r in runs])))
+    return Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=np.radians(2.0))
+
+
+@dataclass(frozen=True)
+class Identification:
+    """The identified model: the ship with fitted values, the fit, the training records and scores."""
+
+    ship: Ship
+    initial: Ship
+    fit: object
+    runs: list
+    segment_s: float
+
+    def scores(self, runs=None, model: str = "identified") -> list[dict]:
+        """Open-loop replay scores (:meth:`trials.predict.Replayed.scores`) of ``runs`` (the training
+        records when omitted) with the identified or the initial model."""
+        ship = self.ship if model == "identified" else self.initial
+        return [{"name": r.name, **replay_record(ship, r).scores()} for r in (runs or self.runs)]
+
+
+def _ship_with(ship: Ship, values: dict) -> Ship:
+    from dataclasses import replace
+
+    hull = {k: v for k, v in values.items() if k in ship.hull.names}
+    s = ship.with_hull(hull) if hull else ship
+    if "w_P0" in values:
+        w = list(s.propeller.w_P0)
+        w[0] = values["w_P0"]
+        s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
+    if "epsilon" in values:
+        s = replace(s, rudder=replace(s.rudder, epsilon=values["epsilon"]))
+    return s
+
+
+def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | None = None, wind: bool | None = None,
+             max_nfev: int = 30, progress=None, say=_log) -> Identification:
+    """Identify ``free`` jointly over the training records (module docstring).
+
+    Parameters
+    ----------
+    ship : Ship
+        The initial model (the prior).
+    paths_or_runs : list of paths or of MeasuredRun
+    free : sequence of str
+        Hull coefficient names, ``"hull-except-constants"``, ``"w_P0"``, ``"epsilon"``.
+    segment_s : float or sequence of float, optional
+        Segment length(s) [s] of successive fits; :data:`DEFAULT_SEGMENTS_L` when omitted.
+    wind : bool, optional
+        Override the ship config's wind switch.
+    """
+    from ekf.identify import Segmented, free_parameters, identify_segments, segment_resets
+
+    items = list(paths_or_runs)
+    runs = [r for r in items if isinstance(r, MeasuredRun)]
+    paths = [r for r in items if not isinstance(r, MeasuredRun)]
+    runs += load_runs(ship, paths, wind=wind, say=say) if paths else []
+    if not runs:
+        raise InputError("--train", "", "no usable training record")
+    L = ship.particulars.L
+    stages = DEFAULT_SEGMENTS_L if segment_s is None else np.atleast_1d(segment_s) / np.sqrt(L / 9.80665)
+    packed = pack(ship)
+    fp = free_parameters(packed, ship.hull.names, _free_names(ship, free))
+    fit = None
+    for k, st in enumerate(stages):
+        seg = float(st) * float(np.sqrt(L / 9.80665))
+        segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg)) for r in runs]
+        fit = identify_segments(packed, segs, fp, _scales(runs, L), max_nfev=max_nfev, progress=progress,
+                                start=None if fit is None else fit.theta)
+    return Identification(ship=_ship_with(ship, fit.values()), initial=ship, fit=fit, runs=runs, segment_s=seg)
+
+
+def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress=None, **kw) -> list[dict]:
+    """k-fold cross-validation: each record kept out once; per record the open-loop heading RMS [deg]
+    (and the other scores) of the initial model and of the model identified without it."""
+    out = []
+    idx = np.arange(len(runs))
+    for k in range(folds):
+        test = idx[k::folds]
+        train = [runs[i] for i in idx if i not in set(test)]
+        ident = identify(ship, train, **kw)
+        for i in test:
+            a = replay_record(ship, runs[i]).scores()
+            b = replay_record(ident.ship, runs[i]).scores()
+            out.append({"name": runs[i].name, "fold": k, "initial": a, "identified": b})
+        if progress:
+            progress(k + 1, folds)
+    return out
+
+
+def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
+    """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
+    ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``."""
+    import yaml
+
+    data = yaml.safe_load(Path(ship_path).read_text())
+    for k, v in values.items():
+        if k in data["hull"]["coefficients"]:
+            data["hull"]["coefficients"][k]["value"] = float(f"{v:.6g}")
+        elif k == "w_P0":
+            data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
+        elif k == "epsilon":
+            data["rudder"]["epsilon"] = float(f"{v:.6g}")
+    data["name"] = f"{data['name']} (identified)"
+    data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
+    head = "".join(f"# {ln}\n" for ln in note.splitlines())
+    return head + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+
+
+def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None) -> dict:
+    """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
+
+    ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
+    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given."""
+    out_dir = Path(out_dir)
+    fit = ident.fit
+    note = (f"segment-wise output error over {len(ident.runs)} records "
+            f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
+    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note))
+    a = ident.scores(model="initial")
+    b = ident.scores()
+    lines = [f"# Identification of {ident.initial.name}", "",
+             f"Records: {len(ident.runs)}; free parameters: {len(fit.free)}; last segment length "
+             f"{ident.segment_s:g} s; residuals {fit.n_residuals}; {fit.iterations} iterations ({fit.message}).", "",
+             "## Values and standard errors", "",
+             "Standard errors from the Gauss-Newton covariance scaled by the residual variance; the 10 Hz "
+             "residuals are correlated, so they are optimistic.", "",
+             "| parameter | config | identified | std | change |", "|---|---|---|---|---|"]
+    for name, row in fit.to_pandas().iterrows():
+        lines.append(f"| {name} | {row.prior:.5g} | {row.estimate:.5g} | {row['std']:.2g} | {row.change_pct:+.0f} % |")
+    names = [f.name for f in fit.free]
+    lines += ["", "## Correlations (|rho| >= 0.8)", ""]
+    strong = [(names[i], names[j], fit.corr[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
+              if np.isfinite(fit.corr[i, j]) and abs(fit.corr[i, j]) >= 0.8]
+    lines += [f"- {x} / {y}: {c:+.2f}" for x, y, c in strong] or ["- none"]
+    lines += ["", "## Training fits (open-loop replay from each record's first state)", "",
+              "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] |",
+              "|---|---|---|---|---|"]
+    for x, y in zip(a, b):
+        lines.append(f"| {x['name']} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | "
+                     f"{x['speed_rms_mps']:.3f} | {y['speed_rms_mps']:.3f} |")
+    ha, hb = np.nanmean([x["heading_rms_deg"] for x in a]), np.nanmean([y["heading_rms_deg"] for y in b])
+    lines.append(f"| **mean** | {ha:.2f} | {hb:.2f} | | |")
+    if cv:
+        lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
+                  "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]
+        for c in cv:
+            x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
+            lines.append(f"| {c['name']} | {c['fold']} | {x:.2f} | {y:.2f} | {x / y:.2f} |")
+        xa = np.nanmean([c["initial"]["heading_rms_deg"] for c in cv])
+        xb = np.nanmean([c["identified"]["heading_rms_deg"] for c in cv])
+        better = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
+        lines.append(f"| **mean** | | {xa:.2f} | {xb:.2f} | {xa / xb:.2f} |")
+        lines += ["", f"Identified better on {better} of {len(cv)} kept-out records; mean ratio {xa / xb:.2f}."]
+    (out_dir / "report.md").write_text("\n".join(lines) + "\n")
+    return {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
