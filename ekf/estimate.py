@@ -468,7 +468,7 @@ def estimate(data: TrialData, cfg: dict, engine: str = "compiled") -> Estimate:
     cfg : dict
         Estimation config (:func:`load_config`).
     engine : {"compiled", "filterpy"}
-        ``"compiled"`` (default): :func:`ekf.filter.run_filter`, the numba loop (about a second
+        ``"compiled"`` (default): :func:`ekf.filter.run_filter`, the numba loop (about half a second
         for 3000 s).  ``"filterpy"``: :class:`ekf.filterpy_ekf.AugmentedEKF` stepped in Python, the
         same predict and filterpy's Joseph-form update (about 100 x slower; the same numbers
         to rounding, ``tests/test_ekf.py``), for users who want to step or modify the filter.

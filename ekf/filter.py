@@ -31,7 +31,7 @@ Two drivers share them:
   ``ExtendedKalmanFilter`` whose ``predict`` is the compiled propagation above and whose
   ``update`` is filterpy's; convenient step by step but ~100 us/step of Python in filterpy's update.
 * :func:`run_filter`, the hot loop: the same predict kernel and the same Joseph-form
-  update written in numba, so a 3000 s pass (30 000 steps) takes about 0.4 s.
+  update written in numba, so a 3000 s pass (30 000 steps) takes about half a second.
   filterpy's update is too slow for the 2 s budget (numpy calls on 16x16 arrays
   dominate), hence this; the two drivers agree to rounding (tested).
 """
