@@ -1,10 +1,14 @@
-"""Disturbances as components shared by the simulator and the estimator.
+"""The trial-config disturbances (``disturbances.current``, ``disturbances.rudder_offset``,
+``log.bias``) as thin SI adapters over the effects of :mod:`mmg.effects`.
 
-Each component is a frozen dataclass that writes its values into the packed
-parameter vector (:mod:`mmg.model`) through :meth:`Disturbance.slots`, so the
-compiled right-hand side (used by both the simulator and the estimator's
-propagation) sees it without a second copy of the physics.  Measurement-side
-effects (sensor biases) act on logs instead, through :meth:`SensorBias.apply`.
+The physics of each is defined once, in its effect (:class:`mmg.effects.Current`,
+:class:`mmg.effects.RudderOffset`); the classes here keep the simulator's SI interface (speed in
+m/s, angles in rad) and write the effect's parameter-vector slots (:mod:`mmg.model`) through
+:meth:`Disturbance.slots`, so the compiled right-hand side (simulator and estimators) sees them
+without a second copy.  :meth:`Disturbance.effect` gives the named effect and values (the
+form the replay, :mod:`ekf.identify` and ``mmg diagnose`` use).  Sensor biases act on logs
+(:class:`SensorBias`, read by :func:`trials.logio.log_frame`); the heading part is the
+``heading_bias`` effect of a logged heading.
 
 Conventions: directions are the direction a flow goes *towards*, clockwise from
 north [rad]; forces in N and moments in N m about midship.
@@ -21,6 +25,7 @@ import math
 from dataclasses import dataclass, fields
 
 from . import model as M
+from . import effects as E
 from .errors import InputError
 from .units import MAX_CURRENT, MAX_RUDDER_OFFSET, is_finite_number
 
@@ -40,8 +45,13 @@ class Disturbance(abc.ABC):
     """A disturbance: maps to parameter-vector slots of the compiled model."""
 
     @abc.abstractmethod
+    def effect(self):
+        """(effect class, named values) of :mod:`mmg.effects`."""
+
     def slots(self) -> dict[int, float]:
-        """Parameter index -> value."""
+        """Parameter index -> value (the effect's slots)."""
+        cls, values = self.effect()
+        return cls.slots(values)
 
 
 @dataclass(frozen=True)
@@ -58,7 +68,10 @@ class UniformCurrent(Disturbance):
     def __post_init__(self):
         _check(self, {"speed": (0.0, MAX_CURRENT)})
 
-    def slots(self):
+    def effect(self):
+        return E.Current, {"speed_mps": self.speed, "direction_deg": math.degrees(self.direction)}
+
+    def slots(self):          # exact radians, no round trip through degrees
         return {M.P_CUR_SPEED: self.speed, M.P_CUR_DIR: self.direction}
 
 
@@ -70,6 +83,9 @@ class RudderOffset(Disturbance):
 
     def __post_init__(self):
         _check(self, {"offset": (-MAX_RUDDER_OFFSET, MAX_RUDDER_OFFSET)})
+
+    def effect(self):
+        return E.RudderOffset, {"offset_deg": math.degrees(self.offset)}
 
     def slots(self):
         return {M.P_RUDDER_OFFSET: self.offset}
@@ -86,6 +102,9 @@ class ConstantForce(Disturbance):
     def __post_init__(self):
         _check(self)
 
+    def effect(self):
+        raise NotImplementedError("a constant force is not a named effect; use its slots")
+
     def slots(self):
         return {M.P_EXT_X: self.X, M.P_EXT_Y: self.Y, M.P_EXT_N: self.N}
 
@@ -100,6 +119,10 @@ class SensorBias:
 
     def __post_init__(self):
         _check(self)
+
+    def effect(self):
+        """The heading part as the ``heading_bias`` effect (speed and rpm biases have no effect module)."""
+        return E.HeadingBias, {"bias_deg": math.degrees(self.heading)}
 
 
 def combine(disturbances) -> dict[int, float]:

@@ -1,0 +1,63 @@
+"""Effects as model components: named physical effects the model can be given (see :mod:`.base`).
+
+Registry: :data:`REGISTRY` maps the effect name to its class; adding an effect is one new
+module with an :class:`~mmg.effects.base.Effect` subclass plus one :func:`register` line here.
+
+========================  =============  =================================================
+name                      kind           parameters
+========================  =============  =================================================
+``current``               kinematic      ``speed_mps``, ``direction_deg`` (sets towards)
+``wind``                  force          ``scale``
+``rudder_offset``         force          ``offset_deg``
+``heading_bias``          measurement    ``bias_deg``
+``shallow_water``         coefficients   ``depth_to_draft``
+========================  =============  =================================================
+
+:func:`effect_set` builds an :class:`~mmg.effects.base.EffectSet` from a mapping such as a
+config section ``{"current": {"speed_mps": 0.05, "direction_deg": 90}, "rudder_offset": {...}}``
+(unknown effects or parameters, values out of range: :class:`mmg.errors.InputError`).
+"""
+from __future__ import annotations
+
+from ..errors import InputError
+from .base import Context, Effect, EffectSet, Parameter
+from .current import Current
+from .heading_bias import HeadingBias
+from .rudder_offset import RudderOffset
+from .shallow_water import ShallowWater
+from .wind import Wind
+
+__all__ = ["Effect", "EffectSet", "Parameter", "Context", "REGISTRY", "register", "get", "names", "effect_set",
+           "Current", "Wind", "RudderOffset", "HeadingBias", "ShallowWater"]
+
+REGISTRY: dict = {}
+
+
+def register(cls):
+    """Add an :class:`Effect` subclass to :data:`REGISTRY` under its ``name``."""
+    REGISTRY[cls.name] = cls
+    return cls
+
+
+for _c in (Current, Wind, RudderOffset, HeadingBias, ShallowWater):
+    register(_c)
+
+
+def names() -> list:
+    return list(REGISTRY)
+
+
+def get(name: str, owner: str = "effects"):
+    try:
+        return REGISTRY[name]
+    except KeyError:
+        raise InputError(owner, name, f"unknown effect; expected one of {', '.join(REGISTRY)}") from None
+
+
+def effect_set(spec=None, owner: str = "effects") -> EffectSet:
+    """An :class:`EffectSet` from ``{name: {parameter: value}}`` (a value ``None`` or ``{}``: defaults)."""
+    items = []
+    for nm, vals in dict(spec or {}).items():
+        cls = get(nm, owner)
+        items.append((cls, cls.values(vals or {}, f"{owner}.{nm}")))
+    return EffectSet(tuple(items))

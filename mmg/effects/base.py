@@ -1,0 +1,242 @@
+"""The abstract :class:`Effect`: a named physical effect the MMG model can be given.
+
+An effect is defined once here and used by the simulator (through the parameter-vector slots
+of :mod:`mmg.model`), the replay (:mod:`mmg.replay`: packed ship, external loads, measured
+states), the estimators (:mod:`ekf.identify` frees its parameters) and the discrepancy workflow
+(:mod:`trials.diagnose`).  It declares
+
+* its named parameters (:class:`Parameter`: unit, default, bounds, the prior width used when
+  it is fitted), in the units their names carry (``speed_mps``, ``direction_deg``, ...);
+* how it acts, by overriding any of
+
+  - :meth:`Effect.pack`: the packed ship with the effect in it (parameter-vector slots such as
+    the current or the rudder offset, or corrected hull coefficients for shallow water);
+  - :meth:`Effect.external`: time-dependent external loads (X, Y, N) from the record's logged
+    channels (wind from the measured relative wind);
+  - :meth:`Effect.to_model` / :meth:`Effect.to_logged`: the map between the logged states and
+    the model's states (a heading bias; a current turning over-ground velocities into
+    water-relative ones), applied to the record's states before a replay (its initial and reset
+    states) and to the replayed states before they are compared with the record;
+
+* the logged channels it needs (:attr:`Effect.channels`): a record without them skips the
+  effect with :meth:`Effect.unavailable`'s reason.
+
+The states are the replay's ``(u, v, r, x, y, psi)`` (:data:`mmg.replay.STATE`): *logged* states
+are as a record logs them (FRT-DS-ESSO: u, v over ground, in ship axes resolved in the logged
+heading; heading as logged); *model* states are the MMG state (u, v through the water, true
+heading; x, y over ground in both).
+
+Fitting: :attr:`Effect.fit_parameters` are the parameters the estimator varies (by default the
+named ones; the current is fitted in north/east components, which stay regular at zero speed)
+and :meth:`Effect.report` maps fitted values and their covariance back to the named parameters
+with standard errors (delta method).
+"""
+from __future__ import annotations
+
+import abc
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["Parameter", "Context", "Effect", "EffectSet"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A named effect parameter in the unit its name carries.
+
+    default: the value that switches the effect off (or its neutral value); lower, upper: the
+    physically allowed range; sigma: the prior standard deviation a fit uses (wide: a prior
+    that keeps a fit regular, not information); start: where a fit starts."""
+
+    name: str
+    unit: str
+    default: float
+    lower: float
+    upper: float
+    sigma: float
+    description: str = ""
+    start: float | None = None
+
+    def check(self, owner: str, value) -> float:
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise InputError(owner, self.name, f"must be a number [{self.unit}], got {value!r:.40}") from None
+        if not math.isfinite(v):
+            raise InputError(owner, self.name, f"must be a finite number [{self.unit}], got {v!r}")
+        if not self.lower <= v <= self.upper:
+            raise InputError(owner, self.name, f"{v:g} {self.unit} is outside {self.lower:g} to {self.upper:g} {self.unit}")
+        return v
+
+
+@dataclass(frozen=True)
+class Context:
+    """What an effect may read from a record besides the states: times, inputs, logged channels.
+
+    t : (N,) [s]; delta (N,) [rad]; n (N,) [rps]; channels: logged channel name -> (N,) array
+    (``wind_speed_rel`` [m/s], ``wind_dir_rel`` [rad], ...); ship: the :class:`mmg.ship.Ship`
+    (wind geometry, particulars) or None."""
+
+    t: np.ndarray
+    delta: np.ndarray
+    n: np.ndarray
+    channels: dict = field(default_factory=dict)
+    ship: object = None
+
+
+class Effect(abc.ABC):
+    """A physical effect with named parameters (module docstring).  Subclasses set the class
+    attributes and override the hooks that apply; the defaults do nothing."""
+
+    name: ClassVar[str]
+    kind: ClassVar[str]          # "force", "kinematic", "measurement" or "coefficients"
+    description: ClassVar[str]
+    parameters: ClassVar[tuple]  # of Parameter
+    channels: ClassVar[tuple] = ()
+    affects: ClassVar[tuple] = ()   # residual channels it shows in: u, v, r, heading, position
+
+    # ---------------------------------------------------------------- values
+    @classmethod
+    def defaults(cls) -> dict:
+        return {p.name: p.default for p in cls.parameters}
+
+    @classmethod
+    def values(cls, given=None, owner: str | None = None) -> dict:
+        """The named values, checked (unknown names and values out of range: InputError)."""
+        owner = owner or cls.name
+        given = dict(given or {})
+        out = cls.defaults()
+        names = {p.name: p for p in cls.parameters}
+        for k, v in given.items():
+            if k not in names:
+                raise InputError(owner, k, f"unknown parameter of {cls.name}; expected one of {', '.join(names)}")
+            out[k] = names[k].check(owner, v)
+        return out
+
+    # ---------------------------------------------------------------- fitting
+    @classmethod
+    def fit_parameters(cls) -> tuple:
+        """The parameters a fit varies (default: the named ones)."""
+        return cls.parameters
+
+    @classmethod
+    def from_fit(cls, theta) -> dict:
+        """Named values from fitted ones (identity by default)."""
+        return {p.name: float(v) for p, v in zip(cls.fit_parameters(), theta)}
+
+    @classmethod
+    def report(cls, theta, cov) -> tuple[dict, dict]:
+        """Named values and standard errors from the fitted ``theta`` and its covariance (delta
+        method, numerically)."""
+        theta = np.asarray(theta, float)
+        cov = np.atleast_2d(np.asarray(cov, float))
+        vals = cls.from_fit(theta)
+        names = list(vals)
+        f0 = np.array([vals[k] for k in names])
+        Jm = np.zeros((len(names), len(theta)))
+        for j in range(len(theta)):
+            h = 1e-7 * max(abs(theta[j]), 1e-3)
+            th = theta.copy()
+            th[j] += h
+            fj = cls.from_fit(th)
+            d = np.array([fj[k] for k in names]) - f0
+            if "direction_deg" in names:                      # wrap angle differences
+                i = names.index("direction_deg")
+                d[i] = (d[i] + 180.0) % 360.0 - 180.0
+            Jm[:, j] = d / h
+        c = Jm @ cov @ Jm.T
+        std = np.sqrt(np.abs(np.diag(c)))
+        return vals, {k: float(s) for k, s in zip(names, std)}
+
+    # ---------------------------------------------------------------- availability
+    @classmethod
+    def unavailable(cls, ctx: Context) -> str | None:
+        """Why the effect cannot be applied to this record (None when it can)."""
+        missing = [c for c in cls.channels if ctx.channels.get(c) is None]
+        if missing:
+            return f"the record has no {' / '.join(missing)} channel{'s' if len(missing) > 1 else ''}"
+        return None
+
+    # ---------------------------------------------------------------- how it acts
+    @classmethod
+    def slots(cls, values: dict) -> dict:
+        """Parameter-vector index -> value (:mod:`mmg.model`); empty by default."""
+        return {}
+
+    @classmethod
+    def pack(cls, packed, values: dict, ship=None):
+        """The packed ship with the effect in it (default: :meth:`slots` written into ``p``)."""
+        s = cls.slots(values)
+        if not s:
+            return packed
+        from dataclasses import replace
+
+        p = packed.p.copy()
+        for k, v in s.items():
+            p[k] = v
+        return replace(packed, p=p)
+
+    @classmethod
+    def external(cls, values: dict, ctx: Context):
+        """(N, 3) external loads [N, N, N m] about midship in ship axes, or None."""
+        return None
+
+    @classmethod
+    def to_model(cls, values: dict, states: np.ndarray) -> np.ndarray:
+        """Logged (N, 6) states -> model states (identity by default)."""
+        return states
+
+    @classmethod
+    def to_logged(cls, values: dict, states: np.ndarray) -> np.ndarray:
+        """Model (N, 6) states -> logged states (identity by default)."""
+        return states
+
+
+@dataclass(frozen=True)
+class EffectSet:
+    """Several effects with their values, applied together: packed ship, loads, state maps.
+
+    ``items`` is a tuple of (Effect class, values dict).  The measurement side composes in a
+    fixed order: logged -> model applies the measurement effects first (a heading bias gives the
+    true heading), then the kinematic ones (a current, resolved in the true heading); model ->
+    logged the reverse."""
+
+    items: tuple = ()
+
+    _ORDER = {"measurement": 0, "kinematic": 1, "force": 2, "coefficients": 3}
+
+    def _sorted(self):
+        return sorted(self.items, key=lambda it: self._ORDER.get(it[0].kind, 9))
+
+    def names(self) -> list:
+        return [e.name for e, _ in self.items]
+
+    def pack(self, packed, ship=None):
+        for e, v in self.items:
+            packed = e.pack(packed, v, ship)
+        return packed
+
+    def external(self, ctx: Context, base=None):
+        out = None if base is None else np.array(base, float)
+        for e, v in self.items:
+            f = e.external(v, ctx)
+            if f is not None:
+                out = f if out is None else out + f
+        return out
+
+    def to_model(self, states):
+        s = np.array(states, float)
+        for e, v in self._sorted():
+            s = e.to_model(v, s)
+        return s
+
+    def to_logged(self, states):
+        s = np.array(states, float)
+        for e, v in reversed(self._sorted()):
+            s = e.to_logged(v, s)
+        return s
