@@ -22,6 +22,8 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--wind", choices=["on", "off", "both"], default="both")
     ap.add_argument("--folds", type=int, default=4)
+    ap.add_argument("--free", nargs="+", default=None, help="free parameters (default: trials.identify.DEFAULT_FREE)")
+    ap.add_argument("--prior", type=float, default=0.5, help="prior std relative to the config value")
     a = ap.parse_args()
     d = frt_data_dir()
     if d is None:
@@ -31,7 +33,8 @@ def main() -> None:
     for wind in ([True, False] if a.wind == "both" else [a.wind == "on"]):
         runs = load_runs(ship, files, wind=wind)
         t0 = time.perf_counter()
-        cv = cross_validate(ship, runs, folds=a.folds, wind=wind,
+        extra = {"free": a.free} if a.free else {}
+        cv = cross_validate(ship, runs, folds=a.folds, wind=wind, prior_rel_std=a.prior, **extra,
                             progress=lambda k, n: print(f"  fold {k}/{n} done, {time.perf_counter() - t0:.0f} s", flush=True))
         print(f"\nwind {'on' if wind else 'off'}: {len(runs)} records, {a.folds} folds, {time.perf_counter() - t0:.0f} s")
         print(f"{'record':32s} {'initial':>8s} {'identified':>10s} {'ratio':>6s}  (heading RMS, deg)")

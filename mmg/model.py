@@ -46,9 +46,10 @@ STATE_UNITS = ("m/s", "m/s", "rad/s", "m", "m", "rad", "rad", "rps")
     N_PARAMS,
 ) = range(43)
 
-LOW_SPEED_FROUDE = 0.02
+LOW_SPEED_FROUDE = 0.01
 """Froude number below which the hull's speed scale is floored (:func:`kinematics`): U_low =
-0.02 sqrt(g L), 0.11 m/s for the 3 m model, 1.13 m/s (2.2 kn) for the 325 m ship."""
+0.01 sqrt(g L): 0.054 m/s for the 3 m model, 0.57 m/s (1.1 kn) for the 325 m ship, below the 0.75 m/s
+the Esso Osaka keeps in the steady phase of its 35 deg turn (so every full-scale trial stays above it)."""
 J_MAX = 1.2
 """Largest advance ratio the propeller polynomials are evaluated at (:func:`propeller`); beyond it
 (a propeller barely turning, n -> 0) K_T is held at K_T(J_MAX) so the thrust n^2 K_T fades to 0."""
@@ -149,7 +150,10 @@ def kinematics(u, v, r, p):
     U_h = U, beta = atan(-v/u), v' = v/U, r' = r L/U.  Below it, where beta and r' lose their
     meaning (every measured record starts at rest), the speed scale is floored smoothly,
     U_h = (U^2 + U_low^2) / (2 U_low) (equal to U, with equal slope, at U_low; U_low/2 at rest),
-    and v' = v/U_h, r' = r L/U_h, beta = atan(-v / sqrt(U_h^2 - v^2)), all bounded at U = 0.  The
+    and v' = v/U_h, r' = r L/U_h, beta = atan(-v / sqrt(U_h^2 - v^2)), all bounded at U = 0.
+    Going astern (u < 0, outside the Kijima polynomials' range) beta is atan(-v/|u|), so the sway
+    and yaw damping keep their sign, and :func:`forces_of` turns the surge force with the motion
+    (factor clip(u / U_low, -1, 1)).  The
     hull forces are the primed forces times 1/2 rho L T U U_h (:func:`hull_scales`), so they fall
     to zero at rest, the quadratic resistance turning linear in U below U_low (a laminar-like
     floor), and the manoeuvring derivatives act as linear damping there, Y = 1/2 rho L T Y_v' v U_h.
@@ -158,7 +162,8 @@ def kinematics(u, v, r, p):
     U = np.sqrt(u * u + v * v)
     ul = p[P_ULOW]
     if U.real >= ul:
-        return U, U, np.arctan(-v / u), v / U, r_prime(r, p[P_L], U)
+        au = u if u.real >= 0.0 else -u          # astern: beta of the flow along the hull, so sway stays damped
+        return U, U, np.arctan(-v / au), v / U, r_prime(r, p[P_L], U)
     Uh = (U * U + ul * ul) / (2.0 * ul)
     uh = np.sqrt(Uh * Uh - v * v)
     return U, Uh, np.arctan(-v / uh), v / Uh, r_prime(r, p[P_L], Uh)
@@ -280,6 +285,18 @@ def hull_scales(U, Uh, p):
     return fs, fs, ms
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def surge_sign(u, p):
+    """Factor on the hull's surge force: 1 for u >= U_low, u / U_low between -U_low and U_low, -1
+    below (the resistance opposes the motion astern too and is 0 at u = 0; :func:`kinematics`)."""
+    ul = p[P_ULOW]
+    if u.real >= ul:
+        return 1.0 + 0.0 * u
+    if u.real <= -ul:
+        return -1.0 + 0.0 * u
+    return u / ul
+
+
 @njit(cache=True, error_model="numpy")
 def forces(x, p, poly, hull_axis, hull_term, hull_coef):
     """Total surge and sway force [N] and yaw moment [N m] about midship, and J_P."""
@@ -296,7 +313,7 @@ def forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef):
     owp = one_minus_wake(u, beta, rp, p, poly)
     J, KT, XP = propeller(u, n, owp, p, poly)
     XR, YR, NR, FN = rudder(u, U, beta, rp, delta, n, owp, KT, p)
-    X = XHp * sX + XP + XR + p[P_EXT_X]
+    X = XHp * sX * surge_sign(u, p) + XP + XR + p[P_EXT_X]
     Y = YHp * sY + YR + p[P_EXT_Y]
     N = NHp * sN + NR + p[P_EXT_N]
     return X, Y, N, J
@@ -371,6 +388,7 @@ def hull_regressors(x, p, hull_axis, hull_term, idx, out):
     """
     U, Uh, beta, vp, rp = kinematics(x[U_], x[V_], x[R_], p)
     sX, sY, sN = hull_scales(U, Uh, p)
+    sX = sX * surge_sign(x[U_], p)
     for j in range(idx.shape[0]):
         i = idx[j]
         val = term_value(hull_term[i], beta, vp, rp)

@@ -107,7 +107,7 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
 
 
 def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | None = None, wind: bool | None = None,
-             max_nfev: int = 30, progress=None, say=_log) -> Identification:
+             max_nfev: int = 30, progress=None, say=_log, prior_rel_std: float = 0.5) -> Identification:
     """Identify ``free`` jointly over the training records (module docstring).
 
     Parameters
@@ -121,6 +121,10 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
         Segment length(s) [s] of successive fits; :data:`DEFAULT_SEGMENTS_L` when omitted.
     wind : bool, optional
         Override the ship config's wind switch.
+    max_nfev : int
+        Most iterations of each stage.
+    prior_rel_std : float
+        Prior std of each freed coefficient relative to its config value (:func:`ekf.identify.free_parameters`).
     """
     from ekf.identify import Segmented, free_parameters, identify_segments, segment_resets
 
@@ -133,7 +137,7 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     L = ship.particulars.L
     stages = DEFAULT_SEGMENTS_L if segment_s is None else np.atleast_1d(segment_s) / np.sqrt(L / 9.80665)
     packed = pack(ship)
-    fp = free_parameters(packed, ship.hull.names, _free_names(ship, free))
+    fp = free_parameters(packed, ship.hull.names, _free_names(ship, free), prior_rel_std)
     fit = None
     for k, st in enumerate(stages):
         seg = float(st) * float(np.sqrt(L / 9.80665))
