@@ -16,6 +16,15 @@ the ship constants ``"w_P0"`` (the constant term of the wake polynomial: the mod
 ``"epsilon"`` (rudder inflow ratio) and ``"X_uu"`` is simply a hull name.  The standard errors
 are from the Gauss-Newton covariance at the optimum, scaled by the residual variance per
 degree of freedom; correlated residuals (10 Hz samples are not independent) make them optimistic.
+
+Effects (:mod:`mmg.effects`): ``identify_segments(..., effects=[Current, ...], ship=ship)`` adds
+named effects to the model; their fit parameters are free parameters of kind ``"effect"``
+(:func:`effect_parameters`; ``index`` the effect's position in ``effects``, ``sub`` the
+parameter's), fitted with the ship's.  Each record's replay then uses the packed ship with the
+effects in it, their external loads (from the record's logged channels, ``Segmented.context``),
+starts and restarts from the model states of the logged ones and is compared in logged states
+(:class:`mmg.effects.EffectSet`).  ``Scales.pos`` [m] adds the position residuals (x, y) to the
+fit; without effects and ``pos`` the fit is the one above, bit for bit.
 """
 from __future__ import annotations
 
@@ -29,7 +38,8 @@ from mmg.model import P_EPS, POLY_WP0, PackedShip
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
-           "segment_resets", "identify_segments", "SHIP_CONSTANTS"]
+           "segment_resets", "identify_segments", "SHIP_CONSTANTS", "effect_parameters", "effect_set_of",
+           "predict_logged"]
 
 SHIP_CONSTANTS = ("w_P0", "epsilon")
 """Ship constants besides the hull coefficients that :func:`free_parameters` can free."""
@@ -43,6 +53,8 @@ class Segmented:
     meas: np.ndarray
     inputs: ReplayInputs
     reset: np.ndarray
+    context: object = None
+    """:class:`mmg.effects.Context` of the record (logged channels the effects read), or None."""
 
 
 @dataclass(frozen=True)
@@ -53,6 +65,8 @@ class Scales:
     v: float
     r: float
     psi: float
+    pos: float | None = None
+    """Position scale [m]: x, y residuals are added when given."""
 
     def array(self) -> np.ndarray:
         return np.array([self.u, self.v, self.r, self.psi])
@@ -69,6 +83,8 @@ class FreeParameter:
     sigma: float
     lower: float = -np.inf
     upper: float = np.inf
+    sub: int = 0
+    """For kind ``"effect"``: the parameter's position in the effect's ``fit_parameters()``."""
 
 
 def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float = 0.5) -> list[FreeParameter]:
@@ -102,9 +118,53 @@ def apply_parameters(packed: PackedShip, free: list[FreeParameter], theta) -> Pa
             coef[f.index] = v
         elif f.kind == "w_P0":
             poly[POLY_WP0][0] = v
+        elif f.kind == "effect":
+            continue                                  # applied by effect_set_of
         else:
             p[f.index] = v
     return replace(packed, p=p, poly=poly, hull_coef=coef)
+
+
+def effect_parameters(effects) -> list[FreeParameter]:
+    """Free parameters (kind ``"effect"``, named ``"<effect>.<parameter>"``) of every fit parameter
+    of ``effects`` (:mod:`mmg.effects` classes), priors at the parameters' neutral values."""
+    out = []
+    for i, e in enumerate(effects):
+        for j, q in enumerate(e.fit_parameters()):
+            out.append(FreeParameter(f"{e.name}.{q.name}", "effect", i, float(q.default), float(q.sigma),
+                                     float(q.lower), float(q.upper), sub=j))
+    return out
+
+
+def effect_set_of(effects, free: list[FreeParameter], theta):
+    """The :class:`mmg.effects.EffectSet` of ``effects`` at the fitted values ``theta`` (effect
+    parameters not in ``free`` at their fit-parameter defaults)."""
+    from mmg.effects import EffectSet
+
+    items = []
+    for i, e in enumerate(effects or ()):
+        fp = e.fit_parameters()
+        vec = [q.default for q in fp]
+        for f, v in zip(free, theta):
+            if f.kind == "effect" and f.index == i:
+                vec[f.sub] = float(v)
+        items.append((e, e.from_fit(vec)))
+    return EffectSet(tuple(items))
+
+
+def predict_logged(packed: PackedShip, rec: Segmented, effects=None, free=(), theta=(), ship=None) -> np.ndarray:
+    """The replayed states of ``rec`` (segments as in ``rec.reset``) as the record logs them:
+    (N, 6) u, v, r, x, y, psi with the ship parameters and effects at ``theta``."""
+    pk = apply_parameters(packed, list(free), theta) if len(free) else packed
+    if not effects:
+        return replay_states(pk, rec.inputs, rec.meas[0], meas=rec.meas, reset=rec.reset)
+    es = effect_set_of(effects, list(free), theta)
+    pk = es.pack(pk, ship)
+    ext = es.external(rec.context, base=rec.inputs.ext)
+    inputs = replace(rec.inputs, ext=ext) if ext is not None else rec.inputs
+    mm = es.to_model(rec.meas)
+    pred = replay_states(pk, inputs, mm[0], meas=mm, reset=rec.reset)
+    return es.to_logged(pred)
 
 
 def segment_resets(t: np.ndarray, segment_s: float) -> np.ndarray:
@@ -118,9 +178,16 @@ def segment_resets(t: np.ndarray, segment_s: float) -> np.ndarray:
     return reset
 
 
-def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int) -> np.ndarray:
-    pred = replay_states(packed, rec.inputs, rec.meas[0], meas=rec.meas, reset=rec.reset)
-    d = (pred[::stride] - rec.meas[::stride])[:, [0, 1, 2, 5]] / sc
+def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=None, free=(), theta=(),
+                  ship=None, pos=None) -> np.ndarray:
+    if effects:
+        pred = predict_logged(packed, rec, effects, free, theta, ship)
+    else:
+        pred = replay_states(packed, rec.inputs, rec.meas[0], meas=rec.meas, reset=rec.reset)
+    diff = pred[::stride] - rec.meas[::stride]
+    d = diff[:, [0, 1, 2, 5]] / sc
+    if pos is not None:
+        d = np.column_stack([d, diff[:, [3, 4]] / pos])
     d[~np.isfinite(d)] = 1e3                          # a diverged segment: a large, finite misfit
     return d.ravel()
 
@@ -155,7 +222,7 @@ class IdentifyResult:
 
 def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
                       stride: int = 2, n_jobs: int | None = None, max_nfev: int = 40, progress=None,
-                      start=None) -> IdentifyResult:
+                      start=None, effects=None, ship=None) -> IdentifyResult:
     """Fit ``free`` jointly over ``records`` (module docstring).
 
     Parameters
@@ -176,6 +243,11 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
         Starting values (a previous fit's); the priors when omitted.
     progress : callable, optional
         ``progress(iteration, cost)`` after each Jacobian.
+    effects : list of mmg.effects classes, optional
+        Effects in the model; their parameters are the ``free`` ones of kind ``"effect"``
+        (:func:`effect_parameters`).
+    ship : mmg.ship.Ship, optional
+        The ship (coefficient effects such as ``shallow_water`` need its particulars).
     """
     from scipy.optimize import least_squares
 
@@ -185,9 +257,13 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
     n_jobs = n_jobs or os.cpu_count() or 1
     pool = ThreadPoolExecutor(max_workers=n_jobs)
 
-    def resid(theta):
+    pos = scales.pos
+    by_columns = effects is not None or pos is not None      # few records: the columns in parallel
+
+    def resid(theta, parallel=True):
         pk = apply_parameters(packed, free, theta)
-        parts = list(pool.map(lambda rec: _residual_one(pk, rec, sc, stride), records))
+        one = lambda rec: _residual_one(pk, rec, sc, stride, effects, free, theta, ship, pos)  # noqa: E731
+        parts = list(pool.map(one, records)) if parallel else [one(rec) for rec in records]
         return np.concatenate(parts + [(theta - theta0) / sig0])
 
     count = [0]
@@ -195,13 +271,18 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
     def jac(theta):
         r0 = resid(theta)
         h = 1e-6 * np.maximum(np.abs(theta), sig0)
-        cols = []
+        steps = []
         for j in range(len(theta)):
             th = theta.copy()
             if th[j] + h[j] > free[j].upper:                 # at an upper bound: step down
                 h[j] = -h[j]
             th[j] += h[j]
-            cols.append((resid(th) - r0) / h[j])
+            steps.append(th)
+        if by_columns:
+            res = list(pool.map(lambda th: resid(th, parallel=False), steps))
+        else:
+            res = [resid(th) for th in steps]
+        cols = [(rj - r0) / h[j] for j, rj in enumerate(res)]
         count[0] += 1
         if progress:
             progress(count[0], 0.5 * float(r0 @ r0))
