@@ -424,7 +424,7 @@ def cmd_identify(args) -> int:
     from .output import StagedOutput, check_output_dir
 
     check_output_dir(args.out)
-    for log in args.train:
+    for log in args.train + (args.test or []):
         if not Path(log).is_file():
             raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
     src = ship_path(args.ship)
@@ -445,8 +445,9 @@ def cmd_identify(args) -> int:
         cv = cross_validate(ship, runs, folds=args.cv, wind=wind,
                             progress=lambda k, n: print(f"cross-validation fold {k}/{n} ({time.perf_counter() - t0:.0f} s)",
                                                         file=sys.stderr, flush=True))
+    tests = load_runs(ship, args.test, wind=wind) if args.test else None
     with StagedOutput(args.out) as stage:
-        write_identification(ident, src, stage.dir, cv)
+        write_identification(ident, src, stage.dir, cv, tests)
     a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
     b = np.mean([x["heading_rms_deg"] for x in ident.scores()])
     print(f"identified {len(ident.fit.free)} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
@@ -591,6 +592,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="wind loads from the measured relative wind (default: as the ship config says)")
     p.add_argument("--cv", type=_whole(2, "--cv"), default=None, metavar="FOLDS",
                    help="also cross-validate in FOLDS folds (each record kept out once) and report it")
+    p.add_argument("--test", nargs="+", default=None, metavar="LOG",
+                   help="records never trained on, predicted with the initial and the identified model in the report")
     p.set_defaults(func=cmd_identify)
     return ap
 

@@ -92,6 +92,38 @@ class Identification:
         return [{"name": r.name, **replay_record(ship, r).scores()} for r in (runs or self.runs)]
 
 
+METRIC_COLUMNS = (("advance_L", "advance [L]"), ("tactical_diameter_L", "tactical diameter [L]"),
+                  ("overshoots_deg", "overshoots [deg]"))
+
+
+def manoeuvre_metrics(rep) -> tuple[dict | None, dict | None]:
+    """Turning / zigzag metrics (:func:`trials.metrics.record_metrics`) of the measured record and of
+    its replay (a :class:`trials.predict.Replayed`); ``None`` where the record is neither manoeuvre."""
+    from .metrics import record_metrics
+    from .records import TrialRecord
+
+    run = rep.run
+    out = []
+    for s in (run.meas, rep.pred):
+        rec = TrialRecord(t=run.t, name=run.name, source=run.source, x=s[:, 3], y=s[:, 4], psi=s[:, 5],
+                          u=s[:, 0], v=s[:, 1], r=s[:, 2], U=np.hypot(s[:, 0], s[:, 1]), delta=run.inputs.delta,
+                          n=run.inputs.n, meta={"length_m": rep.L})
+        try:
+            out.append(record_metrics(rec) if np.all(np.isfinite(s)) else None)
+        except (InputError, ValueError):
+            out.append(None)
+    return out[0], out[1]
+
+
+def _fmt_metric(m: dict | None, key: str) -> str:
+    if m is None or m.get(key) is None:
+        return "-"
+    v = m[key]
+    if isinstance(v, (list, tuple)):
+        return ", ".join(f"{x:.1f}" for x in v[:3]) if len(v) else "-"
+    return f"{v:.2f}" if np.isfinite(v) else "-"
+
+
 def _ship_with(ship: Ship, values: dict) -> Ship:
     from dataclasses import replace
 
@@ -184,11 +216,12 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
     return head + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
 
 
-def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None) -> dict:
+def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
     """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
 
     ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
-    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given."""
+    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given;
+    ``test_runs`` (records never trained on) are predicted with both models and reported."""
     out_dir = Path(out_dir)
     fit = ident.fit
     note = (f"segment-wise output error over {len(ident.runs)} records "
@@ -218,6 +251,24 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
                      f"{x['speed_rms_mps']:.3f} | {y['speed_rms_mps']:.3f} |")
     ha, hb = np.nanmean([x["heading_rms_deg"] for x in a]), np.nanmean([y["heading_rms_deg"] for y in b])
     lines.append(f"| **mean** | {ha:.2f} | {hb:.2f} | | |")
+    lines += ["", "## Manoeuvre metrics: measured, initial model, identified model", "",
+              "From each record and from its open-loop replays (same inputs); '-' where the record or the "
+              "replay is not a complete turn / zigzag.", "",
+              "| record | " + " | ".join(f"{h} meas / init / ident" for _, h in METRIC_COLUMNS) + " |",
+              "|---|" + "---|" * len(METRIC_COLUMNS)]
+    for r in ident.runs:
+        m0, mi = manoeuvre_metrics(replay_record(ident.initial, r))
+        _, mf = manoeuvre_metrics(replay_record(ident.ship, r))
+        lines.append(f"| {r.name} | " + " | ".join(f"{_fmt_metric(m0, k)} / {_fmt_metric(mi, k)} / {_fmt_metric(mf, k)}"
+                                                    for k, _ in METRIC_COLUMNS) + " |")
+    if test_runs:
+        lines += ["", "## Predictions of records never trained on", "",
+                  "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
+                  "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
+        for r in test_runs:
+            x, y = replay_record(ident.initial, r).scores(), replay_record(ident.ship, r).scores()
+            lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
+                         f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
     if cv:
         lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
                   "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]

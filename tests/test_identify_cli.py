@@ -1,0 +1,63 @@
+"""mmg identify end to end on slices of real records: DIR/ship.yaml is a ship config every command
+takes (mmg simulate through a trial file naming it, mmg predict), and mmg predict with it gives
+the report's numbers (issue 11, acceptance 3)."""
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from trials.cli import main
+
+from .conftest import FRT, needs_frt
+
+pytestmark = needs_frt()
+
+
+def _slice(src, dst, seconds):
+    lines = src.read_text().splitlines()
+    keep = [lines[0]] + [ln for ln in lines[1:] if ln.strip() and float(ln.split(",")[0]) <= seconds]
+    dst.write_text("\n".join(keep) + "\n")
+    return dst
+
+
+@pytest.fixture(scope="module")
+def identified(tmp_path_factory):
+    d = tmp_path_factory.mktemp("ident")
+    a = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv", d / "zz.csv", 90.0)
+    b = _slice(FRT / "turning" / "turn_14-Sep-2020_13_51_45.csv", d / "turn.csv", 90.0)
+    out = d / "out"
+    assert main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--out", str(out),
+                 "--wind", "on"]) == 0
+    return d, out, (a, b)
+
+
+def test_report_and_ship_written(identified):
+    _, out, _ = identified
+    assert sorted(p.name for p in out.iterdir()) == ["report.md", "ship.yaml"]
+    rep = (out / "report.md").read_text()
+    for section in ("Values and standard errors", "Correlations", "Training fits", "Manoeuvre metrics"):
+        assert section in rep
+
+
+def test_predict_with_the_identified_ship_gives_the_reports_numbers(identified, tmp_path):
+    d, out, logs = identified
+    js = tmp_path / "p.json"
+    assert main(["predict", "--ship", str(out / "ship.yaml"), *map(str, logs), "--json", str(js), "--wind", "on"]) == 0
+    runs = json.loads(js.read_text())["runs"]
+    rep = (out / "report.md").read_text()
+    for r, log in zip(runs, logs):
+        row = re.search(rf"^\| {log.stem} \| ([0-9.]+) \| ([0-9.]+) \|", rep, re.M)
+        assert row, log.stem
+        assert f"{r['heading_rms_deg']:.2f}" == row.group(2)          # identified model's heading RMS
+
+
+def test_simulate_accepts_the_identified_ship(identified, tmp_path):
+    _, out, _ = identified
+    trial = tmp_path / "turn.yaml"
+    trial.write_text(f"name: T35\nship: {out / 'ship.yaml'}\napproach: {{speed: 0.9 kn, rpm: solve}}\n"
+                     "duration: 60 s\ndt: 0.1 s\nmanoeuvre: {kind: turning, rudder: 35 deg}\n")
+    assert main(["simulate", str(trial), "--out", str(tmp_path / "sim")]) == 0
+    m = json.loads((tmp_path / "sim" / "metrics.json").read_text())
+    assert m["ship"].endswith("(identified)")
