@@ -144,7 +144,9 @@ class Effect(abc.ABC):
             th = theta.copy()
             th[j] += h
             fj = cls.from_fit(th)
-            d = np.array([fj[k] for k in names]) - f0
+            with np.errstate(invalid="ignore"):
+                d = np.array([fj[k] for k in names]) - f0
+            d[~np.isfinite(d)] = 0.0
             if "direction_deg" in names:                      # wrap angle differences
                 i = names.index("direction_deg")
                 d[i] = (d[i] + 180.0) % 360.0 - 180.0
