@@ -230,9 +230,6 @@ def test_bad_records_are_refused_in_one_line(case, tmp_path, capsys):
 
 
 @needs_frt
-@pytest.mark.xfail(strict=True, reason="the FRT reader only bounds wind speeds by 60 m/s: a relative wind in km/h "
-                                       "(x 3.6, ~7 here) passes; it could be checked against the true wind, ship velocity "
-                                       "and heading (mmg.wind.true_wind_from_relative), which the file also logs")
 def test_wind_speed_in_kmh_is_refused(tmp_path, capsys):
     bad = _slice(FRT / ZIGZAG, tmp_path / "kmh.csv",
                  edit=lambda df: df.__setitem__("wind_velo_relative_mid [m/s]", df["wind_velo_relative_mid [m/s]"] * 3.6))

@@ -56,11 +56,10 @@ from mmg.errors import InputError
 from mmg.limits import MAX_SAMPLES, MAX_STEPS
 from mmg.units import DEG, KNOT, M_PER_DEG_LAT, M_PER_DEG_LON
 
+from .logwrite import (FLOAT_FORMAT, LOG_COLUMNS, TRUTH_COLUMNS, formattable, header, log_columns,  # noqa: F401
+                       truth_columns, write_table)
 from .records import TrialRecord
 
-LOG_COLUMNS = ("time_s", "lat_deg", "lon_deg", "heading_deg", "speed_kn", "rpm")
-TRUTH_COLUMNS = ("time_s", "u_mps", "v_mps", "r_radps", "delta_rad", "delta_order_rad",
-                 "x_m", "y_m", "psi_rad", "n_rps")
 FRT_COLUMNS = {"t [s]": "t", "x_position_mid [m]": "x", "y_position_mid [m]": "y",
                "u_velo [m/s]": "u", "vm_velo [m/s]": "v", "psi_hat [rad]": "psi",
                "r_angvelo [rad/s]": "r", "n_prop [rps]": "n", "delta_rudder [rad]": "delta",
@@ -72,9 +71,10 @@ FRT_REQUIRED = ("t [s]", "x_position_mid [m]", "y_position_mid [m]", "psi_hat [r
 
 
 # --------------------------------------------------------------------------- writing
+# (the columns and their printing live in trials.logwrite, which needs no pandas)
 
 def _header(meta: dict) -> str:
-    return "".join(f"# {k}: {v}\n" for k, v in meta.items())
+    return header(meta)
 
 
 def log_frame(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None) -> pd.DataFrame:
@@ -90,31 +90,20 @@ def log_frame(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None
     rng : numpy Generator, optional
         Defaults to ``np.random.default_rng(spec.seed)``.
     """
-    rng = np.random.default_rng(spec.seed) if rng is None else rng
-    step = int(round(spec.interval / (t[1] - t[0])))
-    sel = slice(0, len(t), step)
-    ts = t[sel]
-    k = len(ts)
-
-    def noise(level):
-        return rng.uniform(-level, level, k) if level > 0 else np.zeros(k)
-
-    lat = np.degrees(spec.start_lat) + x[sel] / M_PER_DEG_LAT + noise(np.degrees(spec.noise_lat))
-    lon = np.degrees(spec.start_lon) + y[sel] / M_PER_DEG_LON + noise(np.degrees(spec.noise_lon))
-    b = spec.bias
-    hdg = np.mod(np.degrees(psi[sel] + b.heading) + noise(np.degrees(spec.noise_heading)), 360.0)
-    spd = (sog[sel] + b.speed) / KNOT + noise(spec.noise_speed / KNOT)
-    rpm = (n[sel] + b.rpm) * 60.0 + noise(spec.noise_rpm * 60.0)
-    return pd.DataFrame({"time_s": ts, "lat_deg": lat, "lon_deg": lon, "heading_deg": hdg,
-                         "speed_kn": spd, "rpm": rpm})
-
-
-FLOAT_FORMAT = "%.12g"
-"""How the log and truth files print numbers (12 significant digits)."""
+    return pd.DataFrame(log_columns(t, x, y, psi, sog, n, spec, rng))
 
 
 def write_csv(path: Path, df: pd.DataFrame, meta: dict) -> None:
-    """Write a DataFrame with a ``# key: value`` metadata header."""
+    """Write a DataFrame with a ``# key: value`` metadata header.
+
+    Float tables without NaN are printed by :func:`trials.logwrite.format_table` (the same bytes
+    as ``to_csv``, faster); anything else by pandas.
+    """
+    if df.columns.is_unique and all(isinstance(c, str) for c in df.columns):
+        cols = {c: df[c].to_numpy() for c in df.columns}
+        if formattable(cols):
+            write_table(path, cols, meta)
+            return
     with open(path, "w") as fh:
         fh.write(_header(meta))
         df.to_csv(fh, index=False, float_format=FLOAT_FORMAT)
@@ -132,11 +121,7 @@ def as_written(df: pd.DataFrame) -> pd.DataFrame:
 
 def truth_frame(t, states, orders) -> pd.DataFrame:
     """States at the integration step as the truth-file table."""
-    return pd.DataFrame({
-        "time_s": t, "u_mps": states[:, 0], "v_mps": states[:, 1], "r_radps": states[:, 2],
-        "delta_rad": states[:, 6], "delta_order_rad": orders, "x_m": states[:, 3],
-        "y_m": states[:, 4], "psi_rad": states[:, 5], "n_rps": states[:, 7],
-    })
+    return pd.DataFrame(truth_columns(t, states, orders))
 
 
 # --------------------------------------------------------------------------- reading
@@ -611,6 +596,40 @@ def _check_rps(tab: _Table, col: str, n: np.ndarray, unit: str = "rps", factor: 
                                        f"(at most {MAX_RPS * factor:g} {unit}){hint}")
 
 
+WIND_KMH = 3.6
+"""km/h per m/s: the wrong unit a wind-speed column is most likely in."""
+
+
+def _check_wind_consistency(tab: _Table, a: dict, psi: np.ndarray) -> None:
+    """Relative and true wind against each other: the true wind follows from the relative wind, the
+    ship's u, v and heading (:func:`mmg.wind.true_wind_from_relative`; 3e-4 m/s RMS in the dataset).
+    A speed column off by the factor 3.6 (km/h) or 1.944 (knots) is named; all-zero wind columns pass."""
+    need = ("wind_speed_rel", "wind_dir_rel", "wind_speed_true", "u", "v")
+    if not all(k in a for k in need):
+        return
+    Vr, Vt = a["wind_speed_rel"], a["wind_speed_true"]
+    if not (np.any(Vr > 0) and np.any(Vt > 0)):
+        return
+    from mmg.wind import true_wind_from_relative
+
+    def miss(scale_rel, scale_true):
+        calc, _ = true_wind_from_relative(Vr / scale_rel, a["wind_dir_rel"], a["u"], a["v"], psi)
+        return float(np.median(np.abs(calc - Vt / scale_true)))
+
+    tol = 0.1 + 0.1 * float(np.median(Vt))
+    if miss(1.0, 1.0) <= tol:
+        return
+    for f, unit in ((WIND_KMH, "km/h"), (1.0 / KNOT, "kn")):
+        if miss(f, 1.0) <= tol:
+            raise InputError(tab.src, "wind_velo_relative_mid [m/s]", f"the relative wind does not give the logged true "
+                                      f"wind unless divided by {f:.4g}: in {unit}, not m/s?")
+        if miss(1.0, f) <= tol:
+            raise InputError(tab.src, "wind_velo_true [m/s]", f"the true wind does not follow from the relative wind, "
+                                      f"speed and heading unless divided by {f:.4g}: in {unit}, not m/s?")
+    raise InputError(tab.src, "wind_velo_relative_mid [m/s]", f"relative and true wind disagree (median "
+                              f"{miss(1.0, 1.0):.3g} m/s): not the dataset's conventions or units")
+
+
 def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> TrialRecord:
     df = tab.df
     tab.require(FRT_REQUIRED)
@@ -648,6 +667,7 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
             m = float(np.max(np.abs(w)))
             if m > 2 * np.pi + 0.01:
                 raise InputError(src, col, f"wind direction {m:.4g} is not radians (|value| <= 2 pi){_angle_hint(m, 360)}")
+    _check_wind_consistency(tab, a, psi)
     u, v = a.get("u"), a.get("v")
     U = np.hypot(u, v) if u is not None and v is not None else None
     _check_track(tab, "x_position_mid [m], y_position_mid [m]", t, a["x"], a["y"], L)
