@@ -29,6 +29,7 @@ log-filter    raw-log EKF Monte Carlo                   (:func:`trials.montecarl
 output-error  joint output-error Monte Carlo            (:func:`trials.montecarlo.output_error_monte_carlo`)
 identify      identify a ship model from records        (:func:`trials.identify.identify`)
 predict       replay records against their own inputs   (:func:`trials.predict.predict`)
+diagnose      name the effect the model is missing      (:func:`trials.diagnose.diagnose`)
 """
 from __future__ import annotations
 
@@ -456,6 +457,81 @@ def cmd_identify(args) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- diagnose
+
+
+def cmd_diagnose(args) -> int:
+    from contextlib import nullcontext
+
+    from mmg.resources import ship_path
+    from mmg.ship import load_ship
+
+    from .diagnose import diagnose, prepare
+    from .output import StagedFile, StagedOutput, check_output_dir, check_output_file, dumps_json
+
+    check_output_file(args.json)
+    if args.plots:
+        check_output_dir(args.plots, "--plots")
+    if args.out_ship:
+        check_output_file(args.out_ship, "--out-ship")
+    for log in args.logs:
+        if not Path(log).is_file():
+            raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
+    src = ship_path(args.ship)
+    ship = load_ship(src)
+    wind = False if args.wind is None else args.wind == "on"
+    recs = prepare(ship, args.logs, wind=wind)           # every record read (a bad one: one line) first
+    say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
+    d = diagnose(ship, recs, wind=wind, per_run=len(recs) > 1, say=say)
+    j = d.to_json()
+    b, a = d.rms_before, d.rms_after
+    print(f"named: {', '.join(d.named) or 'nothing'}" + "".join(
+        f"; {e} " + ", ".join(f"{k} {v:.4g} +- {d.standard_errors[e][k]:.2g}" for k, v in p.items())
+        for e, p in d.parameters.items()))
+    print("residual RMS before -> after: " + ", ".join(f"{c} {b[c]:.3g} -> {a[c]:.3g}" for c in b))
+    if d.unexplained:
+        print(f"unexplained: {d.unexplained_description}")
+    text = dumps_json(j)
+    ship_text = None
+    if args.out_ship:
+        from .identify import ship_yaml
+
+        note = (f"mmg diagnose over {len(recs)} record(s): named {', '.join(d.named) or 'nothing'}; "
+                + "; ".join(f"{e} " + ", ".join(f"{k} = {v:.4g}" for k, v in p.items()) for e, p in d.parameters.items())
+                + ". Effects of the environment or the sensors (current, rudder_offset, heading_bias) belong to the "
+                  "trial/record, not the ship: switch them on in a trial config (disturbances.current, "
+                  "disturbances.rudder_offset, log.bias.heading)")
+        ship_text = ship_yaml(src, d.ship_values, note)
+        if "wind" in d.parameters:
+            import yaml
+
+            head, body = [], []
+            for ln in ship_text.splitlines(keepends=True):
+                (head if ln.startswith("#") and not body else body).append(ln)
+            data = yaml.safe_load("".join(body))
+            if data.get("wind") is not None:
+                data["wind"]["enabled"] = True
+                data["wind"]["scale"] = float(f"{d.parameters['wind']['scale']:.4g}")
+            ship_text = "".join(head) + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+    with StagedFile(args.json) as tmp:
+        with StagedFile(args.out_ship) if args.out_ship else nullcontext() as tship:
+            with StagedOutput(args.plots) if args.plots else nullcontext() as stage:
+                if args.plots:
+                    from .diagnose_plots import diagnose_figure
+
+                    seen: dict = {}
+                    for i, r in enumerate(d.records):
+                        base = str(r.name or "run").replace(os.sep, "_").replace("/", "_")
+                        k = seen[base] = seen.get(base, 0) + 1
+                        diagnose_figure(d, i).savefig(stage.path(f"{base}.png" if k == 1 else f"{base}_{k}.png"))
+            if tship is not None:
+                tship.write_text(ship_text)
+        tmp.write_text(text)
+    print(f"wrote {args.json}" + (f", {args.out_ship}" if args.out_ship else "") +
+          (f" and {len(d.records)} plot(s) to {args.plots}" if args.plots else ""))
+    return 0
+
+
 # --------------------------------------------------------------------------- parser
 
 
@@ -595,6 +671,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--test", nargs="+", default=None, metavar="LOG",
                    help="records never trained on, predicted with the initial and the identified model in the report")
     p.set_defaults(func=cmd_identify)
+
+    p = sub.add_parser("diagnose", help="find where the model and the records disagree, name the missing effect "
+                                        "(current, wind, rudder_offset, heading_bias, shallow_water) and show the gap shrink")
+    p.add_argument("logs", nargs="+", metavar="LOG", help="FRT-DS-ESSO CSVs, project logs or truth files")
+    p.add_argument("--ship", required=True, help="ship YAML or bundled name (esso_osaka_3m, esso_osaka, ...)")
+    p.add_argument("--json", required=True, help="write the diagnosis to this JSON file")
+    p.add_argument("--plots", default=None, metavar="DIR", help="also one figure per record, DIR/<name>.png")
+    p.add_argument("--out-ship", default=None, metavar="NEW.yaml", help="write the ship config with the fitted "
+                                                                        "coefficients (and a named wind scale)")
+    p.add_argument("--wind", choices=("on", "off"), default=None,
+                   help="wind loads in the model from the start (default off: wind is then a candidate effect)")
+    p.set_defaults(func=cmd_diagnose)
     return ap
 
 
