@@ -363,8 +363,8 @@ def diagnose(ship: Ship, items, wind: bool | None = False, candidates=None, segm
     segment_s : float, optional
         Segment length [s] (default 52 sqrt(L/g)).
     stride : int, optional
-        Use every ``stride``-th sample in the fits (default: about 2 samples per second of
-        sqrt(L/g)-time: 1 s at full scale, 0.2 s for the 3 m model, at least 1).
+        Use every ``stride``-th sample in the fits (default: samples 0.36 sqrt(L/g) apart, 0.2 s
+        for the 3 m model, 2 s at 325 m; at least 1).
     per_run : bool
         With several records, also diagnose each alone (``runs``).
     """
@@ -383,7 +383,7 @@ def diagnose(ship: Ship, items, wind: bool | None = False, candidates=None, segm
     packed = pack(ship)
     if stride is None:
         dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
-        stride = max(1, int(round(0.066 * math.sqrt(L / 9.80665) / dt)))
+        stride = max(1, int(round(0.36 * math.sqrt(L / 9.80665) / dt)))
     U = float(np.median(np.concatenate([np.hypot(r.seg.meas[:, 0], r.seg.meas[:, 1]) for r in recs])))
     U = max(U, 0.05 * math.sqrt(9.80665 * L))
     noise = np.median(np.vstack([_noise(r.seg.meas) for r in recs]), axis=0)
@@ -544,7 +544,7 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
         states = replay_states(pk, ReplayInputs(t, delta, n), s0)
     lg = es.to_logged(states)
     rng = np.random.default_rng(seed)
-    sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 0.0005 * U0 / L * 10, 0.002 * L,
+    sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(9.80665 / L), 0.002 * L,
                                                     0.002 * L, math.radians(0.05)])
     lg = lg + rng.standard_normal(lg.shape) * sd
     return TrialRecord(t=t, name=name or f"synthetic_{kind}", source=name or f"synthetic_{kind}",
