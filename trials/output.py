@@ -592,16 +592,18 @@ def fmt(v, nd: int = 4) -> str:
 
 def write_trial_outputs(run, stage, show: bool = False) -> dict:
     """log.csv, truth.csv, metrics.json, track.png, histories.png of one simulated trial; returns the metrics."""
-    from .logio import write_csv
+    from .logwrite import log_columns, truth_columns, write_table
     from .plots import plot_histories, plot_track
 
     stage = out_path(stage)
     meta = run.log_meta()
-    write_csv(stage.path("log.csv"), run.log(), meta)
-    write_csv(stage.path("truth.csv"), run.truth(), meta)
+    r = run.result
+    # the columns of run.log() and run.truth(), written without building DataFrames (no pandas import)
+    write_table(stage.path("log.csv"), log_columns(r.t, r.x, r.y, r.psi, run.sog, r.n, run.trial.log), meta)
+    write_table(stage.path("truth.csv"), truth_columns(r.t, r.states, r.orders), meta)
     m = run.metrics()
     dump_json(m, stage.path("metrics.json"))
-    r, sh = run.result, run.trial.ship.particulars
+    sh = run.trial.ship.particulars
     plot_track(r.t, r.x, r.y, r.psi, sh.L, sh.B, f"{run.trial.name} ({run.trial.ship.name})", stage.path("track.png"), show=show)
     plot_histories(r.t, r.psi, r.delta, r.r, r.U, r.n, f"{run.trial.name} ({run.trial.ship.name})",
                    stage.path("histories.png"), delta_order=r.orders, show=show)
