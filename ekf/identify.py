@@ -41,7 +41,7 @@ __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_param
            "segment_resets", "identify_segments", "SHIP_CONSTANTS", "effect_parameters", "effect_set_of",
            "predict_logged"]
 
-SHIP_CONSTANTS = ("w_P0", "epsilon")
+SHIP_CONSTANTS = ("w_P0", "epsilon", "wind_scale")
 """Ship constants besides the hull coefficients that :func:`free_parameters` can free."""
 
 
@@ -105,6 +105,8 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
         elif nm == "epsilon":
             v = float(packed.p[P_EPS])
             out.append(FreeParameter(nm, "epsilon", P_EPS, v, prior_rel_std * v, 0.3, 3.0))
+        elif nm == "wind_scale":                         # factor on the records' external (wind) loads
+            out.append(FreeParameter(nm, "wind_scale", 0, 1.0, 0.5, 0.0, 3.0))
         else:
             raise KeyError(f"unknown parameter {nm!r}: not a hull coefficient of the ship nor one of {SHIP_CONSTANTS}")
     return out
@@ -118,8 +120,8 @@ def apply_parameters(packed: PackedShip, free: list[FreeParameter], theta) -> Pa
             coef[f.index] = v
         elif f.kind == "w_P0":
             poly[POLY_WP0][0] = v
-        elif f.kind == "effect":
-            continue                                  # applied by effect_set_of
+        elif f.kind in ("effect", "wind_scale"):
+            continue                                  # applied by effect_set_of / to the records' loads
         else:
             p[f.index] = v
     return replace(packed, p=p, poly=poly, hull_coef=coef)
@@ -178,8 +180,16 @@ def segment_resets(t: np.ndarray, segment_s: float) -> np.ndarray:
     return reset
 
 
+def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
+    for f, v in zip(free, theta):
+        if f.kind == "wind_scale" and rec.inputs.ext is not None:
+            return replace(rec, inputs=replace(rec.inputs, ext=rec.inputs.ext * v))
+    return rec
+
+
 def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=None, free=(), theta=(),
                   ship=None, pos=None) -> np.ndarray:
+    rec = _wind_scaled(rec, free, theta)
     if effects:
         pred = predict_logged(packed, rec, effects, free, theta, ship)
     else:

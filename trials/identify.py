@@ -33,7 +33,7 @@ from .predict import MeasuredRun, measured_run, replay_record
 __all__ = ["identify", "cross_validate", "write_identification", "load_runs", "ship_yaml", "Identification",
            "DEFAULT_FREE"]
 
-DEFAULT_FREE = ("hull-except-constants", "w_P0", "epsilon")
+DEFAULT_FREE = ("hull-except-constants", "w_P0", "epsilon", "wind_scale")
 DEFAULT_SEGMENTS_L = (52.0, np.inf)
 """Segment lengths of the successive fits, in units of sqrt(L/g): 29 s for a 3 m model, 300 s at
 325 m (about one zigzag half-period: short enough that a poor start does not diverge), then the
@@ -88,8 +88,13 @@ class Identification:
     def scores(self, runs=None, model: str = "identified") -> list[dict]:
         """Open-loop replay scores (:meth:`trials.predict.Replayed.scores`) of ``runs`` (the training
         records when omitted) with the identified or the initial model."""
-        ship = self.ship if model == "identified" else self.initial
-        return [{"name": r.name, **replay_record(ship, r).scores()} for r in (runs or self.runs)]
+        return [{"name": r.name, **self.replay(r, model).scores()} for r in (runs or self.runs)]
+
+    def replay(self, run: MeasuredRun, model: str = "identified"):
+        """:func:`trials.predict.replay_record` of ``run`` with the identified (its wind scale too) or initial model."""
+        if model == "identified":
+            return replay_record(self.ship, with_fitted_wind(run, self.fit.values()))
+        return replay_record(self.initial, run)
 
 
 METRIC_COLUMNS = (("advance_L", "advance [L]"), ("tactical_diameter_L", "tactical diameter [L]"),
@@ -124,6 +129,15 @@ def _fmt_metric(m: dict | None, key: str) -> str:
     return f"{v:.2f}" if np.isfinite(v) else "-"
 
 
+def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
+    """``run`` with its wind loads scaled by a fitted ``wind_scale`` (as the identified ship computes them)."""
+    from dataclasses import replace
+
+    if "wind_scale" not in values or run.inputs.ext is None:
+        return run
+    return replace(run, inputs=replace(run.inputs, ext=run.inputs.ext * values["wind_scale"]))
+
+
 def _ship_with(ship: Ship, values: dict) -> Ship:
     from dataclasses import replace
 
@@ -135,6 +149,8 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
         s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
     if "epsilon" in values:
         s = replace(s, rudder=replace(s.rudder, epsilon=values["epsilon"]))
+    if "wind_scale" in values and s.wind is not None:
+        s = replace(s, wind=replace(s.wind, scale=s.wind.scale * values["wind_scale"]))
     return s
 
 
@@ -169,7 +185,10 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     L = ship.particulars.L
     stages = DEFAULT_SEGMENTS_L if segment_s is None else np.atleast_1d(segment_s) / np.sqrt(L / 9.80665)
     packed = pack(ship)
-    fp = free_parameters(packed, ship.hull.names, _free_names(ship, free), prior_rel_std)
+    names = _free_names(ship, free)
+    if not any(r.inputs.ext is not None for r in runs):
+        names = [n for n in names if n != "wind_scale"]       # no wind loads to scale
+    fp = free_parameters(packed, ship.hull.names, names, prior_rel_std)
     fit = None
     for k, st in enumerate(stages):
         seg = float(st) * float(np.sqrt(L / 9.80665))
@@ -190,7 +209,7 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
         ident = identify(ship, train, **kw)
         for i in test:
             a = replay_record(ship, runs[i]).scores()
-            b = replay_record(ident.ship, runs[i]).scores()
+            b = ident.replay(runs[i]).scores()
             out.append({"name": runs[i].name, "fold": k, "initial": a, "identified": b})
         if progress:
             progress(k + 1, folds)
@@ -210,6 +229,8 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
             data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
         elif k == "epsilon":
             data["rudder"]["epsilon"] = float(f"{v:.6g}")
+        elif k == "wind_scale" and "wind" in data:
+            data["wind"]["scale"] = float(f"{float(data['wind'].get('scale', 1.0)) * v:.6g}")
     data["name"] = f"{data['name']} (identified)"
     data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
     head = "".join(f"# {ln}\n" for ln in note.splitlines())
@@ -258,7 +279,7 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
               "|---|" + "---|" * len(METRIC_COLUMNS)]
     for r in ident.runs:
         m0, mi = manoeuvre_metrics(replay_record(ident.initial, r))
-        _, mf = manoeuvre_metrics(replay_record(ident.ship, r))
+        _, mf = manoeuvre_metrics(ident.replay(r))
         lines.append(f"| {r.name} | " + " | ".join(f"{_fmt_metric(m0, k)} / {_fmt_metric(mi, k)} / {_fmt_metric(mf, k)}"
                                                     for k, _ in METRIC_COLUMNS) + " |")
     if test_runs:
@@ -266,7 +287,7 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
                   "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
                   "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
         for r in test_runs:
-            x, y = replay_record(ident.initial, r).scores(), replay_record(ident.ship, r).scores()
+            x, y = ident.replay(r, "initial").scores(), ident.replay(r).scores()
             lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
                          f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
     if cv:
