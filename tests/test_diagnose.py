@@ -76,9 +76,6 @@ def test_current_found(ship, truth):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="known defect: after the offset (found, 1.0 deg) heading_bias and current are also named on "
-                          "the m_x/m_y/w_P0-perturbed records; the BIC threshold with tau-corrected counts is too "
-                          "lenient for the residual structure the perturbed added masses leave", strict=False)
 def test_rudder_offset_found(ship, truth):
     from trials.diagnose import diagnose
 

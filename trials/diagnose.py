@@ -10,8 +10,9 @@ checking the scale) and the ship config:
    track (x, y) in the record's own (logged) quantities.  ``rms_config`` is this with the
    config as it is.
 2. **Baseline**: fit the ship coefficients the records inform (:data:`SHIP_FREE_TERMS`: the
-   resistance, the linear sway/yaw derivatives and the yaw damping r|r| term, and the wake
-   w_P0; :func:`ekf.identify.identify_segments` with its prior) with no effect: constants of the
+   resistance, the linear sway/yaw derivatives and the yaw damping r|r| term, the wake
+   w_P0 and the added masses and moment, :data:`MASS_FREE`; :func:`ekf.identify.identify_segments`
+   with its prior) with no effect: constants of the
    config that are merely a bit off (added mass, wake, hull) are absorbed here, so they do not
    pass for an effect.  ``rms_before`` is this model's residual.
 3. **Candidates**: each registered effect (:mod:`mmg.effects`) not yet in the model and
@@ -56,7 +57,7 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-__all__ = ["diagnose", "Diagnosis", "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS",
+__all__ = ["diagnose", "Diagnosis", "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
@@ -182,12 +183,35 @@ class _Model:
         return self.fit.theta
 
 
+MASS_FREE = ("m_x", "m_y", "J_z")
+"""Added masses and the added moment of inertia the diagnosis fits with every model (prior:
+the config value, relative std :data:`MASS_PRIOR_REL`): an added mass a few % off leaves a
+residual (surge speed loss in the turn, sway and yaw lag) that an effect would otherwise take."""
+MASS_PRIOR_REL = 0.2
+
+
+def _mass_free(packed, names):
+    from ekf.identify import FreeParameter
+    from mmg import model as M
+
+    slot = {"m_x": M.P_MX, "m_y": M.P_MY, "J_z": M.P_JZ}
+    out = []
+    for nm in names:
+        v = float(packed.p[slot[nm]])
+        out.append(FreeParameter(nm, "p", slot[nm], v, MASS_PRIOR_REL * v, 0.0, 3.0 * v))
+    return out
+
+
 def _ship_free(ship: Ship, packed, names=None):
     from ekf.identify import free_parameters
 
     if names is None:
         names = [n for n, t in zip(ship.hull.names, ship.hull.terms) if t in SHIP_FREE_TERMS] + ["w_P0"]
-    return free_parameters(packed, ship.hull.names, names)
+        mass = list(MASS_FREE)
+    else:
+        mass = [n for n in names if n in MASS_FREE]
+        names = [n for n in names if n not in MASS_FREE]
+    return free_parameters(packed, ship.hull.names, names) + _mass_free(packed, mass)
 
 
 class _Fitter:
