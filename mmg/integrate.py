@@ -74,11 +74,12 @@ def _interp(tq, ts, vs, k):
     return vs[k] + w * (vs[k + 1] - vs[k]), k
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
                     kind, cpar, st, sd, sn, states, orders):
     """Integrate ``nsteps`` RK4 steps from ``x0``; fill ``states`` (nsteps+1, 8) and ``orders``.
 
+    Releases the GIL (it touches no Python object): runs of different threads go on in parallel.
     Returns the number of valid rows (< nsteps+1 when the run stopped because
     the surge speed fell below 1 % of its initial value or a value became NaN).
     """

@@ -33,7 +33,7 @@ log header (the steady approach).  The rudder is driven by
   schedule with whole-step switches (searched greedily; some stay one step off).
 
 Derivative Jacobian columns are forward differences (one simulation per derivative and trial);
-simulations of one Jacobian can go to joblib workers (``n_jobs``).
+simulations of one Jacobian run on ``n_jobs`` threads (the compiled integration releases the GIL).
 
 Modules: :mod:`~ekf.output_error.trial` (one trial: start, rudder command, simulated
 residuals), :mod:`~ekf.output_error.switches` (whole-step switch search of a rebuilt

@@ -1,6 +1,7 @@
 """The joint output-error fit: the scaled least-squares problem, its Jacobian and the EKF start."""
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass
 
@@ -13,6 +14,29 @@ from .trial import FD_STEP, NNUIS, OETrial, trial_from_data
 
 def _sim_task(tr: OETrial, theta, nuis, restart=None):
     return tr.residuals(theta, nuis, restart)
+
+
+_POOLS: dict = {}
+
+
+def _workers(n_jobs) -> int:
+    """Threads for ``n_jobs`` (joblib's convention: None or 1 one, -1 every core, -2 all but one)."""
+    if n_jobs is None:
+        return 1
+    n = int(n_jobs)
+    if n < 0:
+        n = max(1, (os.cpu_count() or 1) + 1 + n)
+    return max(1, n)
+
+
+def _pool(workers: int):
+    """One thread pool per size, kept for the process (a fit calls it some 50 times)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    pool = _POOLS.get(workers)
+    if pool is None:
+        pool = _POOLS[workers] = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="oe-jacobian")
+    return pool
 
 
 TSW_FD = 0.01  # forward-difference step of a reversal time, in steps (stays inside one ramp cell)
@@ -92,10 +116,12 @@ class _Problem:
 
     def _run(self, tasks):
         self.nsim += len(tasks)
-        if self.n_jobs == 1 or len(tasks) < 4:
+        workers = _workers(self.n_jobs)
+        if workers == 1 or len(tasks) < 2:
             return [_sim_task(*a) for a in tasks]
-        from joblib import Parallel, delayed
-        return Parallel(n_jobs=self.n_jobs)(delayed(_sim_task)(*a) for a in tasks)
+        # threads: the compiled integration releases the GIL, so the columns run on every core without
+        # pickling the trials to worker processes; results come back in task order (the same numbers)
+        return list(_pool(workers).map(lambda a: _sim_task(*a), tasks))
 
     def fun(self, q):
         theta, nuis = self.split(q)
