@@ -55,6 +55,14 @@ class Segmented:
     reset: np.ndarray
     context: object = None
     """:class:`mmg.effects.Context` of the record (logged channels the effects read), or None."""
+    start: np.ndarray | None = None
+    """States (N, 6) the replay starts and restarts from (e.g. a smoothed ``meas``: a restart
+    from one noisy sample leaves a transient through the whole segment); ``meas`` when None.
+    The residuals are always against ``meas``."""
+
+    @property
+    def restart(self) -> np.ndarray:
+        return self.meas if self.start is None else self.start
 
 
 @dataclass(frozen=True)
@@ -159,12 +167,12 @@ def predict_logged(packed: PackedShip, rec: Segmented, effects=None, free=(), th
     (N, 6) u, v, r, x, y, psi with the ship parameters and effects at ``theta``."""
     pk = apply_parameters(packed, list(free), theta) if len(free) else packed
     if not effects:
-        return replay_states(pk, rec.inputs, rec.meas[0], meas=rec.meas, reset=rec.reset)
+        return replay_states(pk, rec.inputs, rec.restart[0], meas=rec.restart, reset=rec.reset)
     es = effect_set_of(effects, list(free), theta)
     pk = es.pack(pk, ship)
     ext = es.external(rec.context, base=rec.inputs.ext)
     inputs = replace(rec.inputs, ext=ext) if ext is not None else rec.inputs
-    mm = es.to_model(rec.meas)
+    mm = es.to_model(rec.restart)
     pred = replay_states(pk, inputs, mm[0], meas=mm, reset=rec.reset)
     return es.to_logged(pred)
 
@@ -193,7 +201,7 @@ def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=N
     if effects:
         pred = predict_logged(packed, rec, effects, free, theta, ship)
     else:
-        pred = replay_states(packed, rec.inputs, rec.meas[0], meas=rec.meas, reset=rec.reset)
+        pred = replay_states(packed, rec.inputs, rec.restart[0], meas=rec.restart, reset=rec.reset)
     diff = pred[::stride] - rec.meas[::stride]
     d = diff[:, [0, 1, 2, 5]] / sc
     if pos is not None:

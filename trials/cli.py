@@ -502,17 +502,19 @@ def cmd_diagnose(args) -> int:
                   "trial/record, not the ship: switch them on in a trial config (disturbances.current, "
                   "disturbances.rudder_offset, log.bias.heading)")
         ship_text = ship_yaml(src, d.ship_values, note)
-        if "wind" in d.parameters:
-            import yaml
+        import yaml
 
-            head, body = [], []
-            for ln in ship_text.splitlines(keepends=True):
-                (head if ln.startswith("#") and not body else body).append(ln)
-            data = yaml.safe_load("".join(body))
-            if data.get("wind") is not None:
-                data["wind"]["enabled"] = True
-                data["wind"]["scale"] = float(f"{d.parameters['wind']['scale']:.4g}")
-            ship_text = "".join(head) + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+        head, body = [], []
+        for ln in ship_text.splitlines(keepends=True):
+            (head if ln.startswith("#") and not body else body).append(ln)
+        data = yaml.safe_load("".join(body))
+        for k, v in d.ship_values.items():            # the fitted added masses (ship_yaml writes the hull)
+            if k.endswith("_prime") and k in data.get("mass", {}):
+                data["mass"][k] = float(f"{v:.6g}")
+        if "wind" in d.parameters and data.get("wind") is not None:
+            data["wind"]["enabled"] = True
+            data["wind"]["scale"] = float(f"{d.parameters['wind']['scale']:.4g}")
+        ship_text = "".join(head) + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
     with StagedFile(args.json) as tmp:
         with StagedFile(args.out_ship) if args.out_ship else nullcontext() as tship:
             with StagedOutput(args.plots) if args.plots else nullcontext() as stage:
