@@ -72,9 +72,11 @@ def main(argv=None):
                     help="first clean seed (seeds 0-19 calibrated the threshold; the default tests fresh ones)")
     ap.add_argument("--seeds", type=int, default=5, help="seeds per effect size")
     ap.add_argument("--effects", nargs="*", default=list(SIZES))
+    ap.add_argument("--sizes", type=float, nargs="*", help="effect sizes to try instead of SIZES (with one --effects)")
     ap.add_argument("--quick", action="store_true", help="4 clean pairs, 2 seeds")
     ap.add_argument("--timing-only", action="store_true")
     ap.add_argument("--no-timing", action="store_true")
+    ap.add_argument("--tag", default="", help="suffix of the output names (bench/out/diagnose_bench<tag>.json, ...)")
     a = ap.parse_args(argv)
     if a.timing_only:
         timing()
@@ -93,7 +95,7 @@ def main(argv=None):
     results = {"clean": [], "detection": {}}
 
     def save():
-        (out / "diagnose_bench.json").write_text(json.dumps(results, indent=1))
+        (out / f"diagnose_bench{a.tag}.json").write_text(json.dumps(results, indent=1))
 
     false = 0
     for s in range(a.clean_first, a.clean_first + nclean):
@@ -106,10 +108,11 @@ def main(argv=None):
         save()
         print(f"clean seed {s} ({s - a.clean_first + 1}/{nclean}): named {d.named} (largest candidate dBIC {best:.1f}) "
               f"{time.perf_counter() - t1:.0f} s", flush=True)
-    print(f"false alarms: {false}/{nclean} clean record pairs ({100 * false / nclean:.0f} %)", flush=True)
+    print(f"false alarms: {false}/{nclean} clean record pairs ({100 * false / max(nclean, 1):.0f} %)", flush=True)
     det = {}
     for eff in a.effects:
         par, sizes, spec = SIZES[eff]
+        sizes = a.sizes or sizes
         sizes = sizes[1:] if a.quick else sizes
         det[eff] = []
         for size in sizes:
@@ -133,7 +136,7 @@ def main(argv=None):
             save()
             print(f"{eff} {par}={size:g}: detected {hit}/{seeds}, mean |error| {det[eff][-1][2]:.3g}, "
                   f"others named {wrong}/{seeds}", flush=True)
-    print(f"\nfalse alarms: {false}/{nclean} clean record pairs ({100 * false / nclean:.0f} %)")
+    print(f"\nfalse alarms: {false}/{nclean} clean record pairs ({100 * false / max(nclean, 1):.0f} %)")
     print(f"{'effect':15s} {'size':>8s} {'detection':>10s} {'|error|':>9s} {'others':>7s}")
     for eff, rows in det.items():
         for size, rate, err, wrong in rows:
@@ -154,8 +157,8 @@ def main(argv=None):
             ax.set_xlabel(f"{eff} {SIZES[eff][0]}")
             ax.set_ylabel("detection rate")
             ax.set_title(f"false alarms {false}/{nclean} clean, {seeds} seeds/size", fontsize=8)
-        fig.savefig(out / "diagnose_detection.png", dpi=110)
-        print(f"wrote {out / 'diagnose_detection.png'}")
+        fig.savefig(out / f"diagnose_detection{a.tag}.png", dpi=110)
+        print(f"wrote {out / f'diagnose_detection{a.tag}.png'}")
     print(f"{time.perf_counter() - t0:.0f} s")
     if not a.no_timing:
         timing()
