@@ -1,22 +1,32 @@
 """What a user feels: one 35 deg turn in a fresh process, ours against shipmmg's, and
 ``mmg simulate`` of ST35 with its CSVs and PNGs, whole processes, warm caches.
 
-    python bench/bench_startup.py [--runs 5]
+    python bench/bench_startup.py [--runs 5] [--baseline REV]
 
 Each command runs once to warm the caches (numba's, the OS's), then A and B alternate
 ``--runs`` times; the medians and the median of the pairwise ratios A/B are printed.
 The shipmmg turn is its own KVLCC2 L7 test case (200 s, RK45 at its default tolerance);
 ours is the Esso Osaka ST35 through the public API (3000 s of RK4 at 0.1 s): each tool's
 natural first use.  Needs the ``bench`` extra (shipmmg).
+
+``--baseline REV`` (a git revision, e.g. ``HEAD~3``) instead times ``mmg simulate st35`` of that
+revision against this checkout's, interleaved pair by pair in fresh processes (the revision is
+checked out into a temporary git worktree; its numba cache is warmed by a first run), and prints
+both medians and the median ratio now/baseline: a before/after figure that holds on a shared,
+noisy machine.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
 
 OURS = ("import mmg; r = mmg.simulate(mmg.turning('esso_osaka', rudder='35 deg', speed='10 kn', duration='3000 s')); "
         "print(round(r.metrics()['tactical_diameter_L'], 3))")
@@ -56,10 +66,44 @@ def pair(a, b, runs: int, cwd) -> tuple[float, float, float]:
     return statistics.median(ta), statistics.median(tb), statistics.median(ratios)
 
 
+def simulate_vs_baseline(rev: str, runs: int) -> None:
+    """``mmg simulate st35`` of this checkout against revision ``rev``, interleaved, fresh processes."""
+    with tempfile.TemporaryDirectory() as td:
+        wt = Path(td) / "baseline"
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(wt), rev], check=True,
+                       capture_output=True)
+        try:
+            def cmd(src, out):
+                env = {**os.environ, "PYTHONPATH": str(src)}
+                return lambda: subprocess.run([sys.executable, "-m", "trials.cli", "simulate", "st35", "--out", out],
+                                              cwd=td, env=env, check=True, capture_output=True)
+            now, base = cmd(ROOT, "now"), cmd(wt, "base")
+            for f in (now, base, now, base):        # warm both numba caches and the OS
+                f()
+            tn, tb, ratios = [], [], []
+            for _ in range(runs):
+                t0 = time.perf_counter()
+                now()
+                t1 = time.perf_counter()
+                base()
+                t2 = time.perf_counter()
+                tn.append(t1 - t0)
+                tb.append(t2 - t1)
+                ratios.append((t1 - t0) / (t2 - t1))
+            print(f"mmg simulate st35: this checkout {statistics.median(tn):.2f} s, {rev} {statistics.median(tb):.2f} s, "
+                  f"ratio now/{rev} {statistics.median(ratios):.2f} (median of {runs} interleaved pairs)")
+        finally:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(wt)], capture_output=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument("--baseline", default=None, help="git revision to time mmg simulate st35 against")
     args = ap.parse_args()
+    if args.baseline:
+        simulate_vs_baseline(args.baseline, args.runs)
+        return
     with tempfile.TemporaryDirectory() as td:
         try:
             import shipmmg  # noqa: F401

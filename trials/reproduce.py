@@ -350,6 +350,99 @@ def best_estimator_section(doc, out: Path, full: bool, ekf: dict):
         doc((out / "crb_vs_mc" / "crb_vs_mc.txt").read_text() if (out / "crb_vs_mc" / "crb_vs_mc.txt").exists() else "")
 
 
+class _Background:
+    """A section run in a forked process beside the main one: its report parts come back through a pipe.
+
+    The section writes its files under ``out`` itself (its own folder) and fills a :class:`Report` of its
+    own; :meth:`parts` waits for it and returns that report's parts (or re-raises its exception).  The
+    child starts with SIGINT blocked (a terminal's Ctrl-C reaches only the main process, which stops it)
+    and SIGTERM at its default, so :meth:`stop` ends it at once; it leaves by ``os._exit`` whatever
+    happens, never unwinding the main process's staging it inherited.  Start it before the main process
+    creates worker pools (a forked copy of a loky executor would wait for workers it does not own), and
+    give it no joblib process pool of its own (``os._exit`` skips the clean-up of its semaphores and
+    memory-mapping folder).
+    """
+
+    def __init__(self, section):
+        import multiprocessing as mp
+
+        from .output import children_ignore_sigint
+
+        ctx = mp.get_context("fork")
+        self._recv, send = ctx.Pipe(duplex=False)
+        with children_ignore_sigint():
+            self.proc = ctx.Process(target=_background_main, args=(section, send), daemon=True)
+            self.proc.start()
+        send.close()
+
+    def parts(self) -> list[str]:
+        try:
+            ok, value = self._recv.recv()
+        except EOFError:
+            self.proc.join()
+            raise RuntimeError(f"a report section's process ended without a result (exit {self.proc.exitcode})") from None
+        self.proc.join()
+        if not ok:
+            raise value
+        return value
+
+    def stop(self) -> None:
+        if self.proc.is_alive():
+            self.proc.terminate()
+        self.proc.join()
+
+
+def _background_main(section, send) -> None:
+    import signal
+    import sys
+    import traceback
+
+    code = 1
+    try:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        doc = Report()
+        section(doc)
+        send.send((True, doc.parts))
+        code = 0
+    except BaseException as e:                            # noqa: BLE001 - sent to the main process
+        try:
+            send.send((False, e))
+        except Exception:                                  # an exception that does not pickle
+            send.send((False, RuntimeError("".join(traceback.format_exception(e)).rstrip())))
+    finally:
+        sys.stdout.flush()
+        os._exit(code)
+
+
+def _sections_side_by_side(doc, out: Path, runs: dict, keep: dict, t0: float) -> None:
+    """Sections 6-9 on both cores, their report parts in their places.
+
+    The Nomoto tables need nothing of the others: a process of their own from the start.  The
+    output-error fit needs the EKF's data and joint estimate: a process of its own once the EKF is done
+    (its Jacobian on threads), while this one draws the sensitivity figures (joblib's workers; they come
+    after the forks, so no child inherits a copy of their pool).
+    """
+    background = []
+    try:
+        nomoto = _Background(lambda d: nomoto_section(d, out, False))
+        background.append(nomoto)
+        ekf = Report()
+        keep.update(ekf_section(ekf, out, runs))
+        progress(f"EKF done ({time.perf_counter() - t0:.1f} s)")
+        best = _Background(lambda d: best_estimator_section(d, out, False, keep))
+        background.append(best)
+        sens = Report()
+        sensitivity_section(sens, out)
+        progress(f"sensitivity done ({time.perf_counter() - t0:.1f} s)")
+        parts = nomoto.parts() + ekf.parts + sens.parts + best.parts()
+        progress(f"Nomoto and output error done ({time.perf_counter() - t0:.1f} s)")
+    finally:
+        for b in background:
+            b.stop()
+    for part in parts:
+        doc(part)
+
+
 def reproduce(out, full: bool = False) -> Path:
     """Run the main job into the folder ``out``; returns the path of ``report.md``.
 
@@ -378,13 +471,18 @@ def reproduce(out, full: bool = False) -> Path:
     progress(f"default trials done ({time.perf_counter() - t0:.1f} s)")
     for label, f in [("plausibility", lambda: plausibility_section(doc, runs, ship)),
                      ("ST35 variants", lambda: st35_variants_section(doc, ship)),
-                     ("numerical checks", lambda: checks_section(doc, ship)),
-                     ("Nomoto", lambda: nomoto_section(doc, out, full)),
-                     ("EKF", lambda: keep.update(ekf_section(doc, out, runs))),
-                     ("sensitivity", lambda: sensitivity_section(doc, out)),
-                     ("output error", lambda: best_estimator_section(doc, out, full, keep))]:
+                     ("numerical checks", lambda: checks_section(doc, ship))]:
         f()
         progress(f"{label} done ({time.perf_counter() - t0:.1f} s)")
+    if full:                                   # the Monte Carlo runs take both cores themselves
+        for label, f in [("Nomoto", lambda: nomoto_section(doc, out, full)),
+                         ("EKF", lambda: keep.update(ekf_section(doc, out, runs))),
+                         ("sensitivity", lambda: sensitivity_section(doc, out)),
+                         ("output error", lambda: best_estimator_section(doc, out, full, keep))]:
+            f()
+            progress(f"{label} done ({time.perf_counter() - t0:.1f} s)")
+    else:
+        _sections_side_by_side(doc, out, runs, keep, t0)
     doc(f"\n---\nTotal {time.perf_counter() - t0:.1f} s.")
     path = out / "report.md"
     tmp = out / ".report.md.tmp"
