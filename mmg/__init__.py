@@ -10,6 +10,10 @@ The public API, in one namespace::
     res.to_pandas(); res.plot("track"); res.log(seed=1)
     est = mmg.estimate("zz20")                          # the augmented EKF on the simulated log
     est.to_pandas(); est.plot()
+    m3 = mmg.load_ship("esso_osaka_3m")                 # measured records (FRT-DS-ESSO, logs, truth files)
+    pred = mmg.predict(m3, ["turn.csv"]); pred.to_pandas(); pred.runs[0].plot()
+    ident = mmg.identify(m3, ["turn.csv", "zigzag.csv"]); ident.fit.to_pandas(); ident.scores()
+    diag = mmg.diagnose(m3, ["turn.csv"])               # which effect the model misses
 
 Values with a dimension are strings with their unit, as in the YAML configs
 (``"20 deg"``, ``"10 kn"``, ``"3000 s"``); plain numbers and wrong units are refused
@@ -44,6 +48,11 @@ _LAZY = {
     "simulate": ("trials.run", "run_trial"),
     "TrialRun": ("trials.run", "TrialRun"),
     "estimate": ("trials.estimation", "estimate"),
+    "predict": ("trials.predict", "predict"),
+    "replay_record": ("trials.predict", "replay_record"),
+    "identify": ("trials.identify", "identify"),
+    "cross_validate": ("trials.identify", "cross_validate"),
+    "diagnose": ("trials.diagnose", "diagnose"),
     "config_dir": ("mmg.resources", "config_dir"),
     "config_path": ("mmg.resources", "config_path"),
     "ship_path": ("mmg.resources", "ship_path"),

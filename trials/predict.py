@@ -220,7 +220,24 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
     """Read and replay each record of ``paths`` (:func:`replay_record`); a bad record raises
     :class:`~mmg.errors.InputError` naming it.  Every record is read and made ready
     (:func:`measured_run`: channels, ``start``, wind) before the first is replayed, so a bad one
-    is refused before any work; ``progress(i, n, file name)`` is called after each replay."""
+    is refused before any work.
+
+    Parameters
+    ----------
+    ship : Ship
+    paths : sequence of str or Path
+        Records (FRT-DS-ESSO CSVs, project logs, truth files).
+    start : float, optional
+        Start time [s] of every replay.
+    wind : bool, optional
+        Override the ship config's wind switch.
+    progress : callable, optional
+        ``progress(i, n, file name)`` after each replay.
+
+    Returns
+    -------
+    Prediction
+    """
     from .logio import read_record
 
     measured = [measured_run(ship, read_record(path, length_m=ship.particulars.L), start, wind) for path in paths]
