@@ -75,6 +75,20 @@ def test_current_found(ship, truth):
     assert set(j["rms_before"]) == {"u", "v", "r", "heading", "position"} and j["unexplained"] is False
 
 
+def test_shallow_water_found(ship, truth):
+    """Depth 1.3 x draft hidden (with the added masses and wake off as in every test here): named, and
+    the residuals of the channels it acts on fall by more than half.  The depth itself is poorly
+    determined (the baseline frees Y_beta, Y_r, N_beta, N_r, which the shallow-water factors scale):
+    a 1.55 estimate for 1.3, so only 'clearly shallow' (below 2) is asserted.  Milder depths (1.6 x
+    draft) are absorbed by the freed coefficients and not named."""
+    from trials.diagnose import diagnose
+
+    d = diagnose(ship, _records(ship, truth, {"shallow_water": {"depth_to_draft": 1.3}}))
+    assert d.named == ["shallow_water"]
+    assert 1.0 < d.parameters["shallow_water"]["depth_to_draft"] < 2.0
+    _check_fall(d, "shallow_water")
+
+
 @pytest.mark.slow
 def test_rudder_offset_found(ship, truth):
     from trials.diagnose import diagnose
