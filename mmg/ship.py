@@ -177,29 +177,19 @@ class Wind:
 
     enabled: whether the replay, the estimators and ``mmg predict`` apply them; coefficients: the
     regression (``"fujiwara1998"``: Fujiwara, Ueno & Nimura 1998, J. SNAJ 183); scale: a factor on
-    all three loads (1 = as published); areas [m^2], lengths and heights [m] as in
-    :class:`mmg.wind.WindParticulars` (L_oa the length over all, the moment arm).
+    all three loads (1 = as published); geometry: the above-water particulars the regression
+    needs (:class:`mmg.wind.WindParticulars`: areas [m^2], lengths and heights [m], L the length
+    over all, the moment arm).
     """
 
     enabled: bool
     coefficients: str
-    A_T: float
-    A_L: float
-    L_oa: float
-    B: float
-    A_OD: float
-    H_BR: float
-    x_AL: float
-    z_AL: float
-    x_AOD: float
+    geometry: "WindParticulars"
     scale: float = 1.0
 
     def particulars(self):
         """The :class:`mmg.wind.WindParticulars` of this ship."""
-        from .wind import WindParticulars
-
-        return WindParticulars(A_T=self.A_T, A_L=self.A_L, L=self.L_oa, B=self.B, A_OD=self.A_OD, H_BR=self.H_BR,
-                               x_AL=self.x_AL, z_AL=self.z_AL, x_AOD=self.x_AOD)
+        return self.geometry
 
 
 @dataclass(frozen=True)
@@ -539,19 +529,22 @@ def _build(f: _ShipFile, src: str) -> Ship:
     )
     wind = None
     if f.wind is not None:
+        from .wind import WindParticulars
+
         w = f.wind
         area = (0.001 * L * L, 0.5 * L * L)           # a tenth of a per cent of L^2 to half of it
         wind = Wind(
             enabled=w.enabled, coefficients=w.coefficients,
-            A_T=_qty(src, "wind.A_T", w.A_T, "area", *area, lo_open=True),
-            A_L=_qty(src, "wind.A_L", w.A_L, "area", *area, lo_open=True),
-            L_oa=_qty(src, "wind.L_oa", w.L_oa, "length", L, 1.3 * L) if w.L_oa is not None else L,
-            B=B,
-            A_OD=_qty(src, "wind.A_OD", w.A_OD, "area", 0.0, 0.5 * L * L, lo_open=True),
-            H_BR=_qty(src, "wind.H_BR", w.H_BR, "length", 0.0, L, lo_open=True),
-            x_AL=_qty(src, "wind.x_AL", w.x_AL, "length", -0.5 * L, 0.5 * L),
-            z_AL=_qty(src, "wind.z_AL", w.z_AL, "length", 0.0, L, lo_open=True),
-            x_AOD=_qty(src, "wind.x_AOD", w.x_AOD, "length", -0.5 * L, 0.5 * L),
+            geometry=WindParticulars(
+                A_T=_qty(src, "wind.A_T", w.A_T, "area", *area, lo_open=True),
+                A_L=_qty(src, "wind.A_L", w.A_L, "area", *area, lo_open=True),
+                L=_qty(src, "wind.L_oa", w.L_oa, "length", L, 1.3 * L) if w.L_oa is not None else L,
+                B=B,
+                A_OD=_qty(src, "wind.A_OD", w.A_OD, "area", 0.0, 0.5 * L * L, lo_open=True),
+                H_BR=_qty(src, "wind.H_BR", w.H_BR, "length", 0.0, L, lo_open=True),
+                x_AL=_qty(src, "wind.x_AL", w.x_AL, "length", -0.5 * L, 0.5 * L),
+                z_AL=_qty(src, "wind.z_AL", w.z_AL, "length", 0.0, L, lo_open=True),
+                x_AOD=_qty(src, "wind.x_AOD", w.x_AOD, "length", -0.5 * L, 0.5 * L)),
             scale=_num(src, "wind.scale", w.scale, 0.0, 10.0),
         )
     return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,

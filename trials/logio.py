@@ -78,18 +78,8 @@ def _header(meta: dict) -> str:
 
 
 def log_frame(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None) -> pd.DataFrame:
-    """Sample the trajectory every ``spec.interval`` seconds and add uniform noise.
-
-    Parameters
-    ----------
-    t, x, y, psi, sog, n : arrays at the integration step
-        Time [s], position north/east [m], heading [rad], speed over ground [m/s], rpm [rps].
-    spec : trials.trial.LogSpec
-        Interval, start position, noise levels (half-widths of the uniform noise), seed and
-        constant sensor biases (heading, speed, rpm; :class:`mmg.disturbances.SensorBias`).
-    rng : numpy Generator, optional
-        Defaults to ``np.random.default_rng(spec.seed)``.
-    """
+    """:func:`trials.logwrite.log_columns` (the trajectory sampled every ``spec.interval`` seconds,
+    uniform noise and sensor biases added) as a DataFrame; same parameters."""
     return pd.DataFrame(log_columns(t, x, y, psi, sog, n, spec, rng))
 
 
