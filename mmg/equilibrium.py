@@ -96,7 +96,7 @@ def _newton(fun, z0, tol: float = 1e-13, max_iter: int = 50) -> np.ndarray:
 
 
 def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = True,
-                 disturbance_slots: dict | None = None) -> Equilibrium:
+                 disturbance_slots: dict | None = None, effects=None) -> Equilibrium:
     """Solve the steady straight run at surge speed ``u0`` [m/s].
 
     Parameters
@@ -110,9 +110,17 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
         Solve the trim rudder and sway velocity that cancel Y_0, N_0 (else delta = v = 0).
     disturbance_slots : dict, optional
         Packed disturbance values (see :mod:`mmg.disturbances`).
+    effects : mmg.effects.EffectSet, optional
+        Effects in the packed ship (:meth:`mmg.effects.EffectSet.pack`): a rudder offset, shallow
+        water, a steady wind (the approach is then the straight run in that wind at heading 0).
     """
     power = engine_power(ship, u0) if ship.engine.mode == "constant_power" else 0.0
-    pk = pack(ship, power, disturbance_slots)
+
+    def pack_all(sh):
+        pk = pack(sh, power, disturbance_slots)
+        return pk if effects is None else effects.pack(pk, sh)
+
+    pk = pack_all(ship)
     n_guess = n if n is not None else u0 / (0.6 * ship.propeller.D)
 
     def unpack(z):
@@ -140,7 +148,7 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
         kq = polyval(pk.poly[POLY_KQ], J)
         D, rho = ship.propeller.D, ship.particulars.rho
         scale = power / (2 * np.pi * nn) / (rho * nn**2 * D**5 * kq)
-    pk2 = pack(with_kq_scale(ship, scale), power, disturbance_slots)
+    pk2 = pack_all(with_kq_scale(ship, scale))
     a = _accels(pk2, u0, vv, dd, nn)
     res = float(np.max(np.abs(a[[0, 1, 2, N_]])))
     return Equilibrium(u=u0, v=float(vv), delta=float(dd), n=float(nn), power_W=power,

@@ -26,8 +26,10 @@ import numpy as np
 from numba import njit
 
 from .nondim import force_scale, inertia_scale, mass_scale, moment_scale, r_prime
-from .ship import Ship
 from .terms import AXES, TERMS, sabs, term_value
+from .wind import fujiwara_series
+
+_fujiwara_series = njit(cache=True, error_model="numpy", inline="always")(fujiwara_series)
 
 # state indices
 U_, V_, R_, X_, Y_, PSI_, DELTA_, N_ = range(8)
@@ -43,8 +45,11 @@ STATE_UNITS = ("m/s", "m/s", "rad/s", "m", "m", "rad", "rad", "rps")
     P_ENGINE, P_POWER, P_SHAFT_I,
     P_CUR_SPEED, P_CUR_DIR, P_RUDDER_OFFSET, P_EXT_X, P_EXT_Y, P_EXT_N,
     P_ULOW,
-    N_PARAMS,
-) = range(43)
+    P_WIND_V, P_WIND_FROM, P_WIND_Q, P_WIND_AT, P_WIND_AL, P_WIND_ALL, P_WIND_AMP,
+) = range(49)
+N_WIND_AMP = 10
+"""Slots P_WIND_AMP .. P_WIND_AMP + 9: the Fujiwara amplitudes (:func:`mmg.wind.amplitude_vector`)."""
+N_PARAMS = P_WIND_AMP + N_WIND_AMP
 
 LOW_SPEED_FROUDE = 0.01
 """Froude number below which the hull's speed scale is floored (:func:`kinematics`): U_low =
@@ -87,7 +92,7 @@ def _poly_row(c) -> np.ndarray:
     return row
 
 
-def pack(ship: Ship, engine_power_W: float = 0.0, disturbance_slots: dict | None = None) -> PackedShip:
+def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: dict | None = None) -> PackedShip:
     """Pack a :class:`~mmg.ship.Ship` into arrays.
 
     Parameters
@@ -320,6 +325,48 @@ def forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def wind_loads(u, v, psi, p):
+    """Loads (X, Y [N], N [N m] about midship) of a steady true wind on the ship at u, v [m/s] through
+    the water and heading psi [rad]; (0, 0, 0) unless the ``wind`` effect gives a true wind speed.
+
+    The true wind of speed ``p[P_WIND_V]`` [m/s] comes FROM ``p[P_WIND_FROM]`` [rad, clockwise from
+    north]; the apparent wind is the true one minus the ship's velocity over ground (through the
+    water plus the current; the anemometer is at midship, as :func:`mmg.wind.relative_wind_from_true`
+    takes it) and acts through the Fujiwara series (:func:`mmg.wind.fujiwara_series`, the one
+    definition the replay's measured-wind loads also use):
+    X = q A_T C_X, Y = q A_L C_Y, N = q A_L L_oa C_N, q = 1/2 rho_air V_rel^2 times the effect's scale
+    (``p[P_WIND_Q]`` = 1/2 rho_air scale).  Real or complex states (complex-step derivatives)."""
+    Vt = p[P_WIND_V]
+    if Vt == 0.0:
+        z = 0.0 * u
+        return z, z, z
+    rel = p[P_WIND_FROM] - psi
+    cur = p[P_CUR_DIR] - psi
+    ax = -Vt * np.cos(rel) - u - p[P_CUR_SPEED] * np.cos(cur)    # apparent air velocity, ship axes
+    ay = -Vt * np.sin(rel) - v - p[P_CUR_SPEED] * np.sin(cur)
+    V2 = ax * ax + ay * ay
+    if V2.real < 1e-18:
+        z = 0.0 * u
+        return z, z, z
+    V = np.sqrt(V2)
+    cx, cy, cn = _fujiwara_series(-ax / V, -ay / V, p[P_WIND_AMP:P_WIND_AMP + N_WIND_AMP])
+    q = p[P_WIND_Q] * V2
+    return q * p[P_WIND_AT] * cx, q * p[P_WIND_AL] * cy, q * p[P_WIND_ALL] * cn
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def force_accelerations(X, Y, N, p):
+    """du/dt, dv/dt, dr/dt [m/s^2, m/s^2, rad/s^2] an added load X, Y [N], N [N m] about midship
+    gives: the affine part of :func:`accelerations` (the inverse mass matrix times the load)."""
+    m, mx, xG = p[P_M], p[P_MX], p[P_XG]
+    a11 = m + p[P_MY]
+    a12 = xG * m
+    a22 = p[P_IZ] + xG * xG * m + p[P_JZ]
+    det = a11 * a22 - a12 * a12
+    return X / (m + mx), (Y * a22 - a12 * N) / det, (a11 * N - a12 * Y) / det
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def accelerations(X, Y, N, u, v, r, p, out):
     """The equations of motion about midship: du/dt, dv/dt, dr/dt into out[U_], out[V_], out[R_].
 
@@ -328,15 +375,8 @@ def accelerations(X, Y, N, u, v, r, p, out):
     mass matrix, :func:`inverse_mass`).
     """
     m, mx, my, xG = p[P_M], p[P_MX], p[P_MY], p[P_XG]
-    a11 = m + my
-    a12 = xG * m
-    a22 = p[P_IZ] + xG * xG * m + p[P_JZ]
-    b1 = Y - (m + mx) * u * r
-    b2 = N - xG * m * u * r
-    det = a11 * a22 - a12 * a12
-    out[V_] = (b1 * a22 - a12 * b2) / det
-    out[R_] = (a11 * b2 - a12 * b1) / det
-    out[U_] = (X + (m + my) * v * r + xG * m * r * r) / (m + mx)
+    out[U_], out[V_], out[R_] = force_accelerations(X + (m + my) * v * r + xG * m * r * r,
+                                                    Y - (m + mx) * u * r, N - xG * m * u * r, p)
 
 
 @njit(cache=True, error_model="numpy")
@@ -353,6 +393,12 @@ def rhs(x, delta_cmd, p, poly, hull_axis, hull_term, hull_coef, out):
     """
     u, v, r, psi = x[U_], x[V_], x[R_], x[PSI_]
     dynamics(u, v, r, x[DELTA_], x[N_], p, poly, hull_axis, hull_term, hull_coef, out)
+    if p[P_WIND_V] != 0.0:        # a steady true wind (the ``wind`` effect): loads depend on the heading
+        wx, wy, wn = wind_loads(u, v, psi, p)
+        du, dv, dr = force_accelerations(wx, wy, wn, p)
+        out[U_] += du
+        out[V_] += dv
+        out[R_] += dr
     track(u, v, r, psi, p, out)
     out[DELTA_] = steering_rate(delta_cmd, x[DELTA_], p)
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .model import P_L, PSI_, R_, U_, V_, X_, Y_, PackedShip, dynamics, inverse_mass, track
+from .model import P_L, P_WIND_V, PSI_, R_, U_, V_, X_, Y_, PackedShip, dynamics, inverse_mass, track, wind_loads
 
 __all__ = ["ReplayInputs", "replay", "replay_states", "default_dt_max", "STATE"]
 
@@ -68,6 +68,11 @@ def default_dt_max(L: float) -> float:
 def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef, work, out):
     dynamics(s[0], s[1], s[2], d, n, p, poly, hull_axis, hull_term, hull_coef, work)
     track(s[0], s[1], s[2], s[5], p, work)
+    if p[P_WIND_V] != 0.0:          # a steady true wind, from the state (as the simulator's rhs)
+        wx, wy, wn = wind_loads(s[0], s[1], s[5], p)
+        fx += wx
+        fy += wy
+        fn += wn
     out[0] = work[U_] + minv[0] * fx + minv[1] * fy + minv[2] * fn
     out[1] = work[V_] + minv[3] * fx + minv[4] * fy + minv[5] * fn
     out[2] = work[R_] + minv[6] * fx + minv[7] * fy + minv[8] * fn

@@ -28,13 +28,16 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal, Optional
+from typing import TYPE_CHECKING, Literal, Optional
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from .errors import InputError
 from .terms import AXES, TERMS
+
+if TYPE_CHECKING:
+    from .effects import EffectSet
 from .units import (DENSITY_RANGE, MAX_RUDDER, MAX_STEERING_RATE, MAX_STEERING_TIME_CONSTANT, SHIP_LENGTH_RANGE,
                     check_range, to_si)
 
@@ -206,6 +209,18 @@ class Ship:
     engine: Engine
     source: str = ""
     wind: Wind | None = None
+    effects: "EffectSet | None" = None
+    """The effects the ship config switches on (:mod:`mmg.effects`; its ``effects:`` section and
+    ``wind.enabled``), applied by the simulator, the replay, the estimators and ``mmg diagnose``
+    as part of the ship; None: none."""
+
+    def effect_set(self):
+        """:attr:`effects` as an :class:`mmg.effects.EffectSet` (an empty one when None)."""
+        if self.effects is not None:
+            return self.effects
+        from .effects import EffectSet
+
+        return EffectSet()
 
     def with_hull(self, changes: dict[str, float]) -> "Ship":
         """A copy with some hull coefficients changed (e.g. for sensitivity)."""
@@ -233,6 +248,9 @@ class Ship:
 #   steering     0 < T_E <= 60 s; 0 < rate_max <= 60 deg/s; 0 < delta_max <= 90 deg
 #   engine       constant power: SHP_0 not all zero; watts_per_hp 700-800;
 #                0 < shaft_inertia_coefficient <= 100
+#   effects      {name: {parameter: value}} of mmg.effects (current, wind, rudder_offset,
+#                heading_bias, shallow_water), each parameter within its effect's bounds;
+#                wind needs the wind section; wind.enabled: true is effects: {wind: {scale}}
 #
 # A value outside them is refused with one line naming the ship file and the field.
 
@@ -352,6 +370,7 @@ class _ShipFile(_Strict):
     steering: _Steering
     engine: _Engine
     wind: Optional[_Wind] = None
+    effects: Optional[dict] = None
 
 
 _UNIT_HINT = {"L": "m", "B": "m", "T": "m", "S_wetted": "m^2", "x_G": "m", "rho": "kg/m^3", "D": "m", "P": "m",
@@ -547,8 +566,26 @@ def _build(f: _ShipFile, src: str) -> Ship:
                 x_AOD=_qty(src, "wind.x_AOD", w.x_AOD, "length", -0.5 * L, 0.5 * L)),
             scale=_num(src, "wind.scale", w.scale, 0.0, 10.0),
         )
+    effects = None
+    if f.effects is not None or (wind is not None and wind.enabled):
+        from .effects import effect_set
+
+        effects = effect_set(f.effects, "effects", src)
+        w_eff = effects.get("wind")
+        if w_eff is not None and wind is None:
+            raise InputError(src, "effects.wind", "the wind effect needs the ship's wind section "
+                                                  "(areas and heights of the above-water body)")
+        if wind is not None and wind.enabled and w_eff is None:      # wind.enabled: the shorthand
+            effects = effects.merged(effect_set({"wind": {"scale": wind.scale}}))
+        elif w_eff is not None:
+            if f.wind.scale != 1.0 and w_eff["scale"] != wind.scale:
+                raise InputError(src, "effects.wind.scale", f"{w_eff['scale']:g} disagrees with wind.scale "
+                                                            f"{wind.scale:g}: give the scale in one place")
+            wind = replace(wind, enabled=True, scale=w_eff["scale"])
+        if not effects.items:
+            effects = None
     return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
-                steering=steering, engine=engine, source=f.source, wind=wind)
+                steering=steering, engine=engine, source=f.source, wind=wind, effects=effects)
 
 
 def ship_from_dict(data: Mapping, source: str = "<dict>") -> Ship:

@@ -48,16 +48,25 @@ class SimulationResult:
         return df
 
 
-def prepare(ship: Ship, u0: float, n0: float | None = None, trim: bool = True, disturbances=()):
-    """Solve the straight run and pack the (K_Q-calibrated) ship; returns (packed, equilibrium)."""
+def prepare(ship: Ship, u0: float, n0: float | None = None, trim: bool = True, disturbances=(), effects=None):
+    """Solve the straight run and pack the (K_Q-calibrated) ship; returns (packed, equilibrium).
+
+    ``disturbances``: :mod:`mmg.disturbances` components (slots); ``effects``: an
+    :class:`mmg.effects.EffectSet` added to the ship's own (:attr:`mmg.ship.Ship.effects`; a trial's
+    ``effects:`` section).  Measurement effects (a heading bias) act on logs, not here."""
+    es = ship.effect_set().merged(effects)
+    es = es if es.items else None
     slots = combine(disturbances)
-    eq = straight_run(ship, u0, n=n0, trim=trim, disturbance_slots=slots)
-    pk = pack(with_kq_scale(ship, eq.K_Q_scale), eq.power_W, slots)
+    eq = straight_run(ship, u0, n=n0, trim=trim, disturbance_slots=slots, effects=es)
+    sh = with_kq_scale(ship, eq.K_Q_scale)
+    pk = pack(sh, eq.power_W, slots)
+    if es is not None:
+        pk = es.pack(pk, sh)
     return pk, eq
 
 
 def simulate(ship: Ship, law: CommandLaw, duration: float, dt: float, u0: float,
-             n0: float | None = None, trim: bool = True, disturbances=()) -> SimulationResult:
+             n0: float | None = None, trim: bool = True, disturbances=(), effects=None) -> SimulationResult:
     """Simulate from a steady straight run.
 
     Parameters
@@ -74,7 +83,9 @@ def simulate(ship: Ship, law: CommandLaw, duration: float, dt: float, u0: float,
     trim : bool
         Start from the trimmed straight run (rudder and drift that cancel Y_0, N_0).
     disturbances : sequence of :class:`mmg.disturbances.Disturbance`
+    effects : mmg.effects.EffectSet, optional
+        Effects besides the ship's own (:func:`prepare`).
     """
-    pk, eq = prepare(ship, u0, n0, trim, disturbances)
+    pk, eq = prepare(ship, u0, n0, trim, disturbances, effects)
     t, states, orders, done = integrate(pk, eq.state(), law, duration, dt)
     return SimulationResult(t, states, orders, eq, done, ship.name)

@@ -54,6 +54,9 @@ __all__ = [
     "RHO_AIR",
     "fujiwara_amplitudes",
     "fujiwara_coefficients",
+    "fujiwara_series",
+    "amplitude_vector",
+    "AMPLITUDES",
     "wind_forces",
     "angle_from_dataset",
     "true_wind_from_relative",
@@ -192,11 +195,47 @@ def fujiwara_coefficients(angle, particulars: WindParticulars = ESSO_OSAKA_MODEL
         from starboard gives C_Y < 0.
     """
     a = np.asarray(angle, dtype=float)
+    return fujiwara_series(np.cos(a), np.sin(a), amplitude_vector(particulars))
+
+
+AMPLITUDES = ("X0", "X1", "X3", "X5", "Y1", "Y3", "Y5", "N1", "N2", "N3")
+"""Order of the amplitudes in :func:`amplitude_vector` and :func:`fujiwara_series`."""
+
+
+def amplitude_vector(particulars: WindParticulars = ESSO_OSAKA_MODEL) -> np.ndarray:
+    """The ten Fujiwara amplitudes as an array in the order of :data:`AMPLITUDES`."""
     A = fujiwara_amplitudes(particulars)
-    cx = A["X0"] + A["X1"] * np.cos(a) + A["X3"] * np.cos(3 * a) + A["X5"] * np.cos(5 * a)
+    return np.array([A[k] for k in AMPLITUDES])
+
+
+def fujiwara_series(c, s, A):
+    """The Fujiwara Fourier series C_X, C_Y, C_N from cos gamma and sin gamma.
+
+    The one definition of the series, used by :func:`fujiwara_coefficients` (arrays) and,
+    compiled, by the simulator's steady-wind loads (:func:`mmg.model.wind_loads`, real or complex
+    scalars).  The multiple angles are written as polynomials in ``c = cos gamma`` and
+    ``s = sin gamma`` (cos 3g = 4c^3 - 3c, cos 5g = 16c^5 - 20c^3 + 5c, sin 2g = 2sc,
+    sin 3g = 3s - 4s^3, sin 5g = s (16c^4 - 12c^2 + 1)), so the loads follow from the components
+    of the apparent wind without an arctangent and stay analytic for complex-step derivatives.
+
+    Parameters
+    ----------
+    c, s : float, complex or ndarray
+        cos and sin of the relative wind angle gamma (comes FROM, from the bow, + to starboard).
+    A : sequence of 10 floats
+        :func:`amplitude_vector`.
+
+    Returns
+    -------
+    C_X, C_Y, C_N
+        As :func:`fujiwara_coefficients`.
+    """
+    c2 = c * c
+    s2 = s * s
+    cx = A[0] + A[1] * c + A[2] * (4.0 * c2 - 3.0) * c + A[3] * ((16.0 * c2 - 20.0) * c2 + 5.0) * c
     # The regression angle is -gamma; sin is odd, cos even.
-    cy = -(A["Y1"] * np.sin(a) + A["Y3"] * np.sin(3 * a) + A["Y5"] * np.sin(5 * a))
-    cn = -(A["N1"] * np.sin(a) + A["N2"] * np.sin(2 * a) + A["N3"] * np.sin(3 * a))
+    cy = -(A[4] * s + A[5] * (3.0 - 4.0 * s2) * s + A[6] * ((16.0 * c2 - 12.0) * c2 + 1.0) * s)
+    cn = -(A[7] * s + A[8] * 2.0 * s * c + A[9] * (3.0 - 4.0 * s2) * s)
     return cx, cy, cn
 
 

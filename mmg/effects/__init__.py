@@ -54,10 +54,37 @@ def get(name: str, owner: str = "effects"):
         raise InputError(owner, name, f"unknown effect; expected one of {', '.join(REGISTRY)}") from None
 
 
-def effect_set(spec=None, owner: str = "effects") -> EffectSet:
-    """An :class:`EffectSet` from ``{name: {parameter: value}}`` (a value ``None`` or ``{}``: defaults)."""
+def effect_set(spec=None, owner: str = "effects", source: str | None = None) -> EffectSet:
+    """An :class:`EffectSet` from ``{name: {parameter: value}}`` (a value ``None`` or ``{}``: defaults).
+
+    Parameters
+    ----------
+    spec : mapping, optional
+        Effect name -> its named parameter values (a config's ``effects:`` section).
+    owner : str
+        The field the spec sits in (``"effects"``), named in errors.
+    source : str, optional
+        The file the spec came from: errors then read ``FILE: effects.current.speed_mps: ...``.
+
+    Raises
+    ------
+    mmg.errors.InputError
+        An unknown effect or parameter, a value that is not a number or out of its range, a
+        section that is not a mapping.
+    """
+    if spec is not None and not isinstance(spec, dict):
+        raise InputError(source or owner, owner if source else "",
+                         f"must be a mapping of effect names ({', '.join(REGISTRY)}) to their parameters")
     items = []
     for nm, vals in dict(spec or {}).items():
-        cls = get(nm, owner)
-        items.append((cls, cls.values(vals or {}, f"{owner}.{nm}")))
+        try:
+            cls = get(str(nm), owner)
+            if vals is not None and not isinstance(vals, dict):
+                raise InputError(f"{owner}.{nm}", "", "must be a mapping of parameter names to numbers, e.g. "
+                                 + ", ".join(f"{q.name}: {q.default:g}" for q in cls.parameters if q.default == q.default))
+            items.append((cls, cls.values(vals or {}, f"{owner}.{nm}")))
+        except InputError as e:
+            if source is None:
+                raise
+            raise InputError(source, ".".join(x for x in (e.source, e.field) if x), e.message) from None
     return EffectSet(tuple(items))

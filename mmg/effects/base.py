@@ -218,6 +218,33 @@ class EffectSet:
     def names(self) -> list:
         return [e.name for e, _ in self.items]
 
+    def get(self, name: str):
+        """The values of effect ``name``, or None when it is not in the set."""
+        for e, v in self.items:
+            if e.name == name:
+                return v
+        return None
+
+    def merged(self, other: "EffectSet | None") -> "EffectSet":
+        """This set with ``other``'s effects added; an effect in both takes ``other``'s values
+        (a trial's ``effects:`` over its ship's)."""
+        if other is None or not other.items:
+            return self
+        mine = {e.name: (e, v) for e, v in self.items}
+        for e, v in other.items:
+            mine[e.name] = (e, v)
+        return EffectSet(tuple(mine.values()))
+
+    def without(self, *names: str) -> "EffectSet":
+        """This set without the named effects."""
+        return EffectSet(tuple(it for it in self.items if it[0].name not in names))
+
+    def summary(self) -> str:
+        """One line, e.g. ``current speed_mps=0.3 direction_deg=90; rudder_offset offset_deg=1`` ("none")."""
+        if not self.items:
+            return "none"
+        return "; ".join(f"{e.name} " + " ".join(f"{k}={v:g}" for k, v in vals.items()) for e, vals in self.items)
+
     def pack(self, packed, ship=None):
         for e, v in self.items:
             packed = e.pack(packed, v, ship)
