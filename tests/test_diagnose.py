@@ -156,7 +156,15 @@ def test_cli_on_frt_format_file(tmp_path, ship):
     assert j["named_effects"] == ["rudder_offset"]
     from mmg.ship import load_ship
 
-    load_ship(tmp_path / "new.yaml")
+    new = load_ship(tmp_path / "new.yaml")               # the named effect in its effects: section
+    assert abs(new.effects.get("rudder_offset")["offset_deg"] - 1.0) < 0.3
+    # and mmg predict with it closes the gap on the record
+    scores = []
+    for s in ("esso_osaka_3m", tmp_path / "new.yaml"):
+        r = _mmg("predict", "--ship", s, p, "--json", tmp_path / "p.json", "--wind", "off")
+        assert r.returncode == 0, r.stderr
+        scores.append(json.loads((tmp_path / "p.json").read_text())["runs"][0]["heading_rms_deg"])
+    assert scores[1] < 0.5 * scores[0], scores
 
 
 @needs_frt()

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import math
 import os
 import signal
 import sys
@@ -498,9 +499,9 @@ def cmd_diagnose(args) -> int:
 
         note = (f"mmg diagnose over {len(recs)} record(s): named {', '.join(d.named) or 'nothing'}; "
                 + "; ".join(f"{e} " + ", ".join(f"{k} = {v:.4g}" for k, v in p.items()) for e, p in d.parameters.items())
-                + ". Effects of the environment or the sensors (current, rudder_offset, heading_bias) belong to the "
-                  "trial/record, not the ship: switch them on in a trial config (disturbances.current, "
-                  "disturbances.rudder_offset, log.bias.heading)")
+                + ". The named effects are in the effects: section, so mmg predict with this config replays these "
+                  "records with them; a current, a rudder offset or a heading bias belongs to these records, not the "
+                  "ship: for other trials move it to their trial config's effects: section")
         ship_text = ship_yaml(src, d.ship_values, note)
         import yaml
 
@@ -511,9 +512,13 @@ def cmd_diagnose(args) -> int:
         for k, v in d.ship_values.items():            # the fitted added masses (ship_yaml writes the hull)
             if k.endswith("_prime") and k in data.get("mass", {}):
                 data["mass"][k] = float(f"{v:.6g}")
-        if "wind" in d.parameters and data.get("wind") is not None:
-            data["wind"]["enabled"] = True
-            data["wind"]["scale"] = float(f"{d.parameters['wind']['scale']:.4g}")
+        if d.parameters:
+            eff = dict(data.get("effects") or {})
+            for e, p in d.parameters.items():
+                eff[e] = {k: float(f"{v:.6g}") for k, v in p.items() if math.isfinite(v)}
+            if "wind" in eff and data.get("wind") is not None:
+                data["wind"].pop("scale", None)            # the scale is the effect's now
+            data["effects"] = eff
         ship_text = "".join(head) + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
     with StagedFile(args.json) as tmp:
         with StagedFile(args.out_ship) if args.out_ship else nullcontext() as tship:

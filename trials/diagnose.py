@@ -127,7 +127,8 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
             ch = {c: None for c in ch}
         ctx = Context(t=run.t, delta=run.inputs.delta, n=run.inputs.n, channels=ch, ship=ship)
         seg = Segmented(run.name, run.meas, run.inputs, segment_resets(run.t, seg_s), context=ctx,
-                        start=_smoothed(run.t, run.meas, RESTART_SMOOTH * math.sqrt(L / 9.80665)))
+                        start=_smoothed(run.t, run.meas, RESTART_SMOOTH * math.sqrt(L / 9.80665)),
+                        fixed=run.effects)
         out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes)))
     return out
 

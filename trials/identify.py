@@ -150,7 +150,13 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
     if "epsilon" in values:
         s = replace(s, rudder=replace(s.rudder, epsilon=values["epsilon"]))
     if "wind_scale" in values and s.wind is not None:
-        s = replace(s, wind=replace(s.wind, scale=s.wind.scale * values["wind_scale"]))
+        scale = s.wind.scale * values["wind_scale"]
+        s = replace(s, wind=replace(s.wind, scale=scale))
+        w = s.effect_set().get("wind")
+        if w is not None:
+            import mmg.effects as E
+
+            s = replace(s, effects=s.effect_set().merged(E.effect_set({"wind": {**w, "scale": scale}})))
     return s
 
 
@@ -192,7 +198,7 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     fit = None
     for k, st in enumerate(stages):
         seg = float(st) * float(np.sqrt(L / 9.80665))
-        segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg)) for r in runs]
+        segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects) for r in runs]
         fit = identify_segments(packed, segs, fp, _scales(runs, L), max_nfev=max_nfev, progress=progress,
                                 start=None if fit is None else fit.theta)
     return Identification(ship=_ship_with(ship, fit.values()), initial=ship, fit=fit, runs=runs, segment_s=seg)
@@ -230,7 +236,12 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
         elif k == "epsilon":
             data["rudder"]["epsilon"] = float(f"{v:.6g}")
         elif k == "wind_scale" and "wind" in data:
-            data["wind"]["scale"] = float(f"{float(data['wind'].get('scale', 1.0)) * v:.6g}")
+            eff = (data.get("effects") or {}).get("wind")
+            if isinstance(eff, dict) and "scale" in eff:           # the scale given in the effects section
+                eff["scale"] = float(f"{float(eff['scale']) * v:.6g}")
+                data["wind"].pop("scale", None)
+            else:
+                data["wind"]["scale"] = float(f"{float(data['wind'].get('scale', 1.0)) * v:.6g}")
     data["name"] = f"{data['name']} (identified)"
     data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
     head = "".join(f"# {ln}\n" for ln in note.splitlines())

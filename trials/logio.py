@@ -77,10 +77,10 @@ def _header(meta: dict) -> str:
     return header(meta)
 
 
-def log_frame(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None) -> pd.DataFrame:
+def log_frame(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None, wind=None) -> pd.DataFrame:
     """:func:`trials.logwrite.log_columns` (the trajectory sampled every ``spec.interval`` seconds,
     uniform noise and sensor biases added) as a DataFrame; same parameters."""
-    return pd.DataFrame(log_columns(t, x, y, psi, sog, n, spec, rng))
+    return pd.DataFrame(log_columns(t, x, y, psi, sog, n, spec, rng, wind=wind))
 
 
 def write_csv(path: Path, df: pd.DataFrame, meta: dict) -> None:
@@ -109,9 +109,9 @@ def as_written(df: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def truth_frame(t, states, orders) -> pd.DataFrame:
+def truth_frame(t, states, orders, wind=None) -> pd.DataFrame:
     """States at the integration step as the truth-file table."""
-    return pd.DataFrame(truth_columns(t, states, orders))
+    return pd.DataFrame(truth_columns(t, states, orders, wind=wind))
 
 
 # --------------------------------------------------------------------------- reading
@@ -533,10 +533,12 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         _check_speed(tab, "u_mps", U, L)
         _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L, U, (0.2, 5.0), "u_mps")
         _check_rps(tab, "n_rps", a["n_rps"])
+        wind = _apparent_wind(tab, cols, "wind_rel_mps", "wind_rel_rad", 1.0, 1.0)
         return TrialRecord(t=a["time_s"], name=name, ship=ship, source=src, x=a["x_m"], y=a["y_m"],
                            psi=a["psi_rad"], U=U, u=a["u_mps"],
                            v=a["v_mps"], r=a["r_radps"], delta=a["delta_rad"], n=a["n_rps"],
-                           meta={**meta, "format": "truth", "delta_order": a["delta_order_rad"], "notes": notes})
+                           meta={**meta, "format": "truth", "delta_order": a["delta_order_rad"], "notes": notes},
+                           **wind)
     if "lat_deg" in cols or "heading_deg" in cols or "time_s" in cols:
         tab.require(LOG_COLUMNS)
         a = {c: tab.numeric(c) for c in LOG_COLUMNS}
@@ -563,11 +565,36 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
             d = tab.numeric("rudder_deg")
             _check_rudder_deg(tab, "rudder_deg", d)
             extra["delta"] = d * DEG
+        extra.update(_apparent_wind(tab, cols, "wind_rel_kn", "wind_rel_deg", KNOT, DEG))
         return TrialRecord(t=t, name=name, ship=ship, source=src, x=x, y=y,
                            psi=unwrap_heading(np.radians(a["heading_deg"])), U=U,
                            n=a["rpm"] / 60.0, meta={**meta, "format": "log", "notes": notes}, **extra)
     missing = sorted(set(LOG_COLUMNS) - cols)
     raise InputError(src, missing[0] if missing else "", "missing column (not a project log, truth file or FRT-DS-ESSO CSV)")
+
+
+def _apparent_wind(tab: _Table, cols, speed_col: str, dir_col: str, speed_si: float, dir_si: float) -> dict:
+    """The optional apparent-wind columns of a project log or truth file (both or neither) as
+    ``wind_speed_rel`` [m/s] and ``wind_dir_rel`` [rad, 0 to 2 pi; comes from, from the bow,
+    clockwise]; refused when only one is there, the speed is negative or beyond
+    :data:`MAX_WIND_MPS`, or the direction is outside one turn of its unit."""
+    have = [c for c in (speed_col, dir_col) if c in cols]
+    if not have:
+        return {}
+    if len(have) == 1:
+        other = dir_col if have[0] == speed_col else speed_col
+        raise InputError(tab.src, other, f"missing: {have[0]} needs {other} (the apparent wind is a speed and a direction)")
+    V = tab.numeric(speed_col) * speed_si
+    d = tab.numeric(dir_col)
+    if np.nanmin(V) < 0 or np.nanmax(V) > MAX_WIND_MPS:
+        bad = np.nanmax(np.abs(V)) / speed_si
+        raise InputError(tab.src, speed_col, f"{bad:.4g} is not an apparent wind speed in its column's unit "
+                                             f"(0 to {MAX_WIND_MPS / speed_si:.4g})")
+    turn = 2 * np.pi / dir_si
+    if np.nanmin(d) < -1e-9 or np.nanmax(d) > turn * (1 + 1e-9):
+        raise InputError(tab.src, dir_col, f"must lie in 0 to {turn:.6g} (one turn in its column's unit), "
+                                           f"got {np.nanmin(d):.4g} to {np.nanmax(d):.4g}")
+    return {"wind_speed_rel": V, "wind_dir_rel": np.mod(d * dir_si, 2 * np.pi)}
 
 
 def _check_range(tab: _Table, col: str, v: np.ndarray, lo: float, hi: float, what: str) -> None:

@@ -31,7 +31,15 @@ def header(meta: dict) -> str:
     return "".join(f"# {k}: {v}\n" for k, v in meta.items())
 
 
-def log_columns(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None) -> dict[str, np.ndarray]:
+WIND_LOG_COLUMNS = ("wind_rel_kn", "wind_rel_deg")
+"""Optional log columns of a steady-wind run: apparent wind speed [kn] and the direction it comes
+from, relative to the bow, clockwise [deg, 0-360] (as a ship's anemometer shows them)."""
+WIND_TRUTH_COLUMNS = ("wind_rel_mps", "wind_rel_rad")
+"""The same in the truth file, SI (direction 0 to 2 pi)."""
+
+
+def log_columns(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = None,
+                wind=None) -> dict[str, np.ndarray]:
     """The log's columns (:data:`LOG_COLUMNS`): the trajectory every ``spec.interval`` seconds with uniform noise.
 
     Parameters
@@ -43,6 +51,9 @@ def log_columns(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = No
         constant sensor biases (heading, speed, rpm; :class:`mmg.disturbances.SensorBias`).
     rng : numpy Generator, optional
         Defaults to ``np.random.default_rng(spec.seed)``.
+    wind : (V_rel, gamma) arrays at the integration step, optional
+        The apparent wind (:meth:`trials.run.TrialRun.apparent_wind`): adds :data:`WIND_LOG_COLUMNS`
+        (noise-free: the anemometer's own error is not modelled).
     """
     rng = np.random.default_rng(spec.seed) if rng is None else rng
     step = int(round(spec.interval / (t[1] - t[0])))
@@ -59,14 +70,23 @@ def log_columns(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = No
     hdg = np.mod(np.degrees(psi[sel] + b.heading) + noise(np.degrees(spec.noise_heading)), 360.0)
     spd = (sog[sel] + b.speed) / KNOT + noise(spec.noise_speed / KNOT)
     rpm = (n[sel] + b.rpm) * 60.0 + noise(spec.noise_rpm * 60.0)
-    return {"time_s": ts, "lat_deg": lat, "lon_deg": lon, "heading_deg": hdg, "speed_kn": spd, "rpm": rpm}
+    out = {"time_s": ts, "lat_deg": lat, "lon_deg": lon, "heading_deg": hdg, "speed_kn": spd, "rpm": rpm}
+    if wind is not None:
+        out["wind_rel_kn"] = np.asarray(wind[0])[sel] / KNOT
+        out["wind_rel_deg"] = np.mod(np.degrees(np.asarray(wind[1])[sel]), 360.0)
+    return out
 
 
-def truth_columns(t, states, orders) -> dict[str, np.ndarray]:
-    """The truth file's columns (:data:`TRUTH_COLUMNS`): the states at the integration step."""
-    return {"time_s": t, "u_mps": states[:, 0], "v_mps": states[:, 1], "r_radps": states[:, 2],
-            "delta_rad": states[:, 6], "delta_order_rad": orders, "x_m": states[:, 3],
-            "y_m": states[:, 4], "psi_rad": states[:, 5], "n_rps": states[:, 7]}
+def truth_columns(t, states, orders, wind=None) -> dict[str, np.ndarray]:
+    """The truth file's columns (:data:`TRUTH_COLUMNS`): the states at the integration step, and
+    :data:`WIND_TRUTH_COLUMNS` when ``wind`` (as :func:`log_columns`) is given."""
+    out = {"time_s": t, "u_mps": states[:, 0], "v_mps": states[:, 1], "r_radps": states[:, 2],
+           "delta_rad": states[:, 6], "delta_order_rad": orders, "x_m": states[:, 3],
+           "y_m": states[:, 4], "psi_rad": states[:, 5], "n_rps": states[:, 7]}
+    if wind is not None:
+        out["wind_rel_mps"] = np.asarray(wind[0])
+        out["wind_rel_rad"] = np.mod(np.asarray(wind[1]), 2 * np.pi)
+    return out
 
 
 def formattable(columns: dict) -> bool:

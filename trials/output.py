@@ -599,8 +599,9 @@ def write_trial_outputs(run, stage, show: bool = False) -> dict:
     meta = run.log_meta()
     r = run.result
     # the columns of run.log() and run.truth(), written without building DataFrames (no pandas import)
-    write_table(stage.path("log.csv"), log_columns(r.t, r.x, r.y, r.psi, run.sog, r.n, run.trial.log), meta)
-    write_table(stage.path("truth.csv"), truth_columns(r.t, r.states, r.orders), meta)
+    wind = run.apparent_wind()
+    write_table(stage.path("log.csv"), log_columns(r.t, r.x, r.y, r.psi, run.sog, r.n, run.trial.log, wind=wind), meta)
+    write_table(stage.path("truth.csv"), truth_columns(r.t, r.states, r.orders, wind=wind), meta)
     m = run.metrics()
     dump_json(m, stage.path("metrics.json"))
     sh = run.trial.ship.particulars

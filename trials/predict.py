@@ -30,7 +30,8 @@ from mmg.ship import Ship
 
 from .records import TrialRecord
 
-__all__ = ["MeasuredRun", "Replayed", "Prediction", "measured_run", "replay_record", "predict", "SCORE_KEYS"]
+__all__ = ["MeasuredRun", "Replayed", "Prediction", "measured_run", "replay_record", "predict", "run_effects",
+           "SCORE_KEYS"]
 
 SCORE_KEYS = ("heading_rms_deg", "yaw_rate_rms_degps", "speed_rms_mps", "final_position_error_m", "final_position_error_L")
 """Keys of :meth:`Replayed.scores`, as ``mmg predict`` writes them for each run."""
@@ -53,6 +54,11 @@ class MeasuredRun:
         off) or why it is not applied (``"no wind channels"``).
     notes : list of str
         How channels the record lacks were made up (rebuilt rudder, zero sway, ...).
+    effects : mmg.effects.EffectSet or None
+        The ship config's effects the replay applies besides the measured-wind loads (a current,
+        a rudder offset, a heading bias, shallow water, a steady wind): in the packed ship, the
+        replay's start state (:meth:`~mmg.effects.EffectSet.to_model`) and its output
+        (:meth:`~mmg.effects.EffectSet.to_logged`).
     """
 
     name: str
@@ -61,24 +67,45 @@ class MeasuredRun:
     inputs: ReplayInputs
     wind: str = "off"
     notes: list = field(default_factory=list)
+    effects: object = None
 
     @property
     def t(self) -> np.ndarray:
         return self.inputs.t
 
 
-def _wind_loads(ship: Ship, rec: TrialRecord, wind: bool | None) -> tuple[np.ndarray | None, str]:
-    use = (ship.wind is not None and ship.wind.enabled) if wind is None else bool(wind)
-    if not use:
-        return None, "off"
+def run_effects(ship: Ship, wind: bool | None = None):
+    """The ship config's effects (:attr:`mmg.ship.Ship.effects`) with the wind switched as ``wind``
+    says (None: as the config has it; True: on, at the config's scale; False: off)."""
+    import mmg.effects as E
+
+    es = ship.effect_set()
+    if wind is None:
+        return es
+    if not wind:
+        return es.without("wind")
     if ship.wind is None:
         raise InputError(ship.source or ship.name, "wind", "wind was asked for but the ship config has no wind section")
+    if es.get("wind") is None:
+        es = es.merged(E.effect_set({"wind": {"scale": ship.wind.scale}}))
+    return es
+
+
+def _wind_loads(ship: Ship, rec: TrialRecord, es) -> tuple[np.ndarray | None, str]:
+    """Wind loads [N, N, N m] from the record's measured relative wind, and what was done."""
+    from mmg.effects import Wind
+
+    w = es.get("wind")
+    if w is None:
+        return None, "off"
+    if Wind.steady(w):
+        return None, f"steady {w['true_speed_mps']:g} m/s from {w['true_from_deg']:g} deg (config)"
     if rec.wind_speed_rel is None or rec.wind_dir_rel is None:
         return None, "no wind channels"
     from mmg.wind import angle_from_dataset, wind_forces
 
     X, Y, N = wind_forces(rec.wind_speed_rel, angle_from_dataset(rec.wind_dir_rel), ship.wind.particulars(),
-                          scale=ship.wind.scale)
+                          scale=float(w["scale"]))
     return np.column_stack([X, Y, N]), "on"
 
 
@@ -121,10 +148,14 @@ def measured_run(ship: Ship, rec: TrialRecord, start: float | None = None, wind:
         u, v = rec.speed(), np.zeros_like(rec.t)
         notes.append("u taken as the speed over ground, v as zero (the record has no u, v)")
     meas = np.column_stack([u, v, r, rec.x, rec.y, rec.psi]).astype(float)
-    ext, w = _wind_loads(ship, rec, wind)
+    es = run_effects(ship, wind)
+    ext, w = _wind_loads(ship, rec, es)
+    if ext is not None:
+        es = es.without("wind")                      # in the loads already
     return MeasuredRun(name=rec.name, source=rec.source, meas=meas,
                        inputs=ReplayInputs(t=np.asarray(rec.t, float), delta=np.asarray(rec.delta, float),
-                                           n=np.asarray(rec.n, float), ext=ext), wind=w, notes=notes)
+                                           n=np.asarray(rec.n, float), ext=ext), wind=w, notes=notes,
+                       effects=es if es.items else None)
 
 
 @dataclass(frozen=True)
@@ -195,7 +226,11 @@ def replay_record(ship: Ship, rec: TrialRecord | MeasuredRun, start: float | Non
     """
     run = rec if isinstance(rec, MeasuredRun) else measured_run(ship, rec, start, wind)
     packed = packed or pack(ship)
-    pred = replay_states(packed, run.inputs, run.meas[0])
+    es = run.effects
+    if es is None:
+        pred = replay_states(packed, run.inputs, run.meas[0])
+    else:
+        pred = es.to_logged(replay_states(es.pack(packed, ship), run.inputs, es.to_model(run.meas[:1])[0]))
     return Replayed(run=run, pred=pred, L=ship.particulars.L, B=ship.particulars.B)
 
 

@@ -103,9 +103,32 @@ class TrialRun:
     def sog(self) -> np.ndarray:
         """Speed over ground [m/s] (speed through the water plus any current)."""
         x, y, t = self.result.x, self.result.y, self.result.t
-        if not self.trial.disturbances:
+        if self.trial.current()[0] == 0.0:
             return self.result.U
         return np.hypot(np.gradient(x, t), np.gradient(y, t))
+
+    def apparent_wind(self):
+        """The apparent wind at midship of a steady-wind run, at every integration step, or None.
+
+        Returns
+        -------
+        (V_rel, gamma) : tuple of ndarray, or None
+            Speed [m/s] and direction it comes FROM, from the bow, clockwise [rad, 0 to 2 pi)
+            (the FRT-DS-ESSO convention of ``wind_dir_relative_mid``), from the true wind of the
+            ``wind`` effect and the ship's velocity over ground (:func:`mmg.wind.relative_wind_from_true`);
+            None without a steady wind.
+        """
+        w = self.trial.steady_wind()
+        if w is None:
+            return None
+        from mmg.wind import relative_wind_from_true
+
+        r = self.result
+        cs, cd = self.trial.current()
+        ug = r.u + cs * np.cos(cd - r.psi)
+        vg = r.v + cs * np.sin(cd - r.psi)
+        V, g = relative_wind_from_true(w[0], w[1], ug, vg, r.psi)
+        return V, np.mod(g, 2 * np.pi)
 
     def to_pandas(self) -> "pd.DataFrame":
         """The time history as a DataFrame indexed by time ``t`` [s].
@@ -208,7 +231,64 @@ class TrialRun:
         spec = self.trial.log if seed is None else dataclasses.replace(self.trial.log, seed=int(seed))
         from .logio import log_frame      # pandas only when a log is asked for
 
-        return log_frame(r.t, r.x, r.y, r.psi, self.sog, r.n, spec)
+        return log_frame(r.t, r.x, r.y, r.psi, self.sog, r.n, spec, wind=self.apparent_wind())
+
+    def record(self, interval: float | None = None, noise=None, seed: int | None = None):
+        """The run as an on-board system logs it (the FRT-DS-ESSO channels), with its effects in it.
+
+        What :func:`trials.logio.read_record` gives for a measured FRT-DS-ESSO file: u, v over
+        ground resolved in the logged heading, r, x, y, the logged heading (with a heading bias),
+        the rudder angle and revolutions as measured (the rudder indicator does not see a rudder
+        offset), and with a steady wind the apparent wind at midship (and the true wind).  The
+        effects of the ship and the trial (:meth:`trials.trial.Trial.effect_set`) act exactly as in
+        the replay and the estimators (:meth:`mmg.effects.EffectSet.to_logged`).
+
+        Parameters
+        ----------
+        interval : float, optional
+            Sampling interval [s], a multiple of the step; default the trial's ``log.interval``.
+        noise : sequence of 6 floats, optional
+            Standard deviations of white noise on u, v [m/s], r [rad/s], x, y [m], psi [rad];
+            default none.
+        seed : int, optional
+            Seed of the noise (default the trial's ``log.seed``).
+
+        Returns
+        -------
+        trials.records.TrialRecord
+        """
+        from .records import TrialRecord
+
+        r, tr = self.result, self.trial
+        step = max(1, int(round((interval or tr.log.interval) / tr.dt)))
+        sel = slice(0, len(r.t), step)
+        es = tr.effect_set()
+        cs, cd = tr.current()
+        if cs and es.get("current") is None:           # a disturbances.current acts as the current effect
+            import mmg.effects as E
+
+            es = es.merged(E.effect_set({"current": {"speed_mps": cs, "direction_deg": float(np.degrees(cd))}}))
+        if tr.log.bias.heading and es.get("heading_bias") is None:
+            import mmg.effects as E
+
+            es = es.merged(E.effect_set({"heading_bias": {"bias_deg": float(np.degrees(tr.log.bias.heading))}}))
+        lg = es.to_logged(r.states[sel, :6])
+        if noise is not None:
+            rng = np.random.default_rng(tr.log.seed if seed is None else seed)
+            lg = lg + rng.standard_normal(lg.shape) * np.asarray(noise, float)
+        ch = {}
+        w = self.apparent_wind()
+        if w is not None:
+            from mmg.wind import true_wind_from_relative
+
+            og = es.without("heading_bias").to_logged(r.states[sel, :6])
+            ch["wind_speed_rel"], ch["wind_dir_rel"] = w[0][sel], w[1][sel]
+            ch["wind_speed_true"], ch["wind_dir_true"] = true_wind_from_relative(ch["wind_speed_rel"], ch["wind_dir_rel"],
+                                                                                 og[:, 0], og[:, 1], og[:, 5])
+        return TrialRecord(t=r.t[sel], name=tr.name, ship=tr.ship.name, source=f"simulation of {tr.name}",
+                           u=lg[:, 0], v=lg[:, 1], r=lg[:, 2], x=lg[:, 3], y=lg[:, 4], psi=lg[:, 5],
+                           U=np.hypot(lg[:, 0], lg[:, 1]), delta=r.delta[sel], n=r.n[sel],
+                           meta={"format": "simulation", "trial": tr.name}, **ch)
 
     def log_meta(self) -> dict:
         """Header of the log and truth files."""
@@ -240,7 +320,7 @@ class TrialRun:
         r = self.result
         from .logio import truth_frame
 
-        return truth_frame(r.t, r.states, r.orders)
+        return truth_frame(r.t, r.states, r.orders, wind=self.apparent_wind())
 
     def metrics(self) -> dict:
         """Manoeuvre metrics for this trial's kind.
@@ -284,7 +364,7 @@ def run_trial(trial) -> TrialRun:
         from .trial import load_trial
 
         trial = load_trial(trial)
-    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances)
+    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances, trial.effects)
     law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
     t, states, orders, done = integrate(pk, eq.state(), law, trial.duration, trial.dt)
     return TrialRun(trial, SimulationResult(t, states, orders, eq, done, trial.ship.name, {"trial": trial.name}))

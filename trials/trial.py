@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Annotated, Literal, Optional, Union
 
@@ -169,6 +169,7 @@ class _TrialFile(_Strict):
     manoeuvre: _Manoeuvre
     log: _Log = _Log()
     disturbances: _Disturbances = _Disturbances()
+    effects: Optional[dict] = None
     _t = field_validator("duration", "dt")(_q("time"))
 
 
@@ -222,7 +223,13 @@ class Trial:
     log : LogSpec
         How the sea-trial log is recorded.
     disturbances : tuple
-        Current and rudder offset (:mod:`mmg.disturbances`).
+        Current and rudder offset of the ``disturbances:`` section (:mod:`mmg.disturbances`).
+    effects : mmg.effects.EffectSet or None
+        The ``effects:`` section (:mod:`mmg.effects`: ``current``, ``wind``, ``rudder_offset``,
+        ``heading_bias``, ``shallow_water``), added to the ship's own effects
+        (:attr:`mmg.ship.Ship.effects`; the trial's values win for an effect in both).  A heading
+        bias acts on the log (as ``log.bias.heading``), a steady wind also adds the apparent-wind
+        columns to the log.
     """
 
     name: str
@@ -239,6 +246,7 @@ class Trial:
     manoeuvre: dict
     log: LogSpec
     disturbances: tuple
+    effects: Optional[object] = None
 
     def __post_init__(self):
         # also for dataclasses.replace(trial, duration=...): refuse a run too big to allocate
@@ -281,6 +289,27 @@ class Trial:
                 man.append(f"first={v}")
         return (f"Trial({self.name!r}, {self.kind}: {', '.join(man)}; ship={self.ship.name!r}, "
                 f"speed={self.u0 * 3600 / 1852:.4g} kn, duration={self.duration:g} s, dt={self.dt:g} s)")
+
+    def effect_set(self):
+        """All effects of the run: the ship's and the trial's (:class:`mmg.effects.EffectSet`)."""
+        return self.ship.effect_set().merged(self.effects)
+
+    def steady_wind(self):
+        """(true speed [m/s], direction it comes from [rad], scale) of a steady wind, or None."""
+        w = self.effect_set().get("wind")
+        if w is None or not w["true_speed_mps"] > 0:
+            return None
+        return w["true_speed_mps"], np.radians(w["true_from_deg"]), w["scale"]
+
+    def current(self):
+        """(speed [m/s], direction it sets towards [rad]) of the run's current, (0, 0) without one."""
+        for d in self.disturbances:
+            if type(d).__name__ == "UniformCurrent":
+                return d.speed, d.direction
+        c = self.effect_set().get("current")
+        if c is not None:
+            return c["speed_mps"], float(np.radians(c["direction_deg"]))
+        return 0.0, 0.0
 
     def summary(self) -> dict:
         """Trial parameters for a log header (degrees and knots, as at the edges)."""
@@ -632,10 +661,31 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
     off = q("disturbances.rudder_offset", d.rudder_offset, "angle", -MAX_RUDDER_OFFSET, MAX_RUDDER_OFFSET)
     if off != 0.0:
         dist.append(RudderOffset(off))
+
+    # effects (mmg.effects), besides the ship's
+    effects = None
+    if f.effects is not None:
+        from mmg.effects import effect_set
+
+        effects = effect_set(f.effects, "effects", src)
+        for nm, given in (("current", d.current is not None), ("rudder_offset", off != 0.0),
+                          ("heading_bias", bias["heading"] != 0.0)):
+            if given and effects.get(nm) is not None:
+                where = {"current": "disturbances.current", "rudder_offset": "disturbances.rudder_offset",
+                         "heading_bias": "log.bias.heading"}[nm]
+                raise InputError(src, f"effects.{nm}", f"also given as {where}: give it in one place")
+        w = effects.get("wind")
+        if w is not None and ship.wind is None:
+            raise InputError(src, "effects.wind", f"the wind effect needs a ship with a wind section; {label} has none")
+        if not effects.items:
+            effects = None
+    hb = ship.effect_set().merged(effects).get("heading_bias")
+    if hb is not None:               # a compass error: on the logged heading, as log.bias.heading
+        log = replace(log, bias=replace(log.bias, heading=log.bias.heading + float(np.radians(hb["bias_deg"]))))
     return Trial(
         name=f.name, path=src, ship=ship, ship_path=ship_path, description=f.description,
         u0=u0, n0=n0, trim=f.approach.trim, duration=duration, dt=dt, kind=kind, manoeuvre=conv, log=log,
-        disturbances=tuple(dist),
+        disturbances=tuple(dist), effects=effects,
     )
 
 
@@ -694,7 +744,8 @@ def _schedule(man: dict, ship: Ship, label: str, duration: float, base: Path, sr
 
 def make_trial(ship: Ship | str | Path, manoeuvre: Mapping, *, speed: str, duration: str, dt: str = "0.1 s",
                rpm: str = "solve", trim: bool = True, log: Mapping | None = None,
-               disturbances: Mapping | None = None, name: str | None = None, description: str = "") -> Trial:
+               disturbances: Mapping | None = None, effects: Mapping | None = None, name: str | None = None,
+               description: str = "") -> Trial:
     """Build a trial in code, through the same validation as a trial YAML.
 
     Every dimensional value is a string with its unit, as in the YAML (``"10 kn"``,
@@ -724,6 +775,9 @@ def make_trial(ship: Ship | str | Path, manoeuvre: Mapping, *, speed: str, durat
         The YAML's ``log:`` section (``interval``, ``seed``, ``start_lat``, ``noise``, ``bias``).
     disturbances : mapping, optional
         The YAML's ``disturbances:`` section (``current``, ``rudder_offset``).
+    effects : mapping, optional
+        The YAML's ``effects:`` section, ``{name: {parameter: value}}`` of :mod:`mmg.effects`,
+        e.g. ``{"wind": {"true_speed_mps": 10, "true_from_deg": 45}}``.
     name : str, optional
         The trial's name; default from the manoeuvre.
     description : str, default ""
@@ -747,6 +801,8 @@ def make_trial(ship: Ship | str | Path, manoeuvre: Mapping, *, speed: str, durat
         data["log"] = dict(log)
     if disturbances is not None:
         data["disturbances"] = dict(disturbances)
+    if effects is not None:
+        data["effects"] = {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in dict(effects).items()}
     if isinstance(ship, Ship):
         return trial_from_dict(data, source=f"<{kind}>", ship=ship)
     if not isinstance(ship, (str, os.PathLike)):
@@ -785,7 +841,7 @@ def zigzag(ship: Ship | str | Path, *, rudder: str, heading: str | None = None, 
     first : {"starboard", "port"}, default "starboard"
         The side of the first rudder order.
     **kw
-        ``dt``, ``rpm``, ``trim``, ``log``, ``disturbances``, ``name``, ``description`` of
+        ``dt``, ``rpm``, ``trim``, ``log``, ``disturbances``, ``effects``, ``name``, ``description`` of
         :func:`make_trial`.
 
     Returns
