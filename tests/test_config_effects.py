@@ -225,6 +225,7 @@ def test_replay_applies_the_ship_configs_effects():
     ({"current": {"speed_mps": 25.0}}, "effects.current.speed_mps"),
     ({"current": {"speed_mps": "0.5 kn"}}, "effects.current.speed_mps"),
     ({"current": 0.5}, "effects.current"),
+    ({"wind": {"scale": True}}, "effects.wind.scale"),
     ({"shallow_water": {"depth_to_draft": 0.8}}, "effects.shallow_water.depth_to_draft"),
     ({"wind": {"true_speed_mps": 90.0}}, "effects.wind.true_speed_mps"),
     ({"rudder_offset": {"offset_deg": float("nan")}}, "effects.rudder_offset.offset_deg"),
@@ -333,3 +334,36 @@ def test_diagnose_names_a_steady_wind_of_a_trial_config_from_the_logged_apparent
     assert j["named_effects"] == ["wind"]
     assert abs(j["parameters"]["wind"]["scale"] - 1.0) < 0.2
     assert j["rms_after"]["heading"] <= 0.5 * j["rms_before"]["heading"]
+
+
+# ------------------------------------------------------------------ any effects section: a result or one line
+
+from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
+
+_NAMES = ["current", "wind", "rudder_offset", "heading_bias", "shallow_water", "tide", "Current", ""]
+_PARAMS = ["speed_mps", "direction_deg", "scale", "true_speed_mps", "true_from_deg", "offset_deg", "bias_deg",
+           "depth_to_draft", "speed", "offset", "bias"]
+_VALUES = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**6, 10**6),
+                    st.sampled_from(["0.5 kn", "1", "", "deg", None, True]), st.lists(st.floats(), max_size=2))
+
+
+@settings(max_examples=150, deadline=None, database=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.dictionaries(st.sampled_from(_NAMES),
+                       st.one_of(st.none(), _VALUES, st.dictionaries(st.sampled_from(_PARAMS), _VALUES, max_size=3)),
+                       max_size=4))
+def test_any_effects_section_gives_an_effect_set_or_one_line(spec):
+    import mmg.effects as E
+
+    try:
+        es = E.effect_set(spec, "effects", "t.yaml")
+    except InputError as e:
+        msg = str(e)
+        assert msg.startswith("t.yaml: effects") and "\n" not in msg
+        return
+    # accepted: every effect registered, every value a finite number within its bounds
+    for cls, vals in es.items:
+        assert cls.name in E.REGISTRY
+        for p in cls.parameters:
+            v = vals[p.name]
+            assert type(v) is float and p.lower <= v <= p.upper
+            assert math.isfinite(v) or (p.name == "depth_to_draft" and v == math.inf)

@@ -63,6 +63,8 @@ class Parameter:
     start: float | None = None
 
     def check(self, owner: str, value) -> float:
+        if isinstance(value, bool):
+            raise InputError(owner, self.name, f"must be a number [{self.unit}], got {value!r}")
         try:
             v = float(value)
         except (TypeError, ValueError):
