@@ -13,6 +13,7 @@ difference <= 1e-12.  Run:
 from __future__ import annotations
 
 import argparse
+import inspect
 import statistics
 import sys
 import time
@@ -41,11 +42,13 @@ def setup(name: str):
     x0 = np.asarray(eq.state(), dtype=float)
     p, poly, ha, ht, hc = pk.args()
     out = {}
+    # older versions allocate their work arrays inside (no ``work`` argument): keep them runnable
+    extra = (np.empty((6, 8)),) if "work" in inspect.signature(simulate_kernel.py_func).parameters else ()
 
     def model():
         s, o = np.empty((nsteps + 1, 8)), np.empty(nsteps + 1)
         k = simulate_kernel(x0, float(trial.dt), nsteps, p, poly, ha, ht, hc,
-                            law.kind, law.params, law.t, law.delta, law.n, s, o, np.empty((6, 8)))
+                            law.kind, law.params, law.t, law.delta, law.n, s, o, *extra)
         out["model"] = s[:k]
 
     def reference():
