@@ -104,8 +104,10 @@ def pack(ship: Ship, engine_power_W: float = 0.0, disturbance_slots: dict | None
     pa, ms, pr, ru, st, en = ship.particulars, ship.mass, ship.propeller, ship.rudder, ship.steering, ship.engine
     p = np.zeros(N_PARAMS)
     p[P_RHO], p[P_L], p[P_T], p[P_XG] = pa.rho, pa.L, pa.T, pa.x_G
-    ms_ = mass_scale(pa.rho, pa.L, pa.T)
-    is_ = inertia_scale(pa.rho, pa.L, pa.T)
+    # the Python bodies: compiling a specialisation for two products of four floats would cost
+    # a cold start a second or two (same IEEE operations, same values)
+    ms_ = mass_scale.py_func(pa.rho, pa.L, pa.T)
+    is_ = inertia_scale.py_func(pa.rho, pa.L, pa.T)
     p[P_M], p[P_MX], p[P_MY] = ms.m_prime * ms_, ms.m_x_prime * ms_, ms.m_y_prime * ms_
     p[P_IZ], p[P_JZ] = ms.I_zG_prime * is_, ms.J_z_prime * is_
     p[P_D], p[P_XP] = pr.D, pr.x_P_prime
