@@ -1,4 +1,4 @@
-"""Fill numba's on-disk cache once, on all cores: ``python -m mmg.warmup [--jobs N]``.
+"""Fill numba's on-disk cache once, on all cores: ``python -m trials.warmup [--jobs N]``.
 
 Every compiled function of the project is cached (``cache=True``), but a fresh install or a CI
 run starts with an empty cache and pays the compilation on its first calls, in one process on
@@ -101,7 +101,7 @@ def warmup(groups=DEFAULT_GROUPS, jobs: int | None = None, quiet: bool = False) 
     while pending or running:
         while pending and len(running) < jobs:
             g = pending.pop(0)
-            running.append((g, subprocess.Popen([sys.executable, "-m", "mmg.warmup", "--group", g]),
+            running.append((g, subprocess.Popen([sys.executable, "-m", "trials.warmup", "--group", g]),
                             time.perf_counter()))
         g, proc, ts = running.pop(0)
         rc = proc.wait()
@@ -116,7 +116,7 @@ def warmup(groups=DEFAULT_GROUPS, jobs: int | None = None, quiet: bool = False) 
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m mmg.warmup", description=__doc__,
+    ap = argparse.ArgumentParser(prog="python -m trials.warmup", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--jobs", type=int, default=None, help="processes at once (default: the CPU count)")
     ap.add_argument("--group", choices=GROUPS, action="append",
