@@ -145,7 +145,7 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
     if ship.engine.mode == "constant_power":
         x = np.array([u0, vv, 0.0, 0.0, 0.0, 0.0, dd, nn])
         J = forces(x, *pk.args())[3]
-        kq = polyval(pk.poly[POLY_KQ], J)
+        kq = polyval.py_func(pk.poly, POLY_KQ, J)     # Python body: no specialisation compiled for one call
         D, rho = ship.propeller.D, ship.particulars.rho
         scale = power / (2 * np.pi * nn) / (rho * nn**2 * D**5 * kq)
     pk2 = pack_all(with_kq_scale(ship, scale))

@@ -74,22 +74,27 @@ def _interp(tq, ts, vs, k):
     return vs[k] + w * (vs[k + 1] - vs[k]), k
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
-                    kind, cpar, st, sd, sn, states, orders):
+                    kind, cpar, st, sd, sn, states, orders, work):
     """Integrate ``nsteps`` RK4 steps from ``x0``; fill ``states`` (nsteps+1, 8) and ``orders``.
 
-    Releases the GIL (it touches no Python object): runs of different threads go on in parallel.
-    Returns the number of valid rows (< nsteps+1 when the run stopped because
-    the surge speed fell below 1 % of its initial value or a value became NaN).
+    ``work``: real (6, 8) scratch (the state and the four RK4 stages).  The kernel allocates
+    nothing, so it is compiled without reference counting (``_nrt=False``: no atomic
+    increment / decrement of the arrays' counts in the right-hand side, several per
+    evaluation otherwise).  Releases the GIL (it touches no Python object): runs of different
+    threads go on in parallel.  Returns the number of valid rows (< nsteps+1 when the run
+    stopped because the surge speed fell below 1 % of its initial value or a value became NaN).
     """
     nx = x0.shape[0]
-    x = x0.copy()
-    k1 = np.empty(nx)
-    k2 = np.empty(nx)
-    k3 = np.empty(nx)
-    k4 = np.empty(nx)
-    tmp = np.empty(nx)
+    x = work[0]
+    k1 = work[1]
+    k2 = work[2]
+    k3 = work[3]
+    k4 = work[4]
+    tmp = work[5]
+    for j in range(nx):
+        x[j] = x0[j]
     side = cpar[HS_FIRST]
     ptr = 0
     ptrn = 0
@@ -137,7 +142,7 @@ def integrate(packed: PackedShip, x0: np.ndarray, law: CommandLaw, duration: flo
     orders = np.empty(nsteps + 1)
     nvalid = simulate_kernel(
         np.asarray(x0, dtype=float), float(dt), nsteps, *packed.args(),
-        law.kind, law.params, law.t, law.delta, law.n, states, orders,
+        law.kind, law.params, law.t, law.delta, law.n, states, orders, np.empty((6, 8)),
     )
     t = np.arange(nvalid) * dt
     return t, states[:nvalid], orders[:nvalid], nvalid == nsteps + 1

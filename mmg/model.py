@@ -65,7 +65,6 @@ G = 9.80665
 
 # polynomial table rows
 POLY_KT, POLY_KQ, POLY_TP, POLY_WP0 = range(4)
-POLY_WIDTH = 6
 
 ENGINE_CONSTANT_POWER, ENGINE_CONSTANT_RPM = 0, 1
 WAKE_KIJIMA, WAKE_MMG2015 = 0, 1
@@ -86,10 +85,13 @@ class PackedShip:
         return self.p, self.poly, self.hull_axis, self.hull_term, self.hull_coef
 
 
-def _poly_row(c) -> np.ndarray:
-    row = np.zeros(POLY_WIDTH)
-    row[: len(c)] = c
-    return row
+def _poly_table(rows) -> np.ndarray:
+    """The polynomials as the rows of one table, zero-padded to the longest (Horner over a
+    padded zero is exact, so the width only sets the work of :func:`polyval`)."""
+    out = np.zeros((len(rows), max(1, max(len(c) for c in rows))))
+    for i, c in enumerate(rows):
+        out[i, : len(c)] = c
+    return out
 
 
 def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: dict | None = None) -> PackedShip:
@@ -107,8 +109,10 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: 
     pa, ms, pr, ru, st, en = ship.particulars, ship.mass, ship.propeller, ship.rudder, ship.steering, ship.engine
     p = np.zeros(N_PARAMS)
     p[P_RHO], p[P_L], p[P_T], p[P_XG] = pa.rho, pa.L, pa.T, pa.x_G
-    ms_ = mass_scale(pa.rho, pa.L, pa.T)
-    is_ = inertia_scale(pa.rho, pa.L, pa.T)
+    # the Python bodies: compiling a specialisation for two products of four floats would cost
+    # a cold start a second or two (same IEEE operations, same values)
+    ms_ = mass_scale.py_func(pa.rho, pa.L, pa.T)
+    is_ = inertia_scale.py_func(pa.rho, pa.L, pa.T)
     p[P_M], p[P_MX], p[P_MY] = ms.m_prime * ms_, ms.m_x_prime * ms_, ms.m_y_prime * ms_
     p[P_IZ], p[P_JZ] = ms.I_zG_prime * is_, ms.J_z_prime * is_
     p[P_D], p[P_XP] = pr.D, pr.x_P_prime
@@ -124,7 +128,7 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: 
     p[P_ULOW] = LOW_SPEED_FROUDE * np.sqrt(G * pa.L)
     for k, v in (disturbance_slots or {}).items():
         p[k] = v
-    poly = np.vstack([_poly_row(pr.K_T), _poly_row(pr.K_Q), _poly_row(pr.t_P), _poly_row(pr.w_P0)])
+    poly = _poly_table([pr.K_T, pr.K_Q, pr.t_P, pr.w_P0])
     h = ship.hull
     return PackedShip(
         p=p,
@@ -139,11 +143,15 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: 
 
 
 @njit(cache=True, inline="always")
-def polyval(c, x):
-    """Polynomial with coefficients ``c`` (lowest power first) at ``x`` (Horner)."""
-    acc = c[c.shape[0] - 1] + 0.0 * x
-    for i in range(c.shape[0] - 2, -1, -1):
-        acc = acc * x + c[i]
+def polyval(poly, row, x):
+    """Polynomial ``poly[row]`` (coefficients lowest power first) at ``x`` (Horner).
+
+    Indexes the table in place: a row view ``poly[row]`` would be a new array reference (a
+    reference-count increment and decrement) at every evaluation."""
+    w = poly.shape[1]
+    acc = poly[row, w - 1] + 0.0 * x
+    for i in range(w - 2, -1, -1):
+        acc = acc * x + poly[row, i]
     return acc
 
 
@@ -195,7 +203,7 @@ def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
 @njit(cache=True, error_model="numpy")
 def one_minus_wake(u, beta, rp, p, poly):
     """(1 - w_P) in manoeuvring: Kijima exp(-C beta_P^2) or MMG 2015 form, beta_P = beta - x_P' r'."""
-    w0 = polyval(poly[POLY_WP0], u)
+    w0 = polyval(poly, POLY_WP0, u)
     bp = beta - p[P_XP] * rp
     if p[P_WAKE] == WAKE_KIJIMA:
         return 1.0 - w0 * np.exp(-p[P_CWAKE] * bp * bp)
@@ -208,10 +216,10 @@ def propeller(u, n, one_minus_wP, p, poly):
     """Advance ratio J_P, thrust coefficient K_T and surge force X_P [N] (eq. 12)."""
     D = p[P_D]
     uP = u * one_minus_wP
-    tP = polyval(poly[POLY_TP], u)
+    tP = polyval(poly, POLY_TP, u)
     if n.real < 0.0:                     # astern: no open-water data; K_T(0) x ASTERN_KT, thrust aft
         J = 0.0 * uP
-        KT = ASTERN_KT * polyval(poly[POLY_KT], J)
+        KT = ASTERN_KT * polyval(poly, POLY_KT, J)
         return J, KT, -(1.0 - tP) * p[P_RHO] * n * n * D ** 4 * KT
     if uP.real < 0.0:                    # ahead propeller, ship moving astern: bollard-like, J held at 0
         J = 0.0 * uP
@@ -219,7 +227,7 @@ def propeller(u, n, one_minus_wP, p, poly):
         J = uP / (n * D)
     else:
         J = J_MAX + 0.0 * uP
-    KT = polyval(poly[POLY_KT], J)
+    KT = polyval(poly, POLY_KT, J)
     XP = (1.0 - tP) * p[P_RHO] * n * n * D ** 4 * KT
     return J, KT, XP
 
@@ -273,7 +281,7 @@ def shaft_acceleration(u, n, J, p, poly):
     if p[P_ENGINE] != ENGINE_CONSTANT_POWER:
         return 0.0 * n
     D = p[P_D]
-    KQ = p[P_KQSCALE] * polyval(poly[POLY_KQ], J)
+    KQ = p[P_KQSCALE] * polyval(poly, POLY_KQ, J)
     QP = -p[P_RHO] * n * n * D ** 5 * KQ
     QE = p[P_POWER] / (2.0 * np.pi * n)
     return (QP + QE) / (2.0 * np.pi * p[P_SHAFT_I])
@@ -417,10 +425,16 @@ def dynamics(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef, out):
 @njit(cache=True, error_model="numpy", inline="always")
 def track(u, v, r, psi, p, out):
     """dx0/dt, dy0/dt [m/s] (over ground, with the current) and dpsi/dt [rad/s] of :func:`rhs`
-    into out[X_], out[Y_], out[PSI_]; u, v [m/s], r [rad/s], psi [rad] scalars, real or complex."""
+    into out[X_], out[Y_], out[PSI_]; u, v [m/s], r [rad/s], psi [rad] scalars, real or complex.
+    The current's velocity (constant) is added only when there is one: in still water the
+    trigonometry of its direction is not evaluated at every call (same values either way)."""
     c, s = np.cos(psi), np.sin(psi)
-    out[X_] = u * c - v * s + p[P_CUR_SPEED] * np.cos(p[P_CUR_DIR])
-    out[Y_] = u * s + v * c + p[P_CUR_SPEED] * np.sin(p[P_CUR_DIR])
+    out[X_] = u * c - v * s
+    out[Y_] = u * s + v * c
+    cs = p[P_CUR_SPEED]
+    if cs != 0.0:
+        out[X_] += cs * np.cos(p[P_CUR_DIR])
+        out[Y_] += cs * np.sin(p[P_CUR_DIR])
     out[PSI_] = r
 
 

@@ -1,0 +1,133 @@
+"""Fill numba's on-disk cache once, on all cores: ``python -m trials.warmup [--jobs N]``.
+
+Every compiled function of the project is cached (``cache=True``), but a fresh install or a CI
+run starts with an empty cache and pays the compilation on its first calls, in one process on
+one core.  This module compiles the same specialisations ahead of time by running short
+versions of the everyday workloads, split into groups that share little compiled code, each
+group in its own process:
+
+* ``simulate``: the trial simulator (turning, zigzag, schedule laws), the straight-run
+  equilibrium, the rudder reconstruction, the sensitivities (:mod:`trials.fisher`) and the
+  replay of measured records (:mod:`mmg.replay`);
+* ``ekf``: the augmented EKF of the paper (:mod:`ekf.filter`, complex-step Jacobians) on a
+  short simulated zigzag;
+* ``log-filter``: the raw-log EKF (:mod:`ekf.log_filter`) and the output-error fit (not in
+  the default set, see :data:`DEFAULT_GROUPS`).
+
+The processes write into the same cache (numba's cache files are written atomically, one
+index per function); the command's own later runs then load instead of compiling.  Exit
+status 0, or 1 if a group failed (its traceback on stderr).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+from dataclasses import replace
+
+GROUPS = ("ekf", "simulate", "log-filter")
+"""Warm-up groups, longest first (so that with fewer processes than groups the long one starts
+at once)."""
+DEFAULT_GROUPS = ("ekf", "simulate")
+"""The groups run by default: one per core of a 2-core CI machine.  ``log-filter`` (the
+output-error fit runs the paper EKF first, so it repeats much of ``ekf``) on request."""
+
+SHORT_S = 60.0
+"""Duration [s] of the short trials the groups run: long enough for every branch the
+specialisations depend on (compilation depends on argument types only, not on the length)."""
+
+
+def _short(name: str, duration: float = SHORT_S):
+    from trials.trial import load_trial
+
+    return replace(load_trial(name), duration=duration)
+
+
+def warm_simulate() -> None:
+    """The simulator, the equilibrium, the rudder rebuild, the sensitivities, the replay."""
+    import numpy as np
+
+    from mmg.rudder import reconstruct_rudder
+    from mmg.simulation import prepare
+    from trials.run import run_trial
+
+    for name in ("st35", "zz10"):
+        run = run_trial(_short(name))
+    pk, _ = prepare(run.trial.ship, run.trial.u0)
+    t = np.arange(0.0, 10.0, 1.0)
+    reconstruct_rudder(t, np.zeros_like(t), "zigzag", {"rudder": 0.1, "heading": 0.1}, pk.p)
+    from trials import fisher
+
+    fisher.tangent(_short("zz20", 30.0))
+    fisher.tangent(_short("zz20", 30.0), rudder_timing=True)
+
+
+def warm_ekf() -> None:
+    """The augmented EKF (paper filter) of one short zigzag."""
+    from trials.estimation import estimate
+
+    estimate(_short("zz20", 100.0))
+
+
+def warm_log_filter() -> None:
+    """The raw-log EKF and the output-error fit of one short zigzag."""
+    from trials.estimation import estimate
+
+    estimate(_short("zz20", 100.0), method="output-error")
+
+
+_RUN = {"simulate": warm_simulate, "ekf": warm_ekf, "log-filter": warm_log_filter}
+
+
+def run_group(name: str) -> float:
+    """Run one group in this process; returns its wall time [s]."""
+    t0 = time.perf_counter()
+    _RUN[name]()
+    return time.perf_counter() - t0
+
+
+def warmup(groups=DEFAULT_GROUPS, jobs: int | None = None, quiet: bool = False) -> int:
+    """Run the warm-up ``groups`` in up to ``jobs`` processes at once (default: the CPU count).
+
+    Returns the number of groups that failed.
+    """
+    jobs = max(1, jobs or os.cpu_count() or 1)
+    pending = list(groups)
+    running: list[tuple[str, subprocess.Popen, float]] = []
+    failed = 0
+    t0 = time.perf_counter()
+    while pending or running:
+        while pending and len(running) < jobs:
+            g = pending.pop(0)
+            running.append((g, subprocess.Popen([sys.executable, "-m", "trials.warmup", "--group", g]),
+                            time.perf_counter()))
+        g, proc, ts = running.pop(0)
+        rc = proc.wait()
+        failed += rc != 0
+        if not quiet:
+            print(f"mmg warmup: {g} {'done' if rc == 0 else 'FAILED'} in {time.perf_counter() - ts:.1f} s",
+                  file=sys.stderr)
+    if not quiet:
+        print(f"mmg warmup: {len(groups)} groups in {time.perf_counter() - t0:.1f} s on {jobs} processes",
+              file=sys.stderr)
+    return failed
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m trials.warmup", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=None, help="processes at once (default: the CPU count)")
+    ap.add_argument("--group", choices=GROUPS, action="append",
+                    help="run only this group, in this process (repeatable)")
+    ap.add_argument("--quiet", action="store_true")
+    a = ap.parse_args(argv)
+    if a.group and len(a.group) == 1:
+        run_group(a.group[0])
+        return 0
+    return 1 if warmup(tuple(a.group or DEFAULT_GROUPS), a.jobs, a.quiet) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
