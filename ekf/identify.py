@@ -59,6 +59,9 @@ class Segmented:
     """States (N, 6) the replay starts and restarts from (e.g. a smoothed ``meas``: a restart
     from one noisy sample leaves a transient through the whole segment); ``meas`` when None.
     The residuals are always against ``meas``."""
+    fixed: object = None
+    """:class:`mmg.effects.EffectSet` of effects the ship config has on (a current, a rudder offset,
+    shallow water, a steady wind), applied with their values and not fitted; None: none."""
 
     @property
     def restart(self) -> np.ndarray:
@@ -166,9 +169,11 @@ def predict_logged(packed: PackedShip, rec: Segmented, effects=None, free=(), th
     """The replayed states of ``rec`` (segments as in ``rec.reset``) as the record logs them:
     (N, 6) u, v, r, x, y, psi with the ship parameters and effects at ``theta``."""
     pk = apply_parameters(packed, list(free), theta) if len(free) else packed
-    if not effects:
+    if not effects and rec.fixed is None:
         return replay_states(pk, rec.inputs, rec.restart[0], meas=rec.restart, reset=rec.reset)
     es = effect_set_of(effects, list(free), theta)
+    if rec.fixed is not None:
+        es = rec.fixed.merged(es)
     pk = es.pack(pk, ship)
     ext = es.external(rec.context, base=rec.inputs.ext)
     inputs = replace(rec.inputs, ext=ext) if ext is not None else rec.inputs
@@ -198,7 +203,7 @@ def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
 def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=None, free=(), theta=(),
                   ship=None, pos=None) -> np.ndarray:
     rec = _wind_scaled(rec, free, theta)
-    if effects:
+    if effects or rec.fixed is not None:
         pred = predict_logged(packed, rec, effects, free, theta, ship)
     else:
         pred = replay_states(packed, rec.inputs, rec.restart[0], meas=rec.restart, reset=rec.reset)
