@@ -13,7 +13,8 @@ cores (threads; the compiled replay releases the GIL).
 
 The free parameters (:class:`FreeParameter`) are hull coefficients by name and, optionally,
 the ship constants ``"w_P0"`` (the constant term of the wake polynomial: the model-scale wake),
-``"epsilon"`` (rudder inflow ratio) and ``"X_uu"`` is simply a hull name.  The standard errors
+``"epsilon"`` (rudder inflow ratio), ``"kappa"`` (the share of the propeller slipstream's speed-up
+that reaches the rudder, Yasukawa & Yoshimura 2015) and ``"X_uu"`` is simply a hull name.  The standard errors
 are from the Gauss-Newton covariance at the optimum, scaled by the residual variance per
 degree of freedom; correlated residuals (10 Hz samples are not independent) make them optimistic.
 
@@ -34,14 +35,14 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mmg.model import P_EPS, POLY_WP0, PackedShip
+from mmg.model import P_EPS, P_KAPPA, POLY_WP0, PackedShip
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
            "segment_resets", "identify_segments", "SHIP_CONSTANTS", "effect_parameters", "effect_set_of",
            "predict_logged"]
 
-SHIP_CONSTANTS = ("w_P0", "epsilon", "wind_scale")
+SHIP_CONSTANTS = ("w_P0", "epsilon", "kappa", "wind_scale")
 """Ship constants besides the hull coefficients that :func:`free_parameters` can free."""
 
 
@@ -116,6 +117,9 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
         elif nm == "epsilon":
             v = float(packed.p[P_EPS])
             out.append(FreeParameter(nm, "epsilon", P_EPS, v, prior_rel_std * v, 0.3, 3.0))
+        elif nm == "kappa":                              # a share of the slipstream's speed-up: [0, 1]
+            v = float(packed.p[P_KAPPA])
+            out.append(FreeParameter(nm, "kappa", P_KAPPA, v, prior_rel_std * v, 0.0, 1.0))
         elif nm == "wind_scale":                         # factor on the records' external (wind) loads
             out.append(FreeParameter(nm, "wind_scale", 0, 1.0, 0.5, 0.0, 3.0))
         else:

@@ -11,6 +11,15 @@ value) and later model extensions share the same definitions.
 Each term is a key (the expression as written in the configs) and an integer id
 used inside compiled code.  ``|x|`` is the absolute value: ``beta|beta|`` is the
 odd quadratic Kijima uses.
+
+The low-speed cross-flow model (Yoshimura & Nomoto 1978; Yoshimura 2009, used by the Osaka group
+for the 3 m Esso Osaka) writes the hull's sway force and yaw moment as linear terms
+``Y_v v'|u'| + Y_r r'|u'|`` (``"v*cos(beta)"``, ``"r*cos(beta)"``: cos(beta) = |u|/U is |u'|)
+plus the cross-flow drag of the hull's strips, integrated over x' = x/L in [-1/2, 1/2]:
+``"int(|v+x*r|*(v+x*r))"`` is :func:`crossflow_Y` and ``"int(x*|v+x*r|*(v+x*r))"`` is
+:func:`crossflow_N` of (v', r'); the sway force of a uniform drag coefficient C_D is then
+-C_D times the first, the yaw moment -C_D times the second.  Both stay bounded (quadratic)
+at any drift angle, 90 deg included, where the Kijima polynomials in beta are extrapolated.
 """
 from __future__ import annotations
 
@@ -37,6 +46,10 @@ TERMS: dict[str, int] = {
     "v*r^2": 16,
     "r^3": 17,
     "v|v|": 18,
+    "v*cos(beta)": 19,
+    "r*cos(beta)": 20,
+    "int(|v+x*r|*(v+x*r))": 21,
+    "int(x*|v+x*r|*(v+x*r))": 22,
 }
 """Term expression -> integer id (beta [rad], v = v', r = r', all dimensionless)."""
 
@@ -47,6 +60,62 @@ AXES = {"X": 0, "Y": 1, "N": 2}
 def sabs(x):
     """|x| written so that complex-step differentiation stays analytic (sign from the real part)."""
     return x if x.real >= 0.0 else -x
+
+
+@njit(cache=True, error_model="numpy")
+def crossflow_Y(a, b):
+    """Cross-flow sway integral F(a, b) = integral over x in [-1/2, 1/2] of |a + b x| (a + b x) dx.
+
+    With a = v', b = r' it is the primed sway force of strips of unit drag coefficient across
+    the hull (sign: the force is -C_D F).  Closed form, written without a division by b when
+    the local cross-flow w(x) = a + b x keeps its sign along the hull (|a| >= |b|/2, b = 0
+    included): F = s (a^2 + b^2/12), s the sign of a.  When w changes sign along the hull,
+    F = (w_+^2 |w_+| - w_-^2 |w_-|) / (3 b) with w_+- = a +- b/2 (the two terms add, so no
+    cancellation; |b| > 2 |a| >= 0 keeps b away from 0).  ``sabs`` keeps complex steps analytic.
+
+    Parameters
+    ----------
+    a, b : float or complex
+        v' and r' (dimensionless), real or complex.
+
+    Returns
+    -------
+    float or complex
+    """
+    if sabs(a).real >= 0.5 * sabs(b).real:
+        s = 1.0 if a.real >= 0.0 else -1.0
+        return s * (a * a + b * b / 12.0)
+    wp = a + 0.5 * b
+    wm = a - 0.5 * b
+    return (wp * wp * sabs(wp) - wm * wm * sabs(wm)) / (3.0 * b)
+
+
+@njit(cache=True, error_model="numpy")
+def crossflow_N(a, b):
+    """Cross-flow yaw integral G(a, b) = integral over x in [-1/2, 1/2] of x |a + b x| (a + b x) dx.
+
+    The primed yaw moment of unit-drag strips is -C_D G (see :func:`crossflow_Y`).  Closed form:
+    G = s a b / 6 when a + b x keeps its sign s along the hull (|a| >= |b|/2); otherwise, from
+    x = (w - a)/b, G = [(w_+^3 |w_+| - w_-^3 |w_-|)/4 - a (w_+^2 |w_+| - w_-^2 |w_-|)/3] / b^2,
+    w_+- = a +- b/2.  Pure yaw (a = 0) gives b|b|/32, pure drift (b = 0) gives 0.
+
+    Parameters
+    ----------
+    a, b : float or complex
+        v' and r' (dimensionless), real or complex.
+
+    Returns
+    -------
+    float or complex
+    """
+    if sabs(a).real >= 0.5 * sabs(b).real:
+        s = 1.0 if a.real >= 0.0 else -1.0
+        return s * a * b / 6.0
+    wp = a + 0.5 * b
+    wm = a - 0.5 * b
+    cub = wp * wp * sabs(wp) - wm * wm * sabs(wm)
+    qua = wp * wp * wp * sabs(wp) - wm * wm * wm * sabs(wm)
+    return (0.25 * qua - a * cub / 3.0) / (b * b)
 
 
 @njit(cache=True, error_model="numpy")
@@ -91,6 +160,14 @@ def term_value(tid, beta, vp, rp):
         return rp * rp * rp
     if tid == 18:
         return vp * sabs(vp)
+    if tid == 19:
+        return vp * np.cos(beta)
+    if tid == 20:
+        return rp * np.cos(beta)
+    if tid == 21:
+        return crossflow_Y(vp, rp)
+    if tid == 22:
+        return crossflow_N(vp, rp)
     return 0.0 * beta
 
 

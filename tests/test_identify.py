@@ -88,3 +88,15 @@ def test_unusable_record_is_skipped_with_one_line(tmp_path, capsys):
     ident = identify(ship, runs + [bad], free=["N_r"], segment_s=(20.0,), say=said.append)
     assert len(said) == 1 and "bad.csv" in said[0] and "\n" not in said[0]
     assert len(ident.runs) == 1
+
+
+def test_identify_in_another_form_scores_against_the_initial_model(tmp_path):
+    """--ship the cross-flow form, --initial the Kijima ship: the fit starts from the cross-flow prior,
+    the 'initial' scores and report are the Kijima ship's replay."""
+    kij, cf = mmg.load_ship(SHIP), mmg.load_ship("esso_osaka_3m_crossflow")
+    runs = _synthetic_runs(kij, seeds=(0,), duration=40.0)
+    ident = identify(cf, runs, free=["N_r"], segment_s=(20.0,), say=lambda m: None, initial=kij)
+    assert ident.initial is kij and ident.prior is cf and "N_CD" in ident.ship.hull.names
+    assert ident.scores(model="initial")[0]["heading_rms_deg"] < 1.0      # the Kijima ship made the record
+    rep = write_identification(ident, mmg.config_path("ships", "esso_osaka_3m_crossflow.yaml"), tmp_path)["report"]
+    assert "Fitted in the form of" in rep.read_text()

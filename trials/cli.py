@@ -441,10 +441,11 @@ def cmd_identify(args) -> int:
     def progress(k, cost):
         print(f"  iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
 
-    ident = identify(ship, runs, wind=wind, progress=progress)
+    initial = load_ship(ship_path(args.initial)) if args.initial else None
+    ident = identify(ship, runs, wind=wind, progress=progress, initial=initial)
     cv = None
     if args.cv:
-        cv = cross_validate(ship, runs, folds=args.cv, wind=wind,
+        cv = cross_validate(ship, runs, folds=args.cv, wind=wind, initial=initial,
                             progress=lambda k, n: print(f"cross-validation fold {k}/{n} ({time.perf_counter() - t0:.0f} s)",
                                                         file=sys.stderr, flush=True))
     tests = load_runs(ship, args.test, wind=wind) if args.test else None
@@ -673,6 +674,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--wind", choices=("on", "off"), default=None,
                    help="wind loads from the measured relative wind (default: as the ship config says)")
+    p.add_argument("--initial", default=None, metavar="SHIP",
+                   help="the model the identified one is compared with in the report (default: --ship); e.g. "
+                        "--ship esso_osaka_3m_crossflow --initial esso_osaka_3m fits the cross-flow form of the "
+                        "Kijima ship and scores it against the Kijima one")
     p.add_argument("--cv", type=_whole(2, "--cv"), default=None, metavar="FOLDS",
                    help="also cross-validate in FOLDS folds (each record kept out once) and report it")
     p.add_argument("--test", nargs="+", default=None, metavar="LOG",
