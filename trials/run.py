@@ -262,16 +262,7 @@ class TrialRun:
         r, tr = self.result, self.trial
         step = max(1, int(round((interval or tr.log.interval) / tr.dt)))
         sel = slice(0, len(r.t), step)
-        es = tr.effect_set()
-        cs, cd = tr.current()
-        if cs and es.get("current") is None:           # a disturbances.current acts as the current effect
-            import mmg.effects as E
-
-            es = es.merged(E.effect_set({"current": {"speed_mps": cs, "direction_deg": float(np.degrees(cd))}}))
-        if tr.log.bias.heading and es.get("heading_bias") is None:
-            import mmg.effects as E
-
-            es = es.merged(E.effect_set({"heading_bias": {"bias_deg": float(np.degrees(tr.log.bias.heading))}}))
+        es = tr.logged_effects()
         lg = es.to_logged(r.states[sel, :6])
         if noise is not None:
             rng = np.random.default_rng(tr.log.seed if seed is None else seed)

@@ -304,12 +304,23 @@ class Trial:
     def current(self):
         """(speed [m/s], direction it sets towards [rad]) of the run's current, (0, 0) without one."""
         for d in self.disturbances:
-            if type(d).__name__ == "UniformCurrent":
+            if isinstance(d, UniformCurrent):
                 return d.speed, d.direction
         c = self.effect_set().get("current")
         if c is not None:
             return c["speed_mps"], float(np.radians(c["direction_deg"]))
         return 0.0, 0.0
+
+    def logged_effects(self):
+        """Every effect of the run as the log sees it: :meth:`effect_set` plus the ``disturbances:``
+        section and ``log.bias.heading`` as their effects (:meth:`mmg.disturbances.Disturbance.effect`)."""
+        from mmg.effects import EffectSet
+
+        es = self.effect_set()
+        extra = [d.effect() for d in self.disturbances]
+        if self.log.bias.heading and es.get("heading_bias") is None:
+            extra.append(self.log.bias.effect())
+        return es.merged(EffectSet(tuple(extra)))
 
     def summary(self) -> dict:
         """Trial parameters for a log header (degrees and knots, as at the edges)."""
