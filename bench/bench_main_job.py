@@ -54,6 +54,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=2)
     ap.add_argument("--baseline", default=None, metavar="REV")
+    ap.add_argument("--show", type=int, default=20, help="differing report lines to print")
     a = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -84,8 +85,9 @@ def main() -> None:
                 A, B = masked(tmp / "now_0" / "report.md"), masked(tmp / "baseline_0" / "report.md")
                 diff = [(x, y) for x, y in zip(A, B) if x != y] + ([("<length>", "")] if len(A) != len(B) else [])
                 print("report.md numbers: " + ("identical to the baseline's (timings masked)" if not diff else
-                                                f"{len(diff)} lines differ, e.g.\n  now:      {diff[0][0]}\n"
-                                                f"  baseline: {diff[0][1]}"))
+                                                f"{len(diff)} lines differ:"))
+                for x, y in diff[:a.show]:
+                    print(f"  now:      {x[:160]}\n  baseline: {y[:160]}")
         finally:
             if a.baseline:
                 subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(srcs["baseline"])],
