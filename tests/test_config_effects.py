@@ -367,3 +367,9 @@ def test_any_effects_section_gives_an_effect_set_or_one_line(spec):
             v = vals[p.name]
             assert type(v) is float and p.lower <= v <= p.upper
             assert math.isfinite(v) or (p.name == "depth_to_draft" and v == math.inf)
+
+
+def test_a_ship_with_effects_stays_hashable_and_comparable():
+    a, b = _ship_with_effects({"current": {"speed_mps": 0.1}}), _ship_with_effects({"current": {"speed_mps": 0.1}})
+    assert a == b and hash(a) == hash(b)
+    assert a != _ship_with_effects({"current": {"speed_mps": 0.2}})

@@ -214,6 +214,9 @@ class EffectSet:
 
     _ORDER = {"measurement": 0, "kinematic": 1, "force": 2, "coefficients": 3}
 
+    def __hash__(self):            # the values are dicts: hash their items (a Ship holding a set stays hashable)
+        return hash(tuple((e.name, tuple(sorted(v.items()))) for e, v in self.items))
+
     def _sorted(self):
         return sorted(self.items, key=lambda it: self._ORDER.get(it[0].kind, 9))
 
