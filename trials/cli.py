@@ -405,6 +405,11 @@ def cmd_predict(args) -> int:
         print(f"{r.run.name}: heading {s['heading_rms_deg']:.4g} deg RMS, yaw rate {s['yaw_rate_rms_degps']:.4g} deg/s RMS, "
               f"speed {s['speed_rms_mps']:.4g} m/s RMS, final position {s['final_position_error_m']:.4g} m "
               f"({s['final_position_error_L']:.4g} L), wind {r.run.wind}")
+    if len(pred.runs) > 1:                 # the figure a comparison of two configs quotes
+        sc = [r.scores() for r in pred.runs]
+        mean = lambda k: sum(x[k] for x in sc) / len(sc)  # noqa: E731
+        print(f"mean over {len(sc)} runs: heading {mean('heading_rms_deg'):.4g} deg RMS, "
+              f"final position {mean('final_position_error_L'):.4g} L")
     text = dumps_json(pred.to_json())
     names = _plot_names(pred.runs)
     with StagedFile(args.json) as tmp:     # renamed last, after the plots are in place
