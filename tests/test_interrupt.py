@@ -65,12 +65,22 @@ def zz20_log(tmp_path_factory):
     return d / "zz20" / "log.csv"
 
 
+def long_st35(folder: Path) -> Path:
+    """ST35 run for 30000 s: its log, truth file and plots take seconds to write, so the signal
+    surely meets the command while it stages (the 3000 s run now finishes within the test's delay)."""
+    text = (CONFIGS / "trials" / "st35.yaml").read_text().replace("duration: 3000 s", "duration: 30000 s")
+    assert "duration: 30000 s" in text
+    p = folder / "st35_long.yaml"
+    p.write_text(text)                     # "ship: esso_osaka" is the bundled ship by name
+    return p
+
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
 def test_simulate_interrupted(sig, tmp_path):
     base = tmp_path / "base"
     base.mkdir()
     out = base / "DIR"
-    r = run_and_signal(["simulate", str(CONFIGS / "trials" / "st35.yaml"), "--out", str(out)], out, sig, base)
+    r = run_and_signal(["simulate", str(long_st35(tmp_path)), "--out", str(out)], out, sig, base)
     assert_interrupted(*r, sig, base)
 
 
