@@ -120,16 +120,15 @@ def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
             return i
         if i == nsteps:
             break
-        rhs(x, dcmd, p, poly, hull_axis, hull_term, hull_coef, k1)
-        for j in range(nx):
-            tmp[j] = x[j] + 0.5 * dt * k1[j]
-        rhs(tmp, dcmd, p, poly, hull_axis, hull_term, hull_coef, k2)
-        for j in range(nx):
-            tmp[j] = x[j] + 0.5 * dt * k2[j]
-        rhs(tmp, dcmd, p, poly, hull_axis, hull_term, hull_coef, k3)
-        for j in range(nx):
-            tmp[j] = x[j] + dt * k3[j]
-        rhs(tmp, dcmd, p, poly, hull_axis, hull_term, hull_coef, k4)
+        for s in range(4):                       # one inlined copy of the right-hand side
+            if s == 0:
+                for j in range(nx):
+                    tmp[j] = x[j]
+            else:
+                c = 0.5 * dt if s < 3 else dt
+                for j in range(nx):
+                    tmp[j] = x[j] + c * work[s, j]
+            rhs(tmp, dcmd, p, poly, hull_axis, hull_term, hull_coef, work[s + 1])
         for j in range(nx):
             x[j] += dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
     return nsteps + 1

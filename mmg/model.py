@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from ._inlining import hot_loops_only
 from .nondim import force_scale, inertia_scale, mass_scale, moment_scale, r_prime
 from .terms import AXES, TERMS, sabs, term_value
 from .wind import fujiwara_series
@@ -155,7 +156,7 @@ def polyval(poly, row, x):
     return acc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def kinematics(u, v, r, p):
     """Speed U [m/s], the hull's speed scale U_h [m/s], drift angle beta [rad], v' and r' at midship.
 
@@ -182,7 +183,7 @@ def kinematics(u, v, r, p):
     return U, Uh, np.arctan(-v / uh), v / Uh, r_prime(r, p[P_L], Uh)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
     """Primed hull forces (X_H', Y_H', N_H') = sum of coefficient x term per axis."""
     X = 0.0 * beta
@@ -200,7 +201,7 @@ def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
     return X, Y, N
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def one_minus_wake(u, beta, rp, p, poly):
     """(1 - w_P) in manoeuvring: Kijima exp(-C beta_P^2) or MMG 2015 form, beta_P = beta - x_P' r'."""
     w0 = polyval(poly, POLY_WP0, u)
@@ -211,7 +212,7 @@ def one_minus_wake(u, beta, rp, p, poly):
     return (1.0 - w0) * (1.0 + (1.0 - np.exp(-p[P_C1] * sabs(bp))) * (c2 - 1.0))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def propeller(u, n, one_minus_wP, p, poly):
     """Advance ratio J_P, thrust coefficient K_T and surge force X_P [N] (eq. 12)."""
     D = p[P_D]
@@ -232,7 +233,7 @@ def propeller(u, n, one_minus_wP, p, poly):
     return J, KT, XP
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def rudder(u, U, beta, rp, delta, n, one_minus_wP, KT, p):
     """MMG rudder forces (X_R, Y_R, N_R) [N, N, N m] and the normal force F_N [N].
 
@@ -264,7 +265,7 @@ def rudder(u, U, beta, rp, delta, n, one_minus_wP, KT, p):
     return XR, YR, NR, FN
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def steering_rate(delta_cmd, delta, p):
     """Steering gear, Rhee & Kim eq. (20): rudder rate [rad/s] towards the clipped order."""
     dmax = p[P_DMAX]
@@ -275,7 +276,7 @@ def steering_rate(delta_cmd, delta, p):
     return (p[P_RATE] if err.real > 0.0 else -p[P_RATE]) + 0.0 * err
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def shaft_acceleration(u, n, J, p, poly):
     """dn/dt [rps/s] of the shaft, eq. (15): 2 pi (I+J) dn/dt = Q_P + Q_E (constant power)."""
     if p[P_ENGINE] != ENGINE_CONSTANT_POWER:
@@ -387,7 +388,7 @@ def accelerations(X, Y, N, u, v, r, p, out):
                                                     Y - (m + mx) * u * r, N - xG * m * u * r, p)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def rhs(x, delta_cmd, p, poly, hull_axis, hull_term, hull_coef, out):
     """Time derivative of the state, written into ``out`` (MMG equations of motion).
 

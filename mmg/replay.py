@@ -86,10 +86,7 @@ def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis,
     N = t.shape[0]
     s = s0.copy()
     work = np.zeros(8)
-    k1 = np.zeros(6)
-    k2 = np.zeros(6)
-    k3 = np.zeros(6)
-    k4 = np.zeros(6)
+    ks = np.zeros((4, 6))
     tmp = np.zeros(6)
     out[0, :] = s
     for i in range(N - 1):
@@ -105,33 +102,24 @@ def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis,
             a0 = k / m
             a5 = (k + 0.5) / m
             a1 = (k + 1.0) / m
-            d0 = delta[i] + a0 * (delta[i + 1] - delta[i])
-            d5 = delta[i] + a5 * (delta[i + 1] - delta[i])
-            d1 = delta[i] + a1 * (delta[i + 1] - delta[i])
-            n0 = n[i] + a0 * (n[i + 1] - n[i])
-            n5 = n[i] + a5 * (n[i + 1] - n[i])
-            n1 = n[i] + a1 * (n[i + 1] - n[i])
-            fx0 = ext[i, 0] + a0 * (ext[i + 1, 0] - ext[i, 0])
-            fy0 = ext[i, 1] + a0 * (ext[i + 1, 1] - ext[i, 1])
-            fn0 = ext[i, 2] + a0 * (ext[i + 1, 2] - ext[i, 2])
-            fx5 = ext[i, 0] + a5 * (ext[i + 1, 0] - ext[i, 0])
-            fy5 = ext[i, 1] + a5 * (ext[i + 1, 1] - ext[i, 1])
-            fn5 = ext[i, 2] + a5 * (ext[i + 1, 2] - ext[i, 2])
-            fx1 = ext[i, 0] + a1 * (ext[i + 1, 0] - ext[i, 0])
-            fy1 = ext[i, 1] + a1 * (ext[i + 1, 1] - ext[i, 1])
-            fn1 = ext[i, 2] + a1 * (ext[i + 1, 2] - ext[i, 2])
-            _deriv(s, d0, n0, fx0, fy0, fn0, minv, p, poly, hull_axis, hull_term, hull_coef, work, k1)
+            for st in range(4):                  # the RK4 stages: one inlined copy of the model
+                if st == 0:
+                    a = a0
+                    for jj in range(6):
+                        tmp[jj] = s[jj]
+                else:
+                    a = a5 if st < 3 else a1
+                    c = 0.5 * dt if st < 3 else dt
+                    for jj in range(6):
+                        tmp[jj] = s[jj] + c * ks[st - 1, jj]
+                d = delta[i] + a * (delta[i + 1] - delta[i])
+                nn = n[i] + a * (n[i + 1] - n[i])
+                fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
+                fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
+                fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
+                _deriv(tmp, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef, work, ks[st])
             for j in range(6):
-                tmp[j] = s[j] + 0.5 * dt * k1[j]
-            _deriv(tmp, d5, n5, fx5, fy5, fn5, minv, p, poly, hull_axis, hull_term, hull_coef, work, k2)
-            for j in range(6):
-                tmp[j] = s[j] + 0.5 * dt * k2[j]
-            _deriv(tmp, d5, n5, fx5, fy5, fn5, minv, p, poly, hull_axis, hull_term, hull_coef, work, k3)
-            for j in range(6):
-                tmp[j] = s[j] + dt * k3[j]
-            _deriv(tmp, d1, n1, fx1, fy1, fn1, minv, p, poly, hull_axis, hull_term, hull_coef, work, k4)
-            for j in range(6):
-                s[j] += dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+                s[j] += dt / 6.0 * (ks[0, j] + 2.0 * ks[1, j] + 2.0 * ks[2, j] + ks[3, j])
         ok = True
         for j in range(6):
             if not np.isfinite(s[j]):

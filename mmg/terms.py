@@ -26,6 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ._inlining import hot_loops_only
+
 TERMS: dict[str, int] = {
     "1": 0,
     "beta": 1,
@@ -118,7 +120,7 @@ def crossflow_N(a, b):
     return (0.25 * qua - a * cub / 3.0) / (b * b)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def term_value(tid, beta, vp, rp):
     """Value of term ``tid`` at drift angle beta [rad], v' and r' (dimensionless)."""
     if tid == 0:
