@@ -17,6 +17,7 @@ import argparse
 import os
 import pickle
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -61,6 +62,9 @@ def run(args, cache: Path, tmp: Path) -> float:
 
 
 def main():
+    # started in the background (``cmd &``), the shell hands us SIGINT ignored, and every child would
+    # inherit it: the suite's Ctrl-C tests would then fail; restore Python's handler (children get SIG_DFL)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cases", nargs="+", default=["simulate", "estimate"], choices=sorted(CASES))
     ap.add_argument("--suite", action="store_true", help="add the fast test suite")
