@@ -188,7 +188,8 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
                                     hull_term, idx, ws)
         else:
             propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
-        z[:] = zn
+        for i in range(nz):             # element-wise: a slice assignment compiles numba's shape-mismatch message (~7 s cold)
+            z[i] = zn[i]
         fpft(F, P, NS, FP, P)
         if q > 0.0:
             for i in range(nz):

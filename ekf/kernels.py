@@ -93,17 +93,19 @@ def _held_rows(z, ns, z_next, F):
             F[i, j] = 1.0 if i == j else 0.0
 
 
+_dynamics_complex = njit(cache=True, error_model="numpy")(dynamics.py_func)
+"""The one :func:`mmg.model.dynamics`, compiled once for all-complex states and called (not inlined):
+every column of :func:`jacobian_step` goes through this one specialisation, where inlining a copy per
+column (each with its own mix of real and complex arguments) tripled the kernel's compile time."""
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def _dynamics_column(k, u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef, out):
     """:func:`mmg.model.dynamics` with a complex step in state ``k`` (U_, V_, R_, N_ or DELTA_)."""
     h = 1j * CSTEP
-    if k == U_ or k == V_ or k == R_:
-        dynamics(u + (h if k == U_ else 0j), v + (h if k == V_ else 0j), r + (h if k == R_ else 0j), delta, n,
-                 p, poly, hull_axis, hull_term, hull_coef, out)
-    elif k == N_:
-        dynamics(u, v, r, delta, n + h, p, poly, hull_axis, hull_term, hull_coef, out)
-    else:
-        dynamics(u, v, r, delta + h, n, p, poly, hull_axis, hull_term, hull_coef, out)
+    _dynamics_complex(u + (h if k == U_ else 0j), v + (h if k == V_ else 0j), r + (h if k == R_ else 0j),
+                      delta + (h if k == DELTA_ else 0j), n + (h if k == N_ else 0j),
+                      p, poly, hull_axis, hull_term, hull_coef, out)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

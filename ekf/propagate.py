@@ -48,5 +48,8 @@ def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, 
     """
     ws = workspace(z.shape[0], hull_coef)
     propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws)
-    z_next[:] = ws[8]
-    F[:, :] = ws[9]
+    zn, Fw = ws[8], ws[9]
+    for i in range(zn.shape[0]):      # element-wise (a slice assignment compiles numba's shape-mismatch message)
+        z_next[i] = zn[i]
+        for j in range(Fw.shape[1]):
+            F[i, j] = Fw[i, j]

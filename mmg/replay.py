@@ -88,7 +88,8 @@ def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis,
     work = np.zeros(8)
     ks = np.zeros((4, 6))
     tmp = np.zeros(6)
-    out[0, :] = s
+    for j in range(6):                # element-wise: a slice assignment compiles numba's shape-mismatch message
+        out[0, j] = s[j]
     for i in range(N - 1):
         if reset[i]:
             for j in range(6):

@@ -119,13 +119,14 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
         z[i] = z0[i]
     # the unperturbed run, in complex arithmetic like the perturbed ones (same rounding)
     zh = np.empty((N, LOG_NS), dtype=np.complex128)
-    zh[0, :] = z[:LOG_NS]
+    for i in range(LOG_NS):           # element-wise (a slice assignment compiles numba's shape-mismatch message)
+        zh[0, i] = z[i]
     for k in range(1, N):
         rk4_step(z, LOG_SLOTS, LOG_ND, delta[k - 1] + 0.0j, delta[k] + 0.0j, dt, p, poly, hull_axis, hull_term,
                  coef, idx, xs, k1, k2, k3, k4, nxt)
         for i in range(LOG_NS):
             z[i] = nxt[i]
-        zh[k, :] = nxt
+            zh[k, i] = nxt[i]
     k0 = 0
     for j in range(n_seg):
         while seg[k0] < j:
