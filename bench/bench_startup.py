@@ -48,6 +48,11 @@ print(sol.sol(t)[0][-1])
 """
 
 
+FLOOR = "import numpy, numba, numba.np.arraymath"
+"""What any numba-compiled tool pays in a fresh process before its own code runs: numpy, numba and the
+array-math registry numba loads at its first compiled call (which imports scipy.linalg for BLAS)."""
+
+
 def once(cmd, cwd) -> float:
     t0 = time.perf_counter()
     subprocess.run(cmd, cwd=cwd, check=True, capture_output=True)
@@ -110,6 +115,9 @@ def main() -> None:
             a, b, r = pair([sys.executable, "-c", OURS], [sys.executable, "-c", SHIPMMG], args.runs, td)
             print(f"one turn in a fresh process: ours (API, 3000 s) {a:.2f} s, shipmmg (200 s) {b:.2f} s, "
                   f"ratio ours/shipmmg {r:.2f} (median of {args.runs} pairs; target <= 1)")
+            f, b2, r2 = pair([sys.executable, "-c", FLOOR], [sys.executable, "-c", SHIPMMG], args.runs, td)
+            print(f"  the floor of a numba tool ({FLOOR!r}, nothing of ours) {f:.2f} s: "
+                  f"{r2:.2f} x shipmmg's whole turn ({b2:.2f} s)")
         except ImportError:
             print("shipmmg not installed (pip install 'mmg-toolkit[bench]'): turn comparison skipped")
         t = []
