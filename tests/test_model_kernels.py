@@ -12,9 +12,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from mmg import model as M
 from mmg.integrate import CommandLaw, integrate
+from mmg.effects import effect_set
 from mmg.ship import load_ship
 from mmg.simulation import prepare
 from mmg.units import DEG, KNOT
@@ -55,11 +57,23 @@ def test_track_adds_the_current_velocity():
     assert math.isclose(out[M.Y_] - still[M.Y_], 0.5 * math.sin(math.radians(30.0)), rel_tol=1e-12)
 
 
-def test_simulate_kernel_is_rk4_of_rhs():
-    pk, eq = prepare(load_ship("esso_osaka"), 10 * KNOT)
+@pytest.mark.parametrize("ship_name, effects", [
+    ("esso_osaka", None),
+    # the cross-flow hull terms, a steady wind and a current: every branch the kernel inlines
+    ("esso_osaka_3m_crossflow", {"wind": {"true_speed_mps": 1.8, "true_from_deg": 60.0},
+                                 "current": {"speed_mps": 0.05, "direction_deg": 200.0}}),
+])
+def test_simulate_kernel_is_rk4_of_rhs(ship_name, effects):
+    """The kernel inlines the model (mmg._inlining); the called rhs, stepped here, must agree."""
+    ship = load_ship(ship_name)
+    es = effect_set(effects) if effects else None
+    u0 = 10 * KNOT * math.sqrt(ship.particulars.L / 325.0)
+    pk, eq = prepare(ship, u0, effects=es)
+    if effects:
+        assert pk.p[M.P_WIND_V] > 0.0 and pk.p[M.P_CUR_SPEED] > 0.0
     law = CommandLaw.schedule([0.0, 100.0], [35 * DEG, 35 * DEG])
-    dt = 0.5
-    _, states, _, done = integrate(pk, eq.state(), law, 2.0, dt)
+    dt = 0.5 * math.sqrt(ship.particulars.L / 325.0)
+    _, states, _, done = integrate(pk, eq.state(), law, 8 * dt, dt)
     assert done
     x = np.array(eq.state(), float)
     for i in range(1, states.shape[0]):
@@ -70,3 +84,16 @@ def test_simulate_kernel_is_rk4_of_rhs():
         M.rhs(x + dt * k[2], 35 * DEG, *pk.args(), k[3])
         x = x + dt / 6.0 * (k[0] + 2.0 * k[1] + 2.0 * k[2] + k[3])
         np.testing.assert_allclose(states[i], x, rtol=1e-13, atol=1e-12)
+    assert abs(states[-1, M.R_]) > 0.0                 # the run turned: the rudder and hull terms acted
+
+
+def test_inlining_cost_model_names_only_the_hot_loops():
+    from types import SimpleNamespace
+
+    from mmg._inlining import HOT_LOOPS, hot_loops_only
+
+    ir = lambda name: SimpleNamespace(func_id=SimpleNamespace(func_name=name))  # noqa: E731
+    assert HOT_LOOPS == {"simulate_kernel", "_replay"}
+    assert hot_loops_only(None, ir("simulate_kernel"), ir("rhs"))
+    assert hot_loops_only(None, ir("_replay"), ir("kinematics"))
+    assert not hot_loops_only(None, ir("jacobian_step"), ir("rhs"))
