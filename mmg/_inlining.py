@@ -10,6 +10,9 @@ estimators' many complex-step specialisations (a cold ``mmg estimate`` 25 s -> 6
 """
 from __future__ import annotations
 
+import hashlib
+from pathlib import Path
+
 HOT_LOOPS = frozenset({"simulate_kernel", "_replay"})
 """Names of the compiled functions the helpers are inlined into."""
 
@@ -18,3 +21,21 @@ def hot_loops_only(expr, caller_ir, callee_ir) -> bool:
     """numba inline cost model: inline the call when the caller is one of :data:`HOT_LOOPS`
     (a call left in a helper inlined there is inlined too: the caller is then the loop)."""
     return caller_ir.func_id.func_name in HOT_LOOPS
+
+
+INLINED_SOURCES = ("_inlining.py", "model.py", "nondim.py", "rudder.py", "terms.py", "wind.py")
+"""The files of :mod:`mmg` whose compiled functions the hot loops inline (or call)."""
+
+
+def source_stamp() -> int:
+    """A 60-bit hash of :data:`INLINED_SOURCES`.  The hot loops are compiled as closures over it:
+    numba keys a cached function by its own file's time stamp and its closure's values, so an edit
+    of the model's file alone would otherwise leave the loops' cached, inlined copy of the old
+    model in use."""
+    h = hashlib.sha256()
+    here = Path(__file__).resolve().parent
+    for name in INLINED_SOURCES:
+        f = here / name
+        if f.is_file():                           # (an install without sources has nothing to go stale)
+            h.update(f.read_bytes())
+    return int(h.hexdigest()[:15], 16)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from ._inlining import source_stamp
 from .model import P_L, P_WIND_V, PSI_, R_, U_, V_, X_, Y_, PackedShip, dynamics, inverse_mass, track, wind_loads
 
 __all__ = ["ReplayInputs", "replay", "replay_states", "default_dt_max", "STATE"]
@@ -81,58 +82,72 @@ def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef, 
     out[5] = work[PSI_]
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
-def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis, hull_term, hull_coef, out):
-    N = t.shape[0]
-    s = s0.copy()
-    work = np.zeros(8)
-    ks = np.zeros((4, 6))
-    tmp = np.zeros(6)
-    for j in range(6):                # element-wise: a slice assignment compiles numba's shape-mismatch message
-        out[0, j] = s[j]
-    for i in range(N - 1):
-        if reset[i]:
-            for j in range(6):
-                s[j] = meas[i, j]
-        h = t[i + 1] - t[i]
-        m = int(np.ceil(h / dt_max - 1e-9))
-        if m < 1:
-            m = 1
-        dt = h / m
-        for k in range(m):
-            a0 = k / m
-            a5 = (k + 0.5) / m
-            a1 = (k + 1.0) / m
-            for st in range(4):                  # the RK4 stages: one inlined copy of the model
-                if st == 0:
-                    a = a0
-                    for jj in range(6):
-                        tmp[jj] = s[jj]
-                else:
-                    a = a5 if st < 3 else a1
-                    c = 0.5 * dt if st < 3 else dt
-                    for jj in range(6):
-                        tmp[jj] = s[jj] + c * ks[st - 1, jj]
-                d = delta[i] + a * (delta[i + 1] - delta[i])
-                nn = n[i] + a * (n[i + 1] - n[i])
-                fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
-                fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
-                fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
-                _deriv(tmp, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef, work, ks[st])
-            for j in range(6):
-                s[j] += dt / 6.0 * (ks[0, j] + 2.0 * ks[1, j] + 2.0 * ks[2, j] + ks[3, j])
-        ok = True
-        for j in range(6):
-            if not np.isfinite(s[j]):
-                ok = False
-        if not ok:
-            for ii in range(i + 1, N):
+def _compile_replay(stamp: int):
+    """Compile the replay below as a closure over ``stamp`` (:func:`mmg._inlining.source_stamp`; see
+    :func:`mmg.integrate._compile_simulate_kernel`)."""
+
+    @njit(cache=True, error_model="numpy", nogil=True)
+    def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis, hull_term, hull_coef, out):
+        """RK4 of the dynamics along a record: sub-steps of at most ``dt_max`` between samples, inputs linear
+        within a sample interval, the state reset to ``meas`` where ``reset``; fills ``out`` (N, 6), returns the
+        number of valid rows."""
+        if stamp < 0:                     # never true: ties the cache entry to the inlined sources
+            return 0
+        N = t.shape[0]
+        s = s0.copy()
+        work = np.zeros(8)
+        ks = np.zeros((4, 6))
+        tmp = np.zeros(6)
+        for j in range(6):                # element-wise: a slice assignment compiles numba's shape-mismatch message
+            out[0, j] = s[j]
+        for i in range(N - 1):
+            if reset[i]:
                 for j in range(6):
-                    out[ii, j] = np.nan
-            return i + 1
-        for j in range(6):
-            out[i + 1, j] = s[j]
-    return N
+                    s[j] = meas[i, j]
+            h = t[i + 1] - t[i]
+            m = int(np.ceil(h / dt_max - 1e-9))
+            if m < 1:
+                m = 1
+            dt = h / m
+            for k in range(m):
+                a0 = k / m
+                a5 = (k + 0.5) / m
+                a1 = (k + 1.0) / m
+                for st in range(4):                  # the RK4 stages: one inlined copy of the model
+                    if st == 0:
+                        a = a0
+                        for jj in range(6):
+                            tmp[jj] = s[jj]
+                    else:
+                        a = a5 if st < 3 else a1
+                        c = 0.5 * dt if st < 3 else dt
+                        for jj in range(6):
+                            tmp[jj] = s[jj] + c * ks[st - 1, jj]
+                    d = delta[i] + a * (delta[i + 1] - delta[i])
+                    nn = n[i] + a * (n[i + 1] - n[i])
+                    fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
+                    fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
+                    fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
+                    _deriv(tmp, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef, work, ks[st])
+                for j in range(6):
+                    s[j] += dt / 6.0 * (ks[0, j] + 2.0 * ks[1, j] + 2.0 * ks[2, j] + ks[3, j])
+            ok = True
+            for j in range(6):
+                if not np.isfinite(s[j]):
+                    ok = False
+            if not ok:
+                for ii in range(i + 1, N):
+                    for j in range(6):
+                        out[ii, j] = np.nan
+                return i + 1
+            for j in range(6):
+                out[i + 1, j] = s[j]
+        return N
+
+    return _replay
+
+
+_replay = _compile_replay(source_stamp())
 
 
 def replay_states(packed: PackedShip, inputs: ReplayInputs, s0, *, meas=None, reset=None,
