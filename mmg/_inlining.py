@@ -7,6 +7,11 @@ right-hand side (the simulator's RK4 loop runs 1.9x faster than with calls, ``be
 replay of measured records, :func:`mmg.replay.replay_states`, ``bench/bench_replay.py``), and
 called everywhere else.  Inlining them everywhere would multiply the compile time of the
 estimators' many complex-step specialisations (a cold ``mmg estimate`` 25 s -> 69 s).
+
+A compiled function that inlines code from another file (the hot loops here, the EKF's
+:func:`ekf.kernels.jacobian_step` and its all-complex dynamics) is built as a closure over
+:func:`source_stamp`, so that numba's on-disk cache, keyed by the function's own file, follows an
+edit of the model.
 """
 from __future__ import annotations
 
