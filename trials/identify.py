@@ -41,9 +41,11 @@ from mmg.ship import Ship
 from .predict import MeasuredRun, measured_run, replay_record
 
 __all__ = ["identify", "cross_validate", "write_identification", "load_runs", "ship_yaml", "Identification",
-           "DEFAULT_FREE"]
+           "DEFAULT_FREE", "DEFAULT_WEIGHTING"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "wind_scale")
+DEFAULT_WEIGHTING = "samples"
+"""Default weighting of the training records in the fit (:func:`ekf.identify.record_weights`)."""
 DEFAULT_SEGMENTS_L = (52.0, np.inf)
 """Segment lengths of the successive fits, in units of sqrt(L/g): 29 s for a 3 m model, 300 s at
 325 m (about one zigzag half-period: short enough that a poor start does not diverge), then the
@@ -177,7 +179,8 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
 
 def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | None = None, wind: bool | None = None,
              max_nfev: int = 30, progress=None, say=_log, prior_rel_std: float = 0.5,
-             initial: Ship | None = None) -> Identification:
+             initial: Ship | None = None, record_weighting: str = DEFAULT_WEIGHTING, loss: str = "linear",
+             f_scale: float = 1.0) -> Identification:
     """Identify ``free`` jointly over the training records (module docstring).
 
     Parameters
@@ -200,8 +203,16 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
         The model the identified one is compared with in the scores and the report ("initial");
         ``ship`` (the prior) when omitted.  Given when the prior is the initial model rewritten in
         another hull form (e.g. ``esso_osaka_3m_crossflow`` for the Kijima ``esso_osaka_3m``).
+    record_weighting : str
+        How each training record's residuals count in every stage (:func:`ekf.identify.record_weights`):
+        ``"samples"`` (each sample alike: long records count more), ``"equal"`` (each record alike),
+        ``"relative"`` (each record alike, relative to its own misfit at the stage's start).
+    loss, f_scale : str, float
+        Robust loss of the last (whole-record) stage (:func:`scipy.optimize.least_squares`): ``"linear"``
+        (least squares), ``"soft_l1"``, ``"cauchy"``; ``f_scale`` in units of the scaled residuals.
     """
-    from ekf.identify import Segmented, free_parameters, identify_segments, segment_resets
+    from ekf.identify import Segmented, free_parameters, identify_segments, record_residual_rms, record_weights, \
+        segment_resets
 
     items = list(paths_or_runs)
     runs = [r for r in items if isinstance(r, MeasuredRun)]
@@ -220,8 +231,14 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     for k, st in enumerate(stages):
         seg = float(st) * float(np.sqrt(L / 9.80665))
         segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects) for r in runs]
-        fit = identify_segments(packed, segs, fp, _scales(runs, L), max_nfev=max_nfev, progress=progress,
-                                start=None if fit is None else fit.theta)
+        sc = _scales(runs, L)
+        theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
+        rms = record_residual_rms(packed, segs, fp, theta, sc) if record_weighting == "relative" else None
+        last = k == len(stages) - 1
+        fit = identify_segments(packed, segs, fp, sc, max_nfev=max_nfev, progress=progress,
+                                start=None if fit is None else fit.theta, weights=record_weights(segs, record_weighting,
+                                                                                                 rms=rms),
+                                loss=loss if last else "linear", f_scale=f_scale)
     return Identification(ship=_ship_with(ship, fit.values()), initial=ship if initial is None else initial, fit=fit,
                           runs=runs, segment_s=seg, prior=None if initial is None else ship)
 
