@@ -35,7 +35,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mmg.model import P_EPS, P_KAPPA, POLY_WP0, PackedShip
+from mmg.model import P_EPS, P_GNEG, P_GPOS, P_KAPPA, P_LR, POLY_WP0, PackedShip
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
@@ -43,7 +43,12 @@ __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_param
            "RECORD_WEIGHTINGS", "effect_parameters", "effect_set_of",
            "predict_logged"]
 
-SHIP_CONSTANTS = ("w_P0", "epsilon", "kappa", "wind_scale")
+RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
+                    "l_R_prime": (P_LR, -2.0, 0.0)}
+"""Rudder constants (:class:`mmg.ship.Rudder` fields) :func:`free_parameters` can free: their index in
+the packed parameters and bounds (the flow-straightening coefficients gamma_R of the rudder's
+inflow angle, positive and negative beta_R, and the effective lever l_R' of the yaw rate in it)."""
+SHIP_CONSTANTS = ("w_P0", "epsilon", "kappa", "wind_scale") + tuple(RUDDER_CONSTANTS)
 """Ship constants besides the hull coefficients that :func:`free_parameters` can free."""
 
 
@@ -121,6 +126,10 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
         elif nm == "kappa":                              # a share of the slipstream's speed-up: [0, 1]
             v = float(packed.p[P_KAPPA])
             out.append(FreeParameter(nm, "kappa", P_KAPPA, v, prior_rel_std * v, 0.0, 1.0))
+        elif nm in RUDDER_CONSTANTS:
+            i, lo, hi = RUDDER_CONSTANTS[nm]
+            v = float(packed.p[i])
+            out.append(FreeParameter(nm, "rudder", i, v, max(prior_rel_std * abs(v), 0.05), lo, hi))
         elif nm == "wind_scale":                         # factor on the records' external (wind) loads
             out.append(FreeParameter(nm, "wind_scale", 0, 1.0, 0.5, 0.0, 3.0))
         else:

@@ -163,7 +163,9 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
         w = list(s.propeller.w_P0)
         w[0] = values["w_P0"]
         s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
-    rud = {k: values[k] for k in ("epsilon", "kappa") if k in values}
+    from ekf.identify import RUDDER_CONSTANTS
+
+    rud = {k: values[k] for k in ("epsilon", "kappa", *RUDDER_CONSTANTS) if k in values}
     if rud:
         s = replace(s, rudder=replace(s.rudder, **rud))
     if "wind_scale" in values and s.wind is not None:
@@ -269,13 +271,15 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
     ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``."""
     import yaml
 
+    from ekf.identify import RUDDER_CONSTANTS
+
     data = yaml.safe_load(Path(ship_path).read_text())
     for k, v in values.items():
         if k in data["hull"]["coefficients"]:
             data["hull"]["coefficients"][k]["value"] = float(f"{v:.6g}")
         elif k == "w_P0":
             data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
-        elif k in ("epsilon", "kappa"):
+        elif k in ("epsilon", "kappa", *RUDDER_CONSTANTS):
             data["rudder"][k] = float(f"{v:.6g}")
         elif k == "wind_scale" and "wind" in data:
             eff = (data.get("effects") or {}).get("wind")
