@@ -150,12 +150,17 @@ def test_relative_record_weighting_divides_by_each_records_misfit():
         record_weights(segs, "relative")
 
 
-def test_rudder_constants_can_be_freed_and_are_written_back(tmp_path):
+def test_rudder_constants_and_added_masses_can_be_freed_and_are_written_back(tmp_path):
     ship = mmg.load_ship(SHIP)
     runs = _synthetic_runs(ship.with_hull({}), seeds=(0,), duration=40.0)
-    ident = identify(ship, runs, free=["gamma_R_pos", "l_R_prime"], segment_s=(20.0,), say=lambda m: None, max_nfev=3)
+    ident = identify(ship, runs, free=["gamma_R_pos", "l_R_prime", "m_y", "J_z"], segment_s=(20.0,), say=lambda m: None,
+                     max_nfev=3)
     v = ident.fit.values()
     assert ident.ship.rudder.gamma_R_pos == v["gamma_R_pos"] and ident.ship.rudder.l_R_prime == v["l_R_prime"]
+    from mmg.model import P_JZ, P_MY
+    assert pack(ident.ship).p[P_MY] == pytest.approx(v["m_y"], rel=1e-12)      # the config's prime, rescaled
+    assert pack(ident.ship).p[P_JZ] == pytest.approx(v["J_z"], rel=1e-12)
     back = mmg.load_ship(write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)["ship"])
     assert back.rudder.gamma_R_pos == pytest.approx(v["gamma_R_pos"], rel=1e-5)
+    assert pack(back).p[P_MY] == pytest.approx(v["m_y"], rel=1e-5) and back.mass.m_x_prime == ship.mass.m_x_prime
     assert back.rudder.gamma_R_neg == ship.rudder.gamma_R_neg

@@ -163,8 +163,14 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
         w = list(s.propeller.w_P0)
         w[0] = values["w_P0"]
         s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
-    from ekf.identify import RUDDER_CONSTANTS
+    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
+    from mmg.nondim import inertia_scale, mass_scale
 
+    pa = s.particulars
+    mass = {f"{k}_prime": values[k] / (inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T))
+            for k in MASS_CONSTANTS if k in values}
+    if mass:
+        s = replace(s, mass=replace(s.mass, **mass))
     rud = {k: values[k] for k in ("epsilon", "kappa", *RUDDER_CONSTANTS) if k in values}
     if rud:
         s = replace(s, rudder=replace(s.rudder, **rud))
@@ -271,9 +277,11 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
     ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``."""
     import yaml
 
-    from ekf.identify import RUDDER_CONSTANTS
+    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
+    from mmg.nondim import inertia_scale, mass_scale
 
     data = yaml.safe_load(Path(ship_path).read_text())
+    ship = None
     for k, v in values.items():
         if k in data["hull"]["coefficients"]:
             data["hull"]["coefficients"][k]["value"] = float(f"{v:.6g}")
@@ -281,6 +289,14 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
             data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
         elif k in ("epsilon", "kappa", *RUDDER_CONSTANTS):
             data["rudder"][k] = float(f"{v:.6g}")
+        elif k in MASS_CONSTANTS:
+            if ship is None:
+                from mmg.ship import load_ship
+
+                ship = load_ship(ship_path)
+            pa = ship.particulars
+            sc = inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
+            data["mass"][f"{k}_prime"] = float(f"{v / sc:.6g}")
         elif k == "wind_scale" and "wind" in data:
             eff = (data.get("effects") or {}).get("wind")
             if isinstance(eff, dict) and "scale" in eff:           # the scale given in the effects section
