@@ -34,17 +34,26 @@ def main() -> None:
     ap.add_argument("--prior", type=float, default=0.5, help="prior std relative to the config value")
     ap.add_argument("--ship", default=SHIP, help=f"prior ship: the form identified and its starting values (default {SHIP})")
     ap.add_argument("--initial", default=INITIAL, help=f"the model the identified one is compared with (default {INITIAL})")
+    ap.add_argument("--weighting", choices=["samples", "equal", "relative"], default=None,
+                    help="record weighting in the fit (default: trials.identify.DEFAULT_WEIGHTING)")
+    ap.add_argument("--loss", default="linear", help="least_squares loss of the whole-record stage")
+    ap.add_argument("--f-scale", type=float, default=1.0, help="the robust loss's residual scale")
     a = ap.parse_args()
     d = frt_data_dir()
     if d is None:
         sys.exit("FRT-DS-ESSO data not found (set MMG_FRT_DATA)")
     files = sorted((d / "turning").glob("*.csv")) + sorted((d / "zigzag").glob("*.csv"))
     ship, initial = mmg.load_ship(a.ship), mmg.load_ship(a.initial)
-    print(f"prior {ship.name}; initial {initial.name}; free {a.free or 'default'}", flush=True)
+    print(f"prior {ship.name}; initial {initial.name}; free {a.free or 'default'}; weighting "
+          f"{a.weighting or 'default'}; loss {a.loss} (f_scale {a.f_scale:g})", flush=True)
     for wind in ([True, False] if a.wind == "both" else [a.wind == "on"]):
         runs = load_runs(ship, files, wind=wind)
         t0 = time.perf_counter()
         extra = {"free": a.free} if a.free else {}
+        if a.weighting:
+            extra["record_weighting"] = a.weighting
+        if a.loss != "linear":
+            extra.update(loss=a.loss, f_scale=a.f_scale)
         cv = cross_validate(ship, runs, folds=a.folds, wind=wind, prior_rel_std=a.prior, initial=initial, **extra,
                             progress=lambda k, n: print(f"  fold {k}/{n} done, {time.perf_counter() - t0:.0f} s", flush=True))
         print(f"\nwind {'on' if wind else 'off'}: {len(runs)} records, {a.folds} folds, {time.perf_counter() - t0:.0f} s")

@@ -35,14 +35,23 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mmg.model import P_EPS, P_KAPPA, POLY_WP0, PackedShip
+from mmg.model import P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, POLY_WP0, PackedShip
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
-           "segment_resets", "identify_segments", "SHIP_CONSTANTS", "effect_parameters", "effect_set_of",
+           "segment_resets", "identify_segments", "SHIP_CONSTANTS", "record_weights", "record_residual_rms",
+           "RECORD_WEIGHTINGS", "effect_parameters", "effect_set_of",
            "predict_logged"]
 
-SHIP_CONSTANTS = ("w_P0", "epsilon", "kappa", "wind_scale")
+RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
+                    "l_R_prime": (P_LR, -2.0, 0.0)}
+"""Rudder constants (:class:`mmg.ship.Rudder` fields) :func:`free_parameters` can free: their index in
+the packed parameters and bounds (the flow-straightening coefficients gamma_R of the rudder's
+inflow angle, positive and negative beta_R, and the effective lever l_R' of the yaw rate in it)."""
+MASS_CONSTANTS = {"m_x": P_MX, "m_y": P_MY, "J_z": P_JZ}
+"""Added masses [kg] and added moment of inertia [kg m^2] :func:`free_parameters` can free (the
+config's primed ``m_x_prime``, ``m_y_prime``, ``J_z_prime`` times the mass / inertia scale)."""
+SHIP_CONSTANTS = ("w_P0", "epsilon", "kappa", "wind_scale") + tuple(RUDDER_CONSTANTS) + tuple(MASS_CONSTANTS)
 """Ship constants besides the hull coefficients that :func:`free_parameters` can free."""
 
 
@@ -120,6 +129,13 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
         elif nm == "kappa":                              # a share of the slipstream's speed-up: [0, 1]
             v = float(packed.p[P_KAPPA])
             out.append(FreeParameter(nm, "kappa", P_KAPPA, v, prior_rel_std * v, 0.0, 1.0))
+        elif nm in RUDDER_CONSTANTS:
+            i, lo, hi = RUDDER_CONSTANTS[nm]
+            v = float(packed.p[i])
+            out.append(FreeParameter(nm, "rudder", i, v, max(prior_rel_std * abs(v), 0.05), lo, hi))
+        elif nm in MASS_CONSTANTS:
+            v = float(packed.p[MASS_CONSTANTS[nm]])
+            out.append(FreeParameter(nm, "mass", MASS_CONSTANTS[nm], v, prior_rel_std * v, 0.0, 3.0 * v))
         elif nm == "wind_scale":                         # factor on the records' external (wind) loads
             out.append(FreeParameter(nm, "wind_scale", 0, 1.0, 0.5, 0.0, 3.0))
         else:
@@ -247,9 +263,46 @@ class IdentifyResult:
         return pd.DataFrame(rows).set_index("name")
 
 
+RECORD_WEIGHTINGS = ("samples", "equal", "relative")
+"""How the records' residual blocks are weighted (:func:`record_weights`)."""
+
+
+def record_weights(records: list[Segmented], weighting: str = "samples", stride: int = 2, rms=None) -> np.ndarray:
+    """Factor on each record's residual block.
+
+    ``"samples"``: 1 (every sample counts the same: a record counts in proportion to its length).
+    ``"equal"``: sqrt(mean n / n_i), n_i the record's residual samples, so each record's sum of
+    squares is its mean square times the mean n: every record counts the same whatever its length.
+    ``"relative"``: as ``"equal"`` and divided by the record's residual RMS ``rms`` (at the stage's
+    start) over the median of those, so a record counts by its relative improvement: a record
+    whose open-loop heading error grows to tens of degrees does not outweigh one already within a
+    few.  The factors keep the total count of residuals, so the prior weighs the same against them."""
+    if weighting not in RECORD_WEIGHTINGS:
+        raise ValueError(f"record weighting {weighting!r}: one of {RECORD_WEIGHTINGS}")
+    n = np.array([len(r.meas[::stride]) for r in records], float)
+    if weighting == "samples":
+        return np.ones(len(records))
+    w = np.sqrt(n.mean() / n)
+    if weighting == "relative":
+        if rms is None:
+            raise ValueError("record weighting 'relative' needs each record's residual RMS")
+        rms = np.asarray(rms, float)
+        w = w * float(np.median(rms)) / np.maximum(rms, 1e-12)
+    return w
+
+
+def record_residual_rms(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], theta,
+                        scales: Scales, stride: int = 2, effects=None, ship=None) -> np.ndarray:
+    """RMS of each record's (scaled) residuals with the free parameters at ``theta``."""
+    pk = apply_parameters(packed, free, theta)
+    return np.array([float(np.sqrt(np.mean(_residual_one(pk, rec, scales.array(), stride, effects, free, theta,
+                                                          ship, scales.pos) ** 2))) for rec in records])
+
+
 def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
                       stride: int = 2, n_jobs: int | None = None, max_nfev: int = 40, progress=None,
-                      start=None, effects=None, ship=None) -> IdentifyResult:
+                      start=None, effects=None, ship=None, weights=None, loss: str = "linear",
+                      f_scale: float = 1.0) -> IdentifyResult:
     """Fit ``free`` jointly over ``records`` (module docstring).
 
     Parameters
@@ -275,6 +328,11 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
         (:func:`effect_parameters`).
     ship : mmg.ship.Ship, optional
         The ship (coefficient effects such as ``shallow_water`` need its particulars).
+    weights : array_like, optional
+        Factor on each record's residual block (:func:`record_weights`); 1 when omitted.
+    loss, f_scale : str, float
+        :func:`scipy.optimize.least_squares`'s loss ("linear": least squares; "soft_l1", "cauchy":
+        robust) and its residual scale (in units of the scaled residuals).
     """
     from scipy.optimize import least_squares
 
@@ -286,11 +344,15 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
 
     pos = scales.pos
     by_columns = effects is not None or pos is not None      # few records: the columns in parallel
+    wts = np.ones(len(records)) if weights is None else np.asarray(weights, float)
+    if wts.shape != (len(records),):
+        raise ValueError(f"weights: one per record ({len(records)}), got {wts.shape}")
 
     def resid(theta, parallel=True):
         pk = apply_parameters(packed, free, theta)
-        one = lambda rec: _residual_one(pk, rec, sc, stride, effects, free, theta, ship, pos)  # noqa: E731
-        parts = list(pool.map(one, records)) if parallel else [one(rec) for rec in records]
+        one = lambda k: wts[k] * _residual_one(pk, records[k], sc, stride, effects, free, theta, ship, pos)  # noqa: E731
+        ks = range(len(records))
+        parts = list(pool.map(one, ks)) if parallel else [one(k) for k in ks]
         return np.concatenate(parts + [(theta - theta0) / sig0])
 
     count = [0]
@@ -321,7 +383,7 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
         hi = np.array([f.upper for f in free])
         x0 = theta0 if start is None else np.asarray(start, float)
         sol = least_squares(resid, np.clip(x0, lo, hi), jac=jac, method="trf", x_scale=sig0, max_nfev=max_nfev,
-                            bounds=(lo, hi))
+                            bounds=(lo, hi), loss=loss, f_scale=f_scale)
     finally:
         pool.shutdown()
     J = sol.jac

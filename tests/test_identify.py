@@ -100,3 +100,67 @@ def test_identify_in_another_form_scores_against_the_initial_model(tmp_path):
     assert ident.scores(model="initial")[0]["heading_rms_deg"] < 1.0      # the Kijima ship made the record
     rep = write_identification(ident, mmg.config_path("ships", "esso_osaka_3m_crossflow.yaml"), tmp_path)["report"]
     assert "Fitted in the form of" in rep.read_text()
+
+
+def _doubled(run: MeasuredRun, reset: np.ndarray):
+    """``run`` twice in a row (the second copy restarted from its own first state) and its resets."""
+    dt = run.inputs.t[1] - run.inputs.t[0]
+    t = np.concatenate([run.inputs.t, run.inputs.t + run.inputs.t[-1] + dt])
+    inp = ReplayInputs(t=t, delta=np.tile(run.inputs.delta, 2), n=np.tile(run.inputs.n, 2))
+    return Segmented(run.name + "x2", np.vstack([run.meas, run.meas]), inp, np.concatenate([reset, reset]))
+
+
+def test_equal_record_weighting_makes_a_doubled_record_count_as_the_single_one():
+    """Two records made by two different ships pull N_r apart.  Doubling one record (the same samples
+    twice) moves the samples-weighted fit towards that record's ship; with ``weights=record_weights(...,
+    "equal")`` the fit is the one of the two single records (computed independently: both of one length,
+    unit weights).  The prior is made negligible so that only the records' relative weight matters."""
+    from ekf.identify import record_weights
+
+    ship = mmg.load_ship(SHIP)
+    nr = ship.hull.value("N_r")
+    a = _synthetic_runs(ship.with_hull({"N_r": nr * 1.3}), seeds=(0,), duration=59.9)[0]
+    b = _synthetic_runs(ship.with_hull({"N_r": nr * 0.8}), seeds=(1,), duration=59.9)[0]
+    assert len(a.t) % 2 == 0                                      # stride 2 keeps both copies' samples alike
+    pk = pack(ship)
+    free = free_parameters(pk, ship.hull.names, ["N_r"], prior_rel_std=1e4)
+    sc = Scales(0.005, 0.005, 0.001, np.radians(0.5))
+    ra, rb = segment_resets(a.t, 30.0), segment_resets(b.t, 30.0)
+    sa, sb = Segmented(a.name, a.meas, a.inputs, ra), Segmented(b.name, b.meas, b.inputs, rb)
+    bb = _doubled(b, rb)
+    fit = lambda recs, w=None: identify_segments(pk, recs, free, sc, n_jobs=2, weights=w).values()["N_r"]  # noqa: E731
+    ref = fit([sa, sb])
+    samples = fit([sa, bb], record_weights([sa, bb], "samples"))
+    equal = fit([sa, bb], record_weights([sa, bb], "equal"))
+    assert nr * 0.8 < ref < nr * 1.3 or nr * 1.3 < ref < nr * 0.8
+    assert abs(samples - nr * 0.8) < abs(ref - nr * 0.8) - 0.05 * abs(ref - samples) - 1e-6   # doubled b pulls
+    assert abs(samples - ref) > 0.02 * abs(nr)
+    assert equal == pytest.approx(ref, rel=2e-3)
+
+
+def test_relative_record_weighting_divides_by_each_records_misfit():
+    from ekf.identify import record_weights
+
+    runs = _synthetic_runs(mmg.load_ship(SHIP), seeds=(0, 1), duration=40.0)
+    segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, 20.0)) for r in runs]
+    w = record_weights(segs, "relative", rms=[1.0, 4.0])
+    assert w[0] / w[1] == pytest.approx(4.0)                       # same length: only the misfit differs
+    assert np.all(record_weights(segs, "samples") == 1.0)
+    with pytest.raises(ValueError):
+        record_weights(segs, "relative")
+
+
+def test_rudder_constants_and_added_masses_can_be_freed_and_are_written_back(tmp_path):
+    ship = mmg.load_ship(SHIP)
+    runs = _synthetic_runs(ship.with_hull({}), seeds=(0,), duration=40.0)
+    ident = identify(ship, runs, free=["gamma_R_pos", "l_R_prime", "m_y", "J_z"], segment_s=(20.0,), say=lambda m: None,
+                     max_nfev=3)
+    v = ident.fit.values()
+    assert ident.ship.rudder.gamma_R_pos == v["gamma_R_pos"] and ident.ship.rudder.l_R_prime == v["l_R_prime"]
+    from mmg.model import P_JZ, P_MY
+    assert pack(ident.ship).p[P_MY] == pytest.approx(v["m_y"], rel=1e-12)      # the config's prime, rescaled
+    assert pack(ident.ship).p[P_JZ] == pytest.approx(v["J_z"], rel=1e-12)
+    back = mmg.load_ship(write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)["ship"])
+    assert back.rudder.gamma_R_pos == pytest.approx(v["gamma_R_pos"], rel=1e-5)
+    assert pack(back).p[P_MY] == pytest.approx(v["m_y"], rel=1e-5) and back.mass.m_x_prime == ship.mass.m_x_prime
+    assert back.rudder.gamma_R_neg == ship.rudder.gamma_R_neg

@@ -447,10 +447,11 @@ def cmd_identify(args) -> int:
         print(f"  iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
 
     initial = load_ship(ship_path(args.initial)) if args.initial else None
-    ident = identify(ship, runs, wind=wind, progress=progress, initial=initial)
+    kw = {"record_weighting": args.weighting} if args.weighting else {}
+    ident = identify(ship, runs, wind=wind, progress=progress, initial=initial, **kw)
     cv = None
     if args.cv:
-        cv = cross_validate(ship, runs, folds=args.cv, wind=wind, initial=initial,
+        cv = cross_validate(ship, runs, folds=args.cv, wind=wind, initial=initial, **kw,
                             progress=lambda k, n: print(f"cross-validation fold {k}/{n} ({time.perf_counter() - t0:.0f} s)",
                                                         file=sys.stderr, flush=True))
     tests = load_runs(ship, args.test, wind=wind) if args.test else None
@@ -687,6 +688,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also cross-validate in FOLDS folds (each record kept out once) and report it")
     p.add_argument("--test", nargs="+", default=None, metavar="LOG",
                    help="records never trained on, predicted with the initial and the identified model in the report")
+    p.add_argument("--weighting", choices=("samples", "equal", "relative"), default=None,
+                   help="how each training record counts in the fit: samples (every sample alike: long records count "
+                        "more), equal (every record alike), relative (every record alike relative to its own misfit); "
+                        "default trials.identify.DEFAULT_WEIGHTING")
     p.set_defaults(func=cmd_identify)
 
     p = sub.add_parser("diagnose", help="find where the model and the records disagree, name the missing effect "

@@ -16,7 +16,12 @@ cross-validated heading RMS of the Kijima 3 m model from 17.1 to 15.5 deg with w
 fraction's constant term ``w_P0`` (the model-scale wake is the largest scale effect, see the 3 m
 config), the rudder inflow ratio ``epsilon`` and the slipstream share ``kappa`` (at model scale
 the propeller runs heavily loaded, so how much of its slipstream reaches the rudder sets the
-rudder force: the Osaka set has kappa = 0.20 against the ship's 0.595), and the wind-load scale.
+rudder force: the Osaka set has kappa = 0.20 against the ship's 0.595), the rudder's flow
+straightening ``gamma_R_pos``, ``gamma_R_neg`` and lever ``l_R_prime`` (the inflow angle at the
+rudder: freeing them took the four-fold cross-validated heading RMS with wind from 15.3 to 14.4 deg,
+docs/identify_cv.md), and the wind-load scale.  Each training record counts alike
+(:data:`DEFAULT_WEIGHTING` ``"equal"``): with every sample alike a 400 s turn outweighed a
+140 s zigzag three times.
 The propeller curve, masses and rudder geometry stay at the config values: the records (n
 constant over most of each run) cannot separate them from the freed ones.
 
@@ -41,9 +46,11 @@ from mmg.ship import Ship
 from .predict import MeasuredRun, measured_run, replay_record
 
 __all__ = ["identify", "cross_validate", "write_identification", "load_runs", "ship_yaml", "Identification",
-           "DEFAULT_FREE"]
+           "DEFAULT_FREE", "DEFAULT_WEIGHTING"]
 
-DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "wind_scale")
+DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "l_R_prime", "wind_scale")
+DEFAULT_WEIGHTING = "equal"
+"""Default weighting of the training records in the fit (:func:`ekf.identify.record_weights`)."""
 DEFAULT_SEGMENTS_L = (52.0, np.inf)
 """Segment lengths of the successive fits, in units of sqrt(L/g): 29 s for a 3 m model, 300 s at
 325 m (about one zigzag half-period: short enough that a poor start does not diverge), then the
@@ -161,7 +168,15 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
         w = list(s.propeller.w_P0)
         w[0] = values["w_P0"]
         s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
-    rud = {k: values[k] for k in ("epsilon", "kappa") if k in values}
+    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
+    from mmg.nondim import inertia_scale, mass_scale
+
+    pa = s.particulars
+    mass = {f"{k}_prime": values[k] / (inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T))
+            for k in MASS_CONSTANTS if k in values}
+    if mass:
+        s = replace(s, mass=replace(s.mass, **mass))
+    rud = {k: values[k] for k in ("epsilon", "kappa", *RUDDER_CONSTANTS) if k in values}
     if rud:
         s = replace(s, rudder=replace(s.rudder, **rud))
     if "wind_scale" in values and s.wind is not None:
@@ -177,7 +192,8 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
 
 def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | None = None, wind: bool | None = None,
              max_nfev: int = 30, progress=None, say=_log, prior_rel_std: float = 0.5,
-             initial: Ship | None = None) -> Identification:
+             initial: Ship | None = None, record_weighting: str = DEFAULT_WEIGHTING, loss: str = "linear",
+             f_scale: float = 1.0) -> Identification:
     """Identify ``free`` jointly over the training records (module docstring).
 
     Parameters
@@ -200,8 +216,16 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
         The model the identified one is compared with in the scores and the report ("initial");
         ``ship`` (the prior) when omitted.  Given when the prior is the initial model rewritten in
         another hull form (e.g. ``esso_osaka_3m_crossflow`` for the Kijima ``esso_osaka_3m``).
+    record_weighting : str
+        How each training record's residuals count in every stage (:func:`ekf.identify.record_weights`):
+        ``"samples"`` (each sample alike: long records count more), ``"equal"`` (each record alike),
+        ``"relative"`` (each record alike, relative to its own misfit at the stage's start).
+    loss, f_scale : str, float
+        Robust loss of the last (whole-record) stage (:func:`scipy.optimize.least_squares`): ``"linear"``
+        (least squares), ``"soft_l1"``, ``"cauchy"``; ``f_scale`` in units of the scaled residuals.
     """
-    from ekf.identify import Segmented, free_parameters, identify_segments, segment_resets
+    from ekf.identify import Segmented, free_parameters, identify_segments, record_residual_rms, record_weights, \
+        segment_resets
 
     items = list(paths_or_runs)
     runs = [r for r in items if isinstance(r, MeasuredRun)]
@@ -220,8 +244,14 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     for k, st in enumerate(stages):
         seg = float(st) * float(np.sqrt(L / 9.80665))
         segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects) for r in runs]
-        fit = identify_segments(packed, segs, fp, _scales(runs, L), max_nfev=max_nfev, progress=progress,
-                                start=None if fit is None else fit.theta)
+        sc = _scales(runs, L)
+        theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
+        rms = record_residual_rms(packed, segs, fp, theta, sc) if record_weighting == "relative" else None
+        last = k == len(stages) - 1
+        fit = identify_segments(packed, segs, fp, sc, max_nfev=max_nfev, progress=progress,
+                                start=None if fit is None else fit.theta, weights=record_weights(segs, record_weighting,
+                                                                                                 rms=rms),
+                                loss=loss if last else "linear", f_scale=f_scale)
     return Identification(ship=_ship_with(ship, fit.values()), initial=ship if initial is None else initial, fit=fit,
                           runs=runs, segment_s=seg, prior=None if initial is None else ship)
 
@@ -252,14 +282,26 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
     ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``."""
     import yaml
 
+    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
+    from mmg.nondim import inertia_scale, mass_scale
+
     data = yaml.safe_load(Path(ship_path).read_text())
+    ship = None
     for k, v in values.items():
         if k in data["hull"]["coefficients"]:
             data["hull"]["coefficients"][k]["value"] = float(f"{v:.6g}")
         elif k == "w_P0":
             data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
-        elif k in ("epsilon", "kappa"):
+        elif k in ("epsilon", "kappa", *RUDDER_CONSTANTS):
             data["rudder"][k] = float(f"{v:.6g}")
+        elif k in MASS_CONSTANTS:
+            if ship is None:
+                from mmg.ship import load_ship
+
+                ship = load_ship(ship_path)
+            pa = ship.particulars
+            sc = inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
+            data["mass"][f"{k}_prime"] = float(f"{v / sc:.6g}")
         elif k == "wind_scale" and "wind" in data:
             eff = (data.get("effects") or {}).get("wind")
             if isinstance(eff, dict) and "scale" in eff:           # the scale given in the effects section
