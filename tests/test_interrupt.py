@@ -103,12 +103,13 @@ def test_nomoto_interrupted(sig, tmp_path, zz20_log):
 
 
 def test_signal_before_staging(tmp_path):
-    """A SIGTERM 1.5 s after the start (the command still importing or reading its input)."""
+    """A SIGTERM 0.8 s after the start (the command still importing, reading its input or simulating:
+    a warm 3000 s ST35 now finishes in about 1.5 s, so the 30000 s one, whose files take seconds)."""
     base = tmp_path / "base"
     base.mkdir()
-    p = subprocess.Popen(mmg_argv() + ["simulate", str(CONFIGS / "trials" / "st35.yaml"), "--out", str(base / "DIR")],
+    p = subprocess.Popen(mmg_argv() + ["simulate", str(long_st35(tmp_path)), "--out", str(base / "DIR")],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(1.5)
+    time.sleep(0.8)
     assert p.poll() is None
     p.send_signal(signal.SIGTERM)
     out, err = p.communicate(timeout=300)
