@@ -137,6 +137,17 @@ def _track_column(k, u, v, r, psi, p, out):
         track(u, v, r, psi + h, p, out)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _take_column(kc, slots, mask, c, have_real, A, kr):
+    """From one complex-step evaluation ``kc`` (8,): column c of A on the rows in ``mask`` (bit i: row
+    i, state ``slots[i]``), and their real parts into kr unless ``have_real`` (k_s already taken)."""
+    for i in range(slots.shape[0]):
+        if (mask >> i) & 1:
+            A[i, c] = kc[slots[i]].imag / CSTEP
+            if not have_real:
+                kr[i] = kc[slots[i]].real
+
+
 # _nrt=False: no reference counting in this kernel (it allocates nothing; the work arrays live in
 # ws).  The inlined model code otherwise increfs / decrefs every array argument at every inlined
 # call, ~20 % of this kernel's time.
@@ -240,19 +251,11 @@ def _compile_jacobian_step(stamp: int):
                     A[i, c] = 0.0
                 if dmask != 0 and (k == U_ or k == V_ or k == R_ or k == N_ or k == DELTA_):
                     _dynamics_column(k, u, v, r, e, n, p, poly, hull_axis, hull_term, hc, kc)
-                    for i in range(ns):
-                        if (dmask >> i) & 1:
-                            A[i, c] = kc[slots[i]].imag / CSTEP
-                            if not dyn_real:
-                                kr[i] = kc[slots[i]].real
+                    _take_column(kc, slots, dmask, c, dyn_real, A, kr)
                     dyn_real = True
                 if tmask != 0 and (k == U_ or k == V_ or k == R_ or k == PSI_):
                     _track_column(k, u, v, r, psi, p, kc)
-                    for i in range(ns):
-                        if (tmask >> i) & 1:
-                            A[i, c] = kc[slots[i]].imag / CSTEP
-                            if not trk_real:
-                                kr[i] = kc[slots[i]].real
+                    _take_column(kc, slots, tmask, c, trk_real, A, kr)
                     trk_real = True
             if not dyn_real:                # no dynamic state to differentiate in: k_s alone
                 dynamics(u, v, r, e, n, p, poly, hull_axis, hull_term, hc, w)
