@@ -40,7 +40,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from mmg._jit import njit
 
 from mmg.model import PackedShip
 

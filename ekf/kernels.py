@@ -19,7 +19,7 @@ column of F, ~5 x slower for the paper filter) as the reference for tests and ``
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from mmg._jit import njit
 
 from mmg._inlining import source_stamp
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_, dynamics, inverse_mass, rhs, rhs_hull_jacobian, track

@@ -54,7 +54,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from mmg._jit import njit
 
 from mmg.errors import InputError
 from mmg.model import N_, PSI_, R_, U_, V_, X_, Y_

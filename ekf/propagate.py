@@ -8,7 +8,7 @@ class :class:`ekf.filterpy_ekf.AugmentedEKF`, import it without importing each o
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from mmg._jit import njit
 
 from mmg.model import N_, R_, U_, V_
 

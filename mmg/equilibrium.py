@@ -15,7 +15,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .model import POLY_KQ, N_, PackedShip, forces, pack, polyval, rhs
+from ._aot import model_functions
+from .model import POLY_KQ, N_, PackedShip, pack, polyval
 from .ship import Ship
 
 
@@ -49,7 +50,7 @@ def engine_power(ship: Ship, u0: float) -> float:
 def _accels(pk: PackedShip, u, v, delta, n):
     x = np.array([u, v, 0.0, 0.0, 0.0, 0.0, delta, n])
     out = np.zeros(8)
-    rhs(x, delta, *pk.args(), out)
+    model_functions()[0](x, float(delta), *pk.args(), out)
     return out
 
 
@@ -144,7 +145,7 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
     scale = 1.0
     if ship.engine.mode == "constant_power":
         x = np.array([u0, vv, 0.0, 0.0, 0.0, 0.0, dd, nn])
-        J = forces(x, *pk.args())[3]
+        J = model_functions()[1](x, *pk.args())[3]
         kq = polyval.py_func(pk.poly, POLY_KQ, J)     # Python body: no specialisation compiled for one call
         D, rho = ship.propeller.D, ship.particulars.rho
         scale = power / (2 * np.pi * nn) / (rho * nn**2 * D**5 * kq)

@@ -19,16 +19,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
-from ._inlining import source_stamp
-from .model import N_, P_ENGINE, PSI_, U_, ENGINE_CONSTANT_RPM, PackedShip, rhs
-from .rudder import switch_side
-
-SCHEDULE, HEADING_SWITCH = 0, 1
-
-# HEADING_SWITCH parameters
-HS_AMP, HS_HI, HS_LO, HS_FIRST, HS_PSI0, HS_TSTART, HS_TRIM = range(7)
+from .kernel import (HEADING_SWITCH, HS_AMP, HS_FIRST, HS_HI, HS_LO, HS_PSI0, HS_TRIM,  # noqa: F401 (re-exported)
+                     HS_TSTART, SCHEDULE, _interp, simulate_kernel)
+from .model import PackedShip
 
 
 @dataclass(frozen=True)
@@ -61,100 +55,18 @@ class CommandLaw:
         return CommandLaw(HEADING_SWITCH, par, z, z, z)
 
 
-@njit(cache=True, error_model="numpy")
-def _interp(tq, ts, vs, k):
-    """Linear interpolation with a moving pointer k (ts increasing); holds the ends."""
-    nt = ts.shape[0]
-    while k < nt - 2 and ts[k + 1] <= tq:
-        k += 1
-    if tq <= ts[0]:
-        return vs[0], k
-    if tq >= ts[nt - 1]:
-        return vs[nt - 1], k
-    w = (tq - ts[k]) / (ts[k + 1] - ts[k])
-    return vs[k] + w * (vs[k + 1] - vs[k]), k
-
-
-def _compile_simulate_kernel(stamp: int):
-    """Compile the kernel below as a closure over ``stamp`` (:func:`mmg._inlining.source_stamp`, a hash of
-    the sources it inlines): numba keys its on-disk cache by the function's own file and its closure,
-    so an edit of the inlined model (another file) then recompiles it instead of loading stale code."""
-
-    @njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
-    def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
-                        kind, cpar, st, sd, sn, states, orders, work):
-        """Integrate ``nsteps`` RK4 steps from ``x0``; fill ``states`` (nsteps+1, 8) and ``orders``.
-
-        ``work``: real (6, 8) scratch (the state and the four RK4 stages).  The kernel allocates
-        nothing, so it is compiled without reference counting (``_nrt=False``: no atomic
-        increment / decrement of the arrays' counts in the right-hand side, several per
-        evaluation otherwise).  Releases the GIL (it touches no Python object): runs of different
-        threads go on in parallel.  Returns the number of valid rows (< nsteps+1 when the run
-        stopped because the surge speed fell below 1 % of its initial value or a value became NaN).
-        """
-        if stamp < 0:                     # never true: ties the cache entry to the inlined sources
-            return 0
-        nx = x0.shape[0]
-        x = work[0]
-        k1 = work[1]
-        k2 = work[2]
-        k3 = work[3]
-        k4 = work[4]
-        tmp = work[5]
-        for j in range(nx):
-            x[j] = x0[j]
-        side = cpar[HS_FIRST]
-        ptr = 0
-        ptrn = 0
-        u_min = 0.01 * abs(x0[U_])
-        constant_rpm = p[P_ENGINE] == ENGINE_CONSTANT_RPM
-        for i in range(nsteps + 1):
-            t = i * dt
-            if kind == SCHEDULE:
-                dcmd, ptr = _interp(t, st, sd, ptr)
-                ncmd, ptrn = _interp(t, st, sn, ptrn)
-                if constant_rpm and not np.isnan(ncmd):
-                    x[N_] = ncmd
-            else:
-                if t < cpar[HS_TSTART]:
-                    dcmd = cpar[HS_TRIM]
-                else:
-                    side = switch_side(side, x[PSI_] - cpar[HS_PSI0], cpar[HS_HI], cpar[HS_LO])
-                    dcmd = side * cpar[HS_AMP]
-            for j in range(nx):
-                states[i, j] = x[j]
-            orders[i] = dcmd
-            if not (x[U_] > u_min) or np.isnan(x[PSI_]):
-                return i
-            if i == nsteps:
-                break
-            for s in range(4):                       # one inlined copy of the right-hand side
-                if s == 0:
-                    for j in range(nx):
-                        tmp[j] = x[j]
-                else:
-                    c = 0.5 * dt if s < 3 else dt
-                    for j in range(nx):
-                        tmp[j] = x[j] + c * work[s, j]
-                rhs(tmp, dcmd, p, poly, hull_axis, hull_term, hull_coef, work[s + 1])
-            for j in range(nx):
-                x[j] += dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-        return nsteps + 1
-
-    return simulate_kernel
-
-
-simulate_kernel = _compile_simulate_kernel(source_stamp())
-
-
 def integrate(packed: PackedShip, x0: np.ndarray, law: CommandLaw, duration: float, dt: float):
     """Run the compiled loop; returns (t [s], states (N, 8), rudder orders [rad], completed flag)."""
     nsteps = int(round(duration / dt))
     states = np.empty((nsteps + 1, 8))
     orders = np.empty(nsteps + 1)
-    nvalid = simulate_kernel(
-        np.asarray(x0, dtype=float), float(dt), nsteps, *packed.args(),
-        law.kind, law.params, law.t, law.delta, law.n, states, orders, np.empty((6, 8)),
+    from ._aot import simulate_kernel as the_kernel     # ahead-of-time compiled, or the JIT's (mmg._aot)
+
+    f8 = lambda a: np.asarray(a, dtype=np.float64)                     # noqa: E731 (the compiled types)
+    nvalid = the_kernel()(
+        f8(x0), float(dt), nsteps, f8(packed.p), f8(packed.poly), np.asarray(packed.hull_axis, dtype=np.int64),
+        np.asarray(packed.hull_term, dtype=np.int64), f8(packed.hull_coef),
+        int(law.kind), f8(law.params), f8(law.t), f8(law.delta), f8(law.n), states, orders, np.empty((6, 8)),
     )
     t = np.arange(nvalid) * dt
     return t, states[:nvalid], orders[:nvalid], nvalid == nsteps + 1

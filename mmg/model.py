@@ -23,7 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from ._jit import njit
 
 from ._inlining import hot_loops_only
 from .nondim import force_scale, inertia_scale, mass_scale, moment_scale, r_prime

@@ -21,7 +21,7 @@ they work on plain floats from Python as well.
 """
 from __future__ import annotations
 
-from numba import njit
+from ._jit import njit
 
 
 @njit(cache=True, inline="always")

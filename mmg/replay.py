@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from ._jit import njit
 
 from ._inlining import source_stamp
 from .model import P_L, P_WIND_V, PSI_, R_, U_, V_, X_, Y_, PackedShip, dynamics, inverse_mass, track, wind_loads
@@ -84,7 +84,7 @@ def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef, 
 
 def _compile_replay(stamp: int):
     """Compile the replay below as a closure over ``stamp`` (:func:`mmg._inlining.source_stamp`; see
-    :func:`mmg.integrate._compile_simulate_kernel`)."""
+    :func:`mmg.kernel._compile_simulate_kernel`)."""
 
     @njit(cache=True, error_model="numpy", nogil=True)
     def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis, hull_term, hull_coef, out):

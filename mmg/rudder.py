@@ -13,7 +13,7 @@ EKF, the output-error fit and the Nomoto analysis all rebuild rudders through it
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ._jit import njit
 
 from .model import steering_rate
 

@@ -24,7 +24,7 @@ at any drift angle, 90 deg included, where the Kijima polynomials in beta are ex
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ._jit import njit
 
 from ._inlining import hot_loops_only
 

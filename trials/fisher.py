@@ -59,7 +59,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from mmg._jit import njit
 
 from ekf.filter import NS, propagate_step, workspace
 from ekf.kernels import CSTEP, make_workspace, rk4_step

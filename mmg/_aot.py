@@ -1,0 +1,212 @@
+"""Ahead-of-time compiled simulator kernels: a simulation in a fresh process without numba.
+
+The simulator's hot loop (:func:`mmg.kernel.simulate_kernel`) and the two model functions the
+straight-run solver calls (:func:`mmg.model.rhs`, :func:`mmg.model.forces`) are compiled once, by
+``numba.pycc``, into an extension module, from the very same Python functions the JIT compiles
+(one definition of the physics; the states are the JIT's to the last bit, a test checks).  The
+module imports only numpy, so a process that simulates and does nothing else never imports numba
+(whose import and typing registries cost about 0.3 s, more than the simulated turn itself,
+``bench/bench_startup.py``).
+
+The module is a cache entry like numba's own: built on first use (about 8 s, instead of the JIT's
+compile of the same functions), into ``$NUMBA_CACHE_DIR/mmg_aot`` when that is set, else
+``mmg/__pycache__`` when writable, else the user's cache folder (``$XDG_CACHE_HOME`` or
+``~/.cache``, ``mmg-toolkit``).  Its name carries a hash of the sources it compiles, numba's
+version and the interpreter's extension suffix, so an edit of the model or an upgrade builds a new
+one.  Where it cannot be built (no C compiler, ``Python.h`` missing) a marker file records why and
+the JIT is used from then on; ``MMG_AOT=0`` in the environment always uses the JIT.
+
+The compiled module holds the GIL while it runs (``pycc`` exports cannot release it), so calls from
+threads other than the main one use the JIT kernels (``nogil``: a thread pool's runs go on in
+parallel).
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.machinery
+import importlib.util
+import os
+import tempfile
+import threading
+from pathlib import Path
+
+__all__ = ["kernels", "enabled", "module_path", "module_name", "build", "simulate_kernel", "model_functions"]
+
+SOURCES = ("_inlining.py", "_jit.py", "_aot.py", "model.py", "nondim.py", "rudder.py", "terms.py", "wind.py",
+           "kernel.py")
+"""The files of :mod:`mmg` whose code the compiled module holds (or that say how it is built)."""
+
+SIG_SIMULATE = ("i8(f8[:], f8, i8, f8[:], f8[:,:], i8[:], i8[:], f8[:], i8, f8[:], f8[:], f8[:], f8[:], f8[:,:], "
+                "f8[:], f8[:,:])")
+SIG_RHS = "void(f8[:], f8, f8[:], f8[:,:], i8[:], i8[:], f8[:], f8[:])"
+SIG_FORCES = "UniTuple(f8, 4)(f8[:], f8[:], f8[:,:], i8[:], i8[:], f8[:])"
+
+_lock = threading.Lock()
+_module = None
+_tried = False
+
+
+def enabled() -> bool:
+    """False when ``MMG_AOT=0`` is set (always use the JIT)."""
+    return os.environ.get("MMG_AOT", "1").strip() not in ("0", "false", "no", "off")
+
+
+def _numba_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("numba")
+    except PackageNotFoundError:                  # pragma: no cover - numba is a dependency
+        return "none"
+
+
+def _stamp() -> str:
+    h = hashlib.sha256()
+    here = Path(__file__).resolve().parent
+    for name in SOURCES:
+        f = here / name
+        if f.is_file():
+            h.update(name.encode())
+            h.update(f.read_bytes())
+    h.update(_numba_version().encode())
+    return h.hexdigest()[:16]
+
+
+def _cache_dir() -> Path:
+    env = os.environ.get("NUMBA_CACHE_DIR")
+    if env:
+        return Path(env) / "mmg_aot"
+    here = Path(__file__).resolve().parent / "__pycache__"
+    try:
+        here.mkdir(exist_ok=True)
+        if os.access(here, os.W_OK):
+            return here
+    except OSError:
+        pass
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "mmg-toolkit"
+
+
+def module_name() -> str:
+    """The extension module's name for the current sources and numba."""
+    return f"_mmg_aot_{_stamp()}"
+
+
+def module_path() -> Path:
+    """Where the compiled module for the current sources is (or will be) cached."""
+    suffix = importlib.machinery.EXTENSION_SUFFIXES[0]
+    return _cache_dir() / (module_name() + suffix)
+
+
+def _load(path: Path):
+    name = path.name.split(".")[0]
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def build(path: Path | None = None) -> Path:
+    """Compile the module into ``path`` (:func:`module_path` when omitted) and return it.
+
+    Compiled in a temporary folder beside the target and moved into place (atomic: a process
+    building the same module at the same time leaves one complete file); nothing is left behind
+    when the build fails or is interrupted."""
+    import shutil
+    import warnings
+
+    with warnings.catch_warnings():              # pycc is "pending deprecation" (numba >= 0.57); still built
+        warnings.simplefilter("ignore")
+        from numba.pycc import CC
+
+    from . import kernel, model
+    from ._jit import materialize
+
+    materialize()                                # the real dispatchers, not their stand-ins
+    path = module_path() if path is None else Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    name = path.name.split(".")[0]
+    tmp = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=path.parent))
+    old = tempfile.tempdir
+    try:
+        tempfile.tempdir = str(tmp)              # pycc's own build folder goes in there too
+        cc = CC(name, source_module=__name__)
+        cc.output_dir = str(tmp)
+        sim, rhs, forces = kernel.simulate_kernel, model.rhs, model.forces
+
+        @cc.export("simulate_kernel", SIG_SIMULATE)
+        def _simulate(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders, work):
+            return sim(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders, work)
+
+        @cc.export("rhs", SIG_RHS)
+        def _rhs(x, delta_cmd, p, poly, ha, ht, hc, out):
+            rhs(x, delta_cmd, p, poly, ha, ht, hc, out)
+
+        @cc.export("forces", SIG_FORCES)
+        def _forces(x, p, poly, ha, ht, hc):
+            return forces(x, p, poly, ha, ht, hc)
+
+        cc.compile()
+        os.replace(tmp / cc.output_file, path)
+        if path.parent == Path(__file__).resolve().parent / "__pycache__":
+            for old_module in path.parent.glob("_mmg_aot_*"):     # earlier sources' modules in our own cache
+                if old_module.name.split(".")[0] != name:
+                    old_module.unlink(missing_ok=True)
+    finally:
+        tempfile.tempdir = old
+        shutil.rmtree(tmp, ignore_errors=True)
+    return path
+
+
+def kernels():
+    """The compiled module (attributes ``simulate_kernel``, ``rhs``, ``forces``), built on first use;
+    None where it is disabled, cannot be built, or the caller is not the main thread (module docstring)."""
+    global _module, _tried
+    if threading.current_thread() is not threading.main_thread() or not enabled():
+        return None
+    if _module is not None or _tried:
+        return _module
+    with _lock:
+        if _module is not None or _tried:
+            return _module
+        _tried = True
+        path = module_path()
+        failed = path.with_name(path.name.split(".")[0] + ".failed")
+        try:
+            if not path.is_file():
+                if failed.is_file():
+                    return None
+                try:
+                    build(path)
+                except Exception as e:            # no compiler, no Python headers: the JIT it is
+                    try:
+                        failed.parent.mkdir(parents=True, exist_ok=True)
+                        failed.write_text(f"{type(e).__name__}: {e}\n")
+                    except OSError:
+                        pass
+                    return None
+            _module = _load(path)
+        except (ImportError, OSError):
+            _module = None
+        return _module
+
+
+def simulate_kernel():
+    """The simulator kernel to call here: the compiled module's, or the JIT's."""
+    k = kernels()
+    if k is not None:
+        return k.simulate_kernel
+    from .kernel import simulate_kernel as jit
+
+    return jit
+
+
+def model_functions():
+    """(rhs, forces) to call here: the compiled module's, or the JIT's."""
+    k = kernels()
+    if k is not None:
+        return k.rhs, k.forces
+    from .model import forces, rhs
+
+    return rhs, forces
+

@@ -1,0 +1,115 @@
+"""A lazy ``njit``: numba is imported when compiled code is first needed, not when a module is.
+
+``import numba`` and the typing registries numba loads at its first compiled call cost about
+0.3 s of a fresh process, more than a whole simulated turn.  A run that needs no JIT-compiled
+code (the simulator's ahead-of-time compiled kernels, :mod:`mmg._aot`; reading a log; metrics)
+should not pay it.  Every compiled function of the project is therefore declared with
+:func:`njit` from here: it records the Python function and the options and returns a
+:class:`LazyJit` stand-in.  The first time any stand-in is called (or numba meets one while
+compiling other code), :func:`materialize` imports numba, makes the real dispatcher of every
+recorded function, in the order they were declared, and puts each dispatcher in place of its
+stand-in in the namespaces of the loaded modules, so that compiled code referring to another
+compiled function by its global name sees a numba dispatcher, as it would have without this
+module.  Numba's on-disk cache is keyed by the Python function, so cached code is the same.
+"""
+from __future__ import annotations
+
+import sys
+import threading
+
+__all__ = ["njit", "LazyJit", "materialize", "materialized"]
+
+_registry: list["LazyJit"] = []
+_lock = threading.RLock()
+_done = False
+
+
+class LazyJit:
+    """Stand-in for ``numba.njit(**options)(py_func)`` until :func:`materialize`."""
+
+    def __init__(self, py_func, options: dict):
+        self.py_func = py_func
+        self.options = options
+        self._dispatcher = None
+        self.__name__ = py_func.__name__
+        self.__qualname__ = py_func.__qualname__
+        self.__doc__ = py_func.__doc__
+        self.__module__ = py_func.__module__
+        self.__wrapped__ = py_func
+
+    @property
+    def dispatcher(self):
+        """The numba dispatcher (importing numba and making every declared one first)."""
+        if self._dispatcher is None:
+            materialize()
+        return self._dispatcher
+
+    def __call__(self, *args, **kwargs):
+        return self.dispatcher(*args, **kwargs)
+
+    def __getattr__(self, name):                 # signatures, overloads, stats, ...
+        if name.startswith("__") or name in ("_dispatcher", "py_func", "options"):
+            raise AttributeError(name)
+        return getattr(self.dispatcher, name)
+
+    @property
+    def _numba_type_(self):
+        """What numba's ``typeof`` sees when compiled code outside this project meets a stand-in."""
+        from numba.core import types
+
+        return types.Dispatcher(self.dispatcher)
+
+    def __repr__(self) -> str:
+        state = "compiled" if self._dispatcher is not None else "not yet compiled"
+        return f"<LazyJit {self.__module__}.{self.__qualname__} ({state})>"
+
+
+def njit(*args, **options):
+    """``numba.njit`` with the same options, made when compiled code is first needed (module docstring)."""
+    def wrap(func):
+        lj = LazyJit(func, options)
+        with _lock:
+            _registry.append(lj)
+            if _done:                              # declared after the others were made: make it now
+                _make(lj)
+                _substitute()
+        return lj
+
+    if args and callable(args[0]) and not options and len(args) == 1:
+        return wrap(args[0])
+    return wrap
+
+
+def _make(lj: LazyJit) -> None:
+    import numba
+
+    if lj._dispatcher is None:
+        lj._dispatcher = numba.njit(**lj.options)(lj.py_func)
+
+
+def _substitute() -> None:
+    """Put each dispatcher in place of its stand-in in every loaded module's namespace."""
+    for mod in list(sys.modules.values()):
+        d = getattr(mod, "__dict__", None)
+        if not isinstance(d, dict):
+            continue
+        for k, v in list(d.items()):
+            if type(v) is LazyJit and v._dispatcher is not None:
+                d[k] = v._dispatcher
+
+
+def materialize() -> None:
+    """Import numba and make the dispatcher of every function declared with :func:`njit` (idempotent)."""
+    global _done
+    with _lock:
+        if _done and all(lj._dispatcher is not None for lj in _registry):
+            return
+        for lj in list(_registry):
+            _make(lj)
+        _done = True
+        _substitute()
+
+
+def materialized() -> bool:
+    """Whether numba's dispatchers have been made in this process."""
+    return _done

@@ -1,0 +1,173 @@
+"""The ahead-of-time compiled simulator (:mod:`mmg._aot`) and the lazy ``njit`` (:mod:`mmg._jit`).
+
+* the compiled module's kernel gives the JIT kernel's states, step for step, for a turn, a
+  zigzag (the heading-switch law in the loop) and the cross-flow hull with a steady wind and a
+  current; its ``rhs`` / ``forces`` give the straight-run solver the JIT's equilibrium;
+* a fresh process that only simulates imports neither numba nor scipy, pandas or matplotlib;
+* calls from a thread other than the main one get the JIT (``nogil``) kernel;
+* a module that cannot be built leaves a marker and the JIT is used, with the same results;
+* the lazy ``njit``: stand-ins become numba dispatchers in the modules' namespaces, and
+  compiled code outside the project can call a stand-in.
+"""
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+
+from mmg import _aot
+from mmg import model as M
+from mmg.effects import effect_set
+from mmg.integrate import CommandLaw
+from mmg.ship import load_ship
+from mmg.simulation import prepare
+from mmg.units import DEG, KNOT
+
+from .conftest import REPO
+
+
+@pytest.fixture(scope="module")
+def aot():
+    k = _aot.kernels()
+    if k is None:
+        pytest.skip("the ahead-of-time module cannot be built here (no C compiler or MMG_AOT=0)")
+    return k
+
+
+def _both(pk, x0, law, duration, dt, aot):
+    from mmg.kernel import simulate_kernel as jit
+
+    out = []
+    for kern in (aot.simulate_kernel, jit):
+        nsteps = int(round(duration / dt))
+        states, orders = np.empty((nsteps + 1, 8)), np.empty(nsteps + 1)
+        n = kern(np.asarray(x0, float), float(dt), nsteps, *pk.args(), int(law.kind), law.params, law.t,
+                 law.delta, law.n, states, orders, np.empty((6, 8)))
+        out.append((n, states[:n], orders[:n]))
+    return out
+
+
+@pytest.mark.parametrize("case", ["turn", "zigzag", "wind_current"])
+def test_compiled_module_gives_the_jit_states(aot, case):
+    if case == "wind_current":
+        ship = load_ship("esso_osaka_3m_crossflow")
+        es = effect_set({"wind": {"true_speed_mps": 1.8, "true_from_deg": 60.0},
+                         "current": {"speed_mps": 0.05, "direction_deg": 200.0}})
+    else:
+        ship, es = load_ship("esso_osaka"), None
+    s = math.sqrt(ship.particulars.L / 325.0)
+    pk, eq = prepare(ship, 10 * KNOT * s, effects=es)
+    if case == "zigzag":
+        law = CommandLaw.heading_switch(20 * DEG, 20 * DEG, -20 * DEG, 1)
+    else:
+        law = CommandLaw.schedule([0.0, 10.0 * s, 1e4], [0.0, 35 * DEG, 35 * DEG])
+    (na, sa, oa), (nj, sj, oj) = _both(pk, eq.state(), law, 600.0 * s, 0.1 * s, aot)
+    assert na == nj == sa.shape[0]
+    np.testing.assert_allclose(sa, sj, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(oa, oj)
+    if case == "zigzag":                                   # the law switched in the loop: both sides ordered
+        assert (oa > 0).any() and (oa < 0).any()
+    assert abs(sa[-1, M.PSI_]) > 10 * DEG                  # the ship turned: the rudder and hull acted
+
+
+def test_straight_run_same_with_either_model_functions(aot, monkeypatch):
+    from mmg.equilibrium import straight_run
+
+    ship = load_ship("esso_osaka")
+    a = straight_run(ship, 10 * KNOT)
+    monkeypatch.setenv("MMG_AOT", "0")                  # the JIT's rhs and forces
+    monkeypatch.setattr(_aot, "_module", None)
+    monkeypatch.setattr(_aot, "_tried", False)
+    assert _aot.kernels() is None
+    b = straight_run(ship, 10 * KNOT)
+    for f in ("u", "v", "delta", "n", "power_W", "K_Q_scale"):
+        assert math.isclose(getattr(a, f), getattr(b, f), rel_tol=1e-12, abs_tol=1e-15), f
+    assert a.residual < 1e-9 and b.residual < 1e-9
+
+
+def test_other_threads_get_the_jit_kernel(aot):
+    from mmg.kernel import simulate_kernel as jit
+
+    got = []
+    t = threading.Thread(target=lambda: got.append((_aot.kernels(), _aot.simulate_kernel())))
+    t.start()
+    t.join()
+    assert got[0][0] is None and got[0][1] is jit
+    assert _aot.simulate_kernel() is aot.simulate_kernel
+
+
+def test_a_failed_build_leaves_a_marker_and_the_jit_runs(tmp_path, monkeypatch):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.delenv("MMG_AOT", raising=False)
+    monkeypatch.setattr(_aot, "_module", None)
+    monkeypatch.setattr(_aot, "_tried", False)
+    calls = []
+
+    def no_compiler(path=None):
+        calls.append(path)
+        raise OSError("no C compiler here")
+
+    monkeypatch.setattr(_aot, "build", no_compiler)
+    assert _aot.kernels() is None
+    marker = _aot.module_path().with_name(_aot.module_name() + ".failed")
+    assert marker.is_file() and "no C compiler" in marker.read_text()
+    monkeypatch.setattr(_aot, "_tried", False)          # a new process: the marker stops a second try
+    assert _aot.kernels() is None and len(calls) == 1
+    assert not any(p.name.startswith(".") for p in marker.parent.iterdir())   # no build folder left
+    from mmg.kernel import simulate_kernel as jit
+
+    assert _aot.simulate_kernel() is jit
+
+
+def test_module_name_follows_the_sources(tmp_path, monkeypatch):
+    """An edit of a compiled source gives another module (no stale kernel is loaded)."""
+    a = _aot.module_name()
+    real = _aot.Path.read_bytes
+
+    def edited(self):
+        data = real(self)
+        return data + b"\n# edited\n" if self.name == "model.py" else data
+
+    monkeypatch.setattr(_aot.Path, "read_bytes", edited)
+    assert _aot.module_name() != a
+
+
+FRESH = """
+import sys, mmg
+r = mmg.simulate(mmg.turning('esso_osaka', rudder='35 deg', speed='10 kn', duration='600 s'))
+print(round(r.metrics()['advance_L'], 4))
+print(sorted(m for m in ('numba', 'scipy', 'pandas', 'matplotlib', 'filterpy') if m in sys.modules))
+"""
+
+
+def test_a_fresh_simulation_imports_only_what_it_needs(aot):
+    out = subprocess.run([sys.executable, "-c", FRESH], cwd=REPO, capture_output=True, text=True, check=True)
+    adv, mods = out.stdout.strip().splitlines()
+    assert mods == "[]", out.stdout
+    assert 2.5 < float(adv) < 4.5                          # a 35 deg turn's advance, about 3.5 L
+
+
+def test_lazy_njit_makes_dispatchers_and_external_code_can_call_them():
+    import numba
+
+    from mmg import _jit
+
+    @_jit.njit(cache=False)
+    def twice(x):
+        return 2.0 * x
+
+    assert isinstance(twice, _jit.LazyJit) or _jit.materialized()
+    assert twice(3.0) == 6.0                              # calling it makes the dispatcher
+    assert _jit.materialized()
+    assert isinstance(twice.dispatcher, numba.core.registry.CPUDispatcher)
+    assert not isinstance(M.rhs, _jit.LazyJit)            # the model's stand-ins were replaced in place
+
+    @numba.njit
+    def outside(x):                                       # numba code outside: calls a stand-in
+        return twice(x) + 1.0
+
+    assert outside(2.0) == 5.0
