@@ -9,6 +9,10 @@ The shipmmg turn is its own KVLCC2 L7 test case (200 s, RK45 at its default tole
 ours is the Esso Osaka ST35 through the public API (3000 s of RK4 at 0.1 s): each tool's
 natural first use.  Needs the ``bench`` extra (shipmmg).
 
+It also times our turn against itself with the JIT (``MMG_AOT=0``: numba imported, the kernels
+loaded from numba's cache) instead of the ahead-of-time compiled module (:mod:`mmg._aot`): the
+before/after figure of that module.
+
 ``--baseline REV`` (a git revision, e.g. ``HEAD~3``) instead times ``mmg simulate st35`` of that
 revision against this checkout's, interleaved pair by pair in fresh processes (the revision is
 checked out into a temporary git worktree; its numba cache is warmed by a first run), and prints
@@ -54,8 +58,14 @@ array-math registry numba loads at its first compiled call (which imports scipy.
 
 
 def once(cmd, cwd) -> float:
+    """Wall time of one run; ``cmd`` may start with ``VAR=value`` words (set in its environment)."""
+    env = dict(os.environ)
+    while cmd and "=" in cmd[0] and not cmd[0].startswith("-"):
+        k, v = cmd[0].split("=", 1)
+        env[k] = v
+        cmd = cmd[1:]
     t0 = time.perf_counter()
-    subprocess.run(cmd, cwd=cwd, check=True, capture_output=True)
+    subprocess.run(cmd, cwd=cwd, check=True, capture_output=True, env=env)
     return time.perf_counter() - t0
 
 
@@ -120,6 +130,9 @@ def main() -> None:
                   f"{r2:.2f} x shipmmg's whole turn ({b2:.2f} s)")
         except ImportError:
             print("shipmmg not installed (pip install 'mmg-toolkit[bench]'): turn comparison skipped")
+        a, j, r = pair([sys.executable, "-c", OURS], ["MMG_AOT=0", sys.executable, "-c", OURS], args.runs, td)
+        print(f"  ours with the ahead-of-time compiled kernels (mmg._aot) {a:.2f} s, with the JIT (MMG_AOT=0, "
+              f"numba imported) {j:.2f} s: ratio AOT/JIT {r:.2f}")
         t = []
         once(["mmg", "simulate", "st35", "--out", "o"], td)
         for _ in range(args.runs):
