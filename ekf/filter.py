@@ -275,9 +275,10 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     nz = len(z0)
     zs = np.full((N, nz), np.nan)
     pd_ = np.full((N, nz), np.nan)
-    st, k, P = filter_kernel(np.asarray(z0, float), np.asarray(P0, float), meas, np.asarray(delta, float), dt,
-                             np.asarray(R, float), float(q),
-                             int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max), *packed.args(), np.asarray(slots, np.int64), zs, pd_)
+    c = lambda a, dtype=np.float64: np.ascontiguousarray(a, dtype=dtype)   # noqa: E731 (one specialisation)
+    st, k, P = filter_kernel(c(z0), c(P0), meas, c(delta), dt, c(R), float(q),
+                             int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max), c(packed.p), c(packed.poly), c(packed.hull_axis, np.int64),
+                             c(packed.hull_term, np.int64), c(packed.hull_coef), c(slots, np.int64), zs, pd_)
     if st != OK:
         raise FilterDivergence(trial, t[k], _REASON[st])
     return FilterResult(t, zs, pd_, P, tuple(names))

@@ -229,10 +229,15 @@ def cmd_estimate(args) -> int:
     from .estimation import estimate_and_report, load_inputs
     from .output import StagedOutput, check_output_dir
 
+    from .warmup import compiling_in_background, filter_cache_cold
+
     check_output_dir(args.out)
     cfg = load_config(args.config, args.set or ())
-    with StagedOutput(args.out) as out:
+    # a cold numba cache: the filter compiles on the second core while the inputs are simulated / read
+    cold = args.method == "ekf" and filter_cache_cold()
+    with StagedOutput(args.out) as out, compiling_in_background("filter", when=cold) as compiled:
         datas = load_inputs(args.inputs, cfg, seed=args.seed, ship=args.ship, truth=args.truth)
+        compiled()
         rep = estimate_and_report(datas, cfg, out, joint=args.joint, plots=not args.no_plots, method=args.method)
     for w in rep["warnings"]:
         print(f"warning: {w}", file=sys.stderr)

@@ -12,7 +12,13 @@ group in its own process:
 * ``ekf``: the augmented EKF of the paper (:mod:`ekf.filter`, complex-step Jacobians) on a
   short simulated zigzag;
 * ``log-filter``: the raw-log EKF (:mod:`ekf.log_filter`) and the output-error fit (not in
-  the default set, see :data:`DEFAULT_GROUPS`).
+  the default set, see :data:`DEFAULT_GROUPS`);
+* ``filter``: only the augmented EKF's compiled pass (:func:`ekf.filter.run_filter`), on a
+  three-step dummy record (compilation depends on the argument types, not the values).
+
+:func:`compiling_in_background` runs one group in a child process while the caller does other
+work: ``mmg estimate`` with a cold cache compiles the filter on the second core while it builds
+the simulator (:mod:`mmg._aot`) and simulates the trial on the first.
 
 The processes write into the same cache (numba's cache files are written atomically, one
 index per function); the command's own later runs then load instead of compiling.  Exit
@@ -25,9 +31,10 @@ import os
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 from dataclasses import replace
 
-GROUPS = ("ekf", "simulate", "log-filter")
+GROUPS = ("ekf", "simulate", "log-filter", "filter")
 """Warm-up groups, longest first (so that with fewer processes than groups the long one starts
 at once)."""
 DEFAULT_GROUPS = ("ekf", "simulate")
@@ -78,7 +85,70 @@ def warm_log_filter() -> None:
     estimate(_short("zz20", 100.0), method="output-error")
 
 
-_RUN = {"simulate": warm_simulate, "ekf": warm_ekf, "log-filter": warm_log_filter}
+def warm_filter() -> None:
+    """The augmented EKF's compiled pass on a three-step dummy record of the Esso Osaka (the same
+    argument types as every real pass: :func:`ekf.filter.run_filter` makes them contiguous float64 /
+    int64 arrays)."""
+    import numpy as np
+
+    from ekf.data import estimable_names
+    from ekf.filter import FilterDivergence, run_filter
+    from mmg.model import pack
+    from mmg.ship import load_ship
+
+    ship = load_ship("esso_osaka")
+    pk = pack(ship)
+    names = estimable_names(ship)
+    slots = np.array([list(ship.hull.names).index(n) for n in names], dtype=np.int64)
+    nz = 4 + len(names)
+    t = np.array([0.0, 1.0, 2.0])
+    meas = np.tile([5.0, 0.0, 0.0, 1.0], (3, 1))
+    z0 = np.r_[5.0, 0.0, 0.0, 1.0, pk.hull_coef[slots]]
+    try:
+        run_filter(pk, slots, t, meas, np.zeros(3), z0, np.eye(nz) * 1e-6, np.eye(4) * 1e-4)
+    except FilterDivergence:                       # a dummy record may diverge: the pass is compiled either way
+        pass
+
+
+def filter_cache_cold() -> bool:
+    """Whether numba's on-disk cache has no entry yet for the filter's pass (a fresh install or CI run)."""
+    try:
+        from ekf.filter import filter_kernel
+
+        return not os.path.exists(filter_kernel.dispatcher._cache._cache_file._index_path)
+    except Exception:                              # another numba's internals: assume warm, compile in-process
+        return False
+
+
+_RUN = {"simulate": warm_simulate, "ekf": warm_ekf, "log-filter": warm_log_filter, "filter": warm_filter}
+
+
+@contextmanager
+def compiling_in_background(group: str, when: bool = True):
+    """Run warm-up ``group`` in a child process (when ``when``) while the ``with`` body runs.
+
+    Yields a function that waits for the child (call it before the work that needs the compiled
+    code: it then loads from the cache instead of compiling it again).  The child writes only into
+    numba's cache; it is stopped when the body raises (an interrupt, an error) and waited for on a
+    normal exit.  If it fails, the caller simply compiles in its own process."""
+    proc = None
+    if when:
+        proc = subprocess.Popen([sys.executable, "-m", "trials.warmup", "--group", group],
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def join() -> None:
+        if proc is not None:
+            proc.wait()
+
+    join.process = proc                            # (for the caller's and the tests' eyes)
+    try:
+        yield join
+    except BaseException:
+        if proc is not None and proc.poll() is None:
+            proc.terminate()
+            proc.wait()
+        raise
+    join()
 
 
 def run_group(name: str) -> float:
