@@ -36,10 +36,12 @@ SOURCES = ("_inlining.py", "_jit.py", "_aot.py", "model.py", "nondim.py", "rudde
            "kernel.py")
 """The files of :mod:`mmg` whose code the compiled module holds (or that say how it is built)."""
 
-SIG_SIMULATE = ("i8(f8[:], f8, i8, f8[:], f8[:,:], i8[:], i8[:], f8[:], i8, f8[:], f8[:], f8[:], f8[:], f8[:,:], "
-                "f8[:], f8[:,:])")
-SIG_RHS = "void(f8[:], f8, f8[:], f8[:,:], i8[:], i8[:], f8[:], f8[:])"
-SIG_FORCES = "UniTuple(f8, 4)(f8[:], f8[:], f8[:,:], i8[:], i8[:], f8[:])"
+# C-contiguous arrays: the layout the JIT's own callers pass, so the callees the build compiles are
+# the JIT's specialisations (shared through numba's cache) and not a second, any-layout set
+SIG_SIMULATE = ("i8(f8[::1], f8, i8, f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1], i8, f8[::1], f8[::1], f8[::1], "
+                "f8[::1], f8[:,::1], f8[::1], f8[:,::1])")
+SIG_RHS = "void(f8[::1], f8, f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1], f8[::1])"
+SIG_FORCES = "UniTuple(f8, 4)(f8[::1], f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1])"
 
 _lock = threading.Lock()
 _module = None

@@ -62,10 +62,10 @@ def integrate(packed: PackedShip, x0: np.ndarray, law: CommandLaw, duration: flo
     orders = np.empty(nsteps + 1)
     from ._aot import simulate_kernel as the_kernel     # ahead-of-time compiled, or the JIT's (mmg._aot)
 
-    f8 = lambda a: np.asarray(a, dtype=np.float64)                     # noqa: E731 (the compiled types)
+    f8 = lambda a: np.ascontiguousarray(a, dtype=np.float64)           # noqa: E731 (the compiled types)
     nvalid = the_kernel()(
-        f8(x0), float(dt), nsteps, f8(packed.p), f8(packed.poly), np.asarray(packed.hull_axis, dtype=np.int64),
-        np.asarray(packed.hull_term, dtype=np.int64), f8(packed.hull_coef),
+        f8(x0), float(dt), nsteps, f8(packed.p), f8(packed.poly), np.ascontiguousarray(packed.hull_axis, dtype=np.int64),
+        np.ascontiguousarray(packed.hull_term, dtype=np.int64), f8(packed.hull_coef),
         int(law.kind), f8(law.params), f8(law.t), f8(law.delta), f8(law.n), states, orders, np.empty((6, 8)),
     )
     t = np.arange(nvalid) * dt
