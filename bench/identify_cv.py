@@ -38,6 +38,8 @@ def main() -> None:
                     help="record weighting in the fit (default: trials.identify.DEFAULT_WEIGHTING)")
     ap.add_argument("--loss", default="linear", help="least_squares loss of the whole-record stage")
     ap.add_argument("--f-scale", type=float, default=1.0, help="the robust loss's residual scale")
+    ap.add_argument("--folds-by", choices=["order", "revolutions"], default="order",
+                    help="deal the records into folds in file order or stratified by propeller revolutions")
     a = ap.parse_args()
     d = frt_data_dir()
     if d is None:
@@ -45,7 +47,7 @@ def main() -> None:
     files = sorted((d / "turning").glob("*.csv")) + sorted((d / "zigzag").glob("*.csv"))
     ship, initial = mmg.load_ship(a.ship), mmg.load_ship(a.initial)
     print(f"prior {ship.name}; initial {initial.name}; free {a.free or 'default'}; weighting "
-          f"{a.weighting or 'default'}; loss {a.loss} (f_scale {a.f_scale:g})", flush=True)
+          f"{a.weighting or 'default'}; loss {a.loss} (f_scale {a.f_scale:g}); folds by {a.folds_by}", flush=True)
     for wind in ([True, False] if a.wind == "both" else [a.wind == "on"]):
         runs = load_runs(ship, files, wind=wind)
         t0 = time.perf_counter()
@@ -54,7 +56,8 @@ def main() -> None:
             extra["record_weighting"] = a.weighting
         if a.loss != "linear":
             extra.update(loss=a.loss, f_scale=a.f_scale)
-        cv = cross_validate(ship, runs, folds=a.folds, wind=wind, prior_rel_std=a.prior, initial=initial, **extra,
+        cv = cross_validate(ship, runs, folds=a.folds, wind=wind, prior_rel_std=a.prior, initial=initial,
+                            folds_by=a.folds_by, **extra,
                             progress=lambda k, n: print(f"  fold {k}/{n} done, {time.perf_counter() - t0:.0f} s", flush=True))
         print(f"\nwind {'on' if wind else 'off'}: {len(runs)} records, {a.folds} folds, {time.perf_counter() - t0:.0f} s")
         print(f"{'record':32s} {'initial':>8s} {'identified':>10s} {'ratio':>6s}  (heading RMS, deg)")

@@ -35,7 +35,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mmg.model import P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, POLY_WP0, PackedShip
+from mmg.model import P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_RUDDER_OFFSET, POLY_WP0, PackedShip
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
@@ -48,10 +48,13 @@ RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0
 """Rudder constants (:class:`mmg.ship.Rudder` fields) :func:`free_parameters` can free: their index in
 the packed parameters and bounds (the flow-straightening coefficients gamma_R of the rudder's
 inflow angle, positive and negative beta_R, and the effective lever l_R' of the yaw rate in it)."""
+RUDDER_OFFSET_LIMIT = float(np.radians(10.0))
+"""Bound [rad] of a freed ``rudder_offset`` (:data:`mmg.units.MAX_RUDDER_OFFSET`)."""
 MASS_CONSTANTS = {"m_x": P_MX, "m_y": P_MY, "J_z": P_JZ}
 """Added masses [kg] and added moment of inertia [kg m^2] :func:`free_parameters` can free (the
 config's primed ``m_x_prime``, ``m_y_prime``, ``J_z_prime`` times the mass / inertia scale)."""
-SHIP_CONSTANTS = ("w_P0", "epsilon", "kappa", "wind_scale") + tuple(RUDDER_CONSTANTS) + tuple(MASS_CONSTANTS)
+SHIP_CONSTANTS = (("w_P0", "epsilon", "kappa", "wind_scale", "rudder_offset") + tuple(RUDDER_CONSTANTS)
+                  + tuple(MASS_CONSTANTS))
 """Ship constants besides the hull coefficients that :func:`free_parameters` can free."""
 
 
@@ -133,6 +136,10 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
             i, lo, hi = RUDDER_CONSTANTS[nm]
             v = float(packed.p[i])
             out.append(FreeParameter(nm, "rudder", i, v, max(prior_rel_std * abs(v), 0.05), lo, hi))
+        elif nm == "rudder_offset":                      # the rudder effect's blade offset [rad], prior 0
+            v = float(packed.p[P_RUDDER_OFFSET])
+            out.append(FreeParameter(nm, "rudder", P_RUDDER_OFFSET, v, 0.05, -RUDDER_OFFSET_LIMIT,
+                                     RUDDER_OFFSET_LIMIT))
         elif nm in MASS_CONSTANTS:
             v = float(packed.p[MASS_CONSTANTS[nm]])
             out.append(FreeParameter(nm, "mass", MASS_CONSTANTS[nm], v, prior_rel_std * v, 0.0, 3.0 * v))

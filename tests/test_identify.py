@@ -164,3 +164,75 @@ def test_rudder_constants_and_added_masses_can_be_freed_and_are_written_back(tmp
     assert back.rudder.gamma_R_pos == pytest.approx(v["gamma_R_pos"], rel=1e-5)
     assert pack(back).p[P_MY] == pytest.approx(v["m_y"], rel=1e-5) and back.mass.m_x_prime == ship.mass.m_x_prime
     assert back.rudder.gamma_R_neg == ship.rudder.gamma_R_neg
+
+
+def _fake_run(name, rps, n_rows=50, seed=0, meas=None):
+    from mmg.replay import ReplayInputs
+    from trials.predict import MeasuredRun
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(n_rows) * 0.1
+    m = rng.normal(size=(n_rows, 6)) if meas is None else meas
+    return MeasuredRun(name, name, m, ReplayInputs(t, np.zeros(n_rows), np.full(n_rows, float(rps))))
+
+
+def test_a_cut_copy_of_a_record_stays_in_its_records_fold():
+    """The FRT set's turn_cut_* files are the first minutes of another file: kept out, a record's copy
+    must not be in its training set (the CV would then score partly in-sample)."""
+    from trials.identify import fold_of, same_run_groups
+
+    runs = [_fake_run(f"r{i}", 10, seed=i) for i in range(7)]
+    runs.append(_fake_run("r3_cut", 10, n_rows=20, meas=runs[3].meas[:20].copy()))
+    runs.append(_fake_run("r5_late", 10, n_rows=20, meas=runs[5].meas[10:30].copy()))   # a cut from later on
+    assert same_run_groups(runs) == [0, 1, 2, 3, 4, 5, 6, 3, 5]
+    for by in ("order", "revolutions"):
+        f = fold_of(runs, 4, by)
+        assert f[7] == f[3] and f[8] == f[5]
+        assert sorted(np.bincount(f, minlength=4)) == [2, 2, 2, 3]      # 7 runs in 4 folds, one of them doubled
+
+
+def test_folds_by_revolutions_spread_every_revolution_band_over_the_folds():
+    from trials.identify import fold_of
+
+    rps = [8, 8, 8, 8, 10, 10, 10, 10, 12, 12, 15, 16.7, 16.7, 10, 10, 10]
+    runs = [_fake_run(f"r{i}", n, seed=i) for i, n in enumerate(rps)]
+    f = fold_of(runs, 4, "revolutions")
+    fast = [f[i] for i, n in enumerate(rps) if n >= 15]
+    assert len(set(fast)) == 3                           # the three fastest records in three folds
+    for k in range(4):                                   # every training set holds a record above 12 rps
+        assert any(n > 12 and f[i] != k for i, n in enumerate(rps))
+        assert any(n == 8 and f[i] != k for i, n in enumerate(rps))
+    assert list(fold_of(runs, 4, "order")) == [i % 4 for i in range(16)]
+    with pytest.raises(ValueError):
+        fold_of(runs, 4, "alphabet")
+
+
+def test_a_rudder_offset_is_recovered_and_written_back_as_the_effect(tmp_path):
+    """Records made with the blade 2 deg to starboard of the indicator: the freed ``rudder_offset``
+    finds it, ship.yaml carries it as the ``rudder_offset`` effect, and that config replays the
+    records as the identification scored them (what ``mmg predict --ship DIR/ship.yaml`` does)."""
+    from mmg.model import P_RUDDER_OFFSET
+    from trials.predict import replay_record
+
+    ship = mmg.load_ship(SHIP)
+    pk = pack(ship)
+    pk.p[P_RUDDER_OFFSET] = np.radians(2.0)
+    runs = []
+    for k in (0, 1):
+        t = np.arange(0.0, 90.0 + 1e-9, 0.1)
+        inp = _zigzag_inputs(t, amp_deg=15.0 + 10 * k, period=30.0 + 10 * k)
+        runs.append(MeasuredRun(name=f"off{k}", source=f"off{k}", meas=replay(pk, inp, [0.35, 0, 0, 0, 0, 0]),
+                                inputs=inp))
+    ident = identify(ship, runs, free=["rudder_offset"], segment_s=(30.0, np.inf), say=lambda m: None)
+    assert np.degrees(ident.fit.values()["rudder_offset"]) == pytest.approx(2.0, abs=0.02)
+    assert ident.ship.effect_set().get("rudder_offset")["offset_deg"] == pytest.approx(2.0, abs=0.02)
+    before = [x["heading_rms_deg"] for x in ident.scores(model="initial")]
+    after = [x["heading_rms_deg"] for x in ident.scores()]
+    assert max(after) < 0.02 * min(before)
+    back = mmg.load_ship(write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)["ship"])
+    assert back.effect_set().get("rudder_offset")["offset_deg"] == pytest.approx(2.0, abs=0.02)
+    from dataclasses import replace
+
+    for r, a in zip(runs, after):                           # the written config replays as scored
+        run = replace(r, effects=back.effect_set().without("wind"))
+        assert replay_record(back, run).scores()["heading_rms_deg"] == pytest.approx(a, abs=1e-3)   # 6 digits in YAML

@@ -61,3 +61,12 @@ def test_simulate_accepts_the_identified_ship(identified, tmp_path):
     assert main(["simulate", str(trial), "--out", str(tmp_path / "sim")]) == 0
     m = json.loads((tmp_path / "sim" / "metrics.json").read_text())
     assert m["ship"].endswith("(identified)")
+
+
+def test_unknown_free_name_is_one_line_and_nothing_written(tmp_path, capsys):
+    out = tmp_path / "out"
+    rc = main(["identify", "--ship", "esso_osaka_3m", "--train", str(FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv"),
+               "--out", str(out), "--free", "N_r", "Y_vv_typo"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and not out.exists()
+    assert len(err) == 1 and "--free" in err[0] and "Y_vv_typo" in err[0] and "rudder_offset" in err[0]

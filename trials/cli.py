@@ -426,6 +426,17 @@ def cmd_predict(args) -> int:
     return 0
 
 
+def _check_free(ship, names) -> None:
+    """Refuse (one line, exit 2) a --free name that is neither a hull coefficient of ``ship`` nor a constant."""
+    from ekf.identify import SHIP_CONSTANTS
+
+    known = set(ship.hull.names) | set(SHIP_CONSTANTS) | {"hull", "hull-except-constants"}
+    for n in names:
+        if n not in known:
+            raise InputError("--free", n, f"not a hull coefficient of {ship.name} nor one of "
+                                          f"hull, hull-except-constants, {', '.join(SHIP_CONSTANTS)}")
+
+
 def cmd_identify(args) -> int:
     import numpy as np
 
@@ -441,6 +452,8 @@ def cmd_identify(args) -> int:
             raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
     src = ship_path(args.ship)
     ship = load_ship(src)
+    if args.free:
+        _check_free(ship, args.free)
     wind = None if args.wind is None else args.wind == "on"
     t0 = time.perf_counter()
     runs = load_runs(ship, args.train, wind=wind)        # an unusable record: one line, skipped
@@ -453,10 +466,12 @@ def cmd_identify(args) -> int:
 
     initial = load_ship(ship_path(args.initial)) if args.initial else None
     kw = {"record_weighting": args.weighting} if args.weighting else {}
+    if args.free:
+        kw["free"] = tuple(args.free)
     ident = identify(ship, runs, wind=wind, progress=progress, initial=initial, **kw)
     cv = None
     if args.cv:
-        cv = cross_validate(ship, runs, folds=args.cv, wind=wind, initial=initial, **kw,
+        cv = cross_validate(ship, runs, folds=args.cv, wind=wind, initial=initial, folds_by=args.folds_by, **kw,
                             progress=lambda k, n: print(f"cross-validation fold {k}/{n} ({time.perf_counter() - t0:.0f} s)",
                                                         file=sys.stderr, flush=True))
     tests = load_runs(ship, args.test, wind=wind) if args.test else None
@@ -697,6 +712,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="how each training record counts in the fit: samples (every sample alike: long records count "
                         "more), equal (every record alike), relative (every record alike relative to its own misfit); "
                         "default trials.identify.DEFAULT_WEIGHTING")
+    p.add_argument("--free", nargs="+", default=None, metavar="NAME",
+                   help="the parameters to fit: hull coefficient names, 'hull' (all of them), 'hull-except-constants', "
+                        "w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, rudder_offset, wind_scale, m_x, m_y, "
+                        "J_z (default trials.identify.DEFAULT_FREE)")
+    p.add_argument("--folds-by", choices=("order", "revolutions"), default="order",
+                   help="with --cv: deal the records into folds in the order given or stratified by their propeller "
+                        "revolutions (a record and its cut copies always share a fold)")
     p.set_defaults(func=cmd_identify)
 
     p = sub.add_parser("diagnose", help="find where the model and the records disagree, name the missing effect "

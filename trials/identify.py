@@ -114,7 +114,7 @@ class Identification:
     def replay(self, run: MeasuredRun, model: str = "identified"):
         """:func:`trials.predict.replay_record` of ``run`` with the identified (its wind scale too) or initial model."""
         if model == "identified":
-            return replay_record(self.ship, with_fitted_wind(run, self.fit.values()))
+            return replay_record(self.ship, with_ship_effects(with_fitted_wind(run, self.fit.values()), self.ship))
         return replay_record(self.initial, run)
 
 
@@ -150,6 +150,18 @@ def _fmt_metric(m: dict | None, key: str) -> str:
     return f"{v:.2f}" if np.isfinite(v) else "-"
 
 
+def with_ship_effects(run: MeasuredRun, ship: Ship) -> MeasuredRun:
+    """``run`` with the effects of ``ship``'s config other than the wind (in the run's loads) added, as
+    :func:`trials.predict.measured_run` of that ship would have them (a fitted ``rudder_offset``)."""
+    from dataclasses import replace
+
+    own = ship.effect_set().without("wind")
+    if not own.items:
+        return run
+    es = own if run.effects is None else run.effects.merged(own)
+    return replace(run, effects=es)
+
+
 def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
     """``run`` with its wind loads scaled by a fitted ``wind_scale`` (as the identified ship computes them)."""
     from dataclasses import replace
@@ -179,6 +191,11 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
     rud = {k: values[k] for k in ("epsilon", "kappa", *RUDDER_CONSTANTS) if k in values}
     if rud:
         s = replace(s, rudder=replace(s.rudder, **rud))
+    if "rudder_offset" in values:                 # the rudder_offset effect of mmg.effects, in degrees
+        import mmg.effects as E
+
+        s = replace(s, effects=s.effect_set().merged(
+            E.effect_set({"rudder_offset": {"offset_deg": float(np.degrees(values["rudder_offset"]))}})))
     if "wind_scale" in values and s.wind is not None:
         scale = s.wind.scale * values["wind_scale"]
         s = replace(s, wind=replace(s.wind, scale=scale))
@@ -256,16 +273,62 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
                           runs=runs, segment_s=seg, prior=None if initial is None else ship)
 
 
+FOLD_ASSIGNMENTS = ("order", "revolutions")
+"""How :func:`cross_validate` deals the records into folds (:func:`fold_of`)."""
+
+
+def fold_of(runs: list[MeasuredRun], folds: int, by: str = "order") -> np.ndarray:
+    """The fold (0 .. folds-1) of each record.
+
+    ``"order"``: record i in fold i mod k, in the order given.  ``"revolutions"``: stratified by the
+    record's median propeller revolutions: the records sorted by them (ties by order) are dealt
+    round-robin, so every fold's training set spans the revolutions of all the records and a kept-out
+    record is not outside its training set's operating range by the luck of the file order (with
+    "order" over the sorted FRT files, the 16.7 and 15 rps zigzags fell into one fold, whose training
+    set then held one zigzag above 12 rps)."""
+    if by not in FOLD_ASSIGNMENTS:
+        raise ValueError(f"fold assignment {by!r}: one of {FOLD_ASSIGNMENTS}")
+    group = same_run_groups(runs)
+    firsts = sorted(set(group))                           # a group's first record stands for it
+    if by == "order":
+        key = {g: g for g in firsts}
+    else:
+        rps = {g: float(np.nanmedian(np.abs(runs[g].inputs.n))) for g in firsts}
+        key = {g: (rps[g], g) for g in firsts}
+    deal = {g: k % folds for k, g in enumerate(sorted(firsts, key=lambda g: key[g]))}
+    return np.array([deal[g] for g in group], dtype=int)
+
+
+def same_run_groups(runs: list[MeasuredRun]) -> list[int]:
+    """For each record, the index of the first record of the same run: a record whose first measured
+    sample (position, heading, velocities) is a sample of an earlier one is a copy or a cut of it
+    (the FRT set's ``turn_cut_*`` files are the first minutes of another file).  Cross-validation keeps
+    a run's records in one fold: a kept-out record must not be in its own training set."""
+    out = list(range(len(runs)))
+    for j in range(len(runs)):
+        s0 = runs[j].meas[0]
+        for i in range(j):
+            if out[i] != i:
+                continue
+            m = runs[i].meas
+            if m.shape[1] == s0.shape[0] and np.any(np.all(np.abs(m - s0) <= 1e-9 * (1.0 + np.abs(s0)), axis=1)):
+                out[j] = i
+                break
+    return out
+
+
 def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress=None, initial: Ship | None = None,
-                   **kw) -> list[dict]:
+                   folds_by: str = "order", **kw) -> list[dict]:
     """k-fold cross-validation: each record kept out once; per record the open-loop heading RMS [deg]
     (and the other scores) of the initial model (``initial``, the prior ``ship`` when omitted) and of
-    the model identified from ``ship`` without it (``kw``: :func:`identify`'s options)."""
+    the model identified from ``ship`` without it (``kw``: :func:`identify`'s options); ``folds_by``:
+    how records are dealt into folds (:func:`fold_of`)."""
     ref = ship if initial is None else initial
     out = []
     idx = np.arange(len(runs))
+    fold = fold_of(runs, folds, folds_by)
     for k in range(folds):
-        test = idx[k::folds]
+        test = idx[fold == k]
         train = [runs[i] for i in idx if i not in set(test)]
         ident = identify(ship, train, **kw)
         for i in test:
@@ -302,6 +365,10 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
             pa = ship.particulars
             sc = inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
             data["mass"][f"{k}_prime"] = float(f"{v / sc:.6g}")
+        elif k == "rudder_offset":
+            data.setdefault("effects", {})
+            data["effects"] = dict(data["effects"] or {})
+            data["effects"]["rudder_offset"] = {"offset_deg": float(f"{np.degrees(v):.6g}")}
         elif k == "wind_scale" and "wind" in data:
             eff = (data.get("effects") or {}).get("wind")
             if isinstance(eff, dict) and "scale" in eff:           # the scale given in the effects section
