@@ -38,6 +38,8 @@ def main() -> None:
                     help="record weighting in the fit (default: trials.identify.DEFAULT_WEIGHTING)")
     ap.add_argument("--loss", default="linear", help="least_squares loss of the whole-record stage")
     ap.add_argument("--f-scale", type=float, default=1.0, help="the robust loss's residual scale")
+    ap.add_argument("--nuisance", nargs="+", default=(), metavar="EFFECT",
+                    help="effects fitted once per training record as nuisances (e.g. current)")
     ap.add_argument("--folds-by", choices=["order", "revolutions"], default="order",
                     help="deal the records into folds in file order or stratified by propeller revolutions")
     a = ap.parse_args()
@@ -47,13 +49,16 @@ def main() -> None:
     files = sorted((d / "turning").glob("*.csv")) + sorted((d / "zigzag").glob("*.csv"))
     ship, initial = mmg.load_ship(a.ship), mmg.load_ship(a.initial)
     print(f"prior {ship.name}; initial {initial.name}; free {a.free or 'default'}; weighting "
-          f"{a.weighting or 'default'}; loss {a.loss} (f_scale {a.f_scale:g}); folds by {a.folds_by}", flush=True)
+          f"{a.weighting or 'default'}; loss {a.loss} (f_scale {a.f_scale:g}); folds by {a.folds_by}; "
+          f"per-record nuisance {list(a.nuisance) or 'none'}", flush=True)
     for wind in ([True, False] if a.wind == "both" else [a.wind == "on"]):
         runs = load_runs(ship, files, wind=wind)
         t0 = time.perf_counter()
         extra = {"free": a.free} if a.free else {}
         if a.weighting:
             extra["record_weighting"] = a.weighting
+        if a.nuisance:
+            extra["record_nuisance"] = tuple(a.nuisance)
         if a.loss != "linear":
             extra.update(loss=a.loss, f_scale=a.f_scale)
         cv = cross_validate(ship, runs, folds=a.folds, wind=wind, prior_rel_std=a.prior, initial=initial,

@@ -40,7 +40,7 @@ from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
            "segment_resets", "identify_segments", "SHIP_CONSTANTS", "record_weights", "record_residual_rms",
-           "RECORD_WEIGHTINGS", "effect_parameters", "effect_set_of",
+           "RECORD_WEIGHTINGS", "effect_parameters", "record_effect_parameters", "effect_set_of",
            "predict_logged"]
 
 RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
@@ -109,6 +109,9 @@ class FreeParameter:
     upper: float = np.inf
     sub: int = 0
     """For kind ``"effect"``: the parameter's position in the effect's ``fit_parameters()``."""
+    record: int | None = None
+    """For a record's own nuisance parameter (:func:`record_effect_parameters`): the record's index
+    in the fit; None: shared by every record."""
 
 
 def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float = 0.5) -> list[FreeParameter]:
@@ -176,9 +179,25 @@ def effect_parameters(effects) -> list[FreeParameter]:
     return out
 
 
-def effect_set_of(effects, free: list[FreeParameter], theta):
+def record_effect_parameters(effects, n_records: int, first_index: int = 0, names=None) -> list[FreeParameter]:
+    """Nuisance parameters: every fit parameter of ``effects`` once for each of ``n_records`` records
+    (named ``"<effect>.<parameter>[<record>]"`` with the record's name from ``names`` or its index,
+    :attr:`FreeParameter.record` its index), each acting on its own record only.  ``first_index``:
+    the position of ``effects[0]`` in the effects list of the fit."""
+    out = []
+    for k in range(n_records):
+        tag = names[k] if names is not None else k
+        for i, e in enumerate(effects):
+            for j, q in enumerate(e.fit_parameters()):
+                out.append(FreeParameter(f"{e.name}.{q.name}[{tag}]", "effect", first_index + i, float(q.default),
+                                         float(q.sigma), float(q.lower), float(q.upper), sub=j, record=k))
+    return out
+
+
+def effect_set_of(effects, free: list[FreeParameter], theta, record: int | None = None):
     """The :class:`mmg.effects.EffectSet` of ``effects`` at the fitted values ``theta`` (effect
-    parameters not in ``free`` at their fit-parameter defaults)."""
+    parameters not in ``free`` at their fit-parameter defaults) for record ``record``: the shared
+    parameters and that record's own (:func:`record_effect_parameters`)."""
     from mmg.effects import EffectSet
 
     items = []
@@ -186,19 +205,21 @@ def effect_set_of(effects, free: list[FreeParameter], theta):
         fp = e.fit_parameters()
         vec = [q.default for q in fp]
         for f, v in zip(free, theta):
-            if f.kind == "effect" and f.index == i:
+            if f.kind == "effect" and f.index == i and (f.record is None or f.record == record):
                 vec[f.sub] = float(v)
         items.append((e, e.from_fit(vec)))
     return EffectSet(tuple(items))
 
 
-def predict_logged(packed: PackedShip, rec: Segmented, effects=None, free=(), theta=(), ship=None) -> np.ndarray:
+def predict_logged(packed: PackedShip, rec: Segmented, effects=None, free=(), theta=(), ship=None,
+                   record: int | None = None) -> np.ndarray:
     """The replayed states of ``rec`` (segments as in ``rec.reset``) as the record logs them:
-    (N, 6) u, v, r, x, y, psi with the ship parameters and effects at ``theta``."""
+    (N, 6) u, v, r, x, y, psi with the ship parameters and effects at ``theta`` (with the nuisance
+    parameters of record index ``record``)."""
     pk = apply_parameters(packed, list(free), theta) if len(free) else packed
     if not effects and rec.fixed is None:
         return replay_states(pk, rec.inputs, rec.restart[0], meas=rec.restart, reset=rec.reset)
-    es = effect_set_of(effects, list(free), theta)
+    es = effect_set_of(effects, list(free), theta, record)
     if rec.fixed is not None:
         es = rec.fixed.merged(es)
     pk = es.pack(pk, ship)
@@ -228,10 +249,10 @@ def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
 
 
 def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=None, free=(), theta=(),
-                  ship=None, pos=None) -> np.ndarray:
+                  ship=None, pos=None, record: int | None = None) -> np.ndarray:
     rec = _wind_scaled(rec, free, theta)
     if effects or rec.fixed is not None:
-        pred = predict_logged(packed, rec, effects, free, theta, ship)
+        pred = predict_logged(packed, rec, effects, free, theta, ship, record)
     else:
         pred = replay_states(packed, rec.inputs, rec.restart[0], meas=rec.restart, reset=rec.reset)
     diff = pred[::stride] - rec.meas[::stride]
@@ -303,7 +324,7 @@ def record_residual_rms(packed: PackedShip, records: list[Segmented], free: list
     """RMS of each record's (scaled) residuals with the free parameters at ``theta``."""
     pk = apply_parameters(packed, free, theta)
     return np.array([float(np.sqrt(np.mean(_residual_one(pk, rec, scales.array(), stride, effects, free, theta,
-                                                          ship, scales.pos) ** 2))) for rec in records])
+                                                          ship, scales.pos, k) ** 2))) for k, rec in enumerate(records)])
 
 
 def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
@@ -355,9 +376,15 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
     if wts.shape != (len(records),):
         raise ValueError(f"weights: one per record ({len(records)}), got {wts.shape}")
 
+    own = [f.record for f in free]                            # a record's own (nuisance) parameter, or None
+
+    def block(theta, k, pk=None):
+        pk = apply_parameters(packed, free, theta) if pk is None else pk
+        return wts[k] * _residual_one(pk, records[k], sc, stride, effects, free, theta, ship, pos, k)
+
     def resid(theta, parallel=True):
         pk = apply_parameters(packed, free, theta)
-        one = lambda k: wts[k] * _residual_one(pk, records[k], sc, stride, effects, free, theta, ship, pos)  # noqa: E731
+        one = lambda k: block(theta, k, pk)  # noqa: E731
         ks = range(len(records))
         parts = list(pool.map(one, ks)) if parallel else [one(k) for k in ks]
         return np.concatenate(parts + [(theta - theta0) / sig0])
@@ -374,11 +401,25 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
                 h[j] = -h[j]
             th[j] += h[j]
             steps.append(th)
+        shared = [j for j in range(len(theta)) if own[j] is None]
         if by_columns:
-            res = list(pool.map(lambda th: resid(th, parallel=False), steps))
+            res = dict(zip(shared, pool.map(lambda j: resid(steps[j], parallel=False), shared)))
         else:
-            res = [resid(th) for th in steps]
-        cols = [(rj - r0) / h[j] for j, rj in enumerate(res)]
+            res = {j: resid(steps[j]) for j in shared}
+        # a record's own parameter moves only its record's block (and its prior residual): replay that record alone
+        nch = 4 if pos is None else 6
+        start = np.cumsum([0] + [len(r.meas[::stride]) * nch for r in records])
+
+        def own_column(j):
+            col = np.zeros_like(r0)
+            k = own[j]
+            col[start[k]:start[k + 1]] = (block(steps[j], k) - r0[start[k]:start[k + 1]]) / h[j]
+            col[start[-1] + j] = 1.0 / sig0[j]
+            return col
+
+        own_cols = dict(zip([j for j in range(len(theta)) if own[j] is not None],
+                            pool.map(own_column, [j for j in range(len(theta)) if own[j] is not None])))
+        cols = [(res[j] - r0) / h[j] if j in res else own_cols[j] for j in range(len(theta))]
         count[0] += 1
         if progress:
             progress(count[0], 0.5 * float(r0 @ r0))

@@ -236,3 +236,34 @@ def test_a_rudder_offset_is_recovered_and_written_back_as_the_effect(tmp_path):
     for r, a in zip(runs, after):                           # the written config replays as scored
         run = replace(r, effects=back.effect_set().without("wind"))
         assert replay_record(back, run).scores()["heading_rms_deg"] == pytest.approx(a, abs=1e-3)   # 6 digits in YAML
+
+
+def test_per_record_currents_are_nuisances_that_keep_the_shared_fit_unbiased():
+    """Two records made in two different currents (a pond's wind drift differs run to run): with a
+    current per record as a nuisance the fit recovers each record's current and the hull coefficient
+    that made them; the currents stay out of the identified ship."""
+    from mmg.effects import effect_set
+
+    ship = mmg.load_ship(SHIP)
+    true = {"N_r": ship.hull.value("N_r") * 1.3}
+    truth = ship.with_hull(true)
+    currents = [(0.04, 0.0), (0.0, -0.03)]                     # north, east [m/s]
+    runs = []
+    for k, (cn, ce) in enumerate(currents):
+        es = effect_set({"current": {"speed_mps": float(np.hypot(cn, ce)),
+                                     "direction_deg": float(np.degrees(np.arctan2(ce, cn)))}})
+        t = np.arange(0.0, 90.0 + 1e-9, 0.1)
+        inp = _zigzag_inputs(t, amp_deg=15.0 + 10 * k, period=30.0 + 10 * k)
+        s0 = es.to_model(np.array([[0.35, 0, 0, 0, 0, 0]], float))[0]
+        logged = es.to_logged(replay(es.pack(pack(truth), truth), inp, s0))   # u, v over ground, as logged
+        runs.append(MeasuredRun(name=f"c{k}", source=f"c{k}", meas=logged, inputs=inp))
+    ident = identify(ship, runs, free=["N_r"], segment_s=(30.0, np.inf), say=lambda m: None,
+                     record_nuisance=("current",))
+    v = ident.fit.values()
+    assert v["N_r"] == pytest.approx(true["N_r"], rel=0.02)
+    for k, (cn, ce) in enumerate(currents):
+        assert v[f"current.north_mps[c{k}]"] == pytest.approx(cn, abs=2e-3)
+        assert v[f"current.east_mps[c{k}]"] == pytest.approx(ce, abs=2e-3)
+    assert ident.ship.effect_set().get("current") is None         # not part of the identified ship
+    plain = identify(ship, runs, free=["N_r"], segment_s=(30.0, np.inf), say=lambda m: None)
+    assert abs(plain.fit.values()["N_r"] / true["N_r"] - 1) > abs(v["N_r"] / true["N_r"] - 1)

@@ -210,7 +210,7 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
 def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | None = None, wind: bool | None = None,
              max_nfev: int = 30, progress=None, say=_log, prior_rel_std: float = 0.5,
              initial: Ship | None = None, record_weighting: str = DEFAULT_WEIGHTING, loss: str = "linear",
-             f_scale: float = 1.0) -> Identification:
+             f_scale: float = 1.0, record_nuisance=()) -> Identification:
     """Identify ``free`` jointly over the training records (module docstring).
 
     Parameters
@@ -240,6 +240,11 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     loss, f_scale : str, float
         Robust loss of the last (whole-record) stage (:func:`scipy.optimize.least_squares`): ``"linear"``
         (least squares), ``"soft_l1"``, ``"cauchy"``; ``f_scale`` in units of the scaled residuals.
+    record_nuisance : sequence of str
+        Effects of :mod:`mmg.effects` (e.g. ``("current",)``) fitted once per training record, as a
+        nuisance: each record gets its own values (a pond's wind-driven drift differs from run to run),
+        so the shared parameters need not absorb one record's disturbance.  They are not part of the
+        identified ship: a record it has not seen is predicted without them.
     """
     from ekf.identify import Segmented, free_parameters, identify_segments, record_residual_rms, record_weights, \
         segment_resets
@@ -257,15 +262,23 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     if not any(r.inputs.ext is not None for r in runs):
         names = [n for n in names if n != "wind_scale"]       # no wind loads to scale
     fp = free_parameters(packed, ship.hull.names, names, prior_rel_std)
+    nuisance = None
+    if record_nuisance:
+        import mmg.effects as E
+        from ekf.identify import record_effect_parameters
+
+        nuisance = [E.get(n, "record_nuisance") for n in record_nuisance]
+        fp = fp + record_effect_parameters(nuisance, len(runs), names=[r.name for r in runs])
     fit = None
     for k, st in enumerate(stages):
         seg = float(st) * float(np.sqrt(L / 9.80665))
         segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects) for r in runs]
         sc = _scales(runs, L)
         theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
-        rms = record_residual_rms(packed, segs, fp, theta, sc) if record_weighting == "relative" else None
+        rms = (record_residual_rms(packed, segs, fp, theta, sc, effects=nuisance, ship=ship)
+               if record_weighting == "relative" else None)
         last = k == len(stages) - 1
-        fit = identify_segments(packed, segs, fp, sc, max_nfev=max_nfev, progress=progress,
+        fit = identify_segments(packed, segs, fp, sc, max_nfev=max_nfev, progress=progress, effects=nuisance, ship=ship,
                                 start=None if fit is None else fit.theta, weights=record_weights(segs, record_weighting,
                                                                                                  rms=rms),
                                 loss=loss if last else "linear", f_scale=f_scale)
