@@ -67,12 +67,13 @@ class LazyJit:
 def njit(*args, **options):
     """``numba.njit`` with the same options, made when compiled code is first needed (module docstring)."""
     def wrap(func):
-        lj = LazyJit(func, options)
         with _lock:
+            if _done:                              # numba is in use already: the dispatcher itself
+                import numba
+
+                return numba.njit(**options)(func)
+            lj = LazyJit(func, options)
             _registry.append(lj)
-            if _done:                              # declared after the others were made: make it now
-                _make(lj)
-                _substitute()
         return lj
 
     if args and callable(args[0]) and not options and len(args) == 1:
