@@ -40,7 +40,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from mmg._jit import njit
+from mmg._jit import carray, njit
 
 from mmg.model import PackedShip
 
@@ -184,13 +184,13 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
     nis_sum = 0.0
     for k in range(1, N):
         if reference is not None and reference:
-            jacobian_step_reference(z, delta[k - 1], delta[k], 0.0, 0.0, -1, SLOTS, NS, dt, p, poly, hull_axis,
+            jacobian_step_reference(z, delta[k - 1], delta[k], 0.0, 0.0, np.int64(-1), SLOTS, np.int64(NS), dt, p, poly, hull_axis,
                                     hull_term, idx, ws)
         else:
             propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
         for i in range(nz):             # element-wise: a slice assignment compiles numba's shape-mismatch message (~7 s cold)
             z[i] = zn[i]
-        fpft(F, P, NS, FP, P)
+        fpft(F, P, np.int64(NS), FP, P)
         if q > 0.0:
             for i in range(nz):
                 P[i, i] += q
@@ -270,12 +270,12 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     """
     t = np.asarray(t, float)
     dt = float(t[1] - t[0])
-    meas = np.ascontiguousarray(meas, dtype=float)
+    meas = carray(meas)
     N = len(t)
     nz = len(z0)
     zs = np.full((N, nz), np.nan)
     pd_ = np.full((N, nz), np.nan)
-    c = lambda a, dtype=np.float64: np.ascontiguousarray(a, dtype=dtype)   # noqa: E731 (one specialisation)
+    c = carray                                   # one specialisation for every caller
     st, k, P = filter_kernel(c(z0), c(P0), meas, c(delta), dt, c(R), float(q),
                              int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max), c(packed.p), c(packed.poly), c(packed.hull_axis, np.int64),
                              c(packed.hull_term, np.int64), c(packed.hull_coef), c(slots, np.int64), zs, pd_)

@@ -54,7 +54,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from mmg._jit import njit
+from mmg._jit import carray, njit, readonly
 
 from mmg.errors import InputError
 from mmg.model import N_, PSI_, R_, U_, V_, X_, Y_
@@ -69,7 +69,7 @@ TAU = 7                     # rudder-timing offset of the current rudder movemen
 ND = 8                      # first derivative slot
 NM = 4                      # measured: x, y, psi, n (the first four states)
 # mmg state slot of each dynamic filter state
-SLOTS = np.array([X_, Y_, PSI_, N_, U_, V_, R_], dtype=np.int64)
+SLOTS = readonly(np.array([X_, Y_, PSI_, N_, U_, V_, R_], dtype=np.int64))
 _IU = 4                     # index of u in z
 
 _REASON = {NONFINITE: "a state or covariance became non-finite",
@@ -90,7 +90,7 @@ def propagate_log(z, d0, d1, g0, g1, dt, p, poly, hull_axis, hull_term, idx, ws)
     rebuilt rudder moved by -tau in time, g = -d(delta)/dt, so the timing offset tau [s] is
     estimated like the rest.  ws from :func:`ekf.kernels.make_workspace` (nz, NS, hull_coef).
     """
-    jacobian_step(z, d0, d1, g0, g1, TAU, SLOTS, ND, dt, p, poly, hull_axis, hull_term, idx, ws)
+    jacobian_step(z, d0, d1, g0, g1, np.int64(TAU), SLOTS, np.int64(ND), dt, p, poly, hull_axis, hull_term, idx, ws)
 
 
 @njit(cache=True)
@@ -131,7 +131,7 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
     z = z0.copy()
     P = P0.copy()
     FP = np.empty((NZ, NZ))
-    ws = make_workspace(NZ, NS, hull_coef)
+    ws = make_workspace(NZ, np.int64(NS), hull_coef)
     zn, F = ws[8], ws[9]
     uw = make_update_workspace(NZ, meas.shape[1])
     j = 0
@@ -150,13 +150,13 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
             P[TAU, TAU] = var_tau
             r += 1
         if reference is not None and reference:
-            jacobian_step_reference(z, delta[k - 1], delta[k], g[k - 1], g[k], TAU, SLOTS, ND, dt, p, poly,
+            jacobian_step_reference(z, delta[k - 1], delta[k], g[k - 1], g[k], np.int64(TAU), SLOTS, np.int64(ND), dt, p, poly,
                                     hull_axis, hull_term, idx, ws)
         else:
             propagate_log(z, delta[k - 1], delta[k], g[k - 1], g[k], dt, p, poly, hull_axis, hull_term, idx, ws)
         for i in range(NZ):
             z[i] = zn[i]
-        fpft(F, P, NS, FP, P)
+        fpft(F, P, np.int64(NS), FP, P)
         symmetrise(P, P)
         for i in range(NZ):
             P[i, i] += q[i]
@@ -266,17 +266,17 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
     if rudder not in ("rebuilt", "true"):
         raise ValueError(f"rudder must be 'rebuilt' or 'true', got {rudder!r}")
     delta = np.asarray(m.delta, float)[:N] if rudder == "rebuilt" else _true_rudder(data, t)
-    delta = np.ascontiguousarray(delta)
+    delta = carray(delta)
     g = -np.gradient(delta, dt)
     # rudder movements start where the rebuilt order changes (and at the start)
     info = data.info
     order, _ = reconstruct_rudder(t, np.asarray(m.psi, float)[:N], info.kind, info.manoeuvre, data.packed.p,
                                   info.trim_rudder)
-    reset_k = np.ascontiguousarray(movement_starts(order, dt))
+    reset_k = carray(movement_starts(order, dt), np.int64)
     t_log, obs, R = log_measurements(record, info)
     mk = np.rint((t_log - t[0]) / dt).astype(np.int64)
     sel = (mk >= 0) & (mk < N)
-    mk, obs = np.ascontiguousarray(mk[sel]), np.ascontiguousarray(obs[sel])
+    mk, obs = carray(mk[sel], np.int64), carray(obs[sel])
     zp = initial_state(data, cfg)                     # u, v, r, n, coefficients (paper-filter layout)
     der = zp[4:] if start_derivs is None else np.asarray(start_derivs, float)
     P0p = P0_for(cfg, data.names)
@@ -293,8 +293,9 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
     zs = np.full((N, NZ), np.nan)
     pd_ = np.full((N, NZ), np.nan)
     nis = np.full(len(mk), np.nan)
-    st, k, P = log_filter_kernel(z0, P0, obs, mk, delta, g, reset_k, float(sigma_tau ** 2), dt, R, qv,
-                                 *data.packed.args(), np.asarray(data.slots, np.int64), zs, pd_, nis)
+    st, k, P = log_filter_kernel(carray(z0), carray(P0), obs, mk, delta, carray(g), reset_k, float(sigma_tau ** 2), dt,
+                                 carray(R), qv, *(carray(a, a.dtype) for a in data.packed.args()),
+                                 carray(data.slots, np.int64), zs, pd_, nis)
     if st != OK:
         raise FilterDivergence(data.name, t[k], _REASON[st])
     return LogFilterResult(t, zs, pd_, P, nis, tuple(data.names))

@@ -8,20 +8,20 @@ class :class:`ekf.filterpy_ekf.AugmentedEKF`, import it without importing each o
 from __future__ import annotations
 
 import numpy as np
-from mmg._jit import njit
+from mmg._jit import njit, readonly
 
 from mmg.model import N_, R_, U_, V_
 
 from .kernels import jacobian_step, make_workspace
 
 NS = 4
-SLOTS = np.array([U_, V_, R_, N_], dtype=np.int64)   # mmg state slot of each dynamic state
+SLOTS = readonly(np.array([U_, V_, R_, N_], dtype=np.int64))   # mmg state slot of each dynamic state
 
 
 @njit(cache=True)
 def workspace(nz, hull_coef):
     """Work arrays of :func:`propagate_step` (:func:`ekf.kernels.make_workspace`): z_next = ws[8], F = ws[9]."""
-    return make_workspace(nz, NS, hull_coef)
+    return make_workspace(nz, np.int64(NS), hull_coef)
 
 
 @njit(cache=True, inline="always")
@@ -34,7 +34,9 @@ def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
 
     d0, d1 rudder angle [rad] at the start and end of the step (an input, linear over it), dt [s];
     idx the derivatives' slots in ``hull_coef``; ws from :func:`workspace`."""
-    jacobian_step(z, d0, d1, 0.0, 0.0, -1, SLOTS, NS, dt, p, poly, hull_axis, hull_term, idx, ws)
+    # np.int64(): a literal constant would compile a specialisation of its own (Literal[int](4)),
+    # beside the int64 one every other caller (the raw-log filter, Python) shares
+    jacobian_step(z, d0, d1, 0.0, 0.0, np.int64(-1), SLOTS, np.int64(NS), dt, p, poly, hull_axis, hull_term, idx, ws)
 
 
 @njit(cache=True)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import sys
 import threading
 
-__all__ = ["njit", "LazyJit", "materialize", "materialized"]
+__all__ = ["njit", "LazyJit", "materialize", "materialized", "carray", "readonly"]
 
 _registry: list["LazyJit"] = []
 _lock = threading.RLock()
@@ -114,3 +114,22 @@ def materialize() -> None:
 def materialized() -> bool:
     """Whether numba's dispatchers have been made in this process."""
     return _done
+
+
+def carray(a, dtype=float):
+    """``a`` as the array type every compiled call of the project is specialised for: C-contiguous,
+    writeable, of ``dtype`` (copied only when it is not already).
+
+    Numba compiles one specialisation per argument type, and read-only or strided is another type
+    (a pandas column, a broadcast, a slice): each would cost a compilation of seconds on a cold cache."""
+    import numpy as np
+
+    return np.require(a, dtype=dtype, requirements=("C", "W"))
+
+
+def readonly(a):
+    """``a`` (an index array a module hands to its compiled code as a global) made read-only: numba
+    freezes a global array as a read-only constant, and a Python caller passing the same array then
+    gets the same specialisation instead of a writeable one."""
+    a.setflags(write=False)
+    return a

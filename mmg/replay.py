@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from ._jit import njit
+from ._jit import carray, njit
 
 from ._inlining import source_stamp
 from .model import P_L, P_WIND_V, PSI_, R_, U_, V_, X_, Y_, PackedShip, dynamics, inverse_mass, track, wind_loads
@@ -180,9 +180,9 @@ def replay_states(packed: PackedShip, inputs: ReplayInputs, s0, *, meas=None, re
         raise ValueError("reset needs the measured states meas")
     out = np.empty((N, 6))
     minv = np.array(inverse_mass(packed.p, np.zeros(8)))
-    _replay(t, np.ascontiguousarray(inputs.delta, dtype=float), np.ascontiguousarray(inputs.n, dtype=float),
-            inputs.external(), np.asarray(s0, dtype=float), np.ascontiguousarray(meas, dtype=float),
-            np.ascontiguousarray(reset, dtype=np.bool_), float(dt_max), minv, *packed.args(), out)
+    # carray: read-only inputs (pandas columns) would compile a second specialisation of the replay
+    _replay(carray(t), carray(inputs.delta), carray(inputs.n), carray(inputs.external()), carray(s0),
+            carray(meas), carray(reset, np.bool_), float(dt_max), minv, *(carray(a, a.dtype) for a in packed.args()), out)
     return out
 
 

@@ -1,4 +1,7 @@
+import os
 import signal
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -24,3 +27,35 @@ def esso():
 
 def needs_frt():
     return pytest.mark.skipif(not FRT.is_dir(), reason="FRT-DS-ESSO data folder ../shared/data/frt-ds-esso absent")
+
+
+# --------------------------------------------------------------------------- cold numba cache
+# A fresh install or a CI run starts with numba's on-disk cache empty, and the first test to call
+# each compiled pass compiles it, on one core, while the other core idles.  When the cache is cold,
+# the filters', replay's and sensitivities' specialisations are compiled by
+# ``python -m trials.warmup --serial`` on the second core while the first tests run (they build the
+# simulator's own module; trials.warmup.SUITE_GROUPS, in the order the tests need them): a later
+# test loads them from the cache.  It writes only into numba's cache and is stopped when the run
+# ends; MMG_TEST_WARMUP=0 turns it off.
+_warmup = None
+
+
+def pytest_configure(config):
+    global _warmup
+    if os.environ.get("MMG_TEST_WARMUP", "1") == "0" or config.option.collectonly:
+        return
+    from trials.warmup import SUITE_GROUPS, filter_cache_cold
+
+    if not filter_cache_cold():
+        return
+    cmd = [sys.executable, "-m", "trials.warmup", "--serial", "--quiet"]
+    for g in SUITE_GROUPS:
+        cmd += ["--group", g]
+    _warmup = subprocess.Popen(cmd, cwd=REPO, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+
+
+def pytest_unconfigure(config):
+    if _warmup is not None and _warmup.poll() is None:     # a short or interrupted run: not needed any more
+        _warmup.terminate()
+        _warmup.wait()

@@ -181,30 +181,3 @@ def test_a_stand_in_is_typed_by_numba_before_anything_was_made():
             "f = numba.njit(lambda r: r_prime(r, 2.0, 4.0))\nprint(f(1.0))")
     out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True)
     assert float(out.stdout) == pytest.approx(0.5)            # r' = r L / U
-
-
-def test_filter_warmup_compiles_the_specialisation_a_real_pass_uses():
-    """``mmg estimate`` with a cold cache compiles the filter in a child from a dummy record
-    (trials.warmup.warm_filter); that is only worth it if a real pass then needs no other one."""
-    from ekf.filter import filter_kernel
-    from mmg import estimate, simulate, zigzag
-    from trials.warmup import warm_filter
-
-    warm_filter()
-    before = set(filter_kernel.signatures)
-    ship = load_ship("esso_osaka")
-    estimate(simulate(zigzag(ship, rudder="20 deg", heading="20 deg", speed="10 kn", duration="120 s")), seed=1)
-    assert len(before) == 1 and set(filter_kernel.signatures) == before
-
-
-def test_background_compile_is_stopped_when_the_work_fails():
-    from trials.warmup import compiling_in_background
-
-    with pytest.raises(RuntimeError):
-        with compiling_in_background("filter") as compiled:
-            proc = compiled.process
-            raise RuntimeError("the inputs were bad")
-    assert proc.poll() is not None                        # stopped, not left running
-    with compiling_in_background("filter", when=False) as compiled:
-        assert compiled.process is None
-        compiled()                                        # nothing to wait for

@@ -21,6 +21,7 @@ import ekf.log_filter as ekf_log_filter
 from ekf.data import estimable_names, hull_slots
 from ekf.estimate import P0_for, R_for, initial_state, load_config
 from ekf.kernels import jacobian_step, jacobian_step_reference, make_workspace
+from mmg._jit import readonly
 from mmg.model import N_, PSI_, R_, U_, V_, X_, Y_, inverse_mass, rhs, rhs_hull_jacobian
 from mmg.simulation import prepare
 from trials.estimation import data_from_trial
@@ -30,8 +31,9 @@ REPO = Path(__file__).resolve().parents[1]
 TRIALS = {"esso_osaka": REPO / "configs" / "trials" / "zz20.yaml",
           "kvlcc2": REPO / "configs" / "trials" / "kvlcc2_zz20.yaml"}
 CONFIGS = {"esso_osaka": None, "kvlcc2": REPO / "configs" / "estimation" / "kvlcc2_l7.yaml"}
-PAPER = dict(slots=np.array([U_, V_, R_, N_], dtype=np.int64), c0=4, itau=-1)
-LOG = dict(slots=np.array([X_, Y_, PSI_, N_, U_, V_, R_], dtype=np.int64), c0=8, itau=7)
+# read-only, as the filters' own (global) slot arrays are: the same compiled specialisation
+PAPER = dict(slots=readonly(np.array([U_, V_, R_, N_], dtype=np.int64)), c0=4, itau=-1)
+LOG = dict(slots=readonly(np.array([X_, Y_, PSI_, N_, U_, V_, R_], dtype=np.int64)), c0=8, itau=7)
 
 
 @pytest.fixture(scope="module", params=sorted(TRIALS))

@@ -112,7 +112,7 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
     z0 (20,) the raw-log filter's state layout (x, y, psi, n, u, v, r, tau, derivatives)."""
     N = delta.shape[0]
     h = CSTEP
-    ws = make_workspace(LOG_NZ, LOG_NS, hull_coef)
+    ws = make_workspace(np.int64(LOG_NZ), np.int64(LOG_NS), hull_coef)
     coef, xs, k1, k2, k3, k4, nxt = ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
     z = np.empty(z0.shape[0], dtype=np.complex128)
     for i in range(z0.shape[0]):
@@ -122,7 +122,7 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
     for i in range(LOG_NS):           # element-wise (a slice assignment compiles numba's shape-mismatch message)
         zh[0, i] = z[i]
     for k in range(1, N):
-        rk4_step(z, LOG_SLOTS, LOG_ND, delta[k - 1] + 0.0j, delta[k] + 0.0j, dt, p, poly, hull_axis, hull_term,
+        rk4_step(z, LOG_SLOTS, np.int64(LOG_ND), delta[k - 1] + 0.0j, delta[k] + 0.0j, dt, p, poly, hull_axis, hull_term,
                  coef, idx, xs, k1, k2, k3, k4, nxt)
         for i in range(LOG_NS):
             z[i] = nxt[i]
@@ -139,7 +139,7 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
         for k in range(k0 + 1, N):
             a0 = 1j * h * g[k - 1] if seg[k - 1] == j else 0.0j
             a1 = 1j * h * g[k] if seg[k - 1] == j else 0.0j
-            rk4_step(z, LOG_SLOTS, LOG_ND, delta[k - 1] + a0, delta[k] + a1, dt, p, poly, hull_axis, hull_term,
+            rk4_step(z, LOG_SLOTS, np.int64(LOG_ND), delta[k - 1] + a0, delta[k] + a1, dt, p, poly, hull_axis, hull_term,
                      coef, idx, xs, k1, k2, k3, k4, nxt)
             for i in range(LOG_NS):
                 z[i] = nxt[i]

@@ -14,7 +14,13 @@ group in its own process:
 * ``log-filter``: the raw-log EKF (:mod:`ekf.log_filter`) and the output-error fit (not in
   the default set, see :data:`DEFAULT_GROUPS`);
 * ``filter``: only the augmented EKF's compiled pass (:func:`ekf.filter.run_filter`), on a
-  three-step dummy record (compilation depends on the argument types, not the values).
+  three-step dummy record (compilation depends on the argument types, not the values);
+* ``replay``: only the replay of a record from its measured inputs (:mod:`mmg.replay`);
+* ``reference``: the previous implementations the tests and ``bench/bench_ekf.py`` compare the
+  filters against (``reference=True``: brute-force complex-step Jacobians, allocating updates).
+
+The test suite (``tests/conftest.py``) runs :data:`SUITE_GROUPS` in one process on the second
+core while its first tests run, when it finds the cache cold.
 
 :func:`compiling_in_background` runs one group in a child process while the caller does other
 work: ``mmg estimate`` with a cold cache compiles the filter on the second core while it builds
@@ -34,12 +40,15 @@ import time
 from contextlib import contextmanager
 from dataclasses import replace
 
-GROUPS = ("ekf", "simulate", "log-filter", "filter")
+GROUPS = ("ekf", "simulate", "log-filter", "reference", "filter", "replay")
 """Warm-up groups, longest first (so that with fewer processes than groups the long one starts
 at once)."""
 DEFAULT_GROUPS = ("ekf", "simulate")
 """The groups run by default: one per core of a 2-core CI machine.  ``log-filter`` (the
 output-error fit runs the paper EKF first, so it repeats much of ``ekf``) on request."""
+SUITE_GROUPS = ("filter", "replay", "ekf", "reference", "log-filter", "simulate")
+"""The groups the test suite warms in the background, in the order its tests first need them (the
+simulator's own kernel is built by the suite's first tests, :mod:`mmg._aot`)."""
 
 SHORT_S = 60.0
 """Duration [s] of the short trials the groups run: long enough for every branch the
@@ -83,16 +92,27 @@ def warm_log_filter() -> None:
     from trials.estimation import estimate
 
     estimate(_short("zz20", 100.0), method="output-error")
+    _log_filter_pass()
 
 
 def warm_filter() -> None:
     """The augmented EKF's compiled pass on a three-step dummy record of the Esso Osaka (the same
     argument types as every real pass: :func:`ekf.filter.run_filter` makes them contiguous float64 /
     int64 arrays)."""
+    from ekf.filter import FilterDivergence, run_filter
+
+    try:
+        run_filter(*_filter_args())
+    except FilterDivergence:                       # a dummy record may diverge: the pass is compiled either way
+        pass
+
+
+def _filter_args():
+    """run_filter's arguments for a three-step dummy record of the Esso Osaka (the argument types
+    of every real pass: run_filter makes them contiguous float64 / int64 arrays)."""
     import numpy as np
 
     from ekf.data import estimable_names
-    from ekf.filter import FilterDivergence, run_filter
     from mmg.model import pack
     from mmg.ship import load_ship
 
@@ -104,9 +124,59 @@ def warm_filter() -> None:
     t = np.array([0.0, 1.0, 2.0])
     meas = np.tile([5.0, 0.0, 0.0, 1.0], (3, 1))
     z0 = np.r_[5.0, 0.0, 0.0, 1.0, pk.hull_coef[slots]]
+    return pk, slots, t, meas, np.zeros(3), z0, np.eye(nz) * 1e-6, np.eye(4) * 1e-4
+
+
+def warm_replay() -> None:
+    """The replay of a record from its measured rudder and revolutions (:func:`mmg.replay.replay`)."""
+    import numpy as np
+
+    from mmg.model import pack
+    from mmg.replay import ReplayInputs, replay
+    from mmg.ship import load_ship
+
+    t = np.arange(0.0, 2.0, 0.1)
+    replay(pack(load_ship("esso_osaka_3m")), ReplayInputs(t, np.zeros_like(t), np.full_like(t, 10.0)),
+           [0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
+
+
+@contextmanager
+def _reference(module, name: str):
+    """Inside: ``module.name`` (a compiled pass) runs its previous implementation (``reference=True``)."""
+    import functools
+
+    orig = getattr(module, name)
+    setattr(module, name, functools.partial(orig, reference=True))
     try:
-        run_filter(pk, slots, t, meas, np.zeros(3), z0, np.eye(nz) * 1e-6, np.eye(4) * 1e-4)
-    except FilterDivergence:                       # a dummy record may diverge: the pass is compiled either way
+        yield
+    finally:
+        setattr(module, name, orig)
+
+
+def warm_reference() -> None:
+    """The filters' previous implementations (``reference=True``), which the tests and
+    ``bench/bench_ekf.py`` compare the compiled passes against."""
+    import ekf.filter as ekf_filter
+    import ekf.log_filter as ekf_log_filter
+
+    with _reference(ekf_filter, "filter_kernel"):
+        warm_filter()
+    with _reference(ekf_log_filter, "log_filter_kernel"):
+        _log_filter_pass()
+
+
+def _log_filter_pass() -> None:
+    """The raw-log EKF over a short simulated zigzag's log."""
+    from ekf.estimate import load_config
+    from ekf.filter import FilterDivergence
+    from ekf.log_filter import run_log_filter
+    from trials.estimation import data_from_trial
+
+    cfg = load_config()
+    data = data_from_trial(_short("zz20", 60.0), cfg, seed=1)
+    try:
+        run_log_filter(data, data.record, cfg, passes=1)
+    except FilterDivergence:                       # compiled either way
         pass
 
 
@@ -120,7 +190,8 @@ def filter_cache_cold() -> bool:
         return False
 
 
-_RUN = {"simulate": warm_simulate, "ekf": warm_ekf, "log-filter": warm_log_filter, "filter": warm_filter}
+_RUN = {"simulate": warm_simulate, "ekf": warm_ekf, "log-filter": warm_log_filter, "filter": warm_filter,
+        "replay": warm_replay, "reference": warm_reference}
 
 
 @contextmanager
@@ -185,14 +256,39 @@ def warmup(groups=DEFAULT_GROUPS, jobs: int | None = None, quiet: bool = False) 
     return failed
 
 
+def warmup_serial(groups=DEFAULT_GROUPS, quiet: bool = False) -> int:
+    """Run the warm-up ``groups`` one after another in this process (on one core; what the groups
+    share is compiled or loaded once).  A group that fails is reported and the next one runs.
+
+    Returns the number of groups that failed.
+    """
+    import traceback
+
+    failed = 0
+    for g in groups:
+        try:
+            dt = run_group(g)
+        except Exception:
+            failed += 1
+            print(f"mmg warmup: {g} FAILED\n{traceback.format_exc()}", file=sys.stderr)
+            continue
+        if not quiet:
+            print(f"mmg warmup: {g} done in {dt:.1f} s", file=sys.stderr)
+    return failed
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m trials.warmup", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--jobs", type=int, default=None, help="processes at once (default: the CPU count)")
     ap.add_argument("--group", choices=GROUPS, action="append",
                     help="run only this group, in this process (repeatable)")
+    ap.add_argument("--serial", action="store_true",
+                    help="run the groups one after another in this process (one core)")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
+    if a.serial:
+        return 1 if warmup_serial(tuple(a.group or DEFAULT_GROUPS), a.quiet) else 0
     if a.group and len(a.group) == 1:
         run_group(a.group[0])
         return 0
