@@ -22,6 +22,7 @@ parallel).
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.machinery
 import importlib.util
@@ -30,7 +31,8 @@ import tempfile
 import threading
 from pathlib import Path
 
-__all__ = ["kernels", "enabled", "module_path", "module_name", "build", "simulate_kernel", "model_functions"]
+__all__ = ["kernels", "enabled", "module_path", "module_name", "build", "simulate_kernel", "model_functions",
+           "build_deferred"]
 
 SOURCES = ("_inlining.py", "_jit.py", "_aot.py", "model.py", "nondim.py", "rudder.py", "terms.py", "wind.py",
            "kernel.py")
@@ -46,6 +48,22 @@ SIG_FORCES = "UniTuple(f8, 4)(f8[::1], f8[::1], f8[:,::1], i8[::1], i8[::1], f8[
 _lock = threading.Lock()
 _module = None
 _tried = False
+_deferred = 0
+
+
+@contextlib.contextmanager
+def build_deferred():
+    """Inside: the compiled module is used if it is already built, but not built now (the JIT runs
+    instead; a later call outside builds it).  For a command whose second core is busy compiling
+    other code on a cold cache: the JIT's kernel costs less to compile than the module's build."""
+    global _deferred
+    with _lock:
+        _deferred += 1
+    try:
+        yield
+    finally:
+        with _lock:
+            _deferred -= 1
 
 
 def enabled() -> bool:
@@ -171,8 +189,10 @@ def kernels():
     with _lock:
         if _module is not None or _tried:
             return _module
-        _tried = True
         path = module_path()
+        if _deferred and not path.is_file():
+            return None                           # not now, and not marked as tried: built later
+        _tried = True
         failed = path.with_name(path.name.split(".")[0] + ".failed")
         try:
             if not path.is_file():

@@ -181,3 +181,25 @@ def test_a_stand_in_is_typed_by_numba_before_anything_was_made():
             "f = numba.njit(lambda r: r_prime(r, 2.0, 4.0))\nprint(f(1.0))")
     out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True)
     assert float(out.stdout) == pytest.approx(0.5)            # r' = r L / U
+
+
+def test_a_deferred_build_uses_the_jit_now_and_builds_later(tmp_path, monkeypatch):
+    """Inside build_deferred() a missing module is not built (the JIT runs) and the refusal is not
+    remembered: the first call outside builds it."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.delenv("MMG_AOT", raising=False)
+    monkeypatch.setattr(_aot, "_module", None)
+    monkeypatch.setattr(_aot, "_tried", False)
+    calls = []
+
+    def fake_build(path=None):
+        calls.append(path)
+        raise OSError("stop here")                   # the build itself is tested above
+
+    monkeypatch.setattr(_aot, "build", fake_build)
+    from mmg.kernel import simulate_kernel as jit
+
+    with _aot.build_deferred():
+        assert _aot.simulate_kernel() is jit and _aot.kernels() is None
+    assert calls == []
+    assert _aot.kernels() is None and len(calls) == 1  # built (tried) now, outside

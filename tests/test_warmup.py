@@ -57,3 +57,16 @@ def test_replay_warmup_covers_read_only_and_strided_inputs():
     out = replay(pack(load_ship("esso_osaka_3m")), ReplayInputs(t, delta, n), np.array([0.3, 0, 0, 0, 0, 0.0]))
     assert np.isfinite(out).all()
     assert len(before) == 1 and set(_replay.signatures) == before
+
+
+def test_join_waits_for_one_group_and_the_exit_for_all():
+    """join(group) returns once that group is compiled (the child goes on with the next); a group
+    the child never reports (here: not asked for) does not hang the caller; the with-exit waits."""
+    from trials.warmup import compiling_in_background
+
+    with compiling_in_background("replay", "replay", when=True) as compiled:
+        compiled("replay")
+        proc = compiled.process
+        compiled("not-a-group")                            # the child ended without it: returns
+        assert proc.poll() is not None
+    assert proc.returncode == 0

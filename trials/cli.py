@@ -223,21 +223,36 @@ def cmd_nomoto_paper(args) -> int:
 # --------------------------------------------------------------------------- estimate
 
 
+def _aot_deferred(when: bool):
+    """mmg._aot.build_deferred() when ``when``, else nothing."""
+    from contextlib import nullcontext
+
+    from mmg import _aot
+
+    return _aot.build_deferred() if when else nullcontext()
+
+
 def cmd_estimate(args) -> int:
     from ekf.estimate import load_config
 
     from .estimation import estimate_and_report, load_inputs
     from .output import StagedOutput, check_output_dir
 
-    from .warmup import compiling_in_background, filter_cache_cold
+    from .warmup import compiling_in_background, filter_cache_cold, warm_filter_parts
 
     check_output_dir(args.out)
     cfg = load_config(args.config, args.set or ())
-    # a cold numba cache: the filter compiles on the second core while the inputs are simulated / read
+    # a cold numba cache: the filter's Jacobian compiles on the second core while this one simulates
+    # the inputs (with the JIT's kernel: cheaper to compile than the simulator's module) and compiles
+    # the pass's other parts; the pass then loads them all, while the second core builds the
+    # simulator's module from the JIT's code (mmg._aot) for the next command
     cold = args.method == "ekf" and filter_cache_cold()
-    with StagedOutput(args.out) as out, compiling_in_background("filter", when=cold) as compiled:
+    with StagedOutput(args.out) as out, compiling_in_background("jacobian", "aot", when=cold) as compiled, \
+            _aot_deferred(cold):
         datas = load_inputs(args.inputs, cfg, seed=args.seed, ship=args.ship, truth=args.truth)
-        compiled()
+        if cold:
+            warm_filter_parts()
+        compiled("jacobian")
         rep = estimate_and_report(datas, cfg, out, joint=args.joint, plots=not args.no_plots, method=args.method)
     for w in rep["warnings"]:
         print(f"warning: {w}", file=sys.stderr)

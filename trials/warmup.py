@@ -15,6 +15,11 @@ group in its own process:
   the default set, see :data:`DEFAULT_GROUPS`);
 * ``filter``: only the augmented EKF's compiled pass (:func:`ekf.filter.run_filter`), on a
   three-step dummy record (compilation depends on the argument types, not the values);
+* ``jacobian``: only the paper filter's exact Jacobian step (:func:`ekf.kernels.jacobian_step`,
+  two thirds of the pass's compilation): ``mmg estimate`` on a cold cache compiles it on the
+  second core while it simulates the inputs with the JIT's kernel and compiles the pass's other
+  parts (:func:`warm_filter_parts`) on the first;
+* ``aot``: only the simulator's compiled module (:mod:`mmg._aot`);
 * ``replay``: only the replay of a record from its measured inputs (:mod:`mmg.replay`);
 * ``reference``: the previous implementations the tests and ``bench/bench_ekf.py`` compare the
   filters against (``reference=True``: brute-force complex-step Jacobians, allocating updates).
@@ -40,7 +45,7 @@ import time
 from contextlib import contextmanager
 from dataclasses import replace
 
-GROUPS = ("ekf", "simulate", "log-filter", "reference", "filter", "replay")
+GROUPS = ("ekf", "simulate", "log-filter", "reference", "filter", "jacobian", "replay", "aot")
 """Warm-up groups, longest first (so that with fewer processes than groups the long one starts
 at once)."""
 DEFAULT_GROUPS = ("ekf", "simulate")
@@ -127,6 +132,44 @@ def _filter_args():
     return pk, slots, t, meas, np.zeros(3), z0, np.eye(nz) * 1e-6, np.eye(4) * 1e-4
 
 
+def warm_jacobian() -> None:
+    """The paper filter's Jacobian step (:func:`ekf.kernels.jacobian_step` through
+    :func:`ekf.propagate.workspace`), called with the argument types of the compiled pass."""
+    import numpy as np
+
+    from ekf import propagate
+    from ekf.kernels import jacobian_step
+
+    pk, slots, t, meas, delta, z0, P0, R = _filter_args()
+    ws = propagate.workspace(np.int64(len(z0)), pk.hull_coef)
+    jacobian_step(z0, 0.0, 0.0, 0.0, 0.0, -1, propagate.SLOTS, propagate.NS, 1.0, *pk.args()[:4], slots, ws)
+
+
+def warm_filter_parts() -> None:
+    """The paper filter pass's parts other than its Jacobian step (the covariance propagation, the
+    checks, the Joseph update and their work arrays), called with the pass's argument types."""
+    import numpy as np
+
+    from ekf.filter import _check
+    from ekf.kernels import fpft, joseph_update_ws, make_update_workspace
+    from ekf.propagate import NS
+
+    pk, slots, t, meas, delta, z0, P0, R = _filter_args()
+    nz = len(z0)
+    uw = make_update_workspace(nz, meas.shape[1])
+    P = P0.copy()
+    fpft(np.eye(nz), P, NS, np.empty((nz, nz)), P)
+    _check(z0, P)
+    joseph_update_ws(z0.copy(), P, meas[1], R, uw)
+
+
+def warm_aot() -> None:
+    """The simulator's ahead-of-time compiled module (:mod:`mmg._aot`), built if it is not."""
+    from mmg import _aot
+
+    _aot.kernels()
+
+
 def warm_replay() -> None:
     """The replay of a record from its measured rudder and revolutions (:func:`mmg.replay.replay`)."""
     import numpy as np
@@ -191,33 +234,54 @@ def filter_cache_cold() -> bool:
 
 
 _RUN = {"simulate": warm_simulate, "ekf": warm_ekf, "log-filter": warm_log_filter, "filter": warm_filter,
-        "replay": warm_replay, "reference": warm_reference}
+        "replay": warm_replay, "reference": warm_reference, "jacobian": warm_jacobian, "aot": warm_aot}
 
 
 @contextmanager
-def compiling_in_background(group: str, when: bool = True):
-    """Run warm-up ``group`` in a child process (when ``when``) while the ``with`` body runs.
+def compiling_in_background(*groups: str, when: bool = True):
+    """Run warm-up ``groups`` one after another in a child process (when ``when``) while the
+    ``with`` body runs.
 
-    Yields a function that waits for the child (call it before the work that needs the compiled
-    code: it then loads from the cache instead of compiling it again).  The child writes only into
-    numba's cache; it is stopped when the body raises (an interrupt, an error) and waited for on a
-    normal exit.  If it fails, the caller simply compiles in its own process."""
+    Yields a function ``join(group=None)``: it waits until ``group`` is compiled (call it before the
+    work that needs that code: the work then loads it from the cache instead of compiling it again),
+    or for the whole child when ``group`` is None.  The child writes only into numba's cache (and
+    :mod:`mmg._aot`'s module); it is stopped when the body raises (an interrupt, an error) and
+    waited for on a normal exit.  If a group fails, the caller simply compiles in its own process."""
     proc = None
     if when:
-        proc = subprocess.Popen([sys.executable, "-m", "trials.warmup", "--group", group],
-                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        cmd = [sys.executable, "-m", "trials.warmup", "--serial"]
+        for g in groups:
+            cmd += ["--group", g]
+        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                text=True)
+    finished: set[str] = set()
 
-    def join() -> None:
-        if proc is not None:
-            proc.wait()
+    def end() -> None:
+        if not proc.stderr.closed:
+            proc.stderr.read()
+            proc.stderr.close()
+        proc.wait()
+
+    def join(group: str | None = None) -> None:
+        if proc is None:
+            return
+        while group is not None and group not in finished and not proc.stderr.closed:
+            line = proc.stderr.readline()
+            if not line:                           # the child ended (or failed before the group)
+                break
+            if line.startswith("mmg warmup: "):
+                finished.add(line.split()[2])
+        if group is None or group not in finished:
+            end()
 
     join.process = proc                            # (for the caller's and the tests' eyes)
     try:
         yield join
     except BaseException:
-        if proc is not None and proc.poll() is None:
-            proc.terminate()
-            proc.wait()
+        if proc is not None:
+            if proc.poll() is None:
+                proc.terminate()
+            end()
         raise
     join()
 
@@ -270,10 +334,10 @@ def warmup_serial(groups=DEFAULT_GROUPS, quiet: bool = False) -> int:
             dt = run_group(g)
         except Exception:
             failed += 1
-            print(f"mmg warmup: {g} FAILED\n{traceback.format_exc()}", file=sys.stderr)
+            print(f"mmg warmup: {g} FAILED\n{traceback.format_exc()}", file=sys.stderr, flush=True)
             continue
         if not quiet:
-            print(f"mmg warmup: {g} done in {dt:.1f} s", file=sys.stderr)
+            print(f"mmg warmup: {g} done in {dt:.1f} s", file=sys.stderr, flush=True)
     return failed
 
 
