@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -351,6 +352,9 @@ def main(argv=None) -> int:
                     help="run the groups one after another in this process (one core)")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
+    # stopped by its parent (compiling_in_background): unwind, so that a build in progress removes
+    # its temporary folder (mmg._aot.build) instead of leaving it in the cache
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     if a.serial:
         return 1 if warmup_serial(tuple(a.group or DEFAULT_GROUPS), a.quiet) else 0
     if a.group and len(a.group) == 1:
