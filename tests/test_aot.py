@@ -100,18 +100,26 @@ def test_other_threads_get_the_jit_kernel(aot):
     assert _aot.simulate_kernel() is aot.simulate_kernel
 
 
-def test_a_failed_build_leaves_a_marker_and_the_jit_runs(tmp_path, monkeypatch):
+@pytest.fixture
+def no_compiler(tmp_path, monkeypatch):
+    """A fresh process's view of an empty cache in ``tmp_path`` where every build fails (no C
+    compiler); yields the list of the build's calls."""
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
     monkeypatch.delenv("MMG_AOT", raising=False)
     monkeypatch.setattr(_aot, "_module", None)
     monkeypatch.setattr(_aot, "_tried", False)
     calls = []
 
-    def no_compiler(path=None):
+    def build(path=None):
         calls.append(path)
         raise OSError("no C compiler here")
 
-    monkeypatch.setattr(_aot, "build", no_compiler)
+    monkeypatch.setattr(_aot, "build", build)
+    return calls
+
+
+def test_a_failed_build_leaves_a_marker_and_the_jit_runs(no_compiler, monkeypatch):
+    calls = no_compiler
     assert _aot.kernels() is None
     marker = _aot.module_path().with_name(_aot.module_name() + ".failed")
     assert marker.is_file() and "no C compiler" in marker.read_text()
@@ -183,20 +191,10 @@ def test_a_stand_in_is_typed_by_numba_before_anything_was_made():
     assert float(out.stdout) == pytest.approx(0.5)            # r' = r L / U
 
 
-def test_a_deferred_build_uses_the_jit_now_and_builds_later(tmp_path, monkeypatch):
+def test_a_deferred_build_uses_the_jit_now_and_builds_later(no_compiler):
     """Inside build_deferred() a missing module is not built (the JIT runs) and the refusal is not
     remembered: the first call outside builds it."""
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
-    monkeypatch.delenv("MMG_AOT", raising=False)
-    monkeypatch.setattr(_aot, "_module", None)
-    monkeypatch.setattr(_aot, "_tried", False)
-    calls = []
-
-    def fake_build(path=None):
-        calls.append(path)
-        raise OSError("stop here")                   # the build itself is tested above
-
-    monkeypatch.setattr(_aot, "build", fake_build)
+    calls = no_compiler
     from mmg.kernel import simulate_kernel as jit
 
     with _aot.build_deferred():
