@@ -41,7 +41,7 @@ SOURCES = ("_inlining.py", "_jit.py", "_aot.py", "model.py", "nondim.py", "rudde
 # C-contiguous arrays: the layout the JIT's own callers pass, so the callees the build compiles are
 # the JIT's specialisations (shared through numba's cache) and not a second, any-layout set
 SIG_SIMULATE = ("i8(f8[::1], f8, i8, f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1], i8, f8[::1], f8[::1], f8[::1], "
-                "f8[::1], f8[:,::1], f8[::1], f8[:,::1])")
+                "f8[::1], f8[:,::1], f8[::1])")
 SIG_RHS = "void(f8[::1], f8, f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1], f8[::1])"
 SIG_FORCES = "UniTuple(f8, 4)(f8[::1], f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1])"
 
@@ -155,8 +155,8 @@ def build(path: Path | None = None) -> Path:
         sim, rhs, forces = kernel.simulate_kernel, model.rhs, model.forces
 
         @cc.export("simulate_kernel", SIG_SIMULATE)
-        def _simulate(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders, work):
-            return sim(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders, work)
+        def _simulate(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders):
+            return sim(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders)
 
         @cc.export("rhs", SIG_RHS)
         def _rhs(x, delta_cmd, p, poly, ha, ht, hc, out):

@@ -66,7 +66,7 @@ def integrate(packed: PackedShip, x0: np.ndarray, law: CommandLaw, duration: flo
     nvalid = the_kernel()(
         f8(x0), float(dt), nsteps, f8(packed.p), f8(packed.poly), np.ascontiguousarray(packed.hull_axis, dtype=np.int64),
         np.ascontiguousarray(packed.hull_term, dtype=np.int64), f8(packed.hull_coef),
-        int(law.kind), f8(law.params), f8(law.t), f8(law.delta), f8(law.n), states, orders, np.empty((6, 8)),
+        int(law.kind), f8(law.params), f8(law.t), f8(law.delta), f8(law.n), states, orders,
     )
     t = np.arange(nvalid) * dt
     return t, states[:nvalid], orders[:nvalid], nvalid == nsteps + 1

@@ -383,9 +383,15 @@ def accelerations(X, Y, N, u, v, r, p, out):
     Affine in (X, Y, N): with u = v = r = 0 it is the force-to-acceleration map (the inverse
     mass matrix, :func:`inverse_mass`).
     """
+    out[U_], out[V_], out[R_] = accelerations_of(X, Y, N, u, v, r, p)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def accelerations_of(X, Y, N, u, v, r, p):
+    """:func:`accelerations` as values: (du/dt, dv/dt, dr/dt)."""
     m, mx, my, xG = p[P_M], p[P_MX], p[P_MY], p[P_XG]
-    out[U_], out[V_], out[R_] = force_accelerations(X + (m + my) * v * r + xG * m * r * r,
-                                                    Y - (m + mx) * u * r, N - xG * m * u * r, p)
+    return force_accelerations(X + (m + my) * v * r + xG * m * r * r,
+                               Y - (m + mx) * u * r, N - xG * m * u * r, p)
 
 
 @njit(cache=True, error_model="numpy", inline=hot_loops_only)
@@ -400,16 +406,27 @@ def rhs(x, delta_cmd, p, poly, hull_axis, hull_term, hull_coef, out):
     :func:`dynamics` (u, v, r, n from u, v, r, delta, n), :func:`track` (x0, y0, psi from u, v,
     r, psi) and the steering gear (delta from delta and the order); nothing depends on x0, y0.
     """
-    u, v, r, psi = x[U_], x[V_], x[R_], x[PSI_]
-    dynamics(u, v, r, x[DELTA_], x[N_], p, poly, hull_axis, hull_term, hull_coef, out)
+    (out[U_], out[V_], out[R_], out[X_], out[Y_], out[PSI_], out[DELTA_],
+     out[N_]) = rhs_of(x[U_], x[V_], x[R_], x[PSI_], x[DELTA_], x[N_], delta_cmd, p, poly,
+                       hull_axis, hull_term, hull_coef)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rhs_of(u, v, r, psi, delta, n, delta_cmd, p, poly, hull_axis, hull_term, hull_coef):
+    """:func:`rhs` of the states as scalars (x0 and y0 enter nothing), returned as values in the
+    state order (du/dt, dv/dt, dr/dt, dx0/dt, dy0/dt, dpsi/dt, ddelta/dt, dn/dt): a loop that
+    holds its state in scalars (the simulator's RK4 loop) keeps it in registers."""
+    X, Y, N, J = forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef)
+    du, dv, dr = accelerations_of(X, Y, N, u, v, r, p)
+    dn = shaft_acceleration(u, n, J, p, poly)
     if p[P_WIND_V] != 0.0:        # a steady true wind (the ``wind`` effect): loads depend on the heading
         wx, wy, wn = wind_loads(u, v, psi, p)
-        du, dv, dr = force_accelerations(wx, wy, wn, p)
-        out[U_] += du
-        out[V_] += dv
-        out[R_] += dr
-    track(u, v, r, psi, p, out)
-    out[DELTA_] = steering_rate(delta_cmd, x[DELTA_], p)
+        wu, wv, wr = force_accelerations(wx, wy, wn, p)
+        du += wu
+        dv += wv
+        dr += wr
+    dx, dy, dpsi = track_of(u, v, r, psi, p)
+    return du, dv, dr, dx, dy, dpsi, steering_rate(delta_cmd, delta, p), dn
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -429,14 +446,20 @@ def track(u, v, r, psi, p, out):
     into out[X_], out[Y_], out[PSI_]; u, v [m/s], r [rad/s], psi [rad] scalars, real or complex.
     The current's velocity (constant) is added only when there is one: in still water the
     trigonometry of its direction is not evaluated at every call (same values either way)."""
+    out[X_], out[Y_], out[PSI_] = track_of(u, v, r, psi, p)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def track_of(u, v, r, psi, p):
+    """:func:`track` as values: (dx0/dt, dy0/dt, dpsi/dt)."""
     c, s = np.cos(psi), np.sin(psi)
-    out[X_] = u * c - v * s
-    out[Y_] = u * s + v * c
+    dx = u * c - v * s
+    dy = u * s + v * c
     cs = p[P_CUR_SPEED]
     if cs != 0.0:
-        out[X_] += cs * np.cos(p[P_CUR_DIR])
-        out[Y_] += cs * np.sin(p[P_CUR_DIR])
-    out[PSI_] = r
+        dx += cs * np.cos(p[P_CUR_DIR])
+        dy += cs * np.sin(p[P_CUR_DIR])
+    return dx, dy, r
 
 
 @njit(cache=True, error_model="numpy")

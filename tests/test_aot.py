@@ -46,7 +46,7 @@ def _both(pk, x0, law, duration, dt, aot):
         nsteps = int(round(duration / dt))
         states, orders = np.empty((nsteps + 1, 8)), np.empty(nsteps + 1)
         n = kern(np.asarray(x0, float), float(dt), nsteps, *pk.args(), int(law.kind), law.params, law.t,
-                 law.delta, law.n, states, orders, np.empty((6, 8)))
+                 law.delta, law.n, states, orders)
         out.append((n, states[:n], orders[:n]))
     return out
 
