@@ -3,7 +3,12 @@
 record the open-loop heading RMS of the initial (Froude-scaled) 3 m model and of the model
 identified without it.  The fit starts from the cross-flow form of that ship
 (``esso_osaka_3m_crossflow``, ``--ship``) and is scored against the Kijima one (``--initial``).
-Run: ``python bench/identify_cv.py [--wind on|off|both] [--ship S] [--initial S] [--free ...]``."""
+Run: ``python bench/identify_cv.py [--wind on|off|both] [--ship S] [--initial S] [--free ...]``.
+
+``--offset-spread DEG`` also replays every kept-out record, with both models, under rudder offsets
+from -DEG to +DEG (the ``rudder_offset`` effect: the blade DEG from what the indicator logs) and prints
+the range of heading RMS each model spans and the offset each prefers: how much of a record's score a
+small, record-specific asymmetry (a rudder zero, a steady gust, a pond current) decides."""
 from __future__ import annotations
 
 import argparse
@@ -42,6 +47,8 @@ def main() -> None:
                     help="effects fitted once per training record as nuisances (e.g. current)")
     ap.add_argument("--folds-by", choices=["order", "revolutions"], default="order",
                     help="deal the records into folds in file order or stratified by propeller revolutions")
+    ap.add_argument("--offset-spread", type=float, default=0.0, metavar="DEG",
+                    help="also score each kept-out record under rudder offsets within +-DEG (both models)")
     a = ap.parse_args()
     d = frt_data_dir()
     if d is None:
@@ -73,6 +80,43 @@ def main() -> None:
         xb = np.mean([c["identified"]["heading_rms_deg"] for c in cv])
         nb = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
         print(f"{'mean':32s} {xa:8.2f} {xb:10.2f} {xa / xb:6.2f}   better on {nb} of {len(cv)} kept-out records")
+        if a.offset_spread > 0:
+            offset_spread(cv, runs, initial, a.offset_spread)
+
+
+def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> None:
+    """Per kept-out record: the heading RMS [deg] of the initial and the identified model under rudder
+    offsets in [-spread_deg, +spread_deg] (``n`` values): the range each spans and the offset each
+    prefers; then the comparison with each model at its own preferred offset (an oracle, both alike)."""
+    from trials.identify import _ship_with, with_ship_effects
+    from trials.predict import replay_record
+
+    by_name = {r.name: r for r in runs}
+    offs = np.linspace(-spread_deg, spread_deg, n)
+
+    def scan(ship, run):
+        out = []
+        for o in offs:
+            s = _ship_with(ship, {"rudder_offset": np.radians(o)})
+            out.append(replay_record(s, with_ship_effects(run, s)).scores()["heading_rms_deg"])
+        return np.array(out)
+
+    print(f"\nrudder offsets {offs[0]:+.2f} .. {offs[-1]:+.2f} deg ({n} values): heading RMS range [deg] and "
+          f"preferred offset [deg] of each model")
+    print(f"{'record':32s} {'initial range':>15s} {'at':>6s} {'identified range':>17s} {'at':>6s}")
+    best_a, best_b = [], []
+    for c in cv:
+        run = by_name[c["name"]]
+        ra, rb = scan(initial, run), scan(c["ship"], run)
+        ka, kb = int(np.nanargmin(ra)), int(np.nanargmin(rb))
+        best_a.append(ra[ka])
+        best_b.append(rb[kb])
+        print(f"{c['name']:32s} {np.nanmin(ra):6.2f} - {np.nanmax(ra):6.2f} {offs[ka]:+6.2f} "
+              f"{np.nanmin(rb):7.2f} - {np.nanmax(rb):7.2f} {offs[kb]:+6.2f}")
+    best_a, best_b = np.array(best_a), np.array(best_b)
+    print(f"each model at its own preferred offset: mean {best_a.mean():.2f} (initial) against {best_b.mean():.2f} "
+          f"(identified), ratio {best_a.mean() / best_b.mean():.2f}, identified better on "
+          f"{int(np.sum(best_b < best_a))} of {len(cv)}")
 
 
 if __name__ == "__main__":

@@ -337,7 +337,8 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     """k-fold cross-validation: each record kept out once; per record the open-loop heading RMS [deg]
     (and the other scores) of the initial model (``initial``, the prior ``ship`` when omitted) and of
     the model identified from ``ship`` without it (``kw``: :func:`identify`'s options); ``folds_by``:
-    how records are dealt into folds (:func:`fold_of`)."""
+    how records are dealt into folds (:func:`fold_of`).  Each record's dict also holds ``"ship"``,
+    the model identified without it (for further replays of the kept-out record)."""
     ref = ship if initial is None else initial
     out = []
     idx = np.arange(len(runs))
@@ -349,7 +350,7 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
         for i in test:
             a = replay_record(ref, runs[i]).scores()
             b = ident.replay(runs[i]).scores()
-            out.append({"name": runs[i].name, "fold": k, "initial": a, "identified": b})
+            out.append({"name": runs[i].name, "fold": k, "initial": a, "identified": b, "ship": ident.ship})
         if progress:
             progress(k + 1, folds)
     return out
