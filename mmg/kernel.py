@@ -10,7 +10,7 @@ import numpy as np
 
 from ._inlining import source_stamp
 from ._jit import njit
-from .model import P_ENGINE, U_, ENGINE_CONSTANT_RPM, rhs_of
+from .model import DELTA_, ENGINE_CONSTANT_RPM, N_, P_ENGINE, PSI_, R_, U_, V_, rhs_of
 from .rudder import switch_side
 
 __all__ = ["simulate_kernel", "SCHEDULE", "HEADING_SWITCH"]
@@ -35,6 +35,13 @@ def _interp(tq, ts, vs, k):
     return vs[k] + w * (vs[k + 1] - vs[k]), k
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _axpy(a, c, b):
+    """a + c b of two 8-tuples (the state and a stage derivative) as a tuple: stays in registers."""
+    return (a[0] + c * b[0], a[1] + c * b[1], a[2] + c * b[2], a[3] + c * b[3],
+            a[4] + c * b[4], a[5] + c * b[5], a[6] + c * b[6], a[7] + c * b[7])
+
+
 def _compile_simulate_kernel(stamp: int):
     """Compile the kernel below as a closure over ``stamp`` (:func:`mmg._inlining.source_stamp`, a hash of
     the sources it inlines): numba keys its on-disk cache by the function's own file and its closure,
@@ -45,18 +52,18 @@ def _compile_simulate_kernel(stamp: int):
                         kind, cpar, st, sd, sn, states, orders):
         """Integrate ``nsteps`` RK4 steps from ``x0``; fill ``states`` (nsteps+1, 8) and ``orders``.
 
-        The state and the four RK4 stages are scalars (:func:`mmg.model.rhs_of`, inlined), which
+        The state and the four RK4 stages are tuples of scalars (:func:`mmg.model.rhs_of`, inlined), which
         the compiler keeps in registers: an earlier version staged them through a (6, 8) work
         array, 1.27-1.33x the hand-specialised kernel against 1.20-1.23x now
-        (``bench/bench_kernel.py``).  The kernel allocates nothing, so it is compiled without reference counting (``_nrt=False``: no atomic
-        increment / decrement of the arrays' counts in the right-hand side, several per
+        (``bench/bench_kernel.py``).  The kernel allocates nothing, so it is compiled without
+        reference counting (``_nrt=False``: no atomic increment / decrement of the arrays' counts in the right-hand side, several per
         evaluation otherwise).  Releases the GIL (it touches no Python object): runs of different
         threads go on in parallel.  Returns the number of valid rows (< nsteps+1 when the run
         stopped because the surge speed fell below 1 % of its initial value or a value became NaN).
         """
         if stamp < 0:                     # never true: ties the cache entry to the inlined sources
             return 0
-        u, v, r, x0_, y0_, psi, delta, n = x0[0], x0[1], x0[2], x0[3], x0[4], x0[5], x0[6], x0[7]
+        xs = (x0[0], x0[1], x0[2], x0[3], x0[4], x0[5], x0[6], x0[7])   # the state, as scalars
         side = cpar[HS_FIRST]
         ptr = 0
         ptrn = 0
@@ -69,52 +76,31 @@ def _compile_simulate_kernel(stamp: int):
                 dcmd, ptr = _interp(t, st, sd, ptr)
                 ncmd, ptrn = _interp(t, st, sn, ptrn)
                 if constant_rpm and not np.isnan(ncmd):
-                    n = ncmd
+                    xs = xs[:N_] + (ncmd,)
             else:
                 if t < cpar[HS_TSTART]:
                     dcmd = cpar[HS_TRIM]
                 else:
-                    side = switch_side(side, psi - cpar[HS_PSI0], cpar[HS_HI], cpar[HS_LO])
+                    side = switch_side(side, xs[PSI_] - cpar[HS_PSI0], cpar[HS_HI], cpar[HS_LO])
                     dcmd = side * cpar[HS_AMP]
-            states[i, 0] = u
-            states[i, 1] = v
-            states[i, 2] = r
-            states[i, 3] = x0_
-            states[i, 4] = y0_
-            states[i, 5] = psi
-            states[i, 6] = delta
-            states[i, 7] = n
+            for j in range(8):
+                states[i, j] = xs[j]
             orders[i] = dcmd
-            if not (u > u_min) or np.isnan(psi):
+            if not (xs[U_] > u_min) or np.isnan(xs[PSI_]):
                 return i
             if i == nsteps:
                 break
             # the four RK4 stages through one inlined copy of the right-hand side, the state and
             # the stage derivatives in scalars (registers), summed with the RK4 weights as they come
-            ku = kv = kr = kx = ky = kpsi = kd = kn = 0.0
-            su = sv = sr = sx = sy = spsi = sd_ = sn_ = 0.0
+            k = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+            acc = k
             for s in range(4):
                 c = 0.0 if s == 0 else (half_dt if s < 3 else dt)
-                ku, kv, kr, kx, ky, kpsi, kd, kn = rhs_of(
-                    u + c * ku, v + c * kv, r + c * kr, psi + c * kpsi, delta + c * kd, n + c * kn,
-                    dcmd, p, poly, hull_axis, hull_term, hull_coef)
-                w = 1.0 if (s == 0 or s == 3) else 2.0
-                su += w * ku
-                sv += w * kv
-                sr += w * kr
-                sx += w * kx
-                sy += w * ky
-                spsi += w * kpsi
-                sd_ += w * kd
-                sn_ += w * kn
-            u += dt6 * su
-            v += dt6 * sv
-            r += dt6 * sr
-            x0_ += dt6 * sx
-            y0_ += dt6 * sy
-            psi += dt6 * spsi
-            delta += dt6 * sd_
-            n += dt6 * sn_
+                y = _axpy(xs, c, k)
+                k = rhs_of(y[U_], y[V_], y[R_], y[PSI_], y[DELTA_], y[N_], dcmd, p, poly, hull_axis, hull_term,
+                           hull_coef)
+                acc = _axpy(acc, 1.0 if (s == 0 or s == 3) else 2.0, k)
+            xs = _axpy(xs, dt6, acc)
         return nsteps + 1
 
     return simulate_kernel
