@@ -7,8 +7,8 @@ midship at the samples.  The state is the rigid-body part of :data:`mmg.model.ST
 
     s = [u, v, r, x0, y0, psi]
 
-and the right-hand side is :func:`mmg.model.dynamics` and :func:`mmg.model.track` (the one
-physics of the simulator, the estimators and the workflow).  Between two samples the step is
+and the right-hand side is :func:`mmg.model.forces_of`, :func:`mmg.model.accelerations_of` and
+:func:`mmg.model.track_of` (the one physics of the simulator, the estimators and the workflow).  Between two samples the step is
 split into equal RK4 sub-steps no longer than ``dt_max``.
 
 With ``reset`` the state is set back to the measured one at the flagged samples: the prediction
@@ -22,7 +22,7 @@ import numpy as np
 from ._jit import carray, njit
 
 from ._inlining import source_stamp
-from .model import P_L, P_WIND_V, PSI_, R_, U_, V_, X_, Y_, PackedShip, dynamics, inverse_mass, track, wind_loads
+from .model import P_L, P_WIND_V, PackedShip, accelerations_of, forces_of, inverse_mass, track_of, wind_loads
 
 __all__ = ["ReplayInputs", "replay", "replay_states", "default_dt_max", "STATE"]
 
@@ -66,20 +66,28 @@ def default_dt_max(L: float) -> float:
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef, work, out):
-    dynamics(s[0], s[1], s[2], d, n, p, poly, hull_axis, hull_term, hull_coef, work)
-    track(s[0], s[1], s[2], s[5], p, work)
+def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef):
+    """d/dt of the replayed state ``s`` (a 6-tuple, :data:`STATE`) with the rudder ``d`` [rad], the
+    revolutions ``n`` [rps] and the external loads fx, fy [N], fn [N m] prescribed, as a 6-tuple."""
+    u, v, r, psi = s[0], s[1], s[2], s[5]
+    X, Y, N, _ = forces_of(u, v, r, d, n, p, poly, hull_axis, hull_term, hull_coef)
+    du, dv, dr = accelerations_of(X, Y, N, u, v, r, p)
+    dx, dy, dpsi = track_of(u, v, r, psi, p)
     if p[P_WIND_V] != 0.0:          # a steady true wind, from the state (as the simulator's rhs)
-        wx, wy, wn = wind_loads(s[0], s[1], s[5], p)
+        wx, wy, wn = wind_loads(u, v, psi, p)
         fx += wx
         fy += wy
         fn += wn
-    out[0] = work[U_] + minv[0] * fx + minv[1] * fy + minv[2] * fn
-    out[1] = work[V_] + minv[3] * fx + minv[4] * fy + minv[5] * fn
-    out[2] = work[R_] + minv[6] * fx + minv[7] * fy + minv[8] * fn
-    out[3] = work[X_]
-    out[4] = work[Y_]
-    out[5] = work[PSI_]
+    return (du + minv[0] * fx + minv[1] * fy + minv[2] * fn,
+            dv + minv[3] * fx + minv[4] * fy + minv[5] * fn,
+            dr + minv[6] * fx + minv[7] * fy + minv[8] * fn, dx, dy, dpsi)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _axpy(a, c, b):
+    """a + c b of two 6-tuples (the state and a stage derivative), as a tuple."""
+    return (a[0] + c * b[0], a[1] + c * b[1], a[2] + c * b[2], a[3] + c * b[3], a[4] + c * b[4],
+            a[5] + c * b[5])
 
 
 def _compile_replay(stamp: int):
@@ -94,16 +102,13 @@ def _compile_replay(stamp: int):
         if stamp < 0:                     # never true: ties the cache entry to the inlined sources
             return 0
         N = t.shape[0]
-        s = s0.copy()
-        work = np.zeros(8)
-        ks = np.zeros((4, 6))
-        tmp = np.zeros(6)
-        for j in range(6):                # element-wise: a slice assignment compiles numba's shape-mismatch message
+        # the state and the RK4 stages as 6-tuples of scalars: kept in registers across the stages
+        s = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5])
+        for j in range(6):
             out[0, j] = s[j]
         for i in range(N - 1):
             if reset[i]:
-                for j in range(6):
-                    s[j] = meas[i, j]
+                s = (meas[i, 0], meas[i, 1], meas[i, 2], meas[i, 3], meas[i, 4], meas[i, 5])
             h = t[i + 1] - t[i]
             m = int(np.ceil(h / dt_max - 1e-9))
             if m < 1:
@@ -113,24 +118,20 @@ def _compile_replay(stamp: int):
                 a0 = k / m
                 a5 = (k + 0.5) / m
                 a1 = (k + 1.0) / m
+                kst = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+                acc = kst
                 for st in range(4):                  # the RK4 stages: one inlined copy of the model
-                    if st == 0:
-                        a = a0
-                        for jj in range(6):
-                            tmp[jj] = s[jj]
-                    else:
-                        a = a5 if st < 3 else a1
-                        c = 0.5 * dt if st < 3 else dt
-                        for jj in range(6):
-                            tmp[jj] = s[jj] + c * ks[st - 1, jj]
+                    a = a0 if st == 0 else (a5 if st < 3 else a1)
+                    c = 0.0 if st == 0 else (0.5 * dt if st < 3 else dt)
                     d = delta[i] + a * (delta[i + 1] - delta[i])
                     nn = n[i] + a * (n[i + 1] - n[i])
                     fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
                     fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
                     fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
-                    _deriv(tmp, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef, work, ks[st])
-                for j in range(6):
-                    s[j] += dt / 6.0 * (ks[0, j] + 2.0 * ks[1, j] + 2.0 * ks[2, j] + ks[3, j])
+                    kst = _deriv(_axpy(s, c, kst), d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term,
+                                 hull_coef)
+                    acc = _axpy(acc, 1.0 if (st == 0 or st == 3) else 2.0, kst)
+                s = _axpy(s, dt / 6.0, acc)
             ok = True
             for j in range(6):
                 if not np.isfinite(s[j]):
