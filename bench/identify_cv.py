@@ -76,10 +76,15 @@ def main() -> None:
         for c in cv:
             x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
             print(f"{c['name']:32s} {x:8.2f} {y:10.2f} {x / y:6.2f}")
-        xa = np.mean([c["initial"]["heading_rms_deg"] for c in cv])
-        xb = np.mean([c["identified"]["heading_rms_deg"] for c in cv])
+        ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
+        xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
+        xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
         nb = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
         print(f"{'mean':32s} {xa:8.2f} {xb:10.2f} {xa / xb:6.2f}   better on {nb} of {len(cv)} kept-out records")
+        diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
+        if diverged:
+            print(f"the identified model's replay diverged on {', '.join(diverged)} (counted as not better; "
+                  f"left out of both means)")
         if a.offset_spread > 0:
             offset_spread(cv, runs, initial, a.offset_spread)
 

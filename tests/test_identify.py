@@ -267,3 +267,19 @@ def test_per_record_currents_are_nuisances_that_keep_the_shared_fit_unbiased():
     assert ident.ship.effect_set().get("current") is None         # not part of the identified ship
     plain = identify(ship, runs, free=["N_r"], segment_s=(30.0, np.inf), say=lambda m: None)
     assert abs(plain.fit.values()["N_r"] / true["N_r"] - 1) > abs(v["N_r"] / true["N_r"] - 1)
+
+
+def test_a_diverged_kept_out_replay_is_named_not_counted_better_and_left_out_of_both_means(tmp_path):
+    ship = mmg.load_ship(SHIP)
+    true = {"N_r": ship.hull.value("N_r") * 1.3}
+    runs = _synthetic_runs(ship.with_hull(true), seeds=(0,), duration=60.0)
+    ident = identify(ship, runs, free=list(true), segment_s=(30.0, np.inf), say=lambda m: None)
+    h = lambda x: {"heading_rms_deg": x}                       # noqa: E731 (the one score the summary reads)
+    cv = [{"name": "a", "fold": 0, "initial": h(10.0), "identified": h(2.0)},
+          {"name": "b", "fold": 1, "initial": h(6.0), "identified": h(3.0)},
+          {"name": "gone", "fold": 1, "initial": h(50.0), "identified": h(float("nan"))}]
+    rep = write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path, cv)["report"].read_text()
+    # means over a and b only: (10 + 6) / 2 = 8 against (2 + 3) / 2 = 2.5, ratio 3.2; "gone" is not better
+    assert "| **mean** | | 8.00 | 2.50 | 3.20 |" in rep
+    assert "better on 2 of 3" in rep
+    assert "diverged on 1 kept-out record(s) (gone)" in rep

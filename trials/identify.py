@@ -461,10 +461,15 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
         for c in cv:
             x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
             lines.append(f"| {c['name']} | {c['fold']} | {x:.2f} | {y:.2f} | {x / y:.2f} |")
-        xa = np.nanmean([c["initial"]["heading_rms_deg"] for c in cv])
-        xb = np.nanmean([c["identified"]["heading_rms_deg"] for c in cv])
+        ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
+        xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
+        xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
         better = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
         lines.append(f"| **mean** | | {xa:.2f} | {xb:.2f} | {xa / xb:.2f} |")
         lines += ["", f"Identified better on {better} of {len(cv)} kept-out records; mean ratio {xa / xb:.2f}."]
+        diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
+        if diverged:
+            lines += ["", f"The identified model's replay diverged on {len(diverged)} kept-out record(s) "
+                          f"({', '.join(diverged)}): counted as not better, left out of both means."]
     (out_dir / "report.md").write_text("\n".join(lines) + "\n")
     return {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
