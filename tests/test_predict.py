@@ -326,3 +326,39 @@ def test_wind_on_and_off_on_a_real_slice(tmp_path, ship3m):
     on2, off2 = predict(ship3m, [bare], wind=True).runs[0], predict(ship3m, [bare], wind=False).runs[0]
     assert on2.run.wind == "no wind channels"
     assert np.array_equal(on2.pred, off2.pred) and np.array_equal(off2.pred, off.pred)
+
+
+def test_a_diverged_replay_says_where_and_scores_null(simulated, tmp_path, capsys):
+    """A model whose surge resistance is turned into thrust (X_uu > 0: du/dt grows like u^2, a
+    blow-up in finite time) diverges on the ZZ20 record: ``Replayed.diverged_at`` is the time of
+    the first non-finite predicted sample (finite before it, not after), the scores are NaN, and
+    ``mmg predict`` says where in one line, writes null scores and leaves it out of the mean.  The
+    unchanged ship replays the same record to the end (``diverged_at`` None)."""
+    from mmg.resources import ship_path
+    from trials.identify import ship_yaml
+    from trials.logio import read_record
+    from trials.predict import replay_record
+
+    res, truth, _ = simulated["zz20"]
+    ship = res.trial.ship
+    rec = read_record(truth, length_m=ship.particulars.L)
+    assert replay_record(ship, rec).diverged_at is None
+    bad = ship.with_hull({"X_uu": 0.5})
+    rep = replay_record(bad, rec)
+    t_div = rep.diverged_at
+    assert t_div is not None and rec.t[0] < t_div <= rec.t[-1]
+    k = int(np.searchsorted(rep.run.t, t_div))
+    assert np.isfinite(rep.pred[:k]).all() and not np.isfinite(rep.pred[k:]).all(axis=1).any()
+    assert all(np.isnan(v) for v in rep.scores().values())
+
+    yml = tmp_path / "bad.yaml"
+    yml.write_text(ship_yaml(ship_path("esso_osaka"), {"X_uu": 0.5}, "X_uu with the wrong sign (test)"))
+    js = tmp_path / "p.json"
+    rc, out, err = _run_cli(["predict", "--ship", yml, truth, truth, "--json", js], capsys)
+    assert rc == 0, err
+    lines = out.strip().splitlines()
+    assert lines[0] == f"{rec.name}: the replay diverged at t = {t_div:.1f} s (the predicted state is not finite " \
+                       f"from there; scores null), wind {rep.run.wind}"
+    assert not any(ln.startswith("mean over") for ln in lines)          # nothing finite to average
+    doc = json.loads(js.read_text())
+    assert all(run[k] is None for run in doc["runs"] for k in SCORE_KEYS)

@@ -422,14 +422,20 @@ def cmd_predict(args) -> int:
     pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)
     for r in pred.runs:
         s = r.scores()
+        if r.diverged_at is not None:      # NaN scores (null in the JSON): say where and why
+            print(f"{r.run.name}: the replay diverged at t = {r.diverged_at:.1f} s (the predicted state is not "
+                  f"finite from there; scores null), wind {r.run.wind}")
+            continue
         print(f"{r.run.name}: heading {s['heading_rms_deg']:.4g} deg RMS, yaw rate {s['yaw_rate_rms_degps']:.4g} deg/s RMS, "
               f"speed {s['speed_rms_mps']:.4g} m/s RMS, final position {s['final_position_error_m']:.4g} m "
               f"({s['final_position_error_L']:.4g} L), wind {r.run.wind}")
     if len(pred.runs) > 1:                 # the figure a comparison of two configs quotes
-        sc = [r.scores() for r in pred.runs]
+        sc = [r.scores() for r in pred.runs if r.diverged_at is None]
         mean = lambda k: sum(x[k] for x in sc) / len(sc)  # noqa: E731
-        print(f"mean over {len(sc)} runs: heading {mean('heading_rms_deg'):.4g} deg RMS, "
-              f"final position {mean('final_position_error_L'):.4g} L")
+        left = len(pred.runs) - len(sc)
+        if sc:
+            print(f"mean over {len(sc)} runs{f' ({left} diverged, left out)' if left else ''}: heading "
+                  f"{mean('heading_rms_deg'):.4g} deg RMS, final position {mean('final_position_error_L'):.4g} L")
     text = dumps_json(pred.to_json())
     names = _plot_names(pred.runs)
     with StagedFile(args.json) as tmp:     # renamed last, after the plots are in place

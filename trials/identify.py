@@ -451,10 +451,16 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
         lines += ["", "## Predictions of records never trained on", "",
                   "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
                   "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
+        gone = []
         for r in test_runs:
-            x, y = ident.replay(r, "initial").scores(), ident.replay(r).scores()
+            ri, rf = ident.replay(r, "initial"), ident.replay(r)
+            x, y = ri.scores(), rf.scores()
+            gone += [f"{r.name} ({who}, at t = {g.diverged_at:.1f} s)" for who, g in (("initial", ri), ("identified", rf))
+                     if g.diverged_at is not None]
             lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
                          f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
+        if gone:
+            lines += ["", f"'nan': the replay diverged (its state stopped being finite): {', '.join(gone)}."]
     if cv:
         lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
                   "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]

@@ -176,9 +176,18 @@ class Replayed:
     L: float
     B: float
 
+    @property
+    def diverged_at(self) -> float | None:
+        """Time [s] of the first predicted sample that is not finite (the replay diverged there and
+        :meth:`scores` are NaN), or None when the whole record replayed."""
+        bad = ~np.isfinite(self.pred).all(axis=1)
+        return float(self.run.t[np.argmax(bad)]) if bad.any() else None
+
     def scores(self) -> dict:
         """RMS over the record of heading [deg], yaw rate [deg/s], speed [m/s]; final position
         error [m] and [L] (keys :data:`SCORE_KEYS`); NaN where the replay diverged."""
+        if self.diverged_at is not None:
+            return dict.fromkeys(SCORE_KEYS, float("nan"))
         m, p = self.run.meas, self.pred
         dpsi = np.degrees(p[:, 5] - m[:, 5])
         dr = np.degrees(p[:, 2] - m[:, 2])
