@@ -70,3 +70,59 @@ def test_unknown_free_name_is_one_line_and_nothing_written(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and not out.exists()
     assert len(err) == 1 and "--free" in err[0] and "Y_vv_typo" in err[0] and "rudder_offset" in err[0]
+
+
+def _errors(err):
+    return [ln for ln in err.strip().splitlines() if ln.startswith("error")]
+
+
+def test_cv_with_one_independent_run_is_refused_before_any_fit(tmp_path, capsys):
+    """--cv over one record, or over a record and its own cut (one run: a kept-out copy would be in its
+    own training set), is refused in one line, exit 2, before any iteration, nothing written."""
+    d = tmp_path
+    whole = _slice(FRT / "turning" / "turn_14-Sep-2020_13_51_45.csv", d / "turn.csv", 60.0)
+    cut = _slice(whole, d / "turn_cut.csv", 30.0)
+    for train in ([whole], [whole, cut]):
+        out = d / "out"
+        rc = main(["identify", "--ship", "esso_osaka_3m", "--train", *map(str, train), "--out", str(out), "--cv", "4"])
+        err = capsys.readouterr().err
+        assert rc == 2 and not out.exists()
+        assert _errors(err) == ["error: --cv: cross-validation needs 2 or more independent records, got 1 "
+                                "(a record and its cut copies count once)"]
+        assert "iteration" not in err
+
+
+def test_cv_narrowed_to_the_independent_runs(tmp_path, capsys):
+    """--cv 4 over two runs uses two folds (each record kept out once, said in a note), not four fits
+    of which two keep nothing out."""
+    from trials.identify import cv_folds, load_runs
+
+    import mmg
+
+    a = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv", tmp_path / "zz.csv", 40.0)
+    b = _slice(FRT / "turning" / "turn_14-Sep-2020_13_51_45.csv", tmp_path / "turn.csv", 40.0)
+    runs = load_runs(mmg.load_ship("esso_osaka_3m"), [a, b])
+    assert cv_folds(runs, 4) == 2 and cv_folds(runs, 2) == 2 and cv_folds(runs + runs[:1], 4) == 2
+    out = tmp_path / "out"
+    rc = main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--out", str(out), "--cv", "4"])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert "note: --cv 4: 2 independent records, so 2 folds (each kept out once)" in err
+    assert re.findall(r"cross-validation fold (\d)/(\d)", err) == [("1", "2"), ("2", "2")]
+    report = (out / "report.md").read_text()
+    assert "## Cross-validation (2 folds, each record kept out once)" in report
+    assert re.search(r"\| zz \| 0 \|", report) and re.search(r"\| turn \| 1 \|", report)
+
+
+def test_an_unusable_test_record_is_refused_before_the_fit(tmp_path, capsys):
+    """--test with no usable record stops before the fit (the one record skipped with its line), exit 2,
+    nothing written."""
+    bad = tmp_path / "empty.csv"
+    bad.write_text((FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv").read_text().splitlines()[0] + "\n")
+    out = tmp_path / "out"
+    rc = main(["identify", "--ship", "esso_osaka_3m", "--train", str(FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv"),
+               "--test", str(bad), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 2 and not out.exists() and "iteration" not in err
+    assert any(ln.startswith(f"skipped: {bad}") for ln in err.splitlines())
+    assert _errors(err) == ["error: --test: no usable record"]

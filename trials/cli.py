@@ -464,7 +464,7 @@ def cmd_identify(args) -> int:
     from mmg.resources import ship_path
     from mmg.ship import load_ship
 
-    from .identify import cross_validate, identify, load_runs, write_identification
+    from .identify import cross_validate, cv_folds, identify, load_runs, write_identification
     from .output import StagedOutput, check_output_dir
 
     check_output_dir(args.out)
@@ -480,7 +480,18 @@ def cmd_identify(args) -> int:
     runs = load_runs(ship, args.train, wind=wind)        # an unusable record: one line, skipped
     if not runs:
         raise InputError("--train", "", "no usable training record")
-    print(f"training on {len(runs)} records", file=sys.stderr, flush=True)
+    print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
+    if args.cv:                                          # refused or narrowed before any fit
+        try:
+            folds = cv_folds(runs, args.cv)
+        except ValueError as e:
+            raise InputError("--cv", "", f"{e} (a record and its cut copies count once)") from None
+        if folds < args.cv:
+            print(f"note: --cv {args.cv}: {folds} independent records, so {folds} folds (each kept out once)",
+                  file=sys.stderr, flush=True)
+    tests = load_runs(ship, args.test, wind=wind) if args.test else None   # a bad one: one line, before the fit
+    if args.test and not tests:
+        raise InputError("--test", "", "no usable record")
 
     def progress(k, cost):
         print(f"  iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
@@ -492,10 +503,9 @@ def cmd_identify(args) -> int:
     ident = identify(ship, runs, wind=wind, progress=progress, initial=initial, **kw)
     cv = None
     if args.cv:
-        cv = cross_validate(ship, runs, folds=args.cv, wind=wind, initial=initial, folds_by=args.folds_by, **kw,
+        cv = cross_validate(ship, runs, folds=folds, wind=wind, initial=initial, folds_by=args.folds_by, **kw,
                             progress=lambda k, n: print(f"cross-validation fold {k}/{n} ({time.perf_counter() - t0:.0f} s)",
                                                         file=sys.stderr, flush=True))
-    tests = load_runs(ship, args.test, wind=wind) if args.test else None
     with StagedOutput(args.out) as stage:
         write_identification(ident, src, stage.dir, cv, tests)
     a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])

@@ -47,7 +47,7 @@ from mmg.ship import Ship
 
 from .predict import MeasuredRun, measured_run, replay_record
 
-__all__ = ["identify", "cross_validate", "write_identification", "load_runs", "ship_yaml", "Identification",
+__all__ = ["identify", "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale")
@@ -292,6 +292,17 @@ FOLD_ASSIGNMENTS = ("order", "revolutions")
 """How :func:`cross_validate` deals the records into folds (:func:`fold_of`)."""
 
 
+def cv_folds(runs: list[MeasuredRun], folds: int) -> int:
+    """The number of folds a cross-validation of ``runs`` uses: ``folds``, or fewer when there are
+    fewer independent runs (:func:`same_run_groups`: a record and its cuts count once), since a fold
+    with nothing to keep out would only repeat the fit on all records.  Raises ValueError below two
+    runs, where nothing can be kept out and still leave a training set."""
+    n = len(set(same_run_groups(runs)))
+    if n < 2:
+        raise ValueError(f"cross-validation needs 2 or more independent records, got {n}")
+    return min(int(folds), n)
+
+
 def fold_of(runs: list[MeasuredRun], folds: int, by: str = "order") -> np.ndarray:
     """The fold (0 .. folds-1) of each record.
 
@@ -342,6 +353,7 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     ref = ship if initial is None else initial
     out = []
     idx = np.arange(len(runs))
+    folds = cv_folds(runs, folds)
     fold = fold_of(runs, folds, folds_by)
     for k in range(folds):
         test = idx[fold == k]
