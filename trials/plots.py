@@ -82,6 +82,40 @@ def track_figure(t, x, y, psi, L, B, title, every_s=None, ax=None, pyplot: bool 
     return fig
 
 
+SAVED_LINE_BUCKETS = 1000
+"""Time buckets of a line in a figure that is only saved (:func:`min_max_decimate`): more than the
+histories' 780 pixel columns, so every column still holds the line's lowest and highest sample."""
+
+
+def min_max_decimate(t, y, buckets: int = SAVED_LINE_BUCKETS):
+    """The samples of ``y(t)`` that a plot ``buckets`` pixels wide shows: in each of ``buckets``
+    equal runs of samples its lowest and its highest (in time order), plus the samples after the
+    last full run.  A line drawn through them covers, in every pixel column, the same range as the
+    full line: peaks, overshoots and spikes stay (nothing is averaged away).  Records of up to
+    ``4 * buckets`` samples are returned whole.
+
+    Parameters
+    ----------
+    t, y : ndarray (N,)
+    buckets : int
+
+    Returns
+    -------
+    t, y : ndarray
+        The kept samples, a subset of the input in time order.
+    """
+    t, y = np.asarray(t), np.asarray(y)
+    N = len(t)
+    if N <= 4 * buckets:
+        return t, y
+    k = N // buckets
+    blocks = y[: k * buckets].reshape(buckets, k)
+    base = np.arange(buckets)[:, None] * k
+    pick = np.sort(np.stack([np.argmin(blocks, axis=1), np.argmax(blocks, axis=1)], axis=1), axis=1) + base
+    idx = np.concatenate([pick.ravel(), np.arange(k * buckets, N)])
+    return t[idx], y[idx]
+
+
 def histories_figure(t, psi, delta, r, U, n, title, delta_order=None, ax=None, pyplot: bool = True):
     """Heading, rudder, yaw rate, speed and rpm against time (five panels).
 
@@ -96,7 +130,10 @@ def histories_figure(t, psi, delta, r, U, n, title, delta_order=None, ax=None, p
     ax : sequence of 5 matplotlib.axes.Axes, optional
         Draw into these axes; default a new figure with five panels sharing the time axis.
     pyplot : bool, default True
-        Make the new figure with pyplot.
+        Make the new figure with pyplot.  A new figure that is only saved (``pyplot=False``)
+        draws each line through :func:`min_max_decimate` (a 3000 s run at 0.1 s: 30 000 samples,
+        2000 drawn; the same picture, a fifth of the rendering time); a pyplot figure, which can be
+        zoomed, and axes you give get every sample.
 
     Returns
     -------
@@ -112,18 +149,19 @@ def histories_figure(t, psi, delta, r, U, n, title, delta_order=None, ax=None, p
             raise ValueError(f"histories need 5 axes, got {len(axs)}")
         fig = axs[0].figure
         new = False
-    axs[0].plot(t, psi / DEG, "b")
+    line = (lambda y: min_max_decimate(t, y)) if new and not pyplot else (lambda y: (t, y))  # noqa: E731
+    axs[0].plot(*line(psi / DEG), "b")
     axs[0].set_ylabel("heading ψ (deg)")
-    axs[1].plot(t, delta / DEG, "r", label="rudder δ")
+    axs[1].plot(*line(delta / DEG), "r", label="rudder δ")
     if delta_order is not None:
-        axs[1].plot(t, delta_order / DEG, "k--", lw=0.8, label="order δ*")
+        axs[1].plot(*line(delta_order / DEG), "k--", lw=0.8, label="order δ*")
         axs[1].legend(loc="best")
     axs[1].set_ylabel("rudder (deg)")
-    axs[2].plot(t, r / DEG, "g")
+    axs[2].plot(*line(r / DEG), "g")
     axs[2].set_ylabel("yaw rate r (deg/s)")
-    axs[3].plot(t, U / KNOT, "m")
+    axs[3].plot(*line(U / KNOT), "m")
     axs[3].set_ylabel("speed U (kn)")
-    axs[4].plot(t, n * 60, "k")
+    axs[4].plot(*line(n * 60), "k")
     axs[4].set_ylabel("propeller n (rpm)")
     axs[4].set_xlabel("time t (s)")
     for a in axs:
