@@ -276,6 +276,26 @@ class IdentifyResult:
     n_residuals: int
     iterations: int
     message: str
+    status: int = 1
+    """scipy's ``least_squares`` status: 0 the evaluation limit stopped it, > 0 converged."""
+
+    def warnings(self) -> list[str]:
+        """What a reader of the values should not miss, one sentence each: a parameter on one of its
+        bounds (the bound, not the data, set it), a parameter whose sign is the opposite of its
+        prior's (for a hull derivative: another physics, e.g. a damping that feeds the motion), and a
+        fit stopped by its evaluation limit instead of converging."""
+        out = []
+        for f, v in zip(self.free, self.theta):
+            v = float(v)
+            for side, b in (("lower", f.lower), ("upper", f.upper)):
+                if np.isfinite(b) and abs(v - b) <= 1e-6 * (1.0 + abs(b)):
+                    out.append(f"{f.name} is at its {side} bound {b:.4g}: the bound, not the data, set it")
+            if f.prior != 0.0 and v != 0.0 and np.sign(v) != np.sign(f.prior):
+                out.append(f"{f.name} changed sign: {f.prior:.4g} in the config, {v:.4g} identified")
+        if self.status == 0:
+            out.append(f"the fit stopped at its evaluation limit after {self.iterations} evaluations without "
+                       f"converging ({self.message})")
+        return out
 
     def values(self) -> dict:
         """Fitted value of each free parameter, by name."""
@@ -446,4 +466,4 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
         corr = cov / np.outer(std, std)
     return IdentifyResult(free=free, theta=sol.x, std=std, corr=corr, cost_initial=0.5 * float(r_init @ r_init),
                           cost_final=float(sol.cost), n_residuals=len(sol.fun), iterations=int(sol.nfev),
-                          message=str(sol.message))
+                          message=str(sol.message), status=int(sol.status))

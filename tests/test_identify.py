@@ -283,3 +283,30 @@ def test_a_diverged_kept_out_replay_is_named_not_counted_better_and_left_out_of_
     assert "| **mean** | | 8.00 | 2.50 | 3.20 |" in rep
     assert "better on 2 of 3" in rep
     assert "diverged on 1 kept-out record(s) (gone)" in rep
+
+
+def test_fit_warnings_name_bounds_sign_changes_and_no_convergence():
+    """IdentifyResult.warnings(): a value on a finite bound, a value of the opposite sign to a nonzero
+    prior, and status 0 (evaluation limit) each give one sentence naming the parameter; values inside
+    their bounds with their prior's sign, a zero prior and a converged fit give none."""
+    from ekf.identify import FreeParameter, IdentifyResult
+
+    free = [FreeParameter("Y_bb", "hull", 0, 0.6732, 0.3),                       # sign flips
+            FreeParameter("w_P0", "const", 0, 0.3946, 0.2, lower=0.0, upper=0.9),  # on the lower bound
+            FreeParameter("N_r", "hull", 1, -0.054, 0.03),                       # same sign, changed
+            FreeParameter("N_0", "hull", 2, 0.0, 0.01),                           # zero prior: no sign to keep
+            FreeParameter("epsilon", "const", 0, 1.0, 0.5, lower=0.1, upper=3.0)]  # inside its bounds
+    theta = np.array([-1.131, 0.0, -0.0071, -0.002, 2.999])
+
+    def result(status):
+        return IdentifyResult(free=free, theta=theta, std=np.ones(5), corr=np.eye(5), cost_initial=2.0,
+                              cost_final=1.0, n_residuals=100, iterations=30, message="limit", status=status)
+
+    w = result(0).warnings()
+    assert len(w) == 3
+    assert w[0].startswith("Y_bb changed sign") and "0.6732" in w[0] and "-1.131" in w[0]
+    assert w[1].startswith("w_P0 is at its lower bound 0")
+    assert w[2].startswith("the fit stopped at its evaluation limit after 30 evaluations")
+    assert result(1).warnings() == w[:2]
+    assert IdentifyResult(free=free[2:], theta=theta[2:], std=np.ones(3), corr=np.eye(3), cost_initial=2.0,
+                          cost_final=1.0, n_residuals=100, iterations=9, message="ok", status=2).warnings() == []

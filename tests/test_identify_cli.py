@@ -111,6 +111,14 @@ def test_cv_narrowed_to_the_independent_runs(tmp_path, capsys):
     assert re.findall(r"cross-validation fold (\d)/(\d)", err) == [("1", "2"), ("2", "2")]
     report = (out / "report.md").read_text()
     assert "## Cross-validation (2 folds, each record kept out once)" in report
+    # the report's Warnings items and the one stderr line pointing to them agree, each item naming a
+    # parameter of the values table or the fit's stop
+    table = set(re.findall(r"^\| (\w+) \| [-\d.e+]+ \| [-\d.e+]+ \|", report, flags=re.M))
+    items = re.findall(r"^- (.+)$", report.split("## Warnings", 1)[1].split("\n## ", 1)[0], flags=re.M) \
+        if "## Warnings" in report else []
+    said = re.findall(r"^warning: (\d+) finding\(s\) on where the identified values", err, flags=re.M)
+    assert said == ([str(len(items))] if items else [])
+    assert all(it.split()[0] in table or it.startswith("the fit stopped") for it in items)
     assert re.search(r"\| zz \| 0 \|", report) and re.search(r"\| turn \| 1 \|", report)
 
 
@@ -126,3 +134,4 @@ def test_an_unusable_test_record_is_refused_before_the_fit(tmp_path, capsys):
     assert rc == 2 and not out.exists() and "iteration" not in err
     assert any(ln.startswith(f"skipped: {bad}") for ln in err.splitlines())
     assert _errors(err) == ["error: --test: no usable record"]
+

@@ -513,6 +513,11 @@ def cmd_identify(args) -> int:
     print(f"identified {len(ident.fit.free)} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
           f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
     print(f"wrote {Path(args.out) / 'ship.yaml'} and {Path(args.out) / 'report.md'}")
+    warn = ident.fit.warnings()
+    if warn:
+        print(f"warning: {len(warn)} finding(s) on where the identified values should not be read as the ship's "
+              f"physics (sign changes, bounds, no convergence): {Path(args.out) / 'report.md'}, 'Warnings'",
+              file=sys.stderr)
     return 0
 
 

@@ -436,6 +436,11 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
              "| parameter | config | identified | std | change |", "|---|---|---|---|---|"]
     for name, row in fit.to_pandas().iterrows():
         lines.append(f"| {name} | {row.prior:.5g} | {row.estimate:.5g} | {row['std']:.2g} | {row.change_pct:+.0f} % |")
+    warn = fit.warnings()
+    if warn:
+        lines += ["", "## Warnings", "",
+                  "The identified values predict the training records (below); these say where they should not "
+                  "be read as the ship's physics:", ""] + [f"- {w}" for w in warn]
     names = [f.name for f in fit.free]
     lines += ["", "## Correlations (|rho| >= 0.8)", ""]
     strong = [(names[i], names[j], fit.corr[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
