@@ -350,6 +350,17 @@ def test_a_diverged_replay_says_where_and_scores_null(simulated, tmp_path, capsy
     k = int(np.searchsorted(rep.run.t, t_div))
     assert np.isfinite(rep.pred[:k]).all() and not np.isfinite(rep.pred[k:]).all(axis=1).any()
     assert all(np.isnan(v) for v in rep.scores().values())
+    # the figure marks the divergence and keeps every panel on the measured record's range
+    fig = rep.plot(pyplot=False)
+    hist = [a for a in fig.axes if a.get_ylabel() in ("heading (deg)", "yaw rate (deg/s)", "speed (m/s)", "sway v (m/s)")]
+    assert len(hist) == 4 and f"replay diverged at t = {t_div:.1f} s" in hist[0].get_title()
+    meas = {"heading (deg)": np.degrees(rep.run.meas[:, 5]), "yaw rate (deg/s)": np.degrees(rep.run.meas[:, 2]),
+            "speed (m/s)": np.hypot(rep.run.meas[:, 0], rep.run.meas[:, 1]), "sway v (m/s)": rep.run.meas[:, 1]}
+    for a in hist:
+        lo, hi = a.get_ylim()
+        m = meas[a.get_ylabel()]
+        assert lo <= m.min() and hi >= m.max() and hi - lo <= 3.0 * (m.max() - m.min()) + 1e-5
+        assert any(ln.get_label().startswith("replay diverged") and ln.get_xdata()[0] == t_div for ln in a.get_lines())
 
     yml = tmp_path / "bad.yaml"
     yml.write_text(ship_yaml(ship_path("esso_osaka"), {"X_uu": 0.5}, "X_uu with the wrong sign (test)"))
