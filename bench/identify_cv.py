@@ -49,6 +49,8 @@ def main() -> None:
                     help="effects fitted once per training record as nuisances (e.g. current)")
     ap.add_argument("--folds-by", choices=["order", "revolutions"], default="order",
                     help="deal the records into folds in file order or stratified by propeller revolutions")
+    ap.add_argument("--max-nfev", type=int, default=None,
+                    help="evaluation limit of the whole-record fit (default: trials.identify.identify's)")
     ap.add_argument("--offset-spread", type=float, default=0.0, metavar="DEG",
                     help="also score each kept-out record under rudder offsets within +-DEG (both models)")
     a = ap.parse_args()
@@ -70,6 +72,8 @@ def main() -> None:
             extra["record_nuisance"] = tuple(a.nuisance)
         if a.loss != "linear":
             extra.update(loss=a.loss, f_scale=a.f_scale)
+        if a.max_nfev:
+            extra["max_nfev"] = a.max_nfev
         cv = cross_validate(ship, runs, folds=a.folds, wind=wind, prior_rel_std=a.prior, initial=initial,
                             folds_by=a.folds_by, **extra,
                             progress=lambda k, n: print(f"  fold {k}/{n} done, {time.perf_counter() - t0:.0f} s", flush=True))
