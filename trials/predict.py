@@ -19,6 +19,7 @@ and speed [m/s] and by the final position error [m and ship lengths] (:meth:`Rep
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -176,7 +177,7 @@ class Replayed:
     L: float
     B: float
 
-    @property
+    @cached_property
     def diverged_at(self) -> float | None:
         """Time [s] of the first predicted sample that is not finite (the replay diverged there and
         :meth:`scores` are NaN), or None when the whole record replayed."""

@@ -27,9 +27,8 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True):
     t_div = rep.diverged_at
     div = "" if t_div is None else f"\nreplay diverged at t = {t_div:.1f} s"
 
-    def keep_measured_range(a_, *meas):
-        lo = min(float(np.nanmin(x)) for x in meas)
-        hi = max(float(np.nanmax(x)) for x in meas)
+    def keep_measured_range(x):
+        lo, hi = float(np.nanmin(x)), float(np.nanmax(x))
         pad = max(hi - lo, 1e-6 * max(abs(lo), abs(hi), 1.0))
         return lo - pad, hi + pad
 
@@ -48,12 +47,12 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True):
                 ax.fill(py / L, px / L, fc="none", ec=ec, lw=0.6, label=lab if first else None)
         first = False
     if t_div is not None:
-        ax.set_xlim(*keep_measured_range(ax, m[:, 4] / L))
-        ax.set_ylim(*keep_measured_range(ax, m[:, 3] / L))
+        ax.set_xlim(*keep_measured_range(m[:, 4] / L))
+        ax.set_ylim(*keep_measured_range(m[:, 3] / L))
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("y, east (L)")
     ax.set_ylabel("x, north (L)")
-    ax.set_title(f"{title}: track (L = {L:g} m, wind {run.wind})" + ("" if t_div is None else f"\nreplay diverged at t = {t_div:.1f} s"))
+    ax.set_title(f"{title}: track (L = {L:g} m, wind {run.wind}){div}")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     rows = [("heading (deg)", np.degrees(m[:, 5]), np.degrees(p[:, 5])),
@@ -67,7 +66,7 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True):
         a_.plot(t, b, "r--", lw=1, label="predicted")
         if t_div is not None:
             a_.axvline(t_div, color="r", ls=":", lw=1.2, label=f"replay diverged (t = {t_div:.1f} s)")
-            a_.set_ylim(*keep_measured_range(a_, a))
+            a_.set_ylim(*keep_measured_range(a))
         a_.set_ylabel(lab)
         a_.grid(True, alpha=0.3)
         axs.append(a_)

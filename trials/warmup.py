@@ -134,14 +134,12 @@ def _filter_args():
 
 
 def warm_jacobian() -> None:
-    """The paper filter's Jacobian step (:func:`ekf.kernels.jacobian_step` through
-    :func:`ekf.propagate.workspace`), called with the argument types of the compiled pass."""
+    """The paper filter's Jacobian step (:func:`ekf.kernels.jacobian_step`), called with the argument
+    types of the compiled pass."""
     import numpy as np
 
     from ekf import propagate
-    from ekf.kernels import jacobian_step
-
-    from ekf.kernels import make_workspace
+    from ekf.kernels import jacobian_step, make_workspace
 
     pk, slots, t, meas, delta, z0, P0, R = _filter_args()
     # the work arrays made by the Python original of make_workspace (the same arrays, so the same
