@@ -1,8 +1,7 @@
 """Ahead-of-time compiled simulator kernels: a simulation in a fresh process without numba.
 
-The simulator's hot loop (:func:`mmg.kernel.simulate_kernel`) and the two model functions the
-straight-run solver calls (:func:`mmg.model.rhs`, :func:`mmg.model.forces`) are compiled once, by
-``numba.pycc``, into an extension module, from the very same Python functions the JIT compiles
+The simulator's hot loop (:func:`mmg.kernel.simulate_kernel`) is compiled once, by
+``numba.pycc``, into an extension module, from the very same Python function the JIT compiles
 (one definition of the physics; the states are the JIT's to the last bit, a test checks).  The
 module imports only numpy, so a process that simulates and does nothing else never imports numba
 (whose import and typing registries cost about 0.3 s, more than the simulated turn itself,
@@ -31,8 +30,7 @@ import tempfile
 import threading
 from pathlib import Path
 
-__all__ = ["kernels", "enabled", "module_path", "module_name", "build", "simulate_kernel", "model_functions",
-           "build_deferred"]
+__all__ = ["kernels", "enabled", "module_path", "module_name", "build", "simulate_kernel", "build_deferred"]
 
 SOURCES = ("_inlining.py", "_jit.py", "_aot.py", "model.py", "nondim.py", "rudder.py", "terms.py", "wind.py",
            "kernel.py")
@@ -42,8 +40,6 @@ SOURCES = ("_inlining.py", "_jit.py", "_aot.py", "model.py", "nondim.py", "rudde
 # the JIT's specialisations (shared through numba's cache) and not a second, any-layout set
 SIG_SIMULATE = ("i8(f8[::1], f8, i8, f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1], i8, f8[::1], f8[::1], f8[::1], "
                 "f8[::1], f8[:,::1], f8[::1])")
-SIG_RHS = "void(f8[::1], f8, f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1], f8[::1])"
-SIG_FORCES = "UniTuple(f8, 4)(f8[::1], f8[::1], f8[:,::1], i8[::1], i8[::1], f8[::1])"
 
 _lock = threading.Lock()
 _module = None
@@ -139,7 +135,7 @@ def build(path: Path | None = None) -> Path:
         warnings.simplefilter("ignore")
         from numba.pycc import CC
 
-    from . import kernel, model
+    from . import kernel
     from ._jit import materialize
 
     materialize()                                # the real dispatchers, not their stand-ins
@@ -152,19 +148,11 @@ def build(path: Path | None = None) -> Path:
         tempfile.tempdir = str(tmp)              # pycc's own build folder goes in there too
         cc = CC(name, source_module=__name__)
         cc.output_dir = str(tmp)
-        sim, rhs, forces = kernel.simulate_kernel, model.rhs, model.forces
+        sim = kernel.simulate_kernel
 
         @cc.export("simulate_kernel", SIG_SIMULATE)
         def _simulate(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders):
             return sim(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders)
-
-        @cc.export("rhs", SIG_RHS)
-        def _rhs(x, delta_cmd, p, poly, ha, ht, hc, out):
-            rhs(x, delta_cmd, p, poly, ha, ht, hc, out)
-
-        @cc.export("forces", SIG_FORCES)
-        def _forces(x, p, poly, ha, ht, hc):
-            return forces(x, p, poly, ha, ht, hc)
 
         cc.compile()
         os.replace(tmp / cc.output_file, path)
@@ -179,7 +167,7 @@ def build(path: Path | None = None) -> Path:
 
 
 def kernels():
-    """The compiled module (attributes ``simulate_kernel``, ``rhs``, ``forces``), built on first use;
+    """The compiled module (attribute ``simulate_kernel``), built on first use;
     None where it is disabled, cannot be built, or the caller is not the main thread (module docstring)."""
     global _module, _tried
     if threading.current_thread() is not threading.main_thread() or not enabled():
@@ -221,14 +209,4 @@ def simulate_kernel():
     from .kernel import simulate_kernel as jit
 
     return jit
-
-
-def model_functions():
-    """(rhs, forces) to call here: the compiled module's, or the JIT's."""
-    k = kernels()
-    if k is not None:
-        return k.rhs, k.forces
-    from .model import forces, rhs
-
-    return rhs, forces
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import sys
 import threading
 
-__all__ = ["njit", "LazyJit", "materialize", "materialized", "carray", "readonly"]
+__all__ = ["njit", "LazyJit", "materialize", "materialized", "interpreted", "carray", "readonly"]
 
 _registry: list["LazyJit"] = []
 _lock = threading.RLock()
@@ -114,6 +114,54 @@ def materialize() -> None:
 def materialized() -> bool:
     """Whether numba's dispatchers have been made in this process."""
     return _done
+
+
+def _python_original(obj):
+    """The Python function behind a stand-in or a numba dispatcher, else None."""
+    if type(obj) is LazyJit:
+        return obj.py_func
+    if type(obj).__module__.startswith("numba"):
+        return getattr(obj, "py_func", None)
+    return None
+
+
+_interpreted: dict = {}
+
+
+def interpreted(func):
+    """``func`` (a compiled function of the project, or its Python original) run by the interpreter:
+    a copy of its Python original whose calls to other compiled functions, by their global names,
+    go to their own interpreted copies, recursively.
+
+    The same source as the compiled code, so the same physics; for the few calls where compiling
+    would cost seconds and the interpreter microseconds (the straight-run solver's 30-60 model
+    evaluations before a simulation, :mod:`mmg.equilibrium`).  Results agree with the compiled
+    function's to rounding (``tests/test_aot.py``).  Functions reached through closures are not
+    replaced (those of the hot loops; not for use here)."""
+    import types
+
+    f = _python_original(func) or func
+    with _lock:
+        clone = _interpreted.get(f)
+        if clone is not None:
+            return clone
+        g = dict(f.__globals__)
+        clone = types.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
+        clone.__kwdefaults__, clone.__doc__, clone.__qualname__ = f.__kwdefaults__, f.__doc__, f.__qualname__
+        _interpreted[f] = clone                   # before the callees: a recursive call finds it
+        for name in _global_names(f.__code__):
+            if _python_original(g.get(name)) is not None:
+                g[name] = interpreted(g[name])
+        return clone
+
+
+def _global_names(code) -> set:
+    """The names a code object (and the code nested in it) may look up as globals."""
+    names = set(code.co_names)
+    for c in code.co_consts:
+        if hasattr(c, "co_names"):
+            names |= _global_names(c)
+    return names
 
 
 def carray(a, dtype=float):

@@ -15,8 +15,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ._aot import model_functions
-from .model import POLY_KQ, N_, PackedShip, pack, polyval
+from ._jit import interpreted
+from .model import POLY_KQ, N_, PackedShip, forces, pack, polyval, rhs
 from .ship import Ship
 
 
@@ -45,6 +45,14 @@ class Equilibrium:
 def engine_power(ship: Ship, u0: float) -> float:
     """Constant engine power P_0 [W] = watts_per_hp * SHP_0(u0), eq. (18)-(19)."""
     return ship.engine.watts_per_hp * float(np.polyval(ship.engine.SHP_0[::-1], u0))
+
+
+def model_functions():
+    """(rhs, forces) as the straight-run solver calls them: :func:`mmg.model.rhs` and
+    :func:`mmg.model.forces` run by the interpreter (:func:`mmg._jit.interpreted`).  The solver
+    evaluates the model 30-60 times (about 2 ms interpreted); compiling the two functions would cost
+    3 s of a cold cache's first simulation and does not pay for itself."""
+    return interpreted(rhs), interpreted(forces)
 
 
 def _accels(pk: PackedShip, u, v, delta, n):
@@ -146,7 +154,7 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
     if ship.engine.mode == "constant_power":
         x = np.array([u0, vv, 0.0, 0.0, 0.0, 0.0, dd, nn])
         J = model_functions()[1](x, *pk.args())[3]
-        kq = polyval.py_func(pk.poly, POLY_KQ, J)     # Python body: no specialisation compiled for one call
+        kq = interpreted(polyval)(pk.poly, POLY_KQ, J)     # no specialisation compiled for one call
         D, rho = ship.propeller.D, ship.particulars.rho
         scale = power / (2 * np.pi * nn) / (rho * nn**2 * D**5 * kq)
     pk2 = pack_all(with_kq_scale(ship, scale))

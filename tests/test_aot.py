@@ -74,19 +74,55 @@ def test_compiled_module_gives_the_jit_states(aot, case):
     assert abs(sa[-1, M.PSI_]) > 10 * DEG                  # the ship turned: the rudder and hull acted
 
 
-def test_straight_run_same_with_either_model_functions(aot, monkeypatch):
-    from mmg.equilibrium import straight_run
+def test_straight_run_interpreted_agrees_with_the_compiled_model(monkeypatch):
+    """The straight-run solver evaluates rhs and forces by the interpreter (mmg._jit.interpreted):
+    the same solution as with the JIT-compiled functions, and no numba in the evaluation."""
+    import mmg.equilibrium as E
+    from mmg.model import forces, rhs
 
-    ship = load_ship("esso_osaka")
-    a = straight_run(ship, 10 * KNOT)
-    monkeypatch.setenv("MMG_AOT", "0")                  # the JIT's rhs and forces
-    monkeypatch.setattr(_aot, "_module", None)
-    monkeypatch.setattr(_aot, "_tried", False)
-    assert _aot.kernels() is None
-    b = straight_run(ship, 10 * KNOT)
-    for f in ("u", "v", "delta", "n", "power_W", "K_Q_scale"):
-        assert math.isclose(getattr(a, f), getattr(b, f), rel_tol=1e-12, abs_tol=1e-15), f
-    assert a.residual < 1e-9 and b.residual < 1e-9
+    for name in ("esso_osaka", "esso_osaka_3m", "esso_osaka_3m_crossflow"):
+        ship = load_ship(name)
+        u0 = 10 * KNOT * math.sqrt(ship.particulars.L / 325.0)
+        a = E.straight_run(ship, u0)
+        with monkeypatch.context() as m:
+            m.setattr(E, "model_functions", lambda: (rhs, forces))
+            b = E.straight_run(ship, u0)
+        for f in ("u", "v", "delta", "n", "power_W", "K_Q_scale"):
+            assert math.isclose(getattr(a, f), getattr(b, f), rel_tol=1e-10, abs_tol=1e-13), (name, f)
+        assert a.residual < 1e-9 and b.residual < 1e-9
+
+
+def test_interpreted_model_is_pure_python():
+    """interpreted() reaches every compiled callee by its Python original (no dispatcher left in the
+    copies' namespaces), and agrees with the compiled rhs at random states to rounding."""
+    import numpy as np
+
+    from mmg import _jit
+    from mmg.model import pack, rhs
+
+    f = _jit.interpreted(rhs)
+    clones = set(_jit._interpreted.values())
+    seen, todo = set(), [f]
+    while todo:                                   # every function the copy can reach by a global name
+        g = todo.pop()
+        if g in seen:
+            continue
+        seen.add(g)
+        for name in _jit._global_names(g.__code__):
+            v = g.__globals__.get(name)
+            assert type(v) is not _jit.LazyJit and not type(v).__module__.startswith("numba"), (g.__name__, name)
+            if v in clones:
+                todo.append(v)
+    assert {"hull_primed", "propeller", "rudder", "term_value"} <= {g.__name__ for g in seen}
+    pk = pack(load_ship("esso_osaka"), 5.0e6)
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        x = np.array([rng.uniform(0.5, 8), rng.uniform(-1, 1), rng.uniform(-0.02, 0.02), 0, 0, 0,
+                      rng.uniform(-0.6, 0.6), rng.uniform(0.3, 2)])
+        o1, o2 = np.zeros(8), np.zeros(8)
+        rhs(x, 0.1, *pk.args(), o1)
+        f(x, 0.1, *pk.args(), o2)
+        np.testing.assert_allclose(o2, o1, rtol=1e-12, atol=1e-14 * np.abs(o1).max())
 
 
 def test_other_threads_get_the_jit_kernel(aot):

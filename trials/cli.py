@@ -238,7 +238,7 @@ def cmd_estimate(args) -> int:
     from .estimation import estimate_and_report, load_inputs
     from .output import StagedOutput, check_output_dir
 
-    from .warmup import compiling_in_background, filter_cache_cold, warm_filter_parts
+    from .warmup import compiling_in_background, filter_cache_cold, warm_filter_parts, warm_jacobian_real_parts
 
     check_output_dir(args.out)
     cfg = load_config(args.config, args.set or ())
@@ -251,6 +251,7 @@ def cmd_estimate(args) -> int:
             _aot_deferred(cold):
         datas = load_inputs(args.inputs, cfg, seed=args.seed, ship=args.ship, truth=args.truth)
         if cold:
+            warm_jacobian_real_parts()             # the child's, before it needs them
             warm_filter_parts()
         compiled("jacobian")
         rep = estimate_and_report(datas, cfg, out, joint=args.joint, plots=not args.no_plots, method=args.method)

@@ -149,6 +149,26 @@ def warm_jacobian() -> None:
     jacobian_step(z0, 0.0, 0.0, 0.0, 0.0, -1, propagate.SLOTS, propagate.NS, 1.0, *pk.args()[:4], slots, ws)
 
 
+def warm_jacobian_real_parts() -> None:
+    """The real-valued code the Jacobian step calls (the model's force helpers, through the real
+    :func:`mmg.model.dynamics`, and the analytic hull columns :func:`mmg.model.rhs_hull_jacobian`),
+    with the Jacobian step's argument types.  A cold ``mmg estimate`` compiles them in the command
+    while its child is still compiling the all-complex dynamics, so the child loads them from the
+    cache instead of compiling them after it."""
+    from ekf import propagate
+    from ekf.kernels import make_workspace
+    from mmg._jit import interpreted
+    from mmg.model import dynamics, inverse_mass, rhs_hull_jacobian
+
+    pk, slots, t, meas, delta, z0, P0, R = _filter_args()
+    p, poly, hull_axis, hull_term = pk.args()[:4]
+    ws = make_workspace.py_func(len(z0), propagate.NS, pk.hull_coef)   # the step's own work arrays
+    hc, xr, B, w = ws[10], ws[11], ws[18], ws[19]
+    xr[0] = 5.0
+    dynamics(5.0, 0.0, 0.0, 0.0, 1.0, p, poly, hull_axis, hull_term, hc, w)
+    rhs_hull_jacobian(xr, p, hull_axis, hull_term, slots, interpreted(inverse_mass)(p, w), B)
+
+
 def warm_filter_parts() -> None:
     """The paper filter pass's parts other than its Jacobian step (the covariance propagation, the
     checks, the Joseph update and their work arrays), called with the pass's argument types."""
