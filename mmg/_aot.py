@@ -154,6 +154,7 @@ def build(path: Path | None = None) -> Path:
         def _simulate(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders):
             return sim(x0, dt, nsteps, p, poly, ha, ht, hc, kind, cpar, st, sd, sn, states, orders)
 
+        _defer_signals_in_toolchain(cc)
         cc.compile()
         os.replace(tmp / cc.output_file, path)
         if path.parent == Path(__file__).resolve().parent / "__pycache__":
@@ -164,6 +165,62 @@ def build(path: Path | None = None) -> Path:
         tempfile.tempdir = old
         shutil.rmtree(tmp, ignore_errors=True)
     return path
+
+
+@contextlib.contextmanager
+def _signals_deferred():
+    """SIGINT and SIGTERM deferred inside (main thread only): noted by a stand-in handler and sent
+    again on leaving, so the process's own handler runs then.  They are also blocked in this thread,
+    so processes started inside inherit the mask and a terminal's Ctrl-C (sent to the whole process
+    group) does not kill them either."""
+    import signal
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    sigs = (signal.SIGINT, signal.SIGTERM)
+    got: list = []
+    old = {}
+    for sig in sigs:
+        h = signal.getsignal(sig)
+        if h is not None:                        # (None: a handler not set from Python; left alone)
+            old[sig] = signal.signal(sig, lambda signum, frame: got.append(signum))
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, sigs) if hasattr(signal, "pthread_sigmask") else None
+    try:
+        yield
+    finally:
+        if mask is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)     # a signal held by the mask: noted now
+        for sig, h in old.items():
+            signal.signal(sig, h)
+        if got:
+            os.kill(os.getpid(), got[0])        # to the process's own handler
+
+
+def _defer_signals_in_toolchain(cc) -> None:
+    """The C compiler and linker runs of a pycc build with the interrupt deferred until they end
+    (about a second each).  Interrupted, Python would unwind and remove the build folder while the
+    compiler it started still writes into it (its "can't create ...o" on the terminal, a process
+    left running), and a Ctrl-C killing the compiler would fail the build and mark the module as
+    unbuildable for good.  The Python part of the build (typing, LLVM) stays interruptible.  Where
+    pycc's toolchain is not where this numba keeps it, the whole compile is deferred instead."""
+    tc = getattr(cc, "_toolchain", None)
+    names = ("compile_objects", "link_shared")
+    if tc is None or not all(callable(getattr(tc, n, None)) for n in names):
+        compile_ = cc.compile
+
+        def compile_all():
+            with _signals_deferred():
+                compile_()
+
+        cc.compile = compile_all
+        return
+    for n in names:
+        def deferred(*a, _f=getattr(tc, n), **k):
+            with _signals_deferred():
+                return _f(*a, **k)
+
+        setattr(tc, n, deferred)
 
 
 def kernels():

@@ -237,3 +237,51 @@ def test_a_deferred_build_uses_the_jit_now_and_builds_later(no_compiler):
         assert _aot.simulate_kernel() is jit and _aot.kernels() is None
     assert calls == []
     assert _aot.kernels() is None and len(calls) == 1  # built (tried) now, outside
+
+
+def test_interrupt_waits_for_the_c_compiler():
+    """An interrupt while pycc's C compiler or linker runs is delivered when that run ends: the
+    compiler is never cut off (it would write into a removed folder, or a killed compiler would
+    mark the module unbuildable); the Python part stays interruptible."""
+    import os
+    import signal
+    import time
+
+    events = []
+
+    class Toolchain:
+        def compile_objects(self, *a, **k):
+            os.kill(os.getpid(), signal.SIGINT)          # a Ctrl-C while "the compiler" runs
+            time.sleep(0.1)
+            events.append("compiled")
+            return ["x.o"]
+
+        def link_shared(self, *a, **k):
+            events.append("linked")
+
+    class CC:
+        _toolchain = Toolchain()
+
+        def compile(self):
+            self._toolchain.compile_objects()
+            events.append("after compile_objects")       # never reached: the interrupt comes first
+            self._toolchain.link_shared()
+
+    cc = CC()
+    _aot._defer_signals_in_toolchain(cc)
+    with pytest.raises(KeyboardInterrupt):
+        cc.compile()
+    assert events == ["compiled"]
+
+    class Bare:                                          # no toolchain where expected: the whole compile deferred
+        def compile(self):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.1)
+            events.append("bare compiled")
+
+    bare = Bare()
+    _aot._defer_signals_in_toolchain(bare)
+    with pytest.raises(KeyboardInterrupt):
+        bare.compile()
+    assert events[-1] == "bare compiled"
+    assert not signal.pthread_sigmask(signal.SIG_BLOCK, []) & {signal.SIGINT, signal.SIGTERM}
