@@ -45,7 +45,7 @@ from mmg._jit import carray, njit
 from mmg.model import PackedShip
 
 from .kernels import (CSTEP, fpft, jacobian_step_reference, joseph_update_ws,  # noqa: F401 (CSTEP re-exported)
-                      make_update_workspace, symmetrise)
+                      make_update_workspace, make_workspace, symmetrise)
 from .propagate import NS, SLOTS, propagate_jacobian, propagate_step, workspace  # noqa: F401 (re-exported)
 
 STATES = ("u", "v", "r", "n")
@@ -158,11 +158,13 @@ def _check(z, P):
 
 @njit(cache=True)
 def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag,
-                  reference=None):
+                  ws, uw, reference=None):
     """The whole pass: predict (RK4 + exact F), P = F P F^T, Joseph update, checks.
 
     meas (N, 4) u, v, r, n at times k*dt; delta (N,); zs (N, nz) and pdiag (N, nz) are filled
-    (row 0 the initial values); q: Q = q I (0 in the paper). Returns (status, step index, final P).
+    (row 0 the initial values); q: Q = q I (0 in the paper); ws and uw the work arrays of
+    :func:`propagate_step` (:func:`workspace`) and of the update (:func:`make_update_workspace`),
+    made by :func:`run_filter`.  Returns (status, step index, final P).
     reference: the previous implementation, for tests and ``bench/bench_ekf.py``: F by the
     brute-force complex step (:func:`ekf.kernels.jacobian_step_reference`, one complex RK4 step
     per column) instead of the tangent-linear RK4 of :func:`propagate_step`, and the update by
@@ -174,9 +176,7 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
     z = z0.copy()
     P = P0.copy()
     FP = np.empty((nz, nz))
-    ws = workspace(nz, hull_coef)
     zn, F = ws[8], ws[9]
-    uw = make_update_workspace(nz, meas.shape[1])
     for i in range(nz):
         zs[0, i] = z[i]
         pdiag[0, i] = P[i, i]
@@ -276,9 +276,14 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     zs = np.full((N, nz), np.nan)
     pd_ = np.full((N, nz), np.nan)
     c = carray                                   # one specialisation for every caller
+    hull_coef = c(packed.hull_coef)
+    # the work arrays made here, by the Python originals of their compiled makers (the same arrays):
+    # compiled, the makers cost a cold cache 1.5-2 s for a few allocations a pass
+    ws = make_workspace.py_func(np.int64(nz), NS, hull_coef)
+    uw = make_update_workspace.py_func(nz, meas.shape[1])
     st, k, P = filter_kernel(c(z0), c(P0), meas, c(delta), dt, c(R), float(q),
                              int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max), c(packed.p), c(packed.poly), c(packed.hull_axis, np.int64),
-                             c(packed.hull_term, np.int64), c(packed.hull_coef), c(slots, np.int64), zs, pd_)
+                             c(packed.hull_term, np.int64), hull_coef, c(slots, np.int64), zs, pd_, ws, uw)
     if st != OK:
         raise FilterDivergence(trial, t[k], _REASON[st])
     return FilterResult(t, zs, pd_, P, tuple(names))

@@ -142,9 +142,8 @@ def warm_jacobian() -> None:
     from ekf.kernels import jacobian_step, make_workspace
 
     pk, slots, t, meas, delta, z0, P0, R = _filter_args()
-    # the work arrays made by the Python original of make_workspace (the same arrays, so the same
-    # argument types): compiling propagate.workspace here (1.2 s) would lengthen the critical path
-    # of a cold mmg estimate; :func:`warm_filter_parts` compiles it in the parent instead
+    # the work arrays made by the Python original of make_workspace, as ekf.filter.run_filter makes
+    # them (the same arrays, so the same argument types)
     ws = make_workspace.py_func(np.int64(len(z0)), propagate.NS, pk.hull_coef)
     jacobian_step(z0, 0.0, 0.0, 0.0, 0.0, -1, propagate.SLOTS, propagate.NS, 1.0, *pk.args()[:4], slots, ws)
 
@@ -176,12 +175,11 @@ def warm_filter_parts() -> None:
 
     from ekf.filter import _check
     from ekf.kernels import fpft, joseph_update_ws, make_update_workspace
-    from ekf.propagate import NS, workspace
+    from ekf.propagate import NS
 
     pk, slots, t, meas, delta, z0, P0, R = _filter_args()
     nz = len(z0)
-    workspace(np.int64(nz), pk.hull_coef)             # the Jacobian step's work arrays (not in warm_jacobian)
-    uw = make_update_workspace(nz, meas.shape[1])
+    uw = make_update_workspace.py_func(nz, meas.shape[1])     # as run_filter makes it
     P = P0.copy()
     fpft(np.eye(nz), P, NS, np.empty((nz, nz)), P)
     _check(z0, P)
