@@ -50,7 +50,7 @@ def engine_power(ship: Ship, u0: float) -> float:
 def model_functions():
     """(rhs, forces) as the straight-run solver calls them: :func:`mmg.model.rhs` and
     :func:`mmg.model.forces` run by the interpreter (:func:`mmg._jit.interpreted`).  The solver
-    evaluates the model 30-60 times (about 2 ms interpreted); compiling the two functions would cost
+    evaluates the model 30-60 times (a few ms interpreted); compiling the two functions would cost
     3 s of a cold cache's first simulation and does not pay for itself."""
     return interpreted(rhs), interpreted(forces)
 
