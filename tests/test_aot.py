@@ -80,13 +80,17 @@ def test_straight_run_interpreted_agrees_with_the_compiled_model(monkeypatch):
     import mmg.equilibrium as E
     from mmg.model import forces, rhs
 
-    for name in ("esso_osaka", "esso_osaka_3m", "esso_osaka_3m_crossflow"):
+    wind_current = effect_set({"wind": {"true_speed_mps": 1.8, "true_from_deg": 60.0},
+                               "current": {"speed_mps": 0.05, "direction_deg": 200.0},
+                               "rudder_offset": {"offset_deg": 1.0}})
+    for name, es in (("esso_osaka", None), ("esso_osaka_3m", None), ("esso_osaka_3m_crossflow", None),
+                     ("esso_osaka_3m_crossflow", wind_current)):
         ship = load_ship(name)
         u0 = 10 * KNOT * math.sqrt(ship.particulars.L / 325.0)
-        a = E.straight_run(ship, u0)
+        a = E.straight_run(ship, u0, effects=es)
         with monkeypatch.context() as m:
             m.setattr(E, "model_functions", lambda: (rhs, forces))
-            b = E.straight_run(ship, u0)
+            b = E.straight_run(ship, u0, effects=es)
         for f in ("u", "v", "delta", "n", "power_W", "K_Q_scale"):
             assert math.isclose(getattr(a, f), getattr(b, f), rel_tol=1e-10, abs_tol=1e-13), (name, f)
         assert a.residual < 1e-9 and b.residual < 1e-9
