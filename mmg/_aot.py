@@ -200,9 +200,8 @@ def _signals_deferred():
 def _defer_signals_in_toolchain(cc) -> None:
     """The C compiler and linker runs of a pycc build with the interrupt deferred until they end
     (about a second each).  Interrupted, Python would unwind and remove the build folder while the
-    compiler it started still writes into it (its "can't create ...o" on the terminal, a process
-    left running), and a Ctrl-C killing the compiler would fail the build and mark the module as
-    unbuildable for good.  The Python part of the build (typing, LLVM) stays interruptible.  Where
+    compiler it started still writes into it (its "can't create ...o" on the terminal after
+    "interrupted").  The Python part of the build (typing, LLVM) stays interruptible.  Where
     pycc's toolchain is not where this numba keeps it, the whole compile is deferred instead."""
     tc = getattr(cc, "_toolchain", None)
     names = ("compile_objects", "link_shared")
