@@ -30,6 +30,8 @@ import tempfile
 import threading
 from pathlib import Path
 
+from mmg._signals import deferred as signals_deferred
+
 __all__ = ["kernels", "enabled", "module_path", "module_name", "build", "simulate_kernel", "build_deferred"]
 
 SOURCES = ("_inlining.py", "_jit.py", "_aot.py", "model.py", "nondim.py", "rudder.py", "terms.py", "wind.py",
@@ -167,36 +169,6 @@ def build(path: Path | None = None) -> Path:
     return path
 
 
-@contextlib.contextmanager
-def _signals_deferred():
-    """SIGINT and SIGTERM deferred inside (main thread only): noted by a stand-in handler and sent
-    again on leaving, so the process's own handler runs then.  They are also blocked in this thread,
-    so processes started inside inherit the mask and a terminal's Ctrl-C (sent to the whole process
-    group) does not kill them either."""
-    import signal
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    sigs = (signal.SIGINT, signal.SIGTERM)
-    got: list = []
-    old = {}
-    for sig in sigs:
-        h = signal.getsignal(sig)
-        if h is not None:                        # (None: a handler not set from Python; left alone)
-            old[sig] = signal.signal(sig, lambda signum, frame: got.append(signum))
-    mask = signal.pthread_sigmask(signal.SIG_BLOCK, sigs) if hasattr(signal, "pthread_sigmask") else None
-    try:
-        yield
-    finally:
-        if mask is not None:
-            signal.pthread_sigmask(signal.SIG_SETMASK, mask)     # a signal held by the mask: noted now
-        for sig, h in old.items():
-            signal.signal(sig, h)
-        if got:
-            os.kill(os.getpid(), got[0])        # to the process's own handler
-
-
 def _defer_signals_in_toolchain(cc) -> None:
     """The C compiler and linker runs of a pycc build with the interrupt deferred until they end
     (about a second each).  Interrupted, Python would unwind and remove the build folder while the
@@ -209,14 +181,14 @@ def _defer_signals_in_toolchain(cc) -> None:
         compile_ = cc.compile
 
         def compile_all():
-            with _signals_deferred():
+            with signals_deferred():
                 compile_()
 
         cc.compile = compile_all
         return
     for n in names:
         def deferred(*a, _f=getattr(tc, n), **k):
-            with _signals_deferred():
+            with signals_deferred():
                 return _f(*a, **k)
 
         setattr(tc, n, deferred)

@@ -33,12 +33,16 @@ import shutil
 import signal
 import stat
 import tempfile
-import threading
 from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
+from mmg._signals import can_hold as _can_hold
+from mmg._signals import deferred as _critical
+from mmg._signals import held as signals_held
+from mmg._signals import noted as _noted  # noqa: F401  (the list the noting handler fills; tests read it)
+from mmg._signals import pending as _signal_pending
 from mmg.errors import InputError
 
 #: errno values of a target that cannot be written (reported as one InputError line, exit 2).
@@ -46,40 +50,8 @@ WRITE_ERRNOS = frozenset(getattr(errno, n) for n in ("ENOSPC", "EROFS", "EACCES"
                                                       "EXDEV", "ENAMETOOLONG", "ENOTDIR", "EISDIR", "EMLINK", "EIO")
                          if hasattr(errno, n))
 
-_SIGNALS = tuple(s for s in (getattr(signal, "SIGINT", None), getattr(signal, "SIGTERM", None)) if s is not None)
-
-
 # --------------------------------------------------------------------------- signals held
-
-
-def _can_hold() -> bool:
-    return hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
-
-
-@contextmanager
-def signals_held(signals=None):
-    """SIGINT and SIGTERM (or the ``signals`` given) blocked inside the block and delivered (their
-    handlers run) on leaving it.  Processes started inside the block inherit the mask: started with
-    ``signals_held([signal.SIGINT])``, pool workers never see a terminal's Ctrl-C (the main process
-    gets it and stops them).
-
-    A signal whose handler was already due when the block starts is raised here, before the
-    block runs (never inside it).  A no-op outside the main thread and where the platform has
-    no ``pthread_sigmask``.
-    """
-    if not _can_hold():
-        yield
-        return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, [])        # the mask now (runs any handler due)
-    try:
-        signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS if signals is None else signals)
-    except BaseException:                                     # a handler due raised: nothing blocked stays blocked
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
-        raise
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+# (:mod:`mmg._signals`: one helper for the simulator's build and these outputs)
 
 
 @contextmanager
@@ -103,40 +75,6 @@ def children_ignore_sigint():
         pass
     with signals_held([signal.SIGINT]):
         yield
-
-
-_noted: list[int] = []          # signals caught by the deferring handler of :func:`_critical`
-
-
-@contextmanager
-def _critical():
-    """A section that must not be cut: :func:`signals_held`, and for the same time SIGINT/SIGTERM
-    handlers that only note the signal.  The mask holds a signal sent to this thread; the noting
-    handler catches one the kernel gave to another thread (numba, BLAS or pool threads do not block
-    it), whose Python handler would otherwise run in the middle of the section.  On leaving, a noted
-    signal is raised again in this thread, so the original handler runs when the mask is lifted."""
-    with signals_held():
-        if not _can_hold():
-            yield
-            return
-        old = {s: h for s in _SIGNALS if (h := signal.getsignal(s)) is not None}   # None: set outside Python
-        start = len(_noted)
-        try:
-            for s in old:
-                signal.signal(s, lambda signum, frame: _noted.append(signum))
-            yield
-        finally:
-            for s, h in old.items():
-                signal.signal(s, h)
-            again = _noted[start:]
-            del _noted[start:]
-            for s in dict.fromkeys(again):
-                signal.raise_signal(s)           # pending in this thread until the mask is lifted
-
-
-def _signal_pending() -> bool:
-    """A SIGINT or SIGTERM is waiting (held by :func:`_critical` or :func:`signals_held`)."""
-    return _can_hold() and (bool(_noted) or bool(set(signal.sigpending()) & set(_SIGNALS)))
 
 
 # --------------------------------------------------------------------------- checks before any work
