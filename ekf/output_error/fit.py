@@ -17,6 +17,10 @@ def _sim_task(tr: OETrial, theta, nuis, restart=None):
 
 
 _POOLS: dict = {}
+if hasattr(os, "register_at_fork"):
+    # a forked child (the main job's background section) inherits the pools but not their threads:
+    # a map on one would wait for ever, so the child starts with none and makes its own
+    os.register_at_fork(after_in_child=_POOLS.clear)
 
 
 def _workers(n_jobs) -> int:
