@@ -51,6 +51,8 @@ def main() -> None:
                     help="deal the records into folds in file order or stratified by propeller revolutions")
     ap.add_argument("--max-nfev", type=int, default=None,
                     help="evaluation limit of the whole-record fit (default: trials.identify.identify's)")
+    ap.add_argument("--velocity-weight", type=float, default=1.0,
+                    help="weight of the u, v, r residuals beside the heading's (identify(velocity_weight=))")
     ap.add_argument("--offset-spread", type=float, default=0.0, metavar="DEG",
                     help="also score each kept-out record under rudder offsets within +-DEG (both models)")
     a = ap.parse_args()
@@ -61,7 +63,7 @@ def main() -> None:
     ship, initial = mmg.load_ship(a.ship), mmg.load_ship(a.initial)
     print(f"prior {ship.name}; initial {initial.name}; free {a.free or 'default'}; weighting "
           f"{a.weighting or 'default'}; loss {a.loss} (f_scale {a.f_scale:g}); folds by {a.folds_by}; "
-          f"per-record nuisance {list(a.nuisance) or 'none'}", flush=True)
+          f"per-record nuisance {list(a.nuisance) or 'none'}; velocity weight {a.velocity_weight:g}", flush=True)
     for wind in ([True, False] if a.wind == "both" else [a.wind == "on"]):
         runs = load_runs(ship, files, wind=wind)
         t0 = time.perf_counter()
@@ -72,6 +74,8 @@ def main() -> None:
             extra["record_nuisance"] = tuple(a.nuisance)
         if a.loss != "linear":
             extra.update(loss=a.loss, f_scale=a.f_scale)
+        if a.velocity_weight != 1.0:
+            extra["velocity_weight"] = a.velocity_weight
         if a.max_nfev:
             extra["max_nfev"] = a.max_nfev
         cv = cross_validate(ship, runs, folds=a.folds, wind=wind, prior_rel_std=a.prior, initial=initial,

@@ -135,3 +135,13 @@ def test_an_unusable_test_record_is_refused_before_the_fit(tmp_path, capsys):
     assert any(ln.startswith(f"skipped: {bad}") for ln in err.splitlines())
     assert _errors(err) == ["error: --test: no usable record"]
 
+
+
+@pytest.mark.parametrize("bad", ["0", "-1", "nan", "inf", "ten"])
+def test_a_bad_velocity_weight_is_one_line_and_nothing_written(tmp_path, capsys, bad):
+    out = tmp_path / "out"
+    rc = main(["identify", "--ship", "esso_osaka_3m", "--train", str(FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv"),
+               "--out", str(out), "--velocity-weight", bad])
+    err = _errors(capsys.readouterr().err)
+    assert rc == 2 and not out.exists()
+    assert len(err) == 1 and "--velocity-weight" in err[0] and "positive finite" in err[0]

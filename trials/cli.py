@@ -499,6 +499,8 @@ def cmd_identify(args) -> int:
 
     initial = load_ship(ship_path(args.initial)) if args.initial else None
     kw = {"record_weighting": args.weighting} if args.weighting else {}
+    if args.velocity_weight is not None:
+        kw["velocity_weight"] = args.velocity_weight
     if args.free:
         kw["free"] = tuple(args.free)
     ident = identify(ship, runs, wind=wind, progress=progress, initial=initial, **kw)
@@ -753,6 +755,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the parameters to fit: hull coefficient names, 'hull' (all of them), 'hull-except-constants', "
                         "w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, rudder_offset, wind_scale, m_x, m_y, "
                         "J_z (default trials.identify.DEFAULT_FREE)")
+    p.add_argument("--velocity-weight", type=_finite_positive, default=None, metavar="W",
+                   help="how much the u, v, r residuals count beside the heading's (default 1; 0.1: the fit follows "
+                        "the heading ten times more closely; docs/identify_cv.md)")
     p.add_argument("--folds-by", choices=("order", "revolutions"), default="order",
                    help="with --cv: deal the records into folds in the order given or stratified by their propeller "
                         "revolutions (a record and its cut copies always share a fold)")
