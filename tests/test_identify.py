@@ -312,7 +312,7 @@ def test_fit_warnings_name_bounds_sign_changes_and_no_convergence():
                           cost_final=1.0, n_residuals=100, iterations=9, message="ok", status=2).warnings() == []
 
 
-def test_velocity_weight_sets_whether_the_fit_follows_the_heading_or_a_biased_rate_gyro():
+def test_velocity_weight_sets_whether_the_fit_follows_the_heading_or_a_biased_rate_gyro(tmp_path):
     """A rate gyro reading 30 % high (the heading clean, the start state true): a fit that counts the
     velocities a hundred times as much as the heading follows the gyro and makes the yaw damping N_r
     too weak (the replayed yaw rate larger); counting them a hundredth as much, it follows the heading
@@ -324,9 +324,12 @@ def test_velocity_weight_sets_whether_the_fit_follows_the_heading_or_a_biased_ra
         meas = r.meas.copy()
         meas[1:, 2] *= 1.3
         runs.append(MeasuredRun(name=r.name, source=r.source, meas=meas, inputs=r.inputs))
-    ratio = {w: identify(ship, runs, free=list(true), segment_s=(np.inf,), say=lambda m: None,
-                         velocity_weight=w).fit.values()["N_r"] / true["N_r"] for w in (100.0, 0.01)}
+    idents = {w: identify(ship, runs, free=list(true), segment_s=(np.inf,), say=lambda m: None, velocity_weight=w)
+              for w in (100.0, 0.01)}
+    ratio = {w: i.fit.values()["N_r"] / true["N_r"] for w, i in idents.items()}
     assert ratio[100.0] < 0.85, ratio                   # pulled by the gyro: weaker damping
     assert ratio[0.01] == pytest.approx(1.0, abs=0.03), ratio
+    write_identification(idents[0.01], mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)   # the report says how it was fitted
+    assert "velocity residuals weighted 0.01 beside the heading's" in (tmp_path / "report.md").read_text()
     with pytest.raises(ValueError, match="velocity_weight"):
         identify(ship, runs, free=list(true), say=lambda m: None, velocity_weight=0.0)

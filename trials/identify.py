@@ -111,6 +111,10 @@ class Identification:
     segment_s: float
     prior: Ship | None = None
     """The prior (starting) model when it is not ``initial`` (another hull form of it)."""
+    record_weighting: str = DEFAULT_WEIGHTING
+    """How the training records counted (:func:`ekf.identify.record_weights`)."""
+    velocity_weight: float = 1.0
+    """How much the u, v, r residuals counted beside the heading's (:func:`identify`)."""
 
     def scores(self, runs=None, model: str = "identified") -> list[dict]:
         """Open-loop replay scores (:meth:`trials.predict.Replayed.scores`) of ``runs`` (the training
@@ -253,7 +257,7 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
         identified ship: a record it has not seen is predicted without them.
     velocity_weight : float
         How much the u, v and r residuals count beside the heading's (1: their scales are 5 % of
-        the median speed and 2 deg; 0.1: the fit follows the heading, the score a replay is judged
+        the median speed, the heading's 2 deg; 0.1: the fit follows the heading, the score a replay is judged
         by, ten times more closely than the velocities).  docs/identify_cv.md: 0.1 predicts the
         kept-out records better without wind and worse with it.
     """
@@ -296,7 +300,8 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
                                                                                                  rms=rms),
                                 loss=loss if last else "linear", f_scale=f_scale)
     return Identification(ship=_ship_with(ship, fit.values()), initial=ship if initial is None else initial, fit=fit,
-                          runs=runs, segment_s=seg, prior=None if initial is None else ship)
+                          runs=runs, segment_s=seg, prior=None if initial is None else ship,
+                          record_weighting=record_weighting, velocity_weight=float(velocity_weight))
 
 
 FOLD_ASSIGNMENTS = ("order", "revolutions")
@@ -440,7 +445,9 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
                   f"{ident.initial.name}'s.", ""]
     lines += [
              f"Records: {len(ident.runs)}; free parameters: {len(fit.free)}; last segment length "
-             f"{ident.segment_s:g} s; residuals {fit.n_residuals}; {fit.iterations} iterations ({fit.message}).", "",
+             f"{ident.segment_s:g} s; residuals {fit.n_residuals}; {fit.iterations} iterations ({fit.message}); "
+             f"records weighted {ident.record_weighting!r}; velocity residuals weighted {ident.velocity_weight:g} "
+             f"beside the heading's.", "",
              "## Values and standard errors", "",
              "Standard errors from the Gauss-Newton covariance scaled by the residual variance; the 10 Hz "
              "residuals are correlated, so they are optimistic.", "",
