@@ -72,12 +72,27 @@ def deferred():
                 signal.signal(s, lambda signum, frame: noted.append(signum))
             yield
         finally:
-            for s, h in old.items():
-                signal.signal(s, h)
-            again = noted[start:]
-            del noted[start:]
+            _restore(old, start)
+
+
+def _restore(old: dict, start: int) -> None:
+    """Put back the handlers ``old`` and raise again what was noted since ``start``; a signal whose
+    original handler runs (and raises) while this works cannot leave a handler or a note behind."""
+    again = noted[start:]
+    del noted[start:]                            # first: nothing can leave a stale note
+    items = list(old.items())
+
+    def put_back(k: int) -> None:
+        if k == len(items):
             for s in dict.fromkeys(again):
                 signal.raise_signal(s)           # pending in this thread until the mask is lifted
+            return
+        try:
+            signal.signal(*items[k])
+        finally:
+            put_back(k + 1)                      # the next handler is restored even if this one's ran and raised
+
+    put_back(0)
 
 
 def pending() -> bool:

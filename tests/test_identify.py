@@ -331,5 +331,6 @@ def test_velocity_weight_sets_whether_the_fit_follows_the_heading_or_a_biased_ra
     assert ratio[0.01] == pytest.approx(1.0, abs=0.03), ratio
     write_identification(idents[0.01], mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)   # the report says how it was fitted
     assert "velocity residuals weighted 0.01 beside the heading's" in (tmp_path / "report.md").read_text()
-    with pytest.raises(ValueError, match="velocity_weight"):
-        identify(ship, runs, free=list(true), say=lambda m: None, velocity_weight=0.0)
+    for bad in (0.0, -1.0, float("nan"), "ten", None):
+        with pytest.raises(ValueError, match="velocity_weight"):
+            identify(ship, runs, free=list(true), say=lambda m: None, velocity_weight=bad)

@@ -145,3 +145,18 @@ def test_a_bad_velocity_weight_is_one_line_and_nothing_written(tmp_path, capsys,
     err = _errors(capsys.readouterr().err)
     assert rc == 2 and not out.exists()
     assert len(err) == 1 and "--velocity-weight" in err[0] and "positive finite" in err[0]
+
+
+def test_velocity_weight_reaches_the_fit_and_the_report(identified, tmp_path):
+    """--velocity-weight is passed to the fit (another result than the default's) and the report says it."""
+    d, out, (a, b) = identified
+    out2 = tmp_path / "vw"
+    assert main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--out", str(out2),
+                 "--wind", "on", "--velocity-weight", "0.1"]) == 0
+    rep, rep0 = (out2 / "report.md").read_text(), (out / "report.md").read_text()
+    assert "velocity residuals weighted 0.1 beside the heading's" in rep
+    assert "velocity residuals weighted 1 beside the heading's" in rep0
+    import mmg
+
+    h2, h0 = mmg.load_ship(out2 / "ship.yaml").hull, mmg.load_ship(out / "ship.yaml").hull
+    assert any(abs(h2.value(n) - h0.value(n)) > 1e-6 * (1 + abs(h0.value(n))) for n in h0.names)

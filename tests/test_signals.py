@@ -69,3 +69,28 @@ def test_outside_the_main_thread_nothing_is_held():
     t.start()
     t.join()
     assert out == [False]
+
+
+def test_a_signal_handled_while_the_handlers_are_put_back_leaves_nothing_behind(monkeypatch):
+    """A Ctrl-C another thread takes just after SIGINT's own handler is back runs that handler (a
+    KeyboardInterrupt) in the middle of the clean-up: SIGTERM's handler must still be put back and no
+    note left, or the process would ignore SIGTERM and every later section would think it was cut."""
+    real = signal.signal
+    fired = []
+
+    def signal_then_interrupt(sig, handler):
+        prev = real(sig, handler)
+        if sig == signal.SIGINT and handler is signal.default_int_handler and not fired:
+            fired.append(1)
+            raise KeyboardInterrupt               # what the restored handler does when the Ctrl-C lands here
+        return prev
+
+    before = signal.getsignal(signal.SIGTERM)
+    monkeypatch.setattr(signal, "signal", signal_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        with _signals.deferred():
+            pass
+    monkeypatch.undo()
+    assert fired
+    assert signal.getsignal(signal.SIGTERM) == before and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert _signals.noted == [] and not _signals.pending()

@@ -756,8 +756,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, rudder_offset, wind_scale, m_x, m_y, "
                         "J_z (default trials.identify.DEFAULT_FREE)")
     p.add_argument("--velocity-weight", type=_finite_positive, default=None, metavar="W",
-                   help="how much the u, v, r residuals count beside the heading's (default 1; 0.1: the fit follows "
-                        "the heading ten times more closely; docs/identify_cv.md)")
+                   help="factor on the u, v, r residuals beside the heading's (default 1; 0.1: their squares weigh a "
+                        "hundredth, so the fit follows the heading; docs/identify_cv.md)")
     p.add_argument("--folds-by", choices=("order", "revolutions"), default="order",
                    help="with --cv: deal the records into folds in the order given or stratified by their propeller "
                         "revolutions (a record and its cut copies always share a fold)")

@@ -91,8 +91,8 @@ def _free_names(ship: Ship, free) -> list[str]:
 
 def _scales(runs: list[MeasuredRun], L: float, velocity_weight: float = 1.0):
     """Residual scales: 5 % of the records' median speed for u and v (and that over L for r), 2 deg for
-    the heading; the velocities' residuals count ``velocity_weight`` times as much (their scales
-    divided by it)."""
+    the heading; the velocities' residuals multiplied by ``velocity_weight`` (their scales divided by
+    it, their squares' weight in the cost ``velocity_weight**2``)."""
     from ekf.identify import Scales
 
     U = float(np.median(np.concatenate([np.hypot(r.meas[:, 0], r.meas[:, 1]) for r in runs])))
@@ -256,22 +256,26 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
         so the shared parameters need not absorb one record's disturbance.  They are not part of the
         identified ship: a record it has not seen is predicted without them.
     velocity_weight : float
-        How much the u, v and r residuals count beside the heading's (1: their scales are 5 % of
-        the median speed, the heading's 2 deg; 0.1: the fit follows the heading, the score a replay is judged
-        by, ten times more closely than the velocities).  docs/identify_cv.md: 0.1 predicts the
-        kept-out records better without wind and worse with it.
+        Factor on the u, v and r residuals beside the heading's (1: their scales are 5 % of the
+        median speed, the heading's 2 deg; 0.1: their squares weigh a hundredth in the cost, so the
+        fit follows the heading, the score a replay is judged by).  docs/identify_cv.md: 0.1
+        predicts the kept-out records better without wind and worse with it.
     """
     from ekf.identify import Segmented, free_parameters, identify_segments, record_residual_rms, record_weights, \
         segment_resets
 
+    try:
+        vw_ok = bool(np.isfinite(float(velocity_weight)) and float(velocity_weight) > 0)
+    except (TypeError, ValueError):
+        vw_ok = False
+    if not vw_ok:                                           # before any record is read
+        raise ValueError(f"velocity_weight: a positive finite number, got {velocity_weight!r}")
     items = list(paths_or_runs)
     runs = [r for r in items if isinstance(r, MeasuredRun)]
     paths = [r for r in items if not isinstance(r, MeasuredRun)]
     runs += load_runs(ship, paths, wind=wind, say=say) if paths else []
     if not runs:
         raise InputError("--train", "", "no usable training record")
-    if not (np.isfinite(velocity_weight) and velocity_weight > 0):
-        raise ValueError(f"velocity_weight: a positive number, got {velocity_weight!r}")
     L = ship.particulars.L
     stages = DEFAULT_SEGMENTS_L if segment_s is None else np.atleast_1d(segment_s) / np.sqrt(L / 9.80665)
     packed = pack(ship)
