@@ -40,12 +40,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from mmg._jit import carray, njit
+from mmg._jit import carray, interpreted, njit
 
 from mmg.model import PackedShip
 
 from .kernels import (CSTEP, fpft, jacobian_step_reference, joseph_update_ws,  # noqa: F401 (CSTEP re-exported)
-                      make_update_workspace, make_workspace, symmetrise)
+                      make_update_workspace, symmetrise)
 from .propagate import NS, SLOTS, propagate_jacobian, propagate_step, workspace  # noqa: F401 (re-exported)
 
 STATES = ("u", "v", "r", "n")
@@ -277,10 +277,10 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     pd_ = np.full((N, nz), np.nan)
     c = carray                                   # one specialisation for every caller
     hull_coef = c(packed.hull_coef)
-    # the work arrays made here, by the Python originals of their compiled makers (the same arrays):
-    # compiled, the makers cost a cold cache 1.5-2 s for a few allocations a pass
-    ws = make_workspace.py_func(np.int64(nz), NS, hull_coef)
-    uw = make_update_workspace.py_func(nz, meas.shape[1])
+    # the work arrays made here, by their makers run interpreted (the same arrays): compiled, the
+    # makers cost a cold cache 1.5-2 s for a few allocations a pass
+    ws = interpreted(workspace)(nz, hull_coef)
+    uw = interpreted(make_update_workspace)(nz, meas.shape[1])
     st, k, P = filter_kernel(c(z0), c(P0), meas, c(delta), dt, c(R), float(q),
                              int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max), c(packed.p), c(packed.poly), c(packed.hull_axis, np.int64),
                              c(packed.hull_term, np.int64), hull_coef, c(slots, np.int64), zs, pd_, ws, uw)

@@ -136,15 +136,12 @@ def _filter_args():
 def warm_jacobian() -> None:
     """The paper filter's Jacobian step (:func:`ekf.kernels.jacobian_step`), called with the argument
     types of the compiled pass."""
-    import numpy as np
-
     from ekf import propagate
-    from ekf.kernels import jacobian_step, make_workspace
+    from ekf.kernels import jacobian_step
+    from mmg._jit import interpreted
 
     pk, slots, t, meas, delta, z0, P0, R = _filter_args()
-    # the work arrays made by the Python original of make_workspace, as ekf.filter.run_filter makes
-    # them (the same arrays, so the same argument types)
-    ws = make_workspace.py_func(np.int64(len(z0)), propagate.NS, pk.hull_coef)
+    ws = interpreted(propagate.workspace)(len(z0), pk.hull_coef)     # as ekf.filter.run_filter makes them
     jacobian_step(z0, 0.0, 0.0, 0.0, 0.0, -1, propagate.SLOTS, propagate.NS, 1.0, *pk.args()[:4], slots, ws)
 
 
@@ -155,13 +152,12 @@ def warm_jacobian_real_parts() -> None:
     while its child is still compiling the all-complex dynamics, so the child loads them from the
     cache instead of compiling them after it."""
     from ekf import propagate
-    from ekf.kernels import make_workspace
     from mmg._jit import interpreted
     from mmg.model import dynamics, inverse_mass, rhs_hull_jacobian
 
     pk, slots, t, meas, delta, z0, P0, R = _filter_args()
     p, poly, hull_axis, hull_term = pk.args()[:4]
-    ws = make_workspace.py_func(len(z0), propagate.NS, pk.hull_coef)   # the step's own work arrays
+    ws = interpreted(propagate.workspace)(len(z0), pk.hull_coef)     # the step's own work arrays
     hc, xr, B, w = ws[10], ws[11], ws[18], ws[19]
     xr[0] = 5.0
     dynamics(5.0, 0.0, 0.0, 0.0, 1.0, p, poly, hull_axis, hull_term, hc, w)
@@ -176,10 +172,11 @@ def warm_filter_parts() -> None:
     from ekf.filter import _check
     from ekf.kernels import fpft, joseph_update_ws, make_update_workspace
     from ekf.propagate import NS
+    from mmg._jit import interpreted
 
     pk, slots, t, meas, delta, z0, P0, R = _filter_args()
     nz = len(z0)
-    uw = make_update_workspace.py_func(nz, meas.shape[1])     # as run_filter makes it
+    uw = interpreted(make_update_workspace)(nz, meas.shape[1])     # as run_filter makes it
     P = P0.copy()
     fpft(np.eye(nz), P, NS, np.empty((nz, nz)), P)
     _check(z0, P)
