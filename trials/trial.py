@@ -227,7 +227,8 @@ class Trial:
     effects : mmg.effects.EffectSet or None
         The ``effects:`` section (:mod:`mmg.effects`: ``current``, ``wind``, ``rudder_offset``,
         ``heading_bias``, ``shallow_water``), added to the ship's own effects
-        (:attr:`mmg.ship.Ship.effects`; the trial's values win for an effect in both).  A heading
+        (:attr:`mmg.ship.Ship.effects`; an effect in both has the values each config states, a
+        value stated in both is refused).  A heading
         bias acts on the log (as ``log.bias.heading``), a steady wind also adds the apparent-wind
         columns to the log.
     """
@@ -673,23 +674,8 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
     if off != 0.0:
         dist.append(RudderOffset(off))
 
-    # effects (mmg.effects), besides the ship's
-    effects = None
-    if f.effects is not None:
-        from mmg.effects import effect_set
-
-        effects = effect_set(f.effects, "effects", src)
-        for nm, given in (("current", d.current is not None), ("rudder_offset", off != 0.0),
-                          ("heading_bias", bias["heading"] != 0.0)):
-            if given and effects.get(nm) is not None:
-                where = {"current": "disturbances.current", "rudder_offset": "disturbances.rudder_offset",
-                         "heading_bias": "log.bias.heading"}[nm]
-                raise InputError(src, f"effects.{nm}", f"also given as {where}: give it in one place")
-        w = effects.get("wind")
-        if w is not None and ship.wind is None:
-            raise InputError(src, "effects.wind", f"the wind effect needs a ship with a wind section; {label} has none")
-        if not effects.items:
-            effects = None
+    # effects (mmg.effects), besides the ship's; each value given in one place only
+    effects = _trial_effects(f, ship, src, label, legacy=_legacy_statements(f, dist, bias["heading"], src))
     hb = ship.effect_set().merged(effects).get("heading_bias")
     if hb is not None:               # a compass error: on the logged heading, as log.bias.heading
         log = replace(log, bias=replace(log.bias, heading=log.bias.heading + float(np.radians(hb["bias_deg"]))))
@@ -698,6 +684,64 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
         u0=u0, n0=n0, trim=f.approach.trim, duration=duration, dt=dt, kind=kind, manoeuvre=conv, log=log,
         disturbances=tuple(dist), effects=effects,
     )
+
+
+_LEGACY = {"current": "disturbances.current", "rudder_offset": "disturbances.rudder_offset",
+           "heading_bias": "log.bias.heading"}
+"""The older trial keys of three effects (the same physics as ``effects.<name>``)."""
+
+
+def _legacy_statements(f: _TrialFile, dist: list, heading_bias: float, src: str) -> list:
+    """The effect values the trial's older keys state: ``(effect, parameter, file, field, value)``.
+
+    A key counts when it is written, whatever its value (``rudder_offset: 0 deg`` states a zero offset)."""
+    out = []
+    d = f.disturbances
+    for c in dist:
+        if isinstance(c, UniformCurrent):
+            out += [("current", "speed_mps", src, "disturbances.current.speed", c.speed),
+                    ("current", "direction_deg", src, "disturbances.current.direction", float(np.degrees(c.direction)))]
+    if "rudder_offset" in d.model_fields_set:
+        off = next((c.offset for c in dist if isinstance(c, RudderOffset)), 0.0)
+        out.append(("rudder_offset", "offset_deg", src, "disturbances.rudder_offset", float(np.degrees(off))))
+    if "bias" in f.log.model_fields_set and "heading" in f.log.bias.model_fields_set:
+        out.append(("heading_bias", "bias_deg", src, "log.bias.heading", float(np.degrees(heading_bias))))
+    return out
+
+
+def _trial_effects(f: _TrialFile, ship: Ship, src: str, label: str, legacy: list):
+    """The trial's ``effects:`` as an EffectSet (None: none), every effect value given in one place.
+
+    Refused, in one line naming both places: an effect both in ``effects:`` and in its older key
+    (``disturbances.current``, ``disturbances.rudder_offset``, ``log.bias.heading``); an older key
+    for an effect the ship config has (the ship's would act in the simulator, the key in the log);
+    an effect value stated by the trial and by the ship file (``effects.wind.scale`` here and
+    ``wind.scale`` there), even equal.  An effect in both configs otherwise takes the values each
+    states (the ship's wind scale with the trial's steady wind)."""
+    from mmg.effects import EffectSet, effect_set, refuse_twice, statements
+
+    own = ship.effect_set()
+    for eff, _, _, _, _ in legacy:
+        if own.get(eff) is not None:
+            raise InputError(src, _LEGACY[eff], f"also given as effects.{eff} of the ship config {label}: give it in one place")
+    if f.effects is None:
+        return None
+    effects = effect_set(f.effects, "effects", src)
+    for eff, _, _, _, _ in legacy:
+        if effects.get(eff) is not None:
+            raise InputError(src, f"effects.{eff}", f"also given as {_LEGACY[eff]}: give it in one place")
+    mine = statements(f.effects, effects, "effects", src)
+    shipped = [st for st in ship.stated if own.get(st[0]) is not None or st[:2] == ("wind", "scale")]
+    refuse_twice(shipped + mine, src)
+    if effects.get("wind") is not None and ship.wind is None:
+        raise InputError(src, "effects.wind", f"the wind effect needs a ship with a wind section; {label} has none")
+    items = []
+    for cls, vals in effects.items:                    # the values each config states, together
+        base = dict(own.get(cls.name) or {})
+        base.update({p: v for e, p, _, _, v in shipped if e == cls.name})
+        base.update({p: v for e, p, _, _, v in mine if e == cls.name})
+        items.append((cls, {**vals, **base}))
+    return EffectSet(tuple(items)) if items else None
 
 
 def _schedule(man: dict, ship: Ship, label: str, duration: float, base: Path, src: str) -> np.ndarray:
