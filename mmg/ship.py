@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal, Optional
 
@@ -213,6 +213,10 @@ class Ship:
     """The effects the ship config switches on (:mod:`mmg.effects`; its ``effects:`` section and
     ``wind.enabled``), applied by the simulator, the replay, the estimators and ``mmg diagnose``
     as part of the ship; None: none."""
+    stated: tuple = field(default=(), compare=False, repr=False)
+    """The effect values the ship file states itself, ``(effect, parameter, file, field, value)``
+    (``wind.scale``, ``effects.current.speed_mps``, ...): a trial on this ship may not give them
+    again (:func:`trials.trial.trial_from_dict`)."""
 
     def effect_set(self):
         """:attr:`effects` as an :class:`mmg.effects.EffectSet` (an empty one when None)."""
@@ -250,7 +254,9 @@ class Ship:
 #                0 < shaft_inertia_coefficient <= 100
 #   effects      {name: {parameter: value}} of mmg.effects (current, wind, rudder_offset,
 #                heading_bias, shallow_water), each parameter within its effect's bounds;
-#                wind needs the wind section; wind.enabled: true is effects: {wind: {scale}}
+#                wind needs the wind section; wind.enabled: true is effects: {wind: {scale}};
+#                a value given twice (wind.scale and effects.wind.scale, even equal) is refused,
+#                and so is effects.wind with wind.enabled: false
 #
 # A value outside them is refused with one line naming the ship file and the field.
 
@@ -566,26 +572,41 @@ def _build(f: _ShipFile, src: str) -> Ship:
                 x_AOD=_qty(src, "wind.x_AOD", w.x_AOD, "length", -0.5 * L, 0.5 * L)),
             scale=_num(src, "wind.scale", w.scale, 0.0, 10.0),
         )
-    effects = None
-    if f.effects is not None or (wind is not None and wind.enabled):
-        from .effects import effect_set
+    effects, stated = _effects(f, wind, src)
+    if effects is not None and effects.get("wind") is not None:
+        wind = replace(wind, enabled=True, scale=effects.get("wind")["scale"])
+    return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
+                steering=steering, engine=engine, source=f.source, wind=wind, effects=effects, stated=stated)
 
-        effects = effect_set(f.effects, "effects", src)
-        w_eff = effects.get("wind")
-        if w_eff is not None and wind is None:
+
+def _effects(f: _ShipFile, wind: Wind | None, src: str):
+    """(the ship's :class:`mmg.effects.EffectSet` or None, the effect values the file states itself).
+
+    ``wind.enabled: true`` is shorthand for ``effects: {wind: {scale: <wind.scale>}}``; a value given
+    both ways (``wind.scale`` and ``effects.wind.scale``, even equal) is refused naming both places,
+    and so is ``effects.wind`` with ``wind.enabled: false`` (the one says on, the other off)."""
+    from .effects import effect_set, refuse_twice, statements
+
+    stated = []
+    if wind is not None and "scale" in f.wind.model_fields_set:
+        stated.append(("wind", "scale", src, "wind.scale", wind.scale))
+    if f.effects is None and not (wind is not None and wind.enabled):
+        return None, tuple(stated)
+    effects = effect_set(f.effects, "effects", src)
+    stated += statements(f.effects, effects, "effects", src)
+    refuse_twice(stated, src)
+    if effects.get("wind") is not None:
+        if wind is None:
             raise InputError(src, "effects.wind", "the wind effect needs the ship's wind section "
                                                   "(areas and heights of the above-water body)")
-        if wind is not None and wind.enabled and w_eff is None:      # wind.enabled: the shorthand
-            effects = effects.merged(effect_set({"wind": {"scale": wind.scale}}))
-        elif w_eff is not None:
-            if f.wind.scale != 1.0 and w_eff["scale"] != wind.scale:
-                raise InputError(src, "effects.wind.scale", f"{w_eff['scale']:g} disagrees with wind.scale "
-                                                            f"{wind.scale:g}: give the scale in one place")
-            wind = replace(wind, enabled=True, scale=w_eff["scale"])
-        if not effects.items:
-            effects = None
-    return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
-                steering=steering, engine=engine, source=f.source, wind=wind, effects=effects)
+        if not wind.enabled:
+            raise InputError(src, "effects.wind", "switches the wind on and wind.enabled: false switches it off: "
+                                                  "give one (wind.enabled: true, or drop effects.wind)")
+        if "scale" not in dict(f.effects["wind"] or {}):            # the wind section's scale (stated or 1)
+            effects = effects.merged(effect_set({"wind": {**effects.get("wind"), "scale": wind.scale}}))
+    elif wind is not None and wind.enabled:                           # wind.enabled: the shorthand
+        effects = effects.merged(effect_set({"wind": {"scale": wind.scale}}))
+    return (effects if effects.items else None), tuple(stated)
 
 
 def ship_from_dict(data: Mapping, source: str = "<dict>") -> Ship:

@@ -6,6 +6,7 @@ wrong-unit numbers, and ship-file errors blamed on the ship file.
 """
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -357,3 +358,66 @@ def test_every_bundled_config_still_loads():
         load_ship(name)
     for name in bundled("trials"):
         load_trial(name)
+
+
+# --------------------------------------------------------------------------- approach.rpm against approach.speed
+# (issue 24: "approach.rpm: 5 rpm" exited 0 after a 0.3 s run, the shaft at -7.8 rpm).  Rhee & Kim's
+# published approach of the Esso Osaka is 54.12 rpm at 10 kn (Table 4); MMG 2015 gives the KVLCC2
+# L7 model 17.95 rps at 1.179 m/s (its model-scale self-propulsion point, which the constant-rpm
+# motor holds while the ship runs to the speed it gives).
+
+THREE_M = CONFIGS / "ships" / "esso_osaka_3m.yaml"
+
+RPM_CASES = {
+    "far below: the propeller would not push ahead": ("5 rpm", None, "zero-thrust"),
+    "the wrong sign": ("-54 rpm", None, "positive"),
+    "constant power, pushes but too low": ("30 rpm", None, "cannot hold"),
+    "constant power, too high": ("70 rpm", None, "cannot hold"),
+    "beyond any engine": ("1e5 rpm", None, "wrong unit"),
+    "a model below its zero-thrust rpm": ("100 rpm", THREE_M, "zero-thrust"),
+    "a model's motor beyond its propeller data": ("6000 rpm", THREE_M, "outside [0, 1)"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(RPM_CASES))
+def test_an_approach_rpm_the_speed_cannot_have_is_refused(case, tmp_path, capsys):
+    rpm, ship, why = RPM_CASES[case]
+    edit = trial_set("approach", "rpm", rpm)
+    if ship is not None:
+        def edit(d, rpm=rpm):
+            d["approach"] = {"speed": "0.45 m/s", "rpm": rpm}
+            d.update(dt="0.02 s", duration="60 s", log={"interval": "0.1 s"})
+    line = trial_error(capsys, tmp_path, "approach.rpm", trial_edit=edit,
+                       ship_text=None if ship is None else ship.read_text())
+    assert why in line
+    if ship is None and why in ("zero-thrust", "cannot hold"):          # names the rpm the speed needs
+        import re
+
+        need = float(re.search(r"needs ([0-9.]+) rpm", line).group(1))
+        assert need == pytest.approx(54.12, rel=0.01)
+
+
+def test_the_published_approach_rpm_is_honoured(tmp_path):
+    """Rhee & Kim's 54.12 rpm at 10 kn: a steady straight run (the rpm and speed held before the
+    rudder moves); MMG 2015's 17.95 rps for the KVLCC2 model at 1.179 m/s: the motor holds it and
+    the ship runs up from the approach speed, the shaft never reversing."""
+    import mmg
+
+    tp, _ = write_case(tmp_path, trial_edit=lambda d: (d["approach"].update(rpm="54.12 rpm"), d.update(duration="60 s")))
+    r = mmg.simulate(load_trial(tp))
+    assert r.completed and r.equilibrium.residual < 1e-4         # 0.05 rpm off the solved 54.21: nearly steady
+    assert np.all(np.abs(r.n * 60 / 54.12 - 1) < 0.01) and r.u[0] == pytest.approx(10 * 1852 / 3600)
+    k = make_trial(KVLCC2, {"kind": "turning", "rudder": "35 deg"}, speed="1.179 m/s", rpm="17.95 1/s",
+                   duration="30 s", dt="0.05 s", trim=False)
+    r = mmg.simulate(k)
+    assert r.completed and np.all(r.n == 17.95) and r.u[0] == pytest.approx(1.179)
+
+
+def test_a_constant_power_straight_run_beyond_zero_torque_is_refused():
+    """The library route (no trial file): at 5 rpm and 10 kn K_Q(J) < 0, so calibrating the shaft
+    there gave a negative K_Q scale: the propeller's torque became a drive and the shaft ran
+    through zero.  Now: ValueError, no run."""
+    from mmg.equilibrium import straight_run
+
+    with pytest.raises(ValueError, match="K_Q"):
+        straight_run(load_ship(CONFIGS / "ships" / "esso_osaka.yaml"), 10 * 1852 / 3600, n=5 / 60)

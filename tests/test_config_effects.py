@@ -190,9 +190,9 @@ def test_ship_config_effects_act_like_the_trial_ones():
     b = mmg.simulate(_trial(effects={"rudder_offset": {"offset_deg": 2.0}}))
     np.testing.assert_allclose(a.states, b.states, rtol=0, atol=1e-12)
     assert np.abs(a.states - mmg.simulate(_trial()).states).max() > 1e-3
-    # the trial's values win over the ship's
-    c = mmg.simulate(_on(ship, effects={"rudder_offset": {"offset_deg": 0.0}}))
-    np.testing.assert_allclose(c.states, mmg.simulate(_trial()).states, rtol=0, atol=1e-12)
+    # a value the ship states is not given again by the trial (tests/test_config_twice.py)
+    with pytest.raises(InputError, match="offset_deg"):
+        _on(ship, effects={"rudder_offset": {"offset_deg": 0.0}})
 
 
 def test_shallow_water_widens_the_turning_circle():
@@ -329,7 +329,7 @@ def test_diagnose_names_a_steady_wind_of_a_trial_config_from_the_logged_apparent
     from trials.diagnose import diagnose
 
     d = diagnose(mmg.load_ship("esso_osaka_3m"), _hidden_records(
-        {"wind": {"true_speed_mps": 2.0, "true_from_deg": 60.0, "scale": 1.0}}))
+        {"wind": {"true_speed_mps": 2.0, "true_from_deg": 60.0}}))       # the scale: the ship's wind.scale, 1
     j = d.to_json()
     assert j["named_effects"] == ["wind"]
     assert abs(j["parameters"]["wind"]["scale"] - 1.0) < 0.2

@@ -584,6 +584,7 @@ def cmd_diagnose(args) -> int:
                 eff[e] = {k: float(f"{v:.6g}") for k, v in p.items() if math.isfinite(v)}
             if "wind" in eff and data.get("wind") is not None:
                 data["wind"].pop("scale", None)            # the scale is the effect's now
+                data["wind"]["enabled"] = True             # (effects.wind with enabled: false is refused)
             data["effects"] = eff
         ship_text = "".join(head) + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
     with StagedFile(args.json) as tmp:

@@ -18,6 +18,7 @@ and speed [m/s] and by the final position error [m and ship lengths] (:meth:`Rep
 """
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -29,10 +30,12 @@ from mmg.model import pack
 from mmg.replay import STATE, ReplayInputs, replay_states
 from mmg.ship import Ship
 
-from .records import TrialRecord
+from .records import WIND_CHANNELS, TrialRecord
 
 __all__ = ["MeasuredRun", "Replayed", "Prediction", "measured_run", "replay_record", "predict", "run_effects",
            "SCORE_KEYS"]
+
+_log = logging.getLogger(__name__)
 
 SCORE_KEYS = ("heading_rms_deg", "yaw_rate_rms_degps", "speed_rms_mps", "final_position_error_m", "final_position_error_L")
 """Keys of :meth:`Replayed.scores`, as ``mmg predict`` writes them for each run."""
@@ -101,8 +104,6 @@ def _wind_loads(ship: Ship, rec: TrialRecord, es) -> tuple[np.ndarray | None, st
         return None, "off"
     if Wind.steady(w):
         return None, f"steady {w['true_speed_mps']:g} m/s from {w['true_from_deg']:g} deg (config)"
-    if rec.wind_speed_rel is None or rec.wind_dir_rel is None:
-        return None, "no wind channels"
     from mmg.wind import angle_from_dataset, wind_forces
 
     X, Y, N = wind_forces(rec.wind_speed_rel, angle_from_dataset(rec.wind_dir_rel), ship.wind.particulars(),
@@ -149,8 +150,13 @@ def measured_run(ship: Ship, rec: TrialRecord, start: float | None = None, wind:
         u, v = rec.speed(), np.zeros_like(rec.t)
         notes.append("u taken as the speed over ground, v as zero (the record has no u, v)")
     meas = np.column_stack([u, v, r, rec.x, rec.y, rec.psi]).astype(float)
-    es = run_effects(ship, wind)
+    es, skipped = run_effects(ship, wind).usable({c: getattr(rec, c) for c in WIND_CHANNELS})
+    for name, why in skipped:                        # one rule for every command (EffectSet.usable)
+        notes.append(f"{name} skipped: {why}")
+        _log.warning(f"{src}: {name} skipped: {why}")
     ext, w = _wind_loads(ship, rec, es)
+    if "wind" in dict(skipped):
+        w = "no wind channels"
     if ext is not None:
         es = es.without("wind")                      # in the loads already
     return MeasuredRun(name=rec.name, source=rec.source, meas=meas,

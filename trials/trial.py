@@ -227,7 +227,8 @@ class Trial:
     effects : mmg.effects.EffectSet or None
         The ``effects:`` section (:mod:`mmg.effects`: ``current``, ``wind``, ``rudder_offset``,
         ``heading_bias``, ``shallow_water``), added to the ship's own effects
-        (:attr:`mmg.ship.Ship.effects`; the trial's values win for an effect in both).  A heading
+        (:attr:`mmg.ship.Ship.effects`; an effect in both has the values each config states, a
+        value stated in both is refused).  A heading
         bias acts on the log (as ``log.bias.heading``), a steady wind also adds the apparent-wind
         columns to the log.
     """
@@ -517,7 +518,10 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
     outside them is refused as probably the wrong unit), and against the ship:
 
     * approach speed 0-60 kn, Froude number U/sqrt(gL) at most 1, the ship's t_P(u) and
-      w_P0(u) within [0, 1) and (constant power) SHP_0(u) > 0 at that speed; rpm 0-6000 rpm;
+      w_P0(u) within [0, 1) and (constant power) SHP_0(u) > 0 at that speed; rpm 0-6000 rpm, and
+      one that can drive that approach (:func:`_check_approach_rpm`: the propeller pushing ahead;
+      a constant-power engine's rpm within 5 % of the one the straight run needs; a constant-rpm
+      motor's rpm driving the ship to a speed within its propeller data);
     * dt 0.1 ms to the ship's steering-gear time constant T_E (RK4 on the gear's first-order
       lag is unstable beyond 2.8 T_E); dt <= duration; at most :data:`mmg.limits.MAX_STEPS`
       steps (refused before anything is allocated, saying how much it would need);
@@ -673,23 +677,10 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
     if off != 0.0:
         dist.append(RudderOffset(off))
 
-    # effects (mmg.effects), besides the ship's
-    effects = None
-    if f.effects is not None:
-        from mmg.effects import effect_set
-
-        effects = effect_set(f.effects, "effects", src)
-        for nm, given in (("current", d.current is not None), ("rudder_offset", off != 0.0),
-                          ("heading_bias", bias["heading"] != 0.0)):
-            if given and effects.get(nm) is not None:
-                where = {"current": "disturbances.current", "rudder_offset": "disturbances.rudder_offset",
-                         "heading_bias": "log.bias.heading"}[nm]
-                raise InputError(src, f"effects.{nm}", f"also given as {where}: give it in one place")
-        w = effects.get("wind")
-        if w is not None and ship.wind is None:
-            raise InputError(src, "effects.wind", f"the wind effect needs a ship with a wind section; {label} has none")
-        if not effects.items:
-            effects = None
+    # effects (mmg.effects), besides the ship's; each value given in one place only
+    effects = _trial_effects(f, ship, src, label, legacy=_legacy_statements(f, dist, bias["heading"], src))
+    if n0 is not None:
+        _check_approach_rpm(src, f.approach, ship, label, u0, n0, dist, effects)
     hb = ship.effect_set().merged(effects).get("heading_bias")
     if hb is not None:               # a compass error: on the logged heading, as log.bias.heading
         log = replace(log, bias=replace(log.bias, heading=log.bias.heading + float(np.radians(hb["bias_deg"]))))
@@ -698,6 +689,144 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
         u0=u0, n0=n0, trim=f.approach.trim, duration=duration, dt=dt, kind=kind, manoeuvre=conv, log=log,
         disturbances=tuple(dist), effects=effects,
     )
+
+
+APPROACH_RPM_TOLERANCE = 0.05
+"""How far (relative) a constant-power engine's ``approach.rpm`` may be from the rpm the straight run
+at ``approach.speed`` needs (the engine's power is SHP_0 at that speed: the rpm follows from it)."""
+
+
+def zero_thrust_advance_ratio(ship: Ship) -> float:
+    """The advance ratio J where the open-water K_T(J) first falls to zero (inf if it never does):
+    beyond it the propeller no longer pushes ahead and the K_T, K_Q polynomials are extrapolations."""
+    roots = np.roots(np.asarray(ship.propeller.K_T, float)[::-1]) if len(ship.propeller.K_T) > 1 else []
+    pos = [float(r.real) for r in roots if abs(r.imag) < 1e-12 and r.real > 0]
+    return min(pos) if pos else float("inf")
+
+
+def _surge(ship: Ship, n: float, effects, slots):
+    """du/dt [m/s^2] of the straight run (no drift, rudder amidships) at surge speed u and rpm ``n``, a function of u."""
+    from mmg.equilibrium import _accels
+    from mmg.model import pack
+
+    pk = pack(ship, 0.0, slots)
+    pk = effects.pack(pk, ship) if effects is not None else pk
+    return lambda u: _accels(pk, u, 0.0, 0.0, n)[0]
+
+
+def _check_approach_rpm(src: str, ap, ship: Ship, label: str, u0: float, n0: float, dist, effects) -> None:
+    """InputError naming ``approach.rpm`` unless the given rpm can drive the approach at ``approach.speed``.
+
+    * At the approach the propeller must push ahead: its advance ratio J = u (1 - w_P0(u)) / (n D)
+      below the zero-thrust J of K_T (a lower rpm, or one of the wrong sign, is refused);
+    * a constant-power engine delivers SHP_0(u) at the approach speed, so the rpm is the one the
+      straight run needs (within :data:`APPROACH_RPM_TOLERANCE`; the simulator calibrates the
+      propeller's torque at it, and a far one would rescale K_Q by the cube of the ratio);
+    * a constant-rpm motor holds the rpm: the ship starts at the approach speed and runs up or
+      down to the speed that rpm gives (the MMG 2015 convention of a model-scale self-propulsion
+      rpm), which must lie within the ship's data (Froude number, t_P(u), w_P0(u) in [0, 1))."""
+    from mmg.disturbances import combine
+    from mmg.effects import EffectSet
+    from mmg.equilibrium import straight_run
+
+    es = ship.effect_set().merged(effects)
+    es = es if es.items else None
+    slots = combine(dist)
+    pr = ship.propeller
+    rpm = f"{ap.rpm} ({n0 * 60:.4g} rpm)" if not ap.rpm.strip().endswith("rpm") else ap.rpm
+    try:
+        need = straight_run(ship, u0, None, True, slots, es).n
+    except ValueError:
+        return                                               # no straight run at all: the simulator says so
+    needs = f"the straight run at {ap.speed} needs {need * 60:.4g} rpm"
+    J0, Jz = u0 * (1 - _polyval(pr.w_P0, u0)) / (n0 * pr.D), zero_thrust_advance_ratio(ship)
+    if J0 >= Jz:
+        raise InputError(src, "approach.rpm", f"{rpm} at {ap.speed} is an advance ratio J = {J0:.3g}, beyond the "
+                                              f"zero-thrust J = {Jz:.3g} of {label}'s propeller: it would not push "
+                                              f"ahead; {needs} (or write 'solve')")
+    if ship.engine.mode == "constant_power":
+        if abs(n0 / need - 1) > APPROACH_RPM_TOLERANCE:
+            raise InputError(src, "approach.rpm", f"{rpm} cannot hold {ap.speed} with the constant-power engine of "
+                                                  f"{label} (its power is SHP_0 at that speed): {needs} (within "
+                                                  f"{APPROACH_RPM_TOLERANCE:.0%}; or write 'solve')")
+        return
+    surge = _surge(ship, n0, es, slots)
+    top = MAX_FROUDE * np.sqrt(9.81 * ship.particulars.L)
+    if surge(top) > 0:
+        raise InputError(src, "approach.rpm", f"{rpm} would drive {label} beyond a Froude number of {MAX_FROUDE:g} "
+                                              f"({top:.3g} m/s); {needs}")
+    lo, hi = u0, top
+    if surge(u0) < 0:                                       # slows down: the speed it gives is below u0
+        lo, hi = 0.0, u0
+        if surge(1e-6 * u0) < 0:
+            return                                          # coasts to rest: physical, nothing to check
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if surge(mid) > 0 else (lo, mid)
+    u_n = 0.5 * (lo + hi)
+    for name, poly in (("t_P", pr.t_P), ("w_P0", pr.w_P0)):
+        if not 0.0 <= _polyval(poly, u_n) < 1.0:
+            raise InputError(src, "approach.rpm", f"{rpm} drives {label} to {u_n:.4g} m/s, where its {name}(u) is "
+                                                  f"{_polyval(poly, u_n):.3g}, outside [0, 1): beyond the propeller "
+                                                  f"data; {needs}")
+
+
+_LEGACY = {"current": "disturbances.current", "rudder_offset": "disturbances.rudder_offset",
+           "heading_bias": "log.bias.heading"}
+"""The older trial keys of three effects (the same physics as ``effects.<name>``)."""
+
+
+def _legacy_statements(f: _TrialFile, dist: list, heading_bias: float, src: str) -> list:
+    """The effect values the trial's older keys state: ``(effect, parameter, file, field, value)``.
+
+    A key counts when it is written, whatever its value (``rudder_offset: 0 deg`` states a zero offset)."""
+    out = []
+    d = f.disturbances
+    for c in dist:
+        if isinstance(c, UniformCurrent):
+            out += [("current", "speed_mps", src, "disturbances.current.speed", c.speed),
+                    ("current", "direction_deg", src, "disturbances.current.direction", float(np.degrees(c.direction)))]
+    if "rudder_offset" in d.model_fields_set:
+        off = next((c.offset for c in dist if isinstance(c, RudderOffset)), 0.0)
+        out.append(("rudder_offset", "offset_deg", src, "disturbances.rudder_offset", float(np.degrees(off))))
+    if "bias" in f.log.model_fields_set and "heading" in f.log.bias.model_fields_set:
+        out.append(("heading_bias", "bias_deg", src, "log.bias.heading", float(np.degrees(heading_bias))))
+    return out
+
+
+def _trial_effects(f: _TrialFile, ship: Ship, src: str, label: str, legacy: list):
+    """The trial's ``effects:`` as an EffectSet (None: none), every effect value given in one place.
+
+    Refused, in one line naming both places: an effect both in ``effects:`` and in its older key
+    (``disturbances.current``, ``disturbances.rudder_offset``, ``log.bias.heading``); an older key
+    for an effect the ship config has (the ship's would act in the simulator, the key in the log);
+    an effect value stated by the trial and by the ship file (``effects.wind.scale`` here and
+    ``wind.scale`` there), even equal.  An effect in both configs otherwise takes the values each
+    states (the ship's wind scale with the trial's steady wind)."""
+    from mmg.effects import EffectSet, effect_set, refuse_twice, statements
+
+    own = ship.effect_set()
+    for eff, _, _, _, _ in legacy:
+        if own.get(eff) is not None:
+            raise InputError(src, _LEGACY[eff], f"also given as effects.{eff} of the ship config {label}: give it in one place")
+    if f.effects is None:
+        return None
+    effects = effect_set(f.effects, "effects", src)
+    for eff, _, _, _, _ in legacy:
+        if effects.get(eff) is not None:
+            raise InputError(src, f"effects.{eff}", f"also given as {_LEGACY[eff]}: give it in one place")
+    mine = statements(f.effects, effects, "effects", src)
+    shipped = [st for st in ship.stated if own.get(st[0]) is not None or st[:2] == ("wind", "scale")]
+    refuse_twice(shipped + mine, src)
+    if effects.get("wind") is not None and ship.wind is None:
+        raise InputError(src, "effects.wind", f"the wind effect needs a ship with a wind section; {label} has none")
+    items = []
+    for cls, vals in effects.items:                    # the values each config states, together
+        base = dict(own.get(cls.name) or {})
+        base.update({p: v for e, p, _, _, v in shipped if e == cls.name})
+        base.update({p: v for e, p, _, _, v in mine if e == cls.name})
+        items.append((cls, {**vals, **base}))
+    return EffectSet(tuple(items)) if items else None
 
 
 def _schedule(man: dict, ship: Ship, label: str, duration: float, base: Path, src: str) -> np.ndarray:

@@ -28,7 +28,7 @@ from .shallow_water import ShallowWater
 from .wind import Wind
 
 __all__ = ["Effect", "EffectSet", "Parameter", "Context", "REGISTRY", "register", "get", "names", "effect_set",
-           "Current", "Wind", "RudderOffset", "HeadingBias", "ShallowWater"]
+           "statements", "refuse_twice", "Current", "Wind", "RudderOffset", "HeadingBias", "ShallowWater"]
 
 REGISTRY: dict = {}
 
@@ -88,3 +88,32 @@ def effect_set(spec=None, owner: str = "effects", source: str | None = None) -> 
                 raise
             raise InputError(source, ".".join(x for x in (e.source, e.field) if x), e.message) from None
     return EffectSet(tuple(items))
+
+
+def statements(spec, es: EffectSet, owner: str = "effects", source: str = "") -> list:
+    """Every value an ``effects:`` section states itself: ``(effect, parameter, source, field, value)``.
+
+    ``spec`` is the section as written (validated by :func:`effect_set` into ``es``); a parameter
+    the section leaves out (its default) is not stated.  Used to refuse a value given in two places
+    (:func:`refuse_twice`)."""
+    out = []
+    for nm, vals in dict(spec or {}).items():
+        for k in dict(vals or {}):
+            out.append((str(nm), str(k), source, f"{owner}.{nm}.{k}", es.get(str(nm))[str(k)]))
+    return out
+
+
+def refuse_twice(stated, source: str) -> None:
+    """InputError when two of ``stated`` ((effect, parameter, source, field, value) tuples, from one
+    config or from a trial and its ship) give the same effect parameter, even with equal values:
+    one line naming the later place (in ``source``) and the earlier one (with its file when that
+    is another)."""
+    first: dict = {}
+    for eff, par, src, field, value in stated:
+        key = (eff, par)
+        if key in first:
+            osrc, ofield, ovalue = first[key]
+            there = ofield if osrc == src else f"{ofield} of {osrc}"
+            raise InputError(src or source, field, f"{value:g} here and {ovalue:g} in {there}: the {eff} "
+                                                   f"{par} is given twice; give it in one place")
+        first[key] = (src, field, value)

@@ -159,12 +159,23 @@ class Effect(abc.ABC):
 
     # ---------------------------------------------------------------- availability
     @classmethod
+    def needs(cls, values: dict | None = None) -> tuple:
+        """The logged channels the effect needs with ``values`` (default: :attr:`channels`)."""
+        return cls.channels
+
+    @classmethod
+    def missing(cls, channels, values: dict | None = None) -> str | None:
+        """Why a record with ``channels`` (name -> array or None) cannot give the effect with ``values``
+        what it needs (:meth:`needs`), or None when it can."""
+        gone = [c for c in cls.needs(values) if (channels or {}).get(c) is None]
+        if gone:
+            return f"the record has no {' / '.join(gone)} channel{'s' if len(gone) > 1 else ''}"
+        return None
+
+    @classmethod
     def unavailable(cls, ctx: Context) -> str | None:
         """Why the effect cannot be applied to this record (None when it can)."""
-        missing = [c for c in cls.channels if ctx.channels.get(c) is None]
-        if missing:
-            return f"the record has no {' / '.join(missing)} channel{'s' if len(missing) > 1 else ''}"
-        return None
+        return cls.missing(ctx.channels)
 
     # ---------------------------------------------------------------- how it acts
     @classmethod
@@ -239,6 +250,19 @@ class EffectSet:
         for e, v in other.items:
             mine[e.name] = (e, v)
         return EffectSet(tuple(mine.values()))
+
+    def usable(self, channels) -> tuple["EffectSet", list]:
+        """(this set without the effects a record with ``channels`` cannot feed, [(name, why), ...]).
+
+        The one rule every command applies to a record (``mmg predict``, ``mmg identify``, ``mmg
+        diagnose`` through :func:`trials.predict.measured_run`): an effect whose logged channels
+        (:meth:`Effect.needs`, e.g. the measured relative wind) the record lacks is left out, and
+        why is said, instead of being applied to channels that are not there."""
+        keep, gone = [], []
+        for e, v in self.items:
+            why = e.missing(channels, v)
+            (gone.append((e.name, why)) if why else keep.append((e, v)))
+        return EffectSet(tuple(keep)), gone
 
     def without(self, *names: str) -> "EffectSet":
         """This set without the named effects."""

@@ -68,6 +68,11 @@ class Wind(Effect):
         return None
 
     @classmethod
+    def needs(cls, values=None):
+        """The relative-wind channels, unless ``values`` give a steady true wind (the model's own then)."""
+        return () if values is not None and cls.steady(values) else cls.channels
+
+    @classmethod
     def steady(cls, values) -> bool:
         """Whether the values give a steady true wind (else: the record's measured wind)."""
         return float(values.get("true_speed_mps", 0.0)) > 0.0
