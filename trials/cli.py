@@ -509,7 +509,7 @@ def cmd_identify(args) -> int:
     def progress(k, cost, stage):            # a header per fit stage, then its iterations labelled by it
         if stage != shown[0]:
             shown[0] = stage
-            print(f"{stage} (at most {kw['max_nfev']} evaluations)", file=sys.stderr, flush=True)
+            print(f"{stage}; at most {kw['max_nfev']} evaluations", file=sys.stderr, flush=True)
         print(f"  {stage.split(':')[0]}, iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)",
               file=sys.stderr, flush=True)
 
