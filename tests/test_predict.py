@@ -403,8 +403,10 @@ def test_a_diverged_replay_says_where_and_scores_null(simulated, tmp_path, capsy
     rc, out, err = _run_cli(["predict", "--ship", yml, truth, truth, "--json", js], capsys)
     assert rc == 0, err
     lines = out.strip().splitlines()
-    assert lines[0] == f"{rec.name}: the replay diverged at t = {t_div:.1f} s (the predicted state is not finite " \
-                       f"from there; scores null), wind {rep.run.wind}"
+    said = (f": the replay diverged at t = {t_div:.1f} s (the predicted state is not finite from there; scores null), "
+            f"wind {rep.run.wind}")
+    stem = Path(truth).stem                                             # runs named after their file (issue 24)
+    assert lines[:2] == [stem + said, f"{stem}_2" + said]
     assert not any(ln.startswith("mean over") for ln in lines)          # nothing finite to average
     doc = json.loads(js.read_text())
     assert all(run[k] is None for run in doc["runs"] for k in SCORE_KEYS)
