@@ -200,7 +200,8 @@ def test_max_nfev_stages_labelled_and_explained(tmp_path, capsys):
 
 
 def test_records_named_after_their_files_in_the_report(tmp_path, capsys):
-    """Two records of one stem (two days' zz.csv) are two rows of the report, told apart by their folders."""
+    """Two records of one stem (two days' zz.csv) are two rows of the report, told apart by their folders
+    (a test record of that stem too)."""
     from trials.identify import load_runs
 
     import mmg
@@ -210,9 +211,11 @@ def test_records_named_after_their_files_in_the_report(tmp_path, capsys):
     a = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv", tmp_path / "day1" / "zz.csv", 40.0)
     b = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_22_52.csv", tmp_path / "day2" / "zz.csv", 40.0)
     assert [r.name for r in load_runs(mmg.load_ship("esso_osaka_3m"), [a, b])] == ["day1/zz", "day2/zz"]
+    (tmp_path / "day3").mkdir()                 # a test record of the same stem: named with the training ones
+    c = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_29_19.csv", tmp_path / "day3" / "zz.csv", 40.0)
     out = tmp_path / "out"
-    assert main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--out", str(out),
+    assert main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--test", str(c), "--out", str(out),
                  "--free", "N_r", "--max-nfev", "2"]) == 0
     rep = (out / "report.md").read_text()
-    for name in ("day1/zz", "day2/zz"):
+    for name in ("day1/zz", "day2/zz", "day3/zz"):
         assert re.search(rf"^\| {name} \| [\d.]+ \| [\d.]+ \|", rep, flags=re.M), rep

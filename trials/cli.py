@@ -476,7 +476,7 @@ def cmd_identify(args) -> int:
     from mmg.ship import load_ship
 
     from .identify import DEFAULT_MAX_NFEV, cross_validate, cv_folds, identify, load_runs, write_identification
-    from .output import StagedOutput, check_output_dir
+    from .output import StagedOutput, check_output_dir, record_labels
 
     check_output_dir(args.out)
     for log in args.train + (args.test or []):
@@ -488,7 +488,8 @@ def cmd_identify(args) -> int:
         _check_free(ship, args.free)
     wind = None if args.wind is None else args.wind == "on"
     t0 = time.perf_counter()
-    runs = load_runs(ship, args.train, wind=wind)        # an unusable record: one line, skipped
+    names = record_labels(args.train + (args.test or []))   # training and test records told apart together
+    runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)])   # an unusable one: one line, skipped
     if not runs:
         raise InputError("--train", "", "no usable training record")
     print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
@@ -500,7 +501,8 @@ def cmd_identify(args) -> int:
         if folds < args.cv:
             print(f"note: --cv {args.cv}: {folds} independent records, so {folds} folds (each kept out once)",
                   file=sys.stderr, flush=True)
-    tests = load_runs(ship, args.test, wind=wind) if args.test else None   # a bad one: one line, before the fit
+    tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):])   # a bad one: one line, before the fit
+             if args.test else None)
     if args.test and not tests:
         raise InputError("--test", "", "no usable record")
 

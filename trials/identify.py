@@ -66,10 +66,11 @@ def _log(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
-def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log) -> list[MeasuredRun]:
+def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log, names=None) -> list[MeasuredRun]:
     """Read and prepare each record; one that cannot be used is skipped with one line saying why.
     Each is named after its file (:func:`trials.output.record_labels`: ``ST35``, or ``day1/ST35``
-    and ``day2/ST35`` for two files of one stem), as the report and ship.yaml name it."""
+    and ``day2/ST35`` for two files of one stem), as the report and ship.yaml name it; ``names``:
+    the names to give instead (labels made over the training and test records together)."""
     from dataclasses import replace
 
     from .logio import read_record
@@ -77,7 +78,7 @@ def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log) -> list[Mea
 
     paths = list(paths)
     runs = []
-    for p, label in zip(paths, record_labels(paths)):
+    for p, label in zip(paths, record_labels(paths) if names is None else names):
         try:
             rec = read_record(p, length_m=ship.particulars.L)
             runs.append(replace(measured_run(ship, rec, wind=wind), name=label))
