@@ -50,7 +50,7 @@ def main() -> None:
     ap.add_argument("--folds-by", choices=["order", "revolutions"], default="order",
                     help="deal the records into folds in file order or stratified by propeller revolutions")
     ap.add_argument("--max-nfev", type=int, default=None,
-                    help="evaluation limit of the whole-record fit (default: trials.identify.identify's)")
+                    help="evaluation limit of each fit stage (default: trials.identify.DEFAULT_MAX_NFEV)")
     ap.add_argument("--velocity-weight", type=float, default=1.0,
                     help="weight of the u, v, r residuals beside the heading's (identify(velocity_weight=))")
     ap.add_argument("--offset-spread", type=float, default=0.0, metavar="DEG",

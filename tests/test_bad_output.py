@@ -448,3 +448,136 @@ def test_estimate_no_plots_claims_no_png(tmp_path, capsys):
     for f in out.glob("*.json"):
         strict_json(f)
     assert not list(out.glob(".*"))
+
+
+# --------------------------------------------------------------------------- issue 24: every output option
+
+
+def _output_options(zz20_log):
+    """Every output option of every command, with a command line that gives it ``{}``."""
+    log = str(zz20_log)
+    return {
+        ("simulate", "--out"): ["simulate", ST35, "--out", "{}"],
+        ("metrics", "--json"): ["metrics", log, "--json", "{}"],
+        ("reproduce", "--out"): ["reproduce", "--out", "{}"],
+        ("nomoto", "--json"): ["nomoto", log, "--length", "325", "--json", "{}"],
+        ("nomoto-paper", "--out"): ["nomoto-paper", "--out", "{}"],
+        ("estimate", "--out"): ["estimate", ZZ20, "--out", "{}"],
+        ("sensitivity", "--out"): ["sensitivity", ZZ20, "--out", "{}"],
+        ("sensitivity", "--crb-vs-mc"): ["sensitivity", "--crb-vs-mc", "{}", "--out", "x"],
+        ("montecarlo", "out"): ["montecarlo", "{}", "--seeds", "1"],
+        ("log-filter", "out"): ["log-filter", "{}", "--seeds", "1"],
+        ("output-error", "out"): ["output-error", "{}", "--seeds", "1"],
+        ("predict", "--json"): ["predict", log, "--ship", "esso_osaka", "--json", "{}"],
+        ("predict", "--plots"): ["predict", log, "--ship", "esso_osaka", "--json", "p.json", "--plots", "{}"],
+        ("identify", "--out"): ["identify", "--ship", "esso_osaka", "--train", log, "--out", "{}"],
+        ("diagnose", "--json"): ["diagnose", log, "--ship", "esso_osaka", "--json", "{}"],
+        ("diagnose", "--plots"): ["diagnose", log, "--ship", "esso_osaka", "--json", "d.json", "--plots", "{}"],
+        ("diagnose", "--out-ship"): ["diagnose", log, "--ship", "esso_osaka", "--json", "d.json", "--out-ship", "{}"],
+    }
+
+
+def _parser_output_options() -> set:
+    """(command, option) of every output option build_parser has (a new one must join the table above)."""
+    from trials.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if a.choices and isinstance(a.choices, dict))
+    found = set()
+    for cmd, p in sub.choices.items():
+        for a in p._actions:
+            name = a.option_strings[0] if a.option_strings else a.dest
+            if a.dest in ("out", "json", "plots", "out_ship", "crb_vs_mc") or "output" in (a.help or "").split(" ")[:2]:
+                found.add((cmd, name))
+    return found
+
+
+@pytest.mark.parametrize("empty", ["", " "])
+def test_every_output_option_refuses_an_empty_path(empty, tmp_path, capsys, monkeypatch, zz20_log, no_computation):
+    """`mmg metrics LOG --json ''` wrote nothing and exited 0: an empty path is refused, for every option."""
+    monkeypatch.chdir(tmp_path)
+    assert _parser_output_options() == set(_output_options(zz20_log))
+    for (cmd, opt), argv in _output_options(zz20_log).items():
+        assert main([a.replace("{}", empty) for a in argv]) == 2, (cmd, opt)
+        line = one_error_line(capsys)
+        assert "empty path" in line and (opt if opt.startswith("--") else "out") in line, line
+    assert tree(tmp_path) == []
+
+
+def _closed_pipe_run(argv, cwd, unbuffered: bool, stderr_too: bool = False):
+    """``mmg argv`` with its stdout (and stderr) a pipe nobody reads (closed before the first line)."""
+    import subprocess
+    import sys
+
+    r, w = os.pipe()
+    os.close(r)                                         # the reader left: every write is EPIPE
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    env.pop("PYTHONUNBUFFERED", None)
+    if unbuffered:
+        env["PYTHONUNBUFFERED"] = "1"
+    try:
+        p = subprocess.run([sys.executable, "-m", "trials.cli", *argv], cwd=cwd, env=env, stdout=w,
+                           stderr=w if stderr_too else subprocess.PIPE, timeout=600)
+    finally:
+        os.close(w)
+    return p.returncode, (p.stderr or b"").decode()
+
+
+@pytest.mark.parametrize("unbuffered", [True, False])
+def test_a_closed_stdout_loses_no_file(unbuffered, tmp_path, zz20_log):
+    """`mmg metrics LOG --json m.json | head -c 20` was killed (141) before m.json was written: the files
+    are all written and the exit is the run's own, for every kind of command (a folder, a JSON, plots)."""
+    log = str(zz20_log)
+    cases = [(["metrics", log, "--json", "m.json"], ["m.json"]),
+             (["simulate", ST35, "--out", "sim"], ["sim/log.csv", "sim/metrics.json", "sim/track.png"]),
+             (["nomoto", log, "--length", "325", "--json", "n/n.json", "--no-output-error"], ["n/n.json", "n/n.png"]),
+             (["predict", log, "--ship", "esso_osaka", "--json", "p.json", "--plots", "pl"], ["p.json", "pl/log.png"])]
+    for argv, files in cases:
+        code, err = _closed_pipe_run(argv, tmp_path, unbuffered)
+        assert code == 0, (argv, code, err)
+        assert "Traceback" not in err and "BrokenPipe" not in err and "Exception ignored" not in err, err
+        for f in files:
+            assert (tmp_path / f).is_file(), (argv, f, tree(tmp_path))
+            if f.endswith(".json"):
+                strict_json(tmp_path / f)
+    code, _ = _closed_pipe_run(["metrics", log, "--json", "both.json"], tmp_path, unbuffered, stderr_too=True)
+    assert code == 0 and strict_json(tmp_path / "both.json")["kind"] == "zigzag"
+    assert not [p for p in tmp_path.rglob(".*")]            # no staging or temporary file left
+
+
+def test_a_folder_holding_other_files_is_reported(tmp_path, capsys, zz20_log):
+    """An existing --out keeps an earlier run's files of another command beside the new ones: one note
+    line names them; the same command re-run into its own folder replaces its files without a note."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "m.json").write_text("{}")                       # another command's file
+    (out / "old").mkdir()
+    (out / "old" / "x.csv").write_text("1")
+    assert main(["simulate", ST35, "--out", str(out)]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("note: ") and "2 entries this run did not write" in err[0], err
+    assert "m.json" in err[0] and "old/" in err[0] and str(out) in err[0]
+    assert (out / "m.json").read_text() == "{}" and (out / "old" / "x.csv").read_text() == "1"
+    fresh = tmp_path / "fresh"
+    assert main(["simulate", ST35, "--out", str(fresh)]) == 0
+    assert main(["simulate", ZZ20, "--out", str(fresh)]) == 0      # its own files again: replaced, no note
+    assert "note:" not in capsys.readouterr().err
+    # the same command leaving fewer files: the earlier run's one left over is named
+    assert main(["predict", str(zz20_log), "--ship", "esso_osaka", "--json", str(tmp_path / "p.json"),
+                 "--plots", str(fresh)]) == 0
+    err = capsys.readouterr().err
+    assert "this run did not write" in err and "truth.csv" in err and "log.png" not in err.split("write")[-1]
+    # a JSON written into a folder of other files is a file, not a folder this run wrote into: no note
+    assert main(["metrics", str(zz20_log), "--json", str(out / "m2.json")]) == 0
+    assert main(["nomoto", str(zz20_log), "--length", "325", "--json", str(out / "n.json"), "--no-output-error"]) == 0
+    assert "note:" not in capsys.readouterr().err
+
+
+def test_not_written_looks_only_into_the_folders_written(tmp_path):
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "mine.png").write_text("")
+    (tmp_path / "a" / "old.png").write_text("")
+    (tmp_path / "b" / "c").mkdir(parents=True)
+    (tmp_path / "top.txt").write_text("")
+    (tmp_path / ".staging-xyz").mkdir()                     # another run in progress
+    assert output.not_written(tmp_path, ["a/mine.png"]) == ["a/old.png", "b/", "top.txt"]
+    assert output.not_written(tmp_path, ["a/mine.png", "a/old.png", "top.txt"]) == ["b/"]

@@ -135,6 +135,21 @@ def _mmg(*args):
     return subprocess.run([sys.executable, "-m", "trials.cli", *map(str, args)], capture_output=True, text=True)
 
 
+def test_records_named_after_their_files(tmp_path, ship, clean):
+    """Issue 24: records are named after their files in the JSON and the plots (DIR/<name>.png): two
+    files of one stem (one trial recorded on two days) told apart by their folders, not ``x`` twice."""
+    from trials.diagnose import prepare, synthetic_record, write_frt_csv
+
+    paths = []
+    for day in ("day1", "day2"):
+        (tmp_path / day).mkdir()
+        paths.append(tmp_path / day / "zz.csv")
+        write_frt_csv(synthetic_record(ship, "zigzag", {}, name="ZZ"), paths[-1])
+    assert [r.name for r in prepare(ship, paths + paths[:1])] == ["day1/zz", "day2/zz", "day1/zz_2"]
+    j = clean.to_json()
+    assert j["names"] == ["turn", "zigzag"] and len(j["names"]) == len(j["files"])
+
+
 def test_cli_malformed_record_one_line(tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("t [s],x_position_mid [m],y_position_mid [m],psi_hat [rad]\n0,0,0,0\n0.1,0,0,nan\n")

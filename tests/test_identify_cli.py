@@ -160,3 +160,62 @@ def test_velocity_weight_reaches_the_fit_and_the_report(identified, tmp_path):
 
     h2, h0 = mmg.load_ship(out2 / "ship.yaml").hull, mmg.load_ship(out / "ship.yaml").hull
     assert any(abs(h2.value(n) - h0.value(n)) > 1e-6 * (1 + abs(h0.value(n))) for n in h0.names)
+
+
+def test_max_nfev_stages_labelled_and_explained(tmp_path, capsys):
+    """Issue 24: the fit's evaluation limit is an option (--max-nfev, reaching each stage); the progress
+    names each stage (its iterations labelled by it: the second series is another cost, not a restart);
+    the report says what each stage fitted in words (no "segment length inf s") and how it stopped."""
+    a = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv", tmp_path / "zz.csv", 40.0)
+    b = _slice(FRT / "turning" / "turn_14-Sep-2020_13_51_45.csv", tmp_path / "turn.csv", 40.0)
+    out = tmp_path / "out"
+    rc = main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--out", str(out),
+               "--free", "N_r", "Y_beta", "--max-nfev", "2"])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    heads = [ln for ln in err.splitlines() if ln.startswith("stage ")]
+    assert len(heads) == 2, err
+    assert heads[0].startswith("stage 1/2: segment-wise fit: ") and heads[0].endswith("at most 2 evaluations")
+    assert heads[1].startswith("stage 2/2: whole-record fit: ") and "not cut" in heads[1]
+    its = re.findall(r"^  (stage \d/\d), iteration (\d+): cost", err, flags=re.M)
+    assert its and {s for s, _ in its} == {"stage 1/2", "stage 2/2"} and all(int(k) <= 2 for _, k in its)
+    assert not re.search(r"^  iteration", err, flags=re.M)             # no unlabelled series
+    rep = (out / "report.md").read_text()
+    assert "inf s" not in rep and "segment length" not in rep
+    assert re.search(r"^1\. segment-wise fit: [\d.]+ s segments, each restarted from the measured state; \d+ "
+                     r"evaluations of at most 2", rep, flags=re.M), rep
+    assert re.search(r"^2\. whole-record fit: each record replayed open-loop from its first sample \(not cut into "
+                     r"segments\); \d+ evaluations of at most 2", rep, flags=re.M), rep
+    stopped = re.findall(r"^note: (.+) stopped at its evaluation limit \(2\)", err, flags=re.M)
+    assert stopped == re.findall(r"^\d\. ([\w-]+ fit): .*stopped at its evaluation limit", rep, flags=re.M)
+    # the limit reaches the fit (the library's stages record it) and more evaluations are allowed
+    from trials.identify import identify, load_runs
+
+    import mmg
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    ident = identify(ship, load_runs(ship, [a, b]), free=["N_r", "Y_beta"], max_nfev=3, say=lambda m: None)
+    assert [s["max_nfev"] for s in ident.stages] == [3, 3] and all(s["evaluations"] <= 3 for s in ident.stages)
+    assert ident.stages[0]["segment_s"] < float("inf") == ident.stages[1]["segment_s"]
+
+
+def test_records_named_after_their_files_in_the_report(tmp_path, capsys):
+    """Two records of one stem (two days' zz.csv) are two rows of the report, told apart by their folders
+    (a test record of that stem too)."""
+    from trials.identify import load_runs
+
+    import mmg
+
+    (tmp_path / "day1").mkdir()
+    (tmp_path / "day2").mkdir()
+    a = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv", tmp_path / "day1" / "zz.csv", 40.0)
+    b = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_22_52.csv", tmp_path / "day2" / "zz.csv", 40.0)
+    assert [r.name for r in load_runs(mmg.load_ship("esso_osaka_3m"), [a, b])] == ["day1/zz", "day2/zz"]
+    (tmp_path / "day3").mkdir()                 # a test record of the same stem: named with the training ones
+    c = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_29_19.csv", tmp_path / "day3" / "zz.csv", 40.0)
+    out = tmp_path / "out"
+    assert main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--test", str(c), "--out", str(out),
+                 "--free", "N_r", "--max-nfev", "2"]) == 0
+    rep = (out / "report.md").read_text()
+    for name in ("day1/zz", "day2/zz", "day3/zz"):
+        assert re.search(rf"^\| {name} \| [\d.]+ \| [\d.]+ \|", rep, flags=re.M), rep

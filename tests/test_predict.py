@@ -161,18 +161,53 @@ def test_cli_predict_end_to_end(slices, tmp_path, ship3m, capsys):
     assert list(doc) == ["runs"] and len(doc["runs"]) == 2
     lib = predict(ship3m, slices)
     for run, path, rep in zip(doc["runs"], slices, lib.runs):
-        assert list(run) == ["file", *SCORE_KEYS]
-        assert run["file"] == str(path)
-        assert run == {"file": str(path), **rep.scores()}          # the library's numbers, bit for bit
+        assert list(run) == ["name", "file", *SCORE_KEYS]
+        assert run["file"] == str(path) and run["name"] == path.stem
+        assert run == {"name": path.stem, "file": str(path), **rep.scores()}   # the library's numbers, bit for bit
         assert all(np.isfinite(run[k]) for k in SCORE_KEYS)
         assert run["final_position_error_L"] == pytest.approx(run["final_position_error_m"] / 3.0, rel=1e-15)
     lines = out.strip().splitlines()
     assert [ln.split(":")[0] for ln in lines[:2]] == ["zz_slice", "turn_slice"]
     assert "heading" in lines[0] and "wind on" in lines[0]
     assert [ln for ln in err.splitlines() if ln.startswith("replayed")] == \
-        ["replayed 1/2: zz_slice.csv", "replayed 2/2: turn_slice.csv"]
+        ["replayed 1/2: zz_slice", "replayed 2/2: turn_slice"]
     assert sorted(p.name for p in plots.iterdir()) == ["turn_slice.png", "zz_slice.png"]
     assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in plots.iterdir())
+
+
+@needs_frt
+def test_two_records_of_one_trial_are_named_after_their_files(tmp_path, capsys):
+    """Issue 24: two records of one trial wrote ST35.png and ST35_2.png and printed "ST35" twice: every
+    output and printed line is named after the file, two files of one stem told apart by their folders
+    (the same file given again numbered), the same names in the JSON, the lines and the plots."""
+    a, b = tmp_path / "day1", tmp_path / "day2"
+    a.mkdir()
+    b.mkdir()
+    for d in (a, b):                           # one trial's record, twice: the same name inside the file
+        _slice(FRT / ZIGZAG, d / "zigzag.csv")
+    other = _slice(FRT / TURNING, tmp_path / "turn.csv")
+    js, plots = tmp_path / "p.json", tmp_path / "plots"
+    rc, out, err = _run_cli(["predict", "--ship", "esso_osaka_3m", a / "zigzag.csv", b / "zigzag.csv", other,
+                             a / "zigzag.csv", "--json", js, "--plots", plots], capsys)
+    assert rc == 0, err
+    names = ["day1/zigzag", "day2/zigzag", "turn", "day1/zigzag_2"]
+    runs = json.loads(js.read_text())["runs"]
+    assert [r["name"] for r in runs] == names
+    assert [r["file"] for r in runs] == [str(a / "zigzag.csv"), str(b / "zigzag.csv"), str(other), str(a / "zigzag.csv")]
+    assert [ln.split(":")[0] for ln in out.strip().splitlines()[:4]] == names
+    assert sorted(str(p.relative_to(plots)) for p in plots.rglob("*.png")) == sorted(f"{n}.png" for n in names)
+    assert runs[0]["heading_rms_deg"] == runs[3]["heading_rms_deg"]      # the same file, the same scores
+
+
+def test_record_labels_are_unique_and_deterministic(tmp_path):
+    from trials.output import record_labels
+
+    paths = [tmp_path / "x" / "a" / "ST35.csv", tmp_path / "y" / "a" / "ST35.csv", tmp_path / "ST35_2.csv",
+             tmp_path / "z" / "ZZ.csv", tmp_path / "z" / "ZZ.txt", tmp_path / "x" / "a" / "ST35.csv"]
+    got = record_labels(paths)
+    assert got == ["x/a/ST35", "y/a/ST35", "ST35_2", "ZZ.csv", "ZZ.txt", "x/a/ST35_2"]
+    assert record_labels(paths) == got and len(set(got)) == len(got)
+    assert record_labels([tmp_path / "one.csv"]) == ["one"]
 
 
 @needs_frt
@@ -368,8 +403,10 @@ def test_a_diverged_replay_says_where_and_scores_null(simulated, tmp_path, capsy
     rc, out, err = _run_cli(["predict", "--ship", yml, truth, truth, "--json", js], capsys)
     assert rc == 0, err
     lines = out.strip().splitlines()
-    assert lines[0] == f"{rec.name}: the replay diverged at t = {t_div:.1f} s (the predicted state is not finite " \
-                       f"from there; scores null), wind {rep.run.wind}"
+    said = (f": the replay diverged at t = {t_div:.1f} s (the predicted state is not finite from there; scores null), "
+            f"wind {rep.run.wind}")
+    stem = Path(truth).stem                                             # runs named after their file (issue 24)
+    assert lines[:2] == [stem + said, f"{stem}_2" + said]
     assert not any(ln.startswith("mean over") for ln in lines)          # nothing finite to average
     doc = json.loads(js.read_text())
     assert all(run[k] is None for run in doc["runs"] for k in SCORE_KEYS)

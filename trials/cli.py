@@ -13,7 +13,17 @@ computation; it then writes through :class:`trials.output.StagedOutput` (a stagi
 inside the target, moved in at the end), so an error, a full disk, a read-only filesystem,
 SIGINT or SIGTERM leaves nothing behind: no staging folder, no partial file, no folder it
 created.  A write failure (no space, read-only, no permission) is one line naming the path,
-exit 2.
+exit 2.  An empty path for any output option is refused when the arguments are read
+(:func:`_output_path`).  An existing folder is written into (a command re-run into its own
+folder replaces its own files); when it holds files this run did not write (an earlier run's,
+another command's) one ``note:`` line on stderr names them after the run
+(:func:`trials.output.others_note`).  Inputs are named after their files in printed lines and
+outputs (:func:`trials.output.record_labels`).
+
+Console output: a reader that leaves early (``mmg ... | head``) costs only the lines it did not
+read: stdout and stderr are wrapped (:class:`_ReaderGone`) so that a closed pipe sends the rest
+of the console output to ``os.devnull``; the run goes on, writes every file and exits with its
+own status (no SIGPIPE, no BrokenPipeError).
 
 Subcommands
 -----------
@@ -40,6 +50,7 @@ import os
 import signal
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 from mmg.errors import InputError
@@ -87,6 +98,14 @@ def _whole(minimum: int, what: str):
 
 _positive_int = _whole(1, "it")
 _seed = _whole(0, "a noise seed")
+
+
+def _output_path(text: str) -> str:
+    """An argparse type for every output option (a folder or file written): an empty path is refused
+    (it would otherwise mean "no output" to a command whose option is optional)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"empty path {text!r}: give a file or folder name")
+    return text
 
 
 def _finite_positive(text: str) -> float:
@@ -149,17 +168,17 @@ def cmd_metrics(args) -> int:
     from .metrics import record_metrics
     from .output import check_output_file, dump_json
 
-    if args.json:
+    if args.json is not None:
         check_output_file(args.json)
     rec = read_record(args.log)
     ang = None if args.zigzag_angle is None else np.radians(args.zigzag_angle)
     m = record_metrics(rec, args.kind, args.length, ang)
+    if args.json is not None:
+        dump_json(m, args.json)               # first (a temporary file beside it, renamed), then the console
     print(f"{rec.name} ({m['kind']}, {rec.source})")
     print_metrics(m)
     for note in m.get("notes", []):
         print(f"note: {note}", file=sys.stderr)
-    if args.json:
-        dump_json(m, args.json)               # a temporary file beside it, renamed
     return 0
 
 
@@ -183,18 +202,19 @@ def cmd_nomoto(args) -> int:
     from .nomoto_report import identify_log, report, write_identification
     from .output import StagedOutput, check_output_file
 
-    if args.json:
+    if args.json is not None:
         if Path(args.json).suffix.lower() == ".png":
             raise InputError("--json", args.json, "ends in .png, the name of the plot written beside it")
         check_output_file(args.json, also=[Path(args.json).with_suffix(".png")])
-    with StagedOutput(Path(args.json).parent) if args.json else nullcontext() as stage:
+    # the JSON's folder staged for the JSON and its plot only: what else it holds is not this run's business
+    with StagedOutput(Path(args.json).parent, report=False) if args.json is not None else nullcontext() as stage:
         ident, note = identify_log(args.log, args.length, args.speed, output_error=not args.no_output_error)
-        if note:
-            print(note)
-        print(report(ident))
-        if args.json:
+        if args.json is not None:
             write_identification(ident, stage.path(Path(args.json).name))
-    if args.json:
+    if note:                                     # the files are in place: now the console
+        print(note)
+    print(report(ident))
+    if args.json is not None:
         print(f"wrote {args.json} and {Path(args.json).with_suffix('.png')}")
     return 0
 
@@ -389,17 +409,6 @@ def cmd_output_error(args) -> int:
 # --------------------------------------------------------------------------- predict
 
 
-def _plot_names(runs) -> list[str]:
-    """``<name>.png`` per replayed run; a name met again gets ``_2``, ``_3``, ... (two records of one trial)."""
-    seen: dict = {}
-    out = []
-    for r in runs:
-        base = str(r.run.name or Path(r.run.source).stem).replace(os.sep, "_").replace("/", "_") or "run"
-        k = seen[base] = seen.get(base, 0) + 1
-        out.append(f"{base}.png" if k == 1 else f"{base}_{k}.png")
-    return out
-
-
 def cmd_predict(args) -> int:
     from contextlib import nullcontext
 
@@ -409,7 +418,7 @@ def cmd_predict(args) -> int:
     from .predict import predict
 
     check_output_file(args.json)
-    if args.plots:
+    if args.plots is not None:
         check_output_dir(args.plots, "--plots")
     for log in args.logs:                  # every record there before the first is replayed
         if not Path(log).is_file():
@@ -420,7 +429,14 @@ def cmd_predict(args) -> int:
     def progress(i, n, name):
         print(f"replayed {i}/{n}: {name}", file=sys.stderr, flush=True)
 
-    pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)
+    pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)   # runs named after their files
+    text = dumps_json(pred.to_json())
+    names = [f"{r.run.name}.png" for r in pred.runs]
+    with StagedFile(args.json) as tmp:     # the files first (renamed last, after the plots), then the console
+        with StagedOutput(args.plots) if args.plots is not None else nullcontext() as stage:
+            for r, name in zip(pred.runs, names if args.plots is not None else ()):
+                r.plot(pyplot=False).savefig(stage.path(name))
+        tmp.write_text(text)
     for r in pred.runs:
         s = r.scores()
         if r.diverged_at is not None:      # NaN scores (null in the JSON): say where and why
@@ -437,14 +453,8 @@ def cmd_predict(args) -> int:
         if sc:
             print(f"mean over {len(sc)} runs{f' ({left} diverged, left out)' if left else ''}: heading "
                   f"{mean('heading_rms_deg'):.4g} deg RMS, final position {mean('final_position_error_L'):.4g} L")
-    text = dumps_json(pred.to_json())
-    names = _plot_names(pred.runs)
-    with StagedFile(args.json) as tmp:     # renamed last, after the plots are in place
-        with StagedOutput(args.plots) if args.plots else nullcontext() as stage:
-            for r, name in zip(pred.runs, names if args.plots else ()):
-                r.plot(pyplot=False).savefig(stage.path(name))
-        tmp.write_text(text)
-    print(f"wrote {args.json}" + (f" and {len(names)} plot{'s' if len(names) != 1 else ''} to {args.plots}" if args.plots else ""))
+    print(f"wrote {args.json}" + (f" and {len(names)} plot{'s' if len(names) != 1 else ''} to {args.plots}"
+                                  if args.plots is not None else ""))
     return 0
 
 
@@ -465,8 +475,8 @@ def cmd_identify(args) -> int:
     from mmg.resources import ship_path
     from mmg.ship import load_ship
 
-    from .identify import cross_validate, cv_folds, identify, load_runs, write_identification
-    from .output import StagedOutput, check_output_dir
+    from .identify import DEFAULT_MAX_NFEV, cross_validate, cv_folds, identify, load_runs, write_identification
+    from .output import StagedOutput, check_output_dir, record_labels
 
     check_output_dir(args.out)
     for log in args.train + (args.test or []):
@@ -478,7 +488,8 @@ def cmd_identify(args) -> int:
         _check_free(ship, args.free)
     wind = None if args.wind is None else args.wind == "on"
     t0 = time.perf_counter()
-    runs = load_runs(ship, args.train, wind=wind)        # an unusable record: one line, skipped
+    names = record_labels(args.train + (args.test or []))   # training and test records told apart together
+    runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)])   # an unusable one: one line, skipped
     if not runs:
         raise InputError("--train", "", "no usable training record")
     print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
@@ -490,15 +501,23 @@ def cmd_identify(args) -> int:
         if folds < args.cv:
             print(f"note: --cv {args.cv}: {folds} independent records, so {folds} folds (each kept out once)",
                   file=sys.stderr, flush=True)
-    tests = load_runs(ship, args.test, wind=wind) if args.test else None   # a bad one: one line, before the fit
+    tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):])   # a bad one: one line, before the fit
+             if args.test else None)
     if args.test and not tests:
         raise InputError("--test", "", "no usable record")
 
-    def progress(k, cost):
-        print(f"  iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
+    shown = [None]
+
+    def progress(k, cost, stage):            # a header per fit stage, then its iterations labelled by it
+        if stage != shown[0]:
+            shown[0] = stage
+            print(f"{stage}; at most {kw['max_nfev']} evaluations", file=sys.stderr, flush=True)
+        print(f"  {stage.split(':')[0]}, iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)",
+              file=sys.stderr, flush=True)
 
     initial = load_ship(ship_path(args.initial)) if args.initial else None
     kw = {"record_weighting": args.weighting} if args.weighting else {}
+    kw["max_nfev"] = args.max_nfev or DEFAULT_MAX_NFEV
     if args.velocity_weight is not None:
         kw["velocity_weight"] = args.velocity_weight
     if args.free:
@@ -516,6 +535,10 @@ def cmd_identify(args) -> int:
     print(f"identified {len(ident.fit.free)} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
           f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
     print(f"wrote {Path(args.out) / 'ship.yaml'} and {Path(args.out) / 'report.md'}")
+    for st in ident.stages:
+        if st["status"] == 0:
+            print(f"note: {st['description'].split(':')[0]} stopped at its evaluation limit ({st['max_nfev']}) before "
+                  f"converging; --max-nfev raises it", file=sys.stderr)
     warn = ident.fit.warnings()
     if warn:
         print(f"warning: {len(warn)} finding(s) on where the identified values should not be read as the ship's "
@@ -537,9 +560,9 @@ def cmd_diagnose(args) -> int:
     from .output import StagedFile, StagedOutput, check_output_dir, check_output_file, dumps_json
 
     check_output_file(args.json)
-    if args.plots:
+    if args.plots is not None:
         check_output_dir(args.plots, "--plots")
-    if args.out_ship:
+    if args.out_ship is not None:
         check_output_file(args.out_ship, "--out-ship")
     for log in args.logs:
         if not Path(log).is_file():
@@ -550,17 +573,9 @@ def cmd_diagnose(args) -> int:
     recs = prepare(ship, args.logs, wind=wind)           # every record read (a bad one: one line) first
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
     d = diagnose(ship, recs, wind=wind, per_run=len(recs) > 1, say=say)
-    j = d.to_json()
-    b, a = d.rms_before, d.rms_after
-    print(f"named: {', '.join(d.named) or 'nothing'}" + "".join(
-        f"; {e} " + ", ".join(f"{k} {v:.4g} +- {d.standard_errors[e][k]:.2g}" for k, v in p.items())
-        for e, p in d.parameters.items()))
-    print("residual RMS before -> after: " + ", ".join(f"{c} {b[c]:.3g} -> {a[c]:.3g}" for c in b))
-    if d.unexplained:
-        print(f"unexplained: {d.unexplained_description}")
-    text = dumps_json(j)
+    text = dumps_json(d.to_json())
     ship_text = None
-    if args.out_ship:
+    if args.out_ship is not None:
         from .identify import ship_yaml
 
         note = (f"mmg diagnose over {len(recs)} record(s): named {', '.join(d.named) or 'nothing'}; "
@@ -587,22 +602,26 @@ def cmd_diagnose(args) -> int:
                 data["wind"]["enabled"] = True             # (effects.wind with enabled: false is refused)
             data["effects"] = eff
         ship_text = "".join(head) + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
-    with StagedFile(args.json) as tmp:
-        with StagedFile(args.out_ship) if args.out_ship else nullcontext() as tship:
-            with StagedOutput(args.plots) if args.plots else nullcontext() as stage:
-                if args.plots:
+    with StagedFile(args.json) as tmp:         # the files first, then the console
+        with StagedFile(args.out_ship) if args.out_ship is not None else nullcontext() as tship:
+            with StagedOutput(args.plots) if args.plots is not None else nullcontext() as stage:
+                if args.plots is not None:
                     from .diagnose_plots import diagnose_figure
 
-                    seen: dict = {}
-                    for i, r in enumerate(d.records):
-                        base = str(r.name or "run").replace(os.sep, "_").replace("/", "_")
-                        k = seen[base] = seen.get(base, 0) + 1
-                        diagnose_figure(d, i).savefig(stage.path(f"{base}.png" if k == 1 else f"{base}_{k}.png"))
+                    for i, r in enumerate(d.records):       # named after their files (unique: prepare)
+                        diagnose_figure(d, i).savefig(stage.path(f"{r.name}.png"))
             if tship is not None:
                 tship.write_text(ship_text)
         tmp.write_text(text)
-    print(f"wrote {args.json}" + (f", {args.out_ship}" if args.out_ship else "") +
-          (f" and {len(d.records)} plot(s) to {args.plots}" if args.plots else ""))
+    b, a = d.rms_before, d.rms_after
+    print(f"named: {', '.join(d.named) or 'nothing'}" + "".join(
+        f"; {e} " + ", ".join(f"{k} {v:.4g} +- {d.standard_errors[e][k]:.2g}" for k, v in p.items())
+        for e, p in d.parameters.items()))
+    print("residual RMS before -> after: " + ", ".join(f"{c} {b[c]:.3g} -> {a[c]:.3g}" for c in b))
+    if d.unexplained:
+        print(f"unexplained: {d.unexplained_description}")
+    print(f"wrote {args.json}" + (f", {args.out_ship}" if args.out_ship is not None else "") +
+          (f" and {len(d.records)} plot(s) to {args.plots}" if args.plots is not None else ""))
     return 0
 
 
@@ -617,7 +636,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("simulate", help="simulate a trial from its YAML config")
     p.add_argument("config", help="trial YAML (configs/trials/*.yaml) or a bundled trial name (st35, zz20, ...)")
-    p.add_argument("--out", required=True, help="output folder (log.csv, truth.csv, metrics.json, PNGs)")
+    p.add_argument("--out", required=True, type=_output_path,
+                   help="output folder (log.csv, truth.csv, metrics.json, PNGs)")
     p.add_argument("--show", action="store_true", help="also show the figures on screen")
     p.set_defaults(func=cmd_simulate)
 
@@ -627,11 +647,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--length", type=_finite_positive, help="ship length L [m] when the log does not say")
     p.add_argument("--zigzag-angle", type=_finite_positive,
                    help="switching heading [deg] for a zigzag log without rudder")
-    p.add_argument("--json", help="also write the metrics to this JSON file")
+    p.add_argument("--json", type=_output_path, help="also write the metrics to this JSON file")
     p.set_defaults(func=cmd_metrics)
 
     p = sub.add_parser("reproduce", help="the main job: reproduce the papers on the default Esso Osaka configs")
-    p.add_argument("--out", default="out", help="output folder (default: out)")
+    p.add_argument("--out", default="out", type=_output_path, help="output folder (default: out)")
     p.add_argument("--full", action="store_true",
                    help="also the Monte Carlo runs (EKF and output error, 20 seeds) and the full Nomoto Table 8 (~25 min)")
     p.set_defaults(func=cmd_reproduce)
@@ -640,19 +660,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("log", help="zigzag record (project log/truth CSV or FRT-DS-ESSO CSV)")
     p.add_argument("--length", type=float, required=True, help="ship length L [m]")
     p.add_argument("--speed", type=float, help="speed U [m/s] for s' = tU/L (default: mean approach speed)")
-    p.add_argument("--json", help="write results to this JSON file (plot PNG next to it)")
+    p.add_argument("--json", type=_output_path, help="write results to this JSON file (plot PNG next to it)")
     p.add_argument("--no-output-error", action="store_true", help="skip the output-error fit")
     p.set_defaults(func=cmd_nomoto)
 
     p = sub.add_parser("nomoto-paper", help="reproduce Artyszuk (2018) Tables 1-8 (CSV + Markdown)")
-    p.add_argument("--out", default="out/nomoto-paper", help="output folder")
+    p.add_argument("--out", default="out/nomoto-paper", type=_output_path, help="output folder")
     p.add_argument("--fast", action="store_true", help="skip the output-error fits of the extended Table 8")
     p.set_defaults(func=cmd_nomoto_paper)
 
     p = sub.add_parser("estimate", help="estimate the ship's sway/yaw hull coefficients from trial logs (augmented EKF)")
     p.add_argument("inputs", nargs="+", metavar="LOG_OR_TRIAL.yaml",
                    help="project logs (log.csv) or trial YAMLs / bundled trial names (simulated first)")
-    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--out", required=True, type=_output_path, help="output folder")
     p.add_argument("--seed", type=_seed, default=None, help="noise seed for simulated trials (default: the trial's)")
     p.add_argument("--config", default=None, help="estimation YAML overriding the bundled configs/estimation/rhee_kim.yaml")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
@@ -671,11 +691,11 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("sensitivity", help="derivative sensitivities (Rhee & Kim eqs. 21-22), Fisher information, "
                                            "trial design")
     p.add_argument("trials", nargs="*", help="trial YAMLs to compare (their sensitivities are normalised together)")
-    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--out", required=True, type=_output_path, help="output folder")
     p.add_argument("--paper-figures", action="store_true", help="Rhee & Kim Figs 2, 8-9, 12, 13, 14 and 28 in one go")
     p.add_argument("--ekf-comparison", help="comparison.csv of the EKF reproduction for Fig. 28 (default: run it)")
     p.add_argument("--fisher", action="store_true", help="also write the Cramer-Rao bounds of the given trials")
-    p.add_argument("--crb-vs-mc", metavar="MC_DIR", nargs="+",
+    p.add_argument("--crb-vs-mc", metavar="MC_DIR", nargs="+", type=_output_path,
                    help="CRB vs the EKF Monte Carlo in MC_DIR (runs.csv; run there when a single folder is missing); "
                         "several folders are pooled per trial")
     p.add_argument("--mc-seeds", type=_positive_int, default=20, help="seeds per trial when the Monte Carlo must be run")
@@ -689,7 +709,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_sensitivity)
 
     def mc_common(p, what):
-        p.add_argument("out", help="output folder (runs.csv, summary.csv/.md)")
+        p.add_argument("out", type=_output_path, help="output folder (runs.csv, summary.csv/.md)")
         p.add_argument("--seeds", type=_positive_int, default=20, help="noise seeds per trial (default 20)")
         p.add_argument("--first-seed", type=_seed, default=1000, help="noise seed of the first run of each trial")
         p.add_argument("--jobs", type=_positive_int, default=2, help="workers (default 2)")
@@ -725,8 +745,10 @@ def build_parser() -> argparse.ArgumentParser:
                                        "heading, yaw-rate, speed RMS and final position error per run")
     p.add_argument("logs", nargs="+", metavar="LOG", help="FRT-DS-ESSO CSVs, project logs or truth files")
     p.add_argument("--ship", required=True, help="ship YAML or bundled name (esso_osaka_3m, esso_osaka, ...)")
-    p.add_argument("--json", required=True, help="write the scores of every run to this JSON file")
-    p.add_argument("--plots", default=None, metavar="DIR", help="also one figure per run, DIR/<name>.png")
+    p.add_argument("--json", required=True, type=_output_path, help="write the scores of every run to this JSON file")
+    p.add_argument("--plots", default=None, metavar="DIR", type=_output_path,
+                   help="also one figure per run, DIR/<name>.png (<name>: the record's file name; two files of one "
+                        "name told apart by their folders, DIR/<folder>/<name>.png)")
     p.add_argument("--start", type=float, default=None, metavar="S",
                    help="start time [s] of every replay (default: each record's first sample)")
     p.add_argument("--wind", choices=("on", "off"), default=None,
@@ -737,7 +759,7 @@ def build_parser() -> argparse.ArgumentParser:
                                         "records (segment-wise output error); writes DIR/ship.yaml and DIR/report.md")
     p.add_argument("--ship", required=True, help="initial ship YAML or bundled name (the prior)")
     p.add_argument("--train", required=True, nargs="+", metavar="LOG", help="training records")
-    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--out", required=True, metavar="DIR", type=_output_path, help="output folder")
     p.add_argument("--wind", choices=("on", "off"), default=None,
                    help="wind loads from the measured relative wind (default: as the ship config says)")
     p.add_argument("--initial", default=None, metavar="SHIP",
@@ -759,6 +781,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--velocity-weight", type=_finite_positive, default=None, metavar="W",
                    help="factor on the u, v, r residuals beside the heading's (default 1; 0.1: their squares weigh a "
                         "hundredth, so the fit follows the heading; docs/identify_cv.md)")
+    p.add_argument("--max-nfev", type=_positive_int, default=None, metavar="N",
+                   help="most evaluations of the residuals in each fit stage (segment-wise, then whole-record; "
+                        "default trials.identify.DEFAULT_MAX_NFEV); a stage that reaches it stops unconverged, "
+                        "and the report and a note say so")
     p.add_argument("--folds-by", choices=("order", "revolutions"), default="order",
                    help="with --cv: deal the records into folds in the order given or stratified by their propeller "
                         "revolutions (a record and its cut copies always share a fold)")
@@ -768,10 +794,11 @@ def build_parser() -> argparse.ArgumentParser:
                                         "(current, wind, rudder_offset, heading_bias, shallow_water) and show the gap shrink")
     p.add_argument("logs", nargs="+", metavar="LOG", help="FRT-DS-ESSO CSVs, project logs or truth files")
     p.add_argument("--ship", required=True, help="ship YAML or bundled name (esso_osaka_3m, esso_osaka, ...)")
-    p.add_argument("--json", required=True, help="write the diagnosis to this JSON file")
-    p.add_argument("--plots", default=None, metavar="DIR", help="also one figure per record, DIR/<name>.png")
-    p.add_argument("--out-ship", default=None, metavar="NEW.yaml", help="write the ship config with the fitted "
-                                                                        "coefficients (and a named wind scale)")
+    p.add_argument("--json", required=True, type=_output_path, help="write the diagnosis to this JSON file")
+    p.add_argument("--plots", default=None, metavar="DIR", type=_output_path,
+                   help="also one figure per record, DIR/<name>.png (<name>: the record's file name, as for predict)")
+    p.add_argument("--out-ship", default=None, metavar="NEW.yaml", type=_output_path,
+                   help="write the ship config with the fitted coefficients (and a named wind scale)")
     p.add_argument("--wind", choices=("on", "off"), default=None,
                    help="wind loads in the model from the start (default off: wind is then a candidate effect)")
     p.set_defaults(func=cmd_diagnose)
@@ -850,6 +877,71 @@ def _install_handlers() -> dict:
     return old
 
 
+class _ReaderGone:
+    """A console stream (stdout, stderr) that outlives its reader: when the pipe it writes to is
+    closed (``mmg ... | head``: EPIPE, a BrokenPipeError with SIGPIPE ignored, as Python has it),
+    its file descriptor is pointed at ``os.devnull`` and the write counts as done, so the run goes
+    on and writes its files, and the exit status is its own.  Everything else is the stream's."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self.gone = False
+
+    def _closed(self) -> None:
+        self.gone = True
+        try:
+            fd = os.open(os.devnull, os.O_WRONLY)
+            try:
+                os.dup2(fd, self._stream.fileno())       # the buffered rest, and any later flush, go there
+            finally:
+                os.close(fd)
+        except (OSError, ValueError, AttributeError):
+            pass
+
+    def _guarded(self, call, *a):
+        if self.gone:
+            try:
+                return call(*a)                          # to os.devnull now (or a stream without a descriptor)
+            except (BrokenPipeError, ValueError, OSError):
+                return None
+        try:
+            return call(*a)
+        except BrokenPipeError:
+            self._closed()
+        except OSError as e:
+            if e.errno != errno.EPIPE:
+                raise
+            self._closed()
+        return None
+
+    def write(self, text):
+        self._guarded(self._stream.write, text)
+        return len(text)
+
+    def writelines(self, lines):
+        self._guarded(self._stream.writelines, lines)
+
+    def flush(self):
+        self._guarded(self._stream.flush)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+@contextmanager
+def _console_outlives_reader():
+    """sys.stdout and sys.stderr wrapped in :class:`_ReaderGone` for the block (flushed and put back after)."""
+    old = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = (_ReaderGone(x) if x is not None else x for x in old)
+    try:
+        yield
+    finally:
+        for x in (sys.stdout, sys.stderr):
+            if isinstance(x, _ReaderGone):
+                x.flush()
+        sys.stdout, sys.stderr = old
+
+
 def _interrupted(code: int) -> int:
     print("interrupted", file=sys.stderr)
     return code
@@ -861,7 +953,7 @@ def main(argv=None) -> int:
 
     old = _install_handlers()          # first: an early signal is already one line, 130 / 143
     try:
-        with warnings.catch_warnings():    # _on_signal silences warnings: only for this run
+        with warnings.catch_warnings(), _console_outlives_reader():   # _on_signal silences warnings: only for this run
             try:
                 return _run(argv)
             except KeyboardInterrupt:      # a signal during the last lines of _run's own handling
@@ -900,8 +992,16 @@ def _run(argv) -> int:
         return int(e.code or 0)
     if not getattr(args, "show", False):
         os.environ.setdefault("MPLBACKEND", "Agg")   # files only; no display needed (cheap: nothing imported)
+    from .output import collect_commits, others_note
+
     try:
-        return int(args.func(args) or 0)
+        with collect_commits() as committed:
+            code = int(args.func(args) or 0)
+        for stage in committed:            # the folders written into: what they hold that this run did not write
+            note = others_note(stage)
+            if note:
+                print(note, file=sys.stderr)
+        return code
     except (Exception, KeyboardInterrupt, Interrupted) as e:
         code = _interrupt_code(e)
         if code:
@@ -909,12 +1009,6 @@ def _run(argv) -> int:
         if isinstance(e, InputError):
             print(f"error: {e}", file=sys.stderr)
             return 2
-        if isinstance(e, BrokenPipeError):    # stdout's reader left (mmg ... | head): quiet, as SIGPIPE would be
-            try:
-                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-            except (OSError, ValueError):
-                pass
-            return 141
         if isinstance(e, OSError) and e.errno in _WRITE_ERRNOS():
             # writing (or reading) a file failed: no space, read-only filesystem, no permission
             from .output import write_error

@@ -102,7 +102,10 @@ class Prepared:
 
 def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | None = None) -> list[Prepared]:
     """Read and prepare the records (paths, :class:`trials.records.TrialRecord` or ready
-    :class:`Prepared`); a malformed one raises :class:`~mmg.errors.InputError` naming it."""
+    :class:`Prepared`); a malformed one raises :class:`~mmg.errors.InputError` naming it.  Each is
+    named after its file (:func:`trials.output.record_labels`), in the JSON and the plots."""
+    from dataclasses import replace
+
     from ekf.identify import Segmented, segment_resets
     from mmg.effects import Context
 
@@ -110,15 +113,20 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from .predict import measured_run
     from .records import TrialRecord
 
+    from .output import record_labels
+
     L = ship.particulars.L
     seg_s = segment_s or 52.0 * math.sqrt(L / 9.80665)
+    items = list(items)
+    labels = record_labels([it.source if isinstance(it, Prepared) else
+                            (it.source or it.name) if isinstance(it, TrialRecord) else it for it in items])
     out = []
-    for it in items:
+    for it, label in zip(items, labels):
         if isinstance(it, Prepared):
             out.append(it)
             continue
         rec = it if isinstance(it, TrialRecord) else read_record(it, length_m=L)
-        run = measured_run(ship, rec, wind=wind)
+        run = replace(measured_run(ship, rec, wind=wind), name=label)     # named after its file, unique
         bad = ~np.isfinite(run.meas).all(axis=1)
         if bad.any():
             raise InputError(run.source or run.name, "", f"{int(bad.sum())} rows with NaN: not usable")
@@ -413,9 +421,10 @@ class Diagnosis:
                "candidates": self.candidates, "rounds": self.rounds,
                "threshold": {"delta_bic": BIC_THRESHOLD, "z": Z_THRESHOLD},
                "ship_coefficients": self.ship_values,
-               "files": [r.source for r in self.records], "seconds": round(self.seconds, 2)}
+               "files": [r.source for r in self.records], "names": [r.name for r in self.records],
+               "seconds": round(self.seconds, 2)}
         if self.runs:
-            out["runs"] = [dict(r.to_json(), file=r.records[0].source) for r in self.runs]
+            out["runs"] = [dict(r.to_json(), name=r.records[0].name, file=r.records[0].source) for r in self.runs]
         return out
 
 

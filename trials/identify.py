@@ -48,9 +48,12 @@ from mmg.ship import Ship
 from .predict import MeasuredRun, measured_run, replay_record
 
 __all__ = ["identify", "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
-           "DEFAULT_FREE", "DEFAULT_WEIGHTING"]
+           "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
+           "stage_description"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale")
+DEFAULT_MAX_NFEV = 30
+"""Default limit of the residual evaluations of each fit stage (:func:`identify`'s ``max_nfev``)."""
 DEFAULT_WEIGHTING = "equal"
 """Default weighting of the training records in the fit (:func:`ekf.identify.record_weights`)."""
 DEFAULT_SEGMENTS_L = (52.0, np.inf)
@@ -63,15 +66,22 @@ def _log(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
-def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log) -> list[MeasuredRun]:
-    """Read and prepare each record; one that cannot be used is skipped with one line saying why."""
-    from .logio import read_record
+def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log, names=None) -> list[MeasuredRun]:
+    """Read and prepare each record; one that cannot be used is skipped with one line saying why.
+    Each is named after its file (:func:`trials.output.record_labels`: ``ST35``, or ``day1/ST35``
+    and ``day2/ST35`` for two files of one stem), as the report and ship.yaml name it; ``names``:
+    the names to give instead (labels made over the training and test records together)."""
+    from dataclasses import replace
 
+    from .logio import read_record
+    from .output import record_labels
+
+    paths = list(paths)
     runs = []
-    for p in paths:
+    for p, label in zip(paths, record_labels(paths) if names is None else names):
         try:
             rec = read_record(p, length_m=ship.particulars.L)
-            runs.append(measured_run(ship, rec, wind=wind))
+            runs.append(replace(measured_run(ship, rec, wind=wind), name=label))
         except InputError as e:
             say(f"skipped: {e}")
     return runs
@@ -115,6 +125,10 @@ class Identification:
     """How the training records counted (:func:`ekf.identify.record_weights`)."""
     velocity_weight: float = 1.0
     """How much the u, v, r residuals counted beside the heading's (:func:`identify`)."""
+    stages: tuple = ()
+    """One dict per fit stage, in order: ``segment_s`` (segment length [s]; ``inf``: the whole record,
+    no cut), ``description`` (:func:`stage_description`), ``evaluations`` (residual evaluations used),
+    ``max_nfev`` (the limit), ``cost_initial``, ``cost_final``, ``status``, ``message`` (scipy's)."""
 
     def scores(self, runs=None, model: str = "identified") -> list[dict]:
         """Open-loop replay scores (:meth:`trials.predict.Replayed.scores`) of ``runs`` (the training
@@ -217,8 +231,16 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
     return s
 
 
+def stage_description(segment_s: float) -> str:
+    """What a fit stage with segments of ``segment_s`` [s] fits, in words (an infinite length: the
+    whole record, not cut)."""
+    if not np.isfinite(segment_s):
+        return "whole-record fit: each record replayed open-loop from its first sample (not cut into segments)"
+    return f"segment-wise fit: {segment_s:.3g} s segments, each restarted from the measured state"
+
+
 def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | None = None, wind: bool | None = None,
-             max_nfev: int = 30, progress=None, say=_log, prior_rel_std: float = 0.5,
+             max_nfev: int = DEFAULT_MAX_NFEV, progress=None, say=_log, prior_rel_std: float = 0.5,
              initial: Ship | None = None, record_weighting: str = DEFAULT_WEIGHTING, loss: str = "linear",
              f_scale: float = 1.0, record_nuisance=(), velocity_weight: float = 1.0) -> Identification:
     """Identify ``free`` jointly over the training records (module docstring).
@@ -236,7 +258,12 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     wind : bool, optional
         Override the ship config's wind switch.
     max_nfev : int
-        Most iterations of each stage.
+        Most evaluations of the residuals in each stage (:func:`scipy.optimize.least_squares`'s
+        ``max_nfev``; ``mmg identify --max-nfev``); a stage that reaches it stops there
+        (:attr:`Identification.stages`: its ``status`` 0).
+    progress : callable, optional
+        ``progress(iteration, cost, stage)`` after each Jacobian; ``stage`` names the stage:
+        ``"stage 1/2: segment-wise fit: ..."`` (:func:`stage_description`).
     prior_rel_std : float
         Prior std of each freed coefficient relative to its config value (:func:`ekf.identify.free_parameters`).
     initial : Ship, optional
@@ -291,21 +318,27 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
         nuisance = [E.get(n, "record_nuisance") for n in record_nuisance]
         fp = fp + record_effect_parameters(nuisance, len(runs), names=[r.name for r in runs])
     fit = None
+    done = []
     for k, st in enumerate(stages):
         seg = float(st) * float(np.sqrt(L / 9.80665))
+        label = f"stage {k + 1}/{len(stages)}: {stage_description(seg)}"
+        stage_progress = None if progress is None else (lambda i, c, _l=label: progress(i, c, _l))
         segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects) for r in runs]
         sc = _scales(runs, L, velocity_weight)
         theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
         rms = (record_residual_rms(packed, segs, fp, theta, sc, effects=nuisance, ship=ship)
                if record_weighting == "relative" else None)
         last = k == len(stages) - 1
-        fit = identify_segments(packed, segs, fp, sc, max_nfev=max_nfev, progress=progress, effects=nuisance, ship=ship,
-                                start=None if fit is None else fit.theta, weights=record_weights(segs, record_weighting,
-                                                                                                 rms=rms),
+        fit = identify_segments(packed, segs, fp, sc, max_nfev=max_nfev, progress=stage_progress, effects=nuisance,
+                                ship=ship, start=None if fit is None else fit.theta,
+                                weights=record_weights(segs, record_weighting, rms=rms),
                                 loss=loss if last else "linear", f_scale=f_scale)
+        done.append({"segment_s": seg, "description": stage_description(seg), "evaluations": fit.iterations,
+                     "max_nfev": int(max_nfev), "cost_initial": fit.cost_initial, "cost_final": fit.cost_final,
+                     "status": fit.status, "message": fit.message})
     return Identification(ship=_ship_with(ship, fit.values()), initial=ship if initial is None else initial, fit=fit,
                           runs=runs, segment_s=seg, prior=None if initial is None else ship,
-                          record_weighting=record_weighting, velocity_weight=float(velocity_weight))
+                          record_weighting=record_weighting, velocity_weight=float(velocity_weight), stages=tuple(done))
 
 
 FOLD_ASSIGNMENTS = ("order", "revolutions")
@@ -430,6 +463,23 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
     return head + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
 
 
+def _stage_lines(ident: Identification) -> list[str]:
+    """The report's account of the fit stages: what each fitted, how many evaluations of its limit it
+    used and why it stopped (a stage at its limit says how to raise it)."""
+    st = ident.stages or ({"description": stage_description(ident.segment_s), "evaluations": ident.fit.iterations,
+                           "max_nfev": None, "status": ident.fit.status, "message": ident.fit.message},)
+    out = [f"Fitted in {len(st)} stage{'s' if len(st) > 1 else ''}, each starting from the previous one's values:"]
+    for k, s in enumerate(st):
+        lim = "" if s.get("max_nfev") is None else f" of at most {s['max_nfev']}"
+        stop = (" (stopped at its evaluation limit, not converged: mmg identify --max-nfev raises it)"
+                if s["status"] == 0 else f" ({s['message']})")
+        out.append(f"{k + 1}. {s['description']}; {s['evaluations']} evaluations{lim}{stop}.")
+    if len(st) > 1:
+        out += ["", "Each stage has its own cost (segments restarted from the record, or the whole record open loop): "
+                    "a stage's cost is not comparable with the one before it (the whole record usually costs more)."]
+    return out
+
+
 def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
     """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
 
@@ -448,10 +498,9 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
         lines += [f"Fitted in the form of {ident.prior.name} (the prior, 'config' below); 'initial' scores are "
                   f"{ident.initial.name}'s.", ""]
     lines += [
-             f"Records: {len(ident.runs)}; free parameters: {len(fit.free)}; last segment length "
-             f"{ident.segment_s:g} s; residuals {fit.n_residuals}; {fit.iterations} iterations ({fit.message}); "
+             f"Records: {len(ident.runs)}; free parameters: {len(fit.free)}; residuals {fit.n_residuals}; "
              f"records weighted {ident.record_weighting!r}; velocity residuals weighted {ident.velocity_weight:g} "
-             f"beside the heading's.", "",
+             f"beside the heading's.", "", *_stage_lines(ident), "",
              "## Values and standard errors", "",
              "Standard errors from the Gauss-Newton covariance scaled by the residual variance; the 10 Hz "
              "residuals are correlated, so they are optimistic.", "",

@@ -13,6 +13,12 @@
   onto it.  :func:`dump_json` writes through it.
 * An ``OSError`` while writing (no space left, read-only filesystem, no permission) comes out as
   one :class:`~mmg.errors.InputError` naming the final path (never the staging one).
+* An existing folder is written into (a command re-run into its own folder replaces its own
+  files); after the commit :attr:`StagedOutput.others` lists what the folder holds that this
+  run did not write (an earlier run's files, another command's), which the ``mmg`` command
+  reports in one ``note:`` line (:func:`collect_commits`, :func:`others_note`).
+* :func:`record_labels`: the name of each input record in printed lines and output files,
+  after its file (two files of one stem told apart by their folders).
 
 JSON: :func:`dump_json` writes NaN and +-Infinity as ``null`` (JSON has no NaN; a value is NaN
 here when it is undefined, e.g. an overshoot that never happened or a fit that failed), so
@@ -241,14 +247,20 @@ class StagedOutput:
 
     Use it as a context manager; :meth:`path` outside a ``with`` block opens the staging
     folder, and then :meth:`commit` or :meth:`abort` must follow.
+
+    After the commit, :attr:`written` lists the files moved in and :attr:`others` what ``out``
+    holds besides them (:func:`not_written`; left empty with ``report=False``, for a folder that
+    only holds one output file, and for a staging nested in another).
     """
 
     check = staticmethod(check_output_dir)
 
-    def __init__(self, out: str | Path):
+    def __init__(self, out: str | Path, report: bool = True):
         self.out = Path(out)
+        self.report = report                   # False: a folder holding one output file among others' files
         self.tmp: Path | None = None
         self.written: list[str] = []           # relative paths moved into ``out`` by the commit
+        self.others: list[str] = []            # what ``out`` holds that this run did not write (after commit)
         self._created: list[Path] = []
         self._done = False
 
@@ -345,6 +357,10 @@ class StagedOutput:
                 self._cleanup(remove_created=False)
         if interrupted:                         # the signal's handler did not raise: say so all the same
             raise InputError(str(self.out), "", "interrupted while moving the files in; nothing was written")
+        if self.report and not _nested(self.out):
+            self.others = not_written(self.out, self.written)
+            if _collector is not None:
+                _collector.append(self)
 
     def abort(self) -> None:
         """Remove the staging folder and every folder this staging created (nothing is left)."""
@@ -403,6 +419,117 @@ def _is_write_error(exc: OSError, stage: StagedOutput | None = None) -> bool:
         except (ValueError, TypeError):
             return False
     return False
+
+
+def _nested(out: Path) -> bool:
+    """``out`` lies inside another staging folder (its files are that staging's, reported by it)."""
+    return any(part.startswith(".staging-") for part in _abs(out).parts)
+
+
+def not_written(out, written, limit: int = 10000) -> list[str]:
+    """What the folder ``out`` holds that is not in ``written`` (paths relative to ``out``, ``/``-separated).
+
+    Only the folders a file of ``written`` went into are looked into: a folder this run wrote
+    nothing in is one entry ``name/``; staging folders of runs in progress are left out.  At most
+    ``limit`` entries are looked at (a run into a large folder stays quick).
+    """
+    out = Path(out)
+    mine = set(written)
+    visited = {""} | {"/".join(w.split("/")[:k]) for w in mine for k in range(1, w.count("/") + 1)}
+    found: list[str] = []
+
+    def walk(rel: str) -> None:
+        try:
+            with os.scandir(out / rel if rel else out) as it:
+                entries = sorted(it, key=lambda e: e.name)
+        except OSError:
+            return
+        for e in entries:
+            if len(found) >= limit:
+                return
+            r = f"{rel}/{e.name}" if rel else e.name
+            if e.name.startswith((".staging-", ".mmg-write-check-")) or r in mine:
+                continue
+            if e.is_dir(follow_symlinks=False):
+                if r in visited:
+                    walk(r)
+                else:
+                    found.append(r + "/")
+            else:
+                found.append(r)
+
+    walk("")
+    return found
+
+
+_collector: list | None = None
+
+
+@contextmanager
+def collect_commits():
+    """Inside the block every committed :class:`StagedOutput` (not nested in another) is appended to
+    the list this yields, to report what their folders hold besides the run's files."""
+    global _collector
+    old, _collector = _collector, []
+    try:
+        yield _collector
+    finally:
+        _collector = old
+
+
+def others_note(stage: "StagedOutput", show: int = 6) -> str | None:
+    """One line saying what the folder of a committed ``stage`` holds that this run did not write
+    (an earlier run's or another command's files), or None when it holds only this run's files."""
+    o = stage.others
+    if not o:
+        return None
+    names = ", ".join(o[:show]) + (f" and {len(o) - show} more" if len(o) > show else "")
+    return (f"note: {stage.out} also holds {len(o)} entr{'y' if len(o) == 1 else 'ies'} this run did not write "
+            f"(an earlier run's or another command's; this run wrote {len(stage.written)}): {names}")
+
+
+def record_labels(sources) -> list[str]:
+    """A name for each input record, after its file, unique and in the order given.
+
+    The file's stem (``ST35`` for ``runs/ST35.csv``); records whose stems are the same are told
+    apart by as many of their folders as it takes (``day1/ST35``, ``day2/ST35``), then by the
+    file's suffix; the same file given again gets ``_2``, ``_3``, ...  Used for the printed
+    lines and output files (``<label>.png``, a ``/`` in it is a sub-folder) of ``mmg predict``,
+    ``mmg diagnose`` and ``mmg identify``.
+    """
+    paths = [_abs(os.fspath(s)) for s in sources]
+
+    def candidate(p: Path, level: int) -> str:
+        parts = p.parts[1:] or (p.name,)
+        k = len(parts)
+        if level < k:                          # stem, then parent/stem, ...
+            return "/".join(parts[k - 1 - level:k - 1] + (p.stem or p.name,))
+        level -= k                             # then with the suffix: ST35.csv, day1/ST35.csv, ...
+        return "/".join(parts[max(k - 1 - level, 0):])
+
+    labels = [candidate(p, 0) for p in paths]
+    for stem in sorted({lab for lab in labels if labels.count(lab) > 1}):
+        group = [i for i, lab in enumerate(labels) if lab == stem]
+        distinct = {paths[i] for i in group}
+        if len(distinct) == 1:                 # one file given again: numbered below
+            continue
+        top = max(2 * len(paths[i].parts) for i in group)
+        for level in range(1, top + 1):
+            cand = {paths[i]: candidate(paths[i], level) for i in group}
+            if len(set(cand.values())) == len(distinct):
+                break
+        for i in group:
+            labels[i] = cand[paths[i]]
+    used: set = set()
+    out = []
+    for lab in labels:                         # the same file again: _2, _3, ...
+        k, new = 1, lab
+        while new in used:
+            k += 1
+            new = f"{lab}_{k}"
+        used.add(new)
+        out.append(new)
+    return out
 
 
 class StagedFile:

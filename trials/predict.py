@@ -21,7 +21,6 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
 
 import numpy as np
 
@@ -257,11 +256,12 @@ class Prediction:
     runs: list
 
     def to_json(self) -> dict:
-        """``{"runs": [{"file": ..., "heading_rms_deg": ..., ...}, ...]}`` (``mmg predict --json``)."""
-        return {"runs": [{"file": r.run.source, **r.scores()} for r in self.runs]}
+        """``{"runs": [{"name": ..., "file": ..., "heading_rms_deg": ..., ...}, ...]}`` (``mmg predict --json``;
+        ``name``: the run's name, after its file, as printed and as its plot is named)."""
+        return {"runs": [{"name": r.run.name, "file": r.run.source, **r.scores()} for r in self.runs]}
 
     def to_pandas(self):
-        """One row of scores per run, indexed by the record's name."""
+        """One row of scores per run, indexed by the run's name (after its file: unique)."""
         import pandas as pd
 
         return pd.DataFrame([{"name": r.run.name, "wind": r.run.wind, **r.scores()} for r in self.runs]).set_index("name")
@@ -283,19 +283,26 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
     wind : bool, optional
         Override the ship config's wind switch.
     progress : callable, optional
-        ``progress(i, n, file name)`` after each replay.
+        ``progress(i, n, name)`` after each replay (the run's name, after its file).
 
     Returns
     -------
     Prediction
+        Each run named after its file (:func:`trials.output.record_labels`: ``ST35`` for
+        ``ST35.csv``; two files of one stem as ``day1/ST35``, ``day2/ST35``).
     """
-    from .logio import read_record
+    from dataclasses import replace
 
-    measured = [measured_run(ship, read_record(path, length_m=ship.particulars.L), start, wind) for path in paths]
+    from .logio import read_record
+    from .output import record_labels
+
+    paths = list(paths)
+    measured = [replace(measured_run(ship, read_record(path, length_m=ship.particulars.L), start, wind), name=label)
+                for path, label in zip(paths, record_labels(paths))]
     packed = pack(ship)
     runs = []
-    for i, (path, run) in enumerate(zip(paths, measured)):
+    for i, run in enumerate(measured):
         runs.append(replay_record(ship, run, packed=packed))
         if progress:
-            progress(i + 1, len(paths), Path(path).name)
+            progress(i + 1, len(paths), run.name)
     return Prediction(runs=runs)
