@@ -142,7 +142,7 @@ def straight_run_section(doc, ship):
     ], ["quantity", "ours", "paper"]))
     doc(f"\nThe paper prints two approach rpm for this one steady run: 54.12 (Table 4) and 54.21 (the filter's start, "
         f"Table 7). Ours, {eq.n * 60:.2f} rpm from balancing the surge equation (the paper's own recipe), is the "
-        "second; the paper does not say why its two figures differ (0.17 %). The rows without a paper value are checks of ours (round-off shows as 0).\n")
+        "second; the paper does not say why its two figures differ (0.17 %). The other rows have no value in the paper (round-off shows as 0).\n")
 
 
 def kijima_section(doc, ship):
