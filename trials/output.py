@@ -45,6 +45,9 @@ from mmg._signals import noted as _noted  # noqa: F401  (the list the noting han
 from mmg._signals import pending as _signal_pending
 from mmg.errors import InputError
 
+from .pausepoint import pause as _pause
+from .pausepoint import wanted as _pause_wanted
+
 #: errno values of a target that cannot be written (reported as one InputError line, exit 2).
 WRITE_ERRNOS = frozenset(getattr(errno, n) for n in ("ENOSPC", "EROFS", "EACCES", "EPERM", "EDQUOT", "EFBIG",
                                                       "EXDEV", "ENAMETOOLONG", "ENOTDIR", "EISDIR", "EMLINK", "EIO")
@@ -257,6 +260,7 @@ class StagedOutput:
         """Create ``out`` (and missing parents) and the staging folder in it; idempotent."""
         if self.tmp is not None:
             return self
+        _pause("staging")                      # a test hook (trials.pausepoint); no-op otherwise
         if os.path.lexists(self.out) and not self.out.is_dir():
             raise InputError(str(self.out), "", "is a file, not a folder")
         with _critical():
@@ -274,6 +278,7 @@ class StagedOutput:
                 raise InputError(str(self.out), "", "is a file, not a folder") from None
             except OSError as e:
                 raise write_error(e, self.out) from None
+        _pause("staged")
         return self
 
     @property
@@ -284,6 +289,8 @@ class StagedOutput:
     def path(self, name: str) -> Path:
         """Where to write the output file ``name`` (may contain folders: ``"ekf/comparison.csv"``)."""
         p = self.dir / name
+        if _pause_wanted("staged-file") and any(f.is_file() for f in self.tmp.rglob("*")):
+            _pause("staged-file")
         p.parent.mkdir(parents=True, exist_ok=True)
         return p
 
@@ -373,7 +380,11 @@ class StagedOutput:
         self._done = True
 
     def __enter__(self):
-        return self.open()
+        try:
+            return self.open()
+        except BaseException:      # e.g. a signal held while the staging folder was made, delivered as
+            self.abort()           # open() returns: no __exit__ will run, so remove it (and the folders) here
+            raise
 
     def __exit__(self, exc_type, exc, tb):
         try:
