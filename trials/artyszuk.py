@@ -473,11 +473,12 @@ def table6_note(f5) -> str:
     return (f"T3: ours is negative, the paper prints +{PAPER_TABLE6['T3']}. The sign is not a convention: by eqs. (16) "
             f"and (23), x3 = -K and x4 = -K T3, so T3 = x4 / x3, and the paper's own Table 7 determinants give "
             f"x3 = W_x3 / W = {x3:.4g} (K = {-x3:.3g}, as it prints) and x4 = W_x4 / W = {x4:.4g}, so T3 = "
-            f"{x4 / x3:.5g}: negative, of the paper's magnitude. The paper's +{PAPER_TABLE6['T3']} equals x4 / K = "
-            "-x4 / x3: most likely the minus of K = -x3 was dropped in that division (or |T3| printed). "
+            f"{x4 / x3:.5g}: negative, of the paper's magnitude. The paper's +{PAPER_TABLE6['T3']} is, to the rounding "
+            "of those determinants, x4 / K = -x4 / x3: most likely the minus of K = -x3 was dropped in that division "
+            "(or |T3| printed). "
             f"Our magnitude differs from {abs(x4 / x3):.5g} by the rounding of the inputs (Table 5 prints the "
             "smoothing's output to 5 digits; see Table 7). The \"1.0\" the paper prints as T1's % is a leftover of "
-            "Table 4: it has no T1. " + f5.note())
+            "Table 4: it has no T1. " + (f5.note() + "." if f5.note() else ""))
 
 
 def table7_note(df: pd.DataFrame) -> str:
