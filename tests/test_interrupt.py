@@ -1,8 +1,10 @@
 """SIGTERM and SIGINT while a command works: one line ``interrupted``, exit 143 / 130, nothing left.
 
-The commands run as real processes (the installed ``mmg`` script); the signal is sent while they
-work: once their staging folder exists (it is made before the computation starts) and at least
-1.5 s after the start, and the test checks the process was still running at that moment.
+The commands run as real processes (the installed ``mmg`` script); the signal is sent at a point the
+test controls, whatever the machine's speed: ``MMG_TEST_PAUSE`` (:mod:`trials.pausepoint`) makes the
+command wait at a named point (its staging folder made, a file of its output written, a sweep worker
+started, ...) and say so with a marker file; the test signals once the marker is there, while the command
+is known to wait (it would go on after 120 s).
 """
 import os
 import signal
@@ -26,21 +28,30 @@ def mmg_argv() -> list:
     return [str(script)] if script.is_file() else [sys.executable, "-m", "trials.cli"]
 
 
-def run_and_signal(args, watch: Path, sig, base: Path, min_delay=1.5, group=False, timeout=300):
-    """Start ``mmg args``, wait until ``watch`` holds a staging folder and ``min_delay`` s passed,
-    send ``sig`` (to the process, or its whole process group as a terminal's Ctrl-C does); return
-    (exit code, stdout, stderr)."""
-    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    p = subprocess.Popen(mmg_argv() + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=base,
-                         env=env, start_new_session=True)
+def start_paused(args, point: str, markers: Path, cwd=None, group: bool = True):
+    """Start ``mmg args`` told to wait at ``point`` (:mod:`trials.pausepoint`); returns the process."""
+    markers.mkdir(parents=True, exist_ok=True)
+    env = {**os.environ, "PYTHONUNBUFFERED": "1", "MMG_TEST_PAUSE": f"{point}:{markers}"}
+    return subprocess.Popen(mmg_argv() + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd,
+                            env=env, start_new_session=group)
+
+
+def wait_for_markers(p, point: str, markers: Path, count: int = 1, timeout: float = 300) -> None:
+    """Wait until ``count`` processes wait at ``point`` (their marker files); the command must still run."""
     t0 = time.monotonic()
+    while len(list(markers.glob(f"{point}.*"))) < count:
+        assert p.poll() is None, f"the command ended before it reached {point!r}: {p.communicate()}"
+        assert time.monotonic() - t0 < timeout, f"no process reached {point!r}"
+        time.sleep(0.02)
+    assert p.poll() is None
+
+
+def run_and_signal(args, point: str, sig, base: Path, markers: Path, group=False, count=1, timeout=300):
+    """Start ``mmg args`` (in ``base``), wait until it waits at ``point``, send ``sig`` (to the process, or
+    its whole process group as a terminal's Ctrl-C does); return (exit code, stdout, stderr)."""
+    p = start_paused(args, point, markers, cwd=base)
     try:
-        while not (watch.is_dir() and list(watch.glob(".staging-*"))):
-            assert p.poll() is None, f"mmg {args[0]} ended before it staged anything: {p.communicate()}"
-            assert time.monotonic() - t0 < timeout, "no staging folder appeared"
-            time.sleep(0.02)
-        time.sleep(max(0.0, min_delay - (time.monotonic() - t0)) + 0.2)
-        assert p.poll() is None, f"mmg {args[0]} finished before the signal: the test proves nothing"
+        wait_for_markers(p, point, markers, count, timeout)
         (os.killpg(p.pid, sig) if group else p.send_signal(sig))
         out, err = p.communicate(timeout=timeout)
     finally:
@@ -65,22 +76,14 @@ def zz20_log(tmp_path_factory):
     return d / "zz20" / "log.csv"
 
 
-def long_st35(folder: Path) -> Path:
-    """ST35 run for 30000 s: its log, truth file and plots take seconds to write, so the signal
-    surely meets the command while it stages (the 3000 s run now finishes within the test's delay)."""
-    text = (CONFIGS / "trials" / "st35.yaml").read_text().replace("duration: 3000 s", "duration: 30000 s")
-    assert "duration: 30000 s" in text
-    p = folder / "st35_long.yaml"
-    p.write_text(text)                     # "ship: esso_osaka" is the bundled ship by name
-    return p
-
-
+@pytest.mark.parametrize("point", ["staged", "staged-file"])
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
-def test_simulate_interrupted(sig, tmp_path):
+def test_simulate_interrupted(sig, point, tmp_path):
+    """Once its staging folder exists, and once it holds a written file."""
     base = tmp_path / "base"
     base.mkdir()
-    out = base / "DIR"
-    r = run_and_signal(["simulate", str(long_st35(tmp_path)), "--out", str(out)], out, sig, base)
+    r = run_and_signal(["simulate", str(CONFIGS / "trials" / "st35.yaml"), "--out", str(base / "DIR")], point, sig,
+                       base, tmp_path / "markers")
     assert_interrupted(*r, sig, base)
 
 
@@ -88,8 +91,8 @@ def test_simulate_interrupted(sig, tmp_path):
 def test_estimate_interrupted(sig, tmp_path):
     base = tmp_path / "base"
     base.mkdir()
-    out = base / "DIR"
-    r = run_and_signal(["estimate", str(CONFIGS / "trials" / "zz20.yaml"), "--out", str(out)], out, sig, base)
+    r = run_and_signal(["estimate", str(CONFIGS / "trials" / "zz20.yaml"), "--out", str(base / "DIR")], "staged-file",
+                       sig, base, tmp_path / "markers")
     assert_interrupted(*r, sig, base)
 
 
@@ -97,41 +100,36 @@ def test_estimate_interrupted(sig, tmp_path):
 def test_nomoto_interrupted(sig, tmp_path, zz20_log):
     base = tmp_path / "base"
     base.mkdir()
-    out = base / "DIR"
-    r = run_and_signal(["nomoto", str(zz20_log), "--length", "325", "--json", str(out / "x.json")], out, sig, base)
+    r = run_and_signal(["nomoto", str(zz20_log), "--length", "325", "--json", str(base / "DIR" / "x.json")],
+                       "staged", sig, base, tmp_path / "markers")       # staged before the identification
     assert_interrupted(*r, sig, base)
 
 
 def test_signal_before_staging(tmp_path):
-    """A SIGTERM 0.8 s after the start (the command still importing, reading its input or simulating:
-    a warm 3000 s ST35 now finishes in about 1.5 s, so the 30000 s one, whose files take seconds)."""
+    """A SIGTERM after the trial is read, before the staging folder exists: nothing made, nothing left."""
     base = tmp_path / "base"
     base.mkdir()
-    p = subprocess.Popen(mmg_argv() + ["simulate", str(long_st35(tmp_path)), "--out", str(base / "DIR")],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(0.8)
-    assert p.poll() is None
-    p.send_signal(signal.SIGTERM)
-    out, err = p.communicate(timeout=300)
-    assert_interrupted(p.returncode, out, err, signal.SIGTERM, base)
+    r = run_and_signal(["simulate", str(CONFIGS / "trials" / "st35.yaml"), "--out", str(base / "DIR")], "staging",
+                       signal.SIGTERM, base, tmp_path / "markers")
+    assert_interrupted(*r, signal.SIGTERM, base)
 
 
 def test_montecarlo_interrupted_workers_leave_nothing(tmp_path):
-    """SIGTERM to a Monte Carlo on two loky workers: nothing left, and the workers are gone."""
+    """SIGTERM to a Monte Carlo while both loky workers run a task: nothing left, and the workers are gone."""
     base = tmp_path / "base"
     base.mkdir()
     out = base / "DIR"
-    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    p = subprocess.Popen(mmg_argv() + ["montecarlo", str(out), "--seeds", "1", "--jobs", "2"], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
-    t0 = time.monotonic()
-    while not list(out.glob(".staging-*")) or len(_group(p.pid)) < 3:       # main + 2 workers
-        assert p.poll() is None and time.monotonic() - t0 < 300, p.communicate()
-        time.sleep(0.05)
-    time.sleep(1.0)
-    assert p.poll() is None
-    p.send_signal(signal.SIGTERM)
-    out_, err = p.communicate(timeout=300)
+    markers = tmp_path / "markers"
+    p = start_paused(["montecarlo", str(out), "--seeds", "1", "--jobs", "2"], "sweep-task", markers)
+    try:
+        wait_for_markers(p, "sweep-task", markers, count=2)        # each worker waits in its first task
+        assert list(out.glob(".staging-*"))
+        p.send_signal(signal.SIGTERM)
+        out_, err = p.communicate(timeout=300)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.communicate()
     assert_interrupted(p.returncode, out_, err, signal.SIGTERM, base)
     t1 = time.monotonic()
     while _group(p.pid, running_only=True) and time.monotonic() - t1 < 30:
@@ -153,6 +151,19 @@ def _group(pgid: int, running_only=False) -> list:
         if int(fields[2]) == pgid and not (running_only and fields[0] == "Z"):
             pids.append(int(d.name))
     return pids
+
+
+def test_pause_point_is_inert_without_the_variable(monkeypatch, tmp_path):
+    """The hook does nothing unless MMG_TEST_PAUSE names the point (it returns at once)."""
+    from trials import pausepoint
+
+    monkeypatch.delenv(pausepoint.ENV, raising=False)
+    monkeypatch.setattr(pausepoint, "_done", set())
+    t0 = time.monotonic()
+    pausepoint.pause("staged")
+    monkeypatch.setenv(pausepoint.ENV, f"staging:{tmp_path}")
+    pausepoint.pause("staged")                        # another point named: no wait, no marker
+    assert time.monotonic() - t0 < 1.0 and not list(tmp_path.iterdir())
 
 
 # --------------------------------------------------------------------------- the mechanics
@@ -241,7 +252,6 @@ def test_montecarlo_ctrl_c_to_the_process_group(tmp_path):
     """Ctrl-C in a terminal (SIGINT to the whole group, workers included): one line, 130, nothing left."""
     base = tmp_path / "base"
     base.mkdir()
-    out = base / "DIR"
-    r = run_and_signal(["montecarlo", str(out), "--seeds", "1", "--jobs", "2"], out, signal.SIGINT, base, min_delay=1.0,
-                       group=True)
+    r = run_and_signal(["montecarlo", str(base / "DIR"), "--seeds", "1", "--jobs", "2"], "sweep-task", signal.SIGINT,
+                       base, tmp_path / "markers", group=True, count=2)
     assert_interrupted(*r, signal.SIGINT, base)

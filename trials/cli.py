@@ -232,7 +232,7 @@ def cmd_nomoto_paper(args) -> int:
     with pd.option_context("display.width", 200, "display.max_columns", 40, "display.float_format", "{:.5g}".format):
         for key, title in a.TITLES.items():
             print(f"\n{title}")
-            print(tables[key].to_string(index=False))
+            print(a.printable(tables[key])[0].to_string(index=False))     # as artyszuk_tables.md: no empty column
             note = tables.get("notes", {}).get(key)
             if note:
                 print(f"note: {note}")

@@ -51,6 +51,9 @@ from mmg._signals import noted as _noted  # noqa: F401  (the list the noting han
 from mmg._signals import pending as _signal_pending
 from mmg.errors import InputError
 
+from .pausepoint import pause as _pause
+from .pausepoint import wanted as _pause_wanted
+
 #: errno values of a target that cannot be written (reported as one InputError line, exit 2).
 WRITE_ERRNOS = frozenset(getattr(errno, n) for n in ("ENOSPC", "EROFS", "EACCES", "EPERM", "EDQUOT", "EFBIG",
                                                       "EXDEV", "ENAMETOOLONG", "ENOTDIR", "EISDIR", "EMLINK", "EIO")
@@ -269,6 +272,7 @@ class StagedOutput:
         """Create ``out`` (and missing parents) and the staging folder in it; idempotent."""
         if self.tmp is not None:
             return self
+        _pause("staging")                      # a test hook (trials.pausepoint); no-op otherwise
         if os.path.lexists(self.out) and not self.out.is_dir():
             raise InputError(str(self.out), "", "is a file, not a folder")
         with _critical():
@@ -286,6 +290,7 @@ class StagedOutput:
                 raise InputError(str(self.out), "", "is a file, not a folder") from None
             except OSError as e:
                 raise write_error(e, self.out) from None
+        _pause("staged")
         return self
 
     @property
@@ -296,6 +301,8 @@ class StagedOutput:
     def path(self, name: str) -> Path:
         """Where to write the output file ``name`` (may contain folders: ``"ekf/comparison.csv"``)."""
         p = self.dir / name
+        if _pause_wanted("staged-file") and any(f.is_file() for f in self.tmp.rglob("*")):
+            _pause("staged-file")
         p.parent.mkdir(parents=True, exist_ok=True)
         return p
 
@@ -389,7 +396,11 @@ class StagedOutput:
         self._done = True
 
     def __enter__(self):
-        return self.open()
+        try:
+            return self.open()
+        except BaseException:      # e.g. a signal held while the staging folder was made, delivered as
+            self.abort()           # open() returns: no __exit__ will run, so remove it (and the folders) here
+            raise
 
     def __exit__(self, exc_type, exc, tb):
         try:
@@ -644,14 +655,56 @@ def out_path(out):
     return out if hasattr(out, "path") else Folder(out)
 
 
+ZERO_REL = 1e-9
+"""A printed table's numerical zero: a value within this fraction of its column's largest magnitude."""
+
+
+def numerical_zeros(values, rel: float = ZERO_REL, atol: float = 0.0) -> np.ndarray:
+    """The numbers of one table column with its numerical zeros made exact zeros, for printing.
+
+    A value is a numerical zero when ``|x| <= max(rel * max|column|, atol)``: round-off left where the
+    exact result is 0 (an overshoot point's yaw rate of -1.6e-17, a heading error of 6.8e-16 deg
+    beside 54 rpm).  ``atol`` is for columns whose values are all round-off (a percentage error
+    that is exactly 0 in exact arithmetic: 1e-9 %); -0.0 becomes 0.0.  Non-numbers (None, text)
+    are left as they are; NaN stays NaN.
+
+    Parameters
+    ----------
+    values : sequence
+        One column.
+    rel : float
+        Tolerance relative to the column's largest finite magnitude.
+    atol : float
+        Absolute tolerance.
+
+    Returns
+    -------
+    ndarray of object
+        The column, numbers with their zeros exact.
+    """
+    values = list(values)
+    out = np.empty(len(values), dtype=object)      # filled one by one: lists stay cells
+    out[:] = values
+    num = [i for i, v in enumerate(out) if isinstance(v, (int, float, np.integer, np.floating))
+           and not isinstance(v, (bool, np.bool_))]
+    mags = [abs(float(out[i])) for i in num if np.isfinite(float(out[i]))]
+    tol = max(rel * max(mags, default=0.0), atol)
+    for i in num:
+        x = float(out[i])
+        if np.isfinite(x) and abs(x) <= tol and not isinstance(out[i], (int, np.integer)):
+            out[i] = 0.0
+    return out
+
+
 def fmt(v, nd: int = 4) -> str:
-    """A value for a printed table: 4 significant digits, lists as [a, b, ...], None as '-'."""
+    """A value for a printed table: 4 significant digits, lists as [a, b, ...], None as '-',
+    zero (also -0.0) as '0'."""
     if v is None:
         return "-"
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(f"{x:.{min(nd, 2)}f}" for x in v) + "]"
     if isinstance(v, (float, np.floating)):
-        return f"{v:.{nd}g}"
+        return "0" if v == 0 else f"{v:.{nd}g}"
     return str(v)
 
 

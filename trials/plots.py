@@ -37,8 +37,107 @@ def ship_outline(x, y, psi, L, B):
     return x + s * c - b * sn, y + s * sn + b * c
 
 
+TURN_RATIO = 1.5
+"""A track whose north-south extent exceeds this many times its east-west one is drawn turned a quarter
+(north to the right, east down: the map rotated, not mirrored), its long side along the canvas's."""
+
+PANEL_RATIO = 5.0
+"""The longest side ratio of one track panel: a longer track is cut into parts along its long side,
+one panel each, stacked (all to the same scale), so that its narrow side stays readable."""
+
+
+class TrackView:
+    """How a track is placed in an Axes: the map view (east right, north up) or turned a quarter
+    (north right, east down), always to scale (equal axes).
+
+    Parameters
+    ----------
+    turned : bool
+        Draw north along the horizontal axis (a long north-south track on a wide canvas).
+    unit : str
+        The axes' unit, for the labels ("L", "m").
+    """
+
+    def __init__(self, turned: bool, unit: str = "L"):
+        self.turned = turned
+        self.unit = unit
+
+    @classmethod
+    def for_extent(cls, north, east, unit: str = "L", box_ratio: float = 1.0) -> "TrackView":
+        """The view that runs a track's long side along the long side of a box ``box_ratio`` (width /
+        height) wide: turned when the track is long north-south (more than ``TURN_RATIO``) and the box is
+        wide, or long east-west and the box tall."""
+        n_span = float(np.nanmax(north) - np.nanmin(north))
+        e_span = float(np.nanmax(east) - np.nanmin(east))
+        if box_ratio >= 1.0:
+            return cls(n_span > TURN_RATIO * max(e_span, 1e-12), unit)
+        return cls(e_span > TURN_RATIO * max(n_span, 1e-12), unit)
+
+    def hv(self, north, east):
+        """Horizontal and vertical plot coordinates of (north, east)."""
+        return (north, east) if self.turned else (east, north)
+
+    def finish(self, ax, xlabel: bool = True, adjustable: str = "datalim") -> None:
+        """Equal axes (``adjustable`` as :meth:`matplotlib.axes.Axes.set_aspect`), labels, the east axis
+        downward when turned, the grid."""
+        ax.set_aspect("equal", adjustable=adjustable)
+        if self.turned:
+            if not ax.yaxis_inverted():
+                ax.invert_yaxis()                        # east down: the map turned, not mirrored
+            if xlabel:
+                ax.set_xlabel(f"x, north ({self.unit}) \u2192  (track turned a quarter: north to the right)")
+            ax.set_ylabel(f"y, east ({self.unit})")
+        else:
+            if xlabel:
+                ax.set_xlabel(f"y, east ({self.unit})")
+            ax.set_ylabel(f"x, north ({self.unit})")
+        ax.grid(True, alpha=0.3)
+
+
+def track_layout(north, east, pad: float, width_in: float = 10.0) -> dict:
+    """Canvas of a track figure from the track's extent (in the units of ``north``, ``east``).
+
+    A track close to square keeps the map view on a canvas of its own proportions; a long one is turned so
+    its long side runs across a wide canvas, and one longer than ``PANEL_RATIO`` times its width is cut
+    into ``panels`` parts along that side, stacked, each to the same scale.
+
+    Returns
+    -------
+    dict
+        ``view`` (:class:`TrackView`), ``panels`` (int), ``lo``, ``hi`` (the horizontal range, padded),
+        ``vlim`` (the vertical range, padded), ``figsize`` (inches), ``adjust`` (the subplot margins).
+    """
+    view = TrackView.for_extent(north, east)
+    h, v = view.hv(np.asarray(north), np.asarray(east))
+    h_lo, h_hi = float(np.nanmin(h)) - pad, float(np.nanmax(h)) + pad
+    v_lo, v_hi = float(np.nanmin(v)) - pad, float(np.nanmax(v)) + pad
+    ratio = (h_hi - h_lo) / (v_hi - v_lo)
+    lay = {"view": view, "lo": h_lo, "hi": h_hi, "vlim": (v_lo, v_hi)}
+    if ratio < 1.0:                                      # taller than wide (close to square): map view
+        axes_w, axes_h, panels = max(3.5, 7.0 * ratio), 7.0, 1
+    else:
+        panels = int(np.ceil(ratio / PANEL_RATIO))
+        axes_w = width_in - _MARGIN_IN["left"] - _MARGIN_IN["right"]
+        axes_h = axes_w / (ratio / panels)
+    w = axes_w + _MARGIN_IN["left"] + _MARGIN_IN["right"]
+    h = panels * axes_h + (panels - 1) * _MARGIN_IN["gap"] + _MARGIN_IN["top"] + _MARGIN_IN["bottom"]
+    adjust = {"left": _MARGIN_IN["left"] / w, "right": 1 - _MARGIN_IN["right"] / w, "top": 1 - _MARGIN_IN["top"] / h,
+              "bottom": _MARGIN_IN["bottom"] / h, "hspace": _MARGIN_IN["gap"] / axes_h}
+    return {**lay, "panels": panels, "figsize": (w, h), "adjust": adjust}
+
+
+_MARGIN_IN = {"left": 0.9, "right": 0.3, "top": 0.5, "bottom": 1.0, "gap": 0.7}
+"""A track figure's margins [in]: the labels, the title above, the x label and the legend below."""
+
+
 def track_figure(t, x, y, psi, L, B, title, every_s=None, ax=None, pyplot: bool = True):
-    """Track (east right, north up) in ship lengths with outlines every ``every_s`` seconds.
+    """Track in ship lengths, to scale, with hull outlines every ``every_s`` seconds and the start marked.
+
+    A new figure takes its shape from the track (:func:`track_layout`): a track close to square in the
+    map view (east right, north up); a long one turned so its long side runs across a wide canvas (a
+    north-south zigzag: north to the right, east down, labelled so), and cut into stacked parts when
+    longer than ``PANEL_RATIO`` times its width, so its narrow side stays readable and the outlines (to
+    scale) visible.  The legend sits below the axes, off the track.  Axes you give get the map view.
 
     Parameters
     ----------
@@ -58,27 +157,45 @@ def track_figure(t, x, y, psi, L, B, title, every_s=None, ax=None, pyplot: bool 
     -------
     matplotlib.figure.Figure
     """
-    if ax is None:
-        fig = _figure((7, 7), pyplot)
-        ax = fig.add_subplot()
-    fig = ax.figure
     from matplotlib.collections import PolyCollection
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
-    ax.plot(y / L, x / L, "b-", lw=1, label="midship track")
     every_s = every_s or max(60.0, (t[-1] - t[0]) / 25)
     ts = np.arange(t[0], t[-1] + 1e-9, every_s)
     idx = np.minimum(np.searchsorted(t, ts), len(t) - 1)
     px, py = ship_outline(x[idx, None], y[idx, None], psi[idx, None], L, B)
-    # the outlines as one collection: one artist instead of one polygon each
-    ax.add_collection(PolyCollection(np.stack([py / L, px / L], axis=-1), facecolors="0.8", edgecolors="k",
-                                     linewidths=0.6, zorder=1.5))
-    ax.autoscale_view()
-    ax.set_aspect("equal")
-    ax.set_xlabel("y, east (L)")
-    ax.set_ylabel("x, north (L)")
-    ax.set_title(f"{title}: track (L = {L:g} m)")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best")
+    if ax is None:
+        lay = track_layout(x / L, y / L, pad=0.6)
+        fig = _figure(lay["figsize"], pyplot)
+        axs = list(np.ravel(fig.subplots(lay["panels"], 1, squeeze=False)))
+        view = lay["view"]
+    else:
+        fig, axs, view, lay = ax.figure, [ax], TrackView(False), None
+    for k, a in enumerate(axs):
+        a.plot(*view.hv(x / L, y / L), "b-", lw=1, label="midship track")
+        h, v = view.hv(px / L, py / L)
+        # the outlines as one collection: one artist instead of one polygon each
+        a.add_collection(PolyCollection(np.stack([h, v], axis=-1), facecolors="0.8", edgecolors="k",
+                                        linewidths=0.6, zorder=1.5))
+        a.plot(*view.hv(x[:1] / L, y[:1] / L), "o", color="g", ms=6, zorder=3, label="start")
+        if lay is not None:                              # this part's stretch; the box takes the shape
+            step = (lay["hi"] - lay["lo"]) / lay["panels"]
+            a.set_xlim(lay["lo"] + k * step - (0.02 * step if k else 0), lay["lo"] + (k + 1) * step)
+            a.set_ylim(*lay["vlim"])
+        else:
+            a.autoscale_view()
+        view.finish(a, xlabel=(k == len(axs) - 1), adjustable="box" if lay is not None else "datalim")
+    part = "" if len(axs) == 1 else f", in {len(axs)} parts along its length, each to the same scale"
+    axs[0].set_title(f"{title}: track (L = {L:g} m){part}")
+    handles = [Line2D([], [], color="b", lw=1, label="midship track"),
+               Patch(facecolor="0.8", edgecolor="k", lw=0.6, label=f"hull outline every {every_s:g} s (to scale)"),
+               Line2D([], [], color="g", marker="o", ls="none", label="start")]
+    if ax is None:                       # fixed margins (no tight_layout: a second rendering)
+        fig.subplots_adjust(**lay["adjust"])
+        fig.legend(handles=handles, loc="lower center", ncol=3, frameon=False)
+    else:
+        ax.legend(handles=handles, loc="best")
     return fig
 
 
@@ -184,7 +301,7 @@ def plot_histories(t, psi, delta, r, U, n, title, path, delta_order=None, show=F
 
 
 PNG_DPI = 100
-"""Resolution of the written PNGs (the 7 x 7 in track 700 x 700 px, the histories 900 x 1100 px)."""
+"""Resolution of the written PNGs (a long track 1000 px wide, the histories 900 x 1100 px)."""
 
 
 def _save(fig, path, show):

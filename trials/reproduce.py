@@ -35,7 +35,7 @@ from mmg.simulation import prepare, simulate
 from mmg.units import DEG, KNOT
 
 from .metrics import imo_criteria, record_metrics, turning_metrics
-from .output import StagedOutput, fmt, write_trial_outputs
+from .output import StagedOutput, fmt, numerical_zeros, write_trial_outputs
 from .run import run_trial
 from .trial import load_trial
 
@@ -111,11 +111,14 @@ def frt_data_dir() -> Path | None:
 
 
 def table(rows, cols, headers=None) -> str:
-    """A Markdown table of dict rows (numbers to 4 significant digits, None as '-')."""
+    """A Markdown table of dict rows (numbers to 4 significant digits, numerical zeros of a column as 0
+    (:func:`trials.output.numerical_zeros`), None as '-')."""
     headers = headers or cols
+    columns = {c: numerical_zeros([r.get(c) for r in rows]) for c in cols}
     out = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(cols)]
-    for r in rows:
-        out.append("| " + " | ".join(fmt(r.get(c)) if not isinstance(r.get(c), str) else r.get(c) for c in cols) + " |")
+    for i in range(len(rows)):
+        cells = (columns[c][i] if isinstance(columns[c][i], str) else fmt(columns[c][i]) for c in cols)
+        out.append("| " + " | ".join(cells) + " |")
     return "\n".join(out)
 
 
@@ -137,14 +140,43 @@ def straight_run_section(doc, ship):
         {"quantity": "rudder amidships, no trim: heading after 3000 s (deg)", "ours": float(free.psi[-1] / DEG), "paper": None},
         {"quantity": "rudder amidships, no trim: speed after 3000 s (kn)", "ours": float(free.U[-1] / KNOT), "paper": None},
     ], ["quantity", "ours", "paper"]))
-    doc("\nTable 7 of the paper starts the filter at 54.21 rpm; Table 4 says 54.12 rpm.\n")
+    doc(f"\nThe paper prints two approach rpm for this one steady run: 54.12 (Table 4) and 54.21 (the filter's start, "
+        f"Table 7). Ours, {eq.n * 60:.2f} rpm from balancing the surge equation (the paper's own recipe), is the "
+        "second; the paper does not say why its two figures differ (0.17 %). The other rows have no value in the paper (round-off shows as 0).\n")
 
 
 def kijima_section(doc, ship):
     doc("## 2. Kijima (1990) formulas vs Table 2\n")
-    doc(table(compare(ship), ["coefficient", "kijima", "config", "difference_pct"],
+    rows = compare(ship)
+    doc(table(rows, ["coefficient", "kijima", "config", "difference_pct"],
                 ["coefficient", "Kijima formula", "Table 2", "difference (%)"]))
-    doc()
+    doc("\n" + kijima_note(rows) + "\n")
+
+
+def printed_half_unit(v: float) -> float:
+    """Half a unit in the last digit of ``v`` as a config prints it (its shortest repr): the rounding of a
+    value the paper printed with those digits."""
+    if v == 0 or not np.isfinite(v):
+        return 0.0
+    mant = repr(abs(float(v))).lower().split("e")[0]
+    mant = mant.rstrip("0").rstrip(".") if "." in mant else mant
+    digits = mant.replace(".", "").lstrip("0")
+    exp = int(np.floor(np.log10(abs(v))))
+    return 0.5 * 10.0 ** (exp - len(digits) + 1)
+
+
+def kijima_note(rows) -> str:
+    """Why the Kijima formulas and Table 2 differ: the rows within Table 2's rounding, and the others."""
+    off = [r for r in rows if abs(r["kijima"] - r["config"]) > printed_half_unit(r["config"]) * (1 + 1e-9)]
+    text = (f"{len(rows) - len(off)} of {len(rows)} differences are within half a unit of the last digit Table 2 "
+            "prints: its rounding.")
+    for r in off:
+        if r["coefficient"] == "Y_r":
+            text += (f" Y_r differs by {abs(r['kijima'] - r['config']):.2g}: it contains the added mass m_x', which the "
+                     "paper does not print; the config's m_x' = 0.0200 rounds the 0.01998 that Table 2's Y_r implies.")
+        else:
+            text += f" {r['coefficient']} differs by {r['difference_pct']:.3g} %: not explained."
+    return text
 
 
 def trials_section(doc, out: Path):
@@ -232,7 +264,13 @@ def st35_variants_section(doc, ship):
                      "U": float(r.U[-1] / r.U[0])})
     doc(table(rows, ["variant", "heading", "TD", "U"],
                 ["variant", "heading change at 3000 s (deg)", "tactical D (L)", "final U / U0"]))
-    doc()
+    h = [r["heading"] for r in rows]
+    doc(f"\nRhee & Kim chose t_f = 3000 s \"to make the ship turn 560 deg\"; ours turns {h[0]:.0f} deg. The paper does "
+        "not publish the constants varied here (wake change in the turn, flow-straightening kappa, rudder position "
+        f"l_R', yaw inertia, engine model); each moves ours by {min(x - h[0] for x in h[1:]):+.0f} to "
+        f"{max(x - h[0] for x in h[1:]):+.0f} deg, " + ("none to 560 deg: the rest of the difference is not explained "
+        "by them (the paper's speed loss in the turn, which sets how far a slowing ship turns in 3000 s, is not "
+        "published)." if min(abs(x - 560) for x in h) > 20 else "one of them to within 20 deg of 560 deg.") + "\n")
 
 
 def checks_section(doc, ship):
@@ -266,11 +304,8 @@ def nomoto_section(doc, out: Path, full: bool):
     t0 = time.perf_counter()
     tables = artyszuk.reproduce(fast=not full)
     artyszuk.write_tables(tables, out / "nomoto")
-    for key, title in artyszuk.TITLES.items():
-        if key in tables:
-            doc(f"### {title}\n")
-            doc(artyszuk.to_markdown(tables[key]))
-            doc()
+    for part in artyszuk.markdown_parts(tables, level=3):     # each table with its note on the paper
+        doc(part)
     doc("(every table also as CSV in `nomoto/`)\n")
     progress(f"Nomoto tables {time.perf_counter() - t0:.1f} s")
 
@@ -285,6 +320,9 @@ def ekf_section(doc, out: Path, runs: dict) -> dict:
     reproduce_rhee_kim(out / "ekf", verbose=False, runs={k: runs[s][0] for k, s in stems.items() if s in runs},
                        keep=keep)
     doc((out / "ekf" / "comparison.md").read_text())
+    doc("\nOurs and the paper's errors differ because each is one draw of the measurement noise: the paper's noise "
+        "sequence is not published (only its levels, Table 5), so a single run can only match in size, not value; "
+        "section 10 of `mmg reproduce --full` gives the spread over 20 seeds to set them against.\n")
     doc("\nThe estimates, the Table-10 error table and the free-run check are in `ekf/` "
         "([estimates.json](ekf/estimates.json), [error_table.md](ekf/error_table.md), "
         "[free_run.json](ekf/free_run.json)); convergence figures, one per derivative, e.g. "
@@ -302,6 +340,9 @@ def sensitivity_section(doc, out: Path):
     cmp_ = out / "ekf" / "comparison.csv"
     paper_figures(out / "sensitivity", ekf_comparison=cmp_ if cmp_.exists() else None, verbose=False)
     doc(demote((out / "sensitivity" / "sensitivity_figures.md").read_text(), drop_title=True))
+    doc("\nThe paper's Figs 2-14 are charts whose numbers it does not print: these tables are ours only, to set "
+        "against its bars. The two Fig. 28 tables (ours; the same formula on the paper's Table 10) differ as the "
+        "errors of section 7 do: one noise draw each, the paper's not published.\n")
     doc("\nFigures: [Fig. 2](sensitivity/fig02_conventional.png), [Figs 8-9](sensitivity/fig08_09_sine_sawtooth.png), "
         "[Fig. 12](sensitivity/fig12_stype.png), [Fig. 13](sensitivity/fig13_conventional_vs_stype120.png), "
         "[Fig. 14](sensitivity/fig14_sums.png), [Fig. 28](sensitivity/fig28_efficiency.png); CSVs beside them.\n")

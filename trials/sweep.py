@@ -100,4 +100,7 @@ def run_sweep(func: Callable, tasks: Sequence, *, backend: str = "loky", n_jobs:
 
 
 def _indexed(func, i, task):
+    from .pausepoint import pause
+
+    pause("sweep-task")                 # a test hook (trials.pausepoint); no-op otherwise
     return i, func(task)
