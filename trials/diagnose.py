@@ -109,6 +109,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from .logio import read_record
     from .predict import measured_run
     from .records import TrialRecord
+    from .shipcheck import check_record_ship
 
     L = ship.particulars.L
     seg_s = segment_s or 52.0 * math.sqrt(L / 9.80665)
@@ -117,7 +118,11 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
         if isinstance(it, Prepared):
             out.append(it)
             continue
-        rec = it if isinstance(it, TrialRecord) else read_record(it, length_m=L)
+        if not isinstance(it, TrialRecord):
+            rec = read_record(it, length_m=L)
+            check_record_ship(rec, ship)      # a record of another ship is refused, not diagnosed
+        else:
+            rec = it
         run = measured_run(ship, rec, wind=wind)
         bad = ~np.isfinite(run.meas).all(axis=1)
         if bad.any():

@@ -57,7 +57,12 @@ def identify_log(path, length: float, speed: float | None = None, output_error: 
         raise InputError("--length", "", f"ship length must be a positive number of metres, got {length}")
     if speed is not None and (not np.isfinite(speed) or speed <= 0):
         raise InputError("--speed", "", f"speed must be a positive number of m/s, got {speed}")
-    rec = read_record(path)
+    from trials.shipcheck import check_record_ship, check_speed_option
+
+    rec = read_record(path, length_m=length)
+    check_record_ship(rec, length)          # a length the record contradicts is refused
+    if speed is not None:
+        check_speed_option(rec, speed, length)
     note = None
     if rec.delta is None and rec.meta.get("format") == "log":
         from trials.rudder import with_rebuilt_rudder

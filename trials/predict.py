@@ -284,8 +284,14 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
     Prediction
     """
     from .logio import read_record
+    from .shipcheck import check_record_ship
 
-    measured = [measured_run(ship, read_record(path, length_m=ship.particulars.L), start, wind) for path in paths]
+    def read(path):
+        rec = read_record(path, length_m=ship.particulars.L)
+        check_record_ship(rec, ship)          # a record of another ship: refused, not replayed as this one
+        return rec
+
+    measured = [measured_run(ship, read(path), start, wind) for path in paths]
     packed = pack(ship)
     runs = []
     for i, (path, run) in enumerate(zip(paths, measured)):
