@@ -61,13 +61,15 @@ def judge(path: Path, ship) -> tuple[dict | None, str]:
     """(statistics, verdict) of one record with one ship, read as the commands read it."""
     try:
         rec = read_record(path, length_m=ship.particulars.L)
-    except InputError as e:
-        return None, f"refused by the reader ({e.field})"
-    stats = sc.record_statistics(rec, ship.particulars.L)
+        stats = sc.record_statistics(rec, ship.particulars.L)
+    except InputError:
+        stats = None                         # the reader refuses it (its unit checks)
     try:
-        sc.check_record_ship(rec, ship)
+        sc.read_for_ship(path, ship)         # as the commands read it
     except sc.ShipMismatch as e:
         return stats, f"refused: {e.field}"
+    except InputError as e:
+        return stats, f"refused by the reader, not as another ship's ({e.field})"
     return stats, "accepted"
 
 

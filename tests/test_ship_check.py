@@ -232,10 +232,9 @@ def test_estimate_refuses_kvlcc2_log_with_esso(sims):
 
 
 def _check(path, ship):
-    from trials.logio import read_record
-    from trials.shipcheck import check_record_ship
+    from trials.shipcheck import read_for_ship
 
-    return check_record_ship(read_record(path, length_m=ship.particulars.L), ship)
+    return read_for_ship(path, ship)
 
 
 @needs_frt
@@ -272,7 +271,7 @@ def test_real_3m_records_refused_as_full_scale():
 def test_full_scale_dev_logs_accepted_and_refused_as_models():
     """The independent simulator's full-scale logs: accepted with esso_osaka, refused with the 3 m and 7 m models."""
     import mmg
-    from mmg.errors import InputError
+    from trials.shipcheck import ShipMismatch
 
     files = sorted(DEV.glob("*.csv"))
     assert len(files) >= 30
@@ -280,7 +279,7 @@ def test_full_scale_dev_logs_accepted_and_refused_as_models():
     for p in files:
         _check(p, esso)
         for s in (m3, kv):
-            with pytest.raises(InputError):
+            with pytest.raises(ShipMismatch, match=f"{s.particulars.L:g} m {s.name}"):
                 _check(p, s)
 
 

@@ -151,13 +151,16 @@ def cmd_metrics(args) -> int:
 
     if args.json:
         check_output_file(args.json)
-    from .shipcheck import check_record_ship
+    from .shipcheck import check_record_ship, read_for_ship
 
-    rec = read_record(args.log, length_m=args.length)
-    length = args.length if args.length is not None else rec.meta.get("length_m")
-    if length is not None and float(length) > 0:      # no length at all: record_metrics says so
-        assumed = args.length is None and rec.meta.get("format") == "frt-ds-esso"
-        check_record_ship(rec, float(length), name="model the FRT-DS-ESSO layout assumes" if assumed else None)
+    if args.length is not None:
+        rec = read_for_ship(args.log, args.length)
+    else:                    # the header's length, or the FRT-DS-ESSO layout's 3 m model
+        rec = read_record(args.log)
+        length = rec.meta.get("length_m")
+        if isinstance(length, (int, float)) and length > 0:          # none at all: record_metrics says so
+            assumed = rec.meta.get("format") == "frt-ds-esso"
+            check_record_ship(rec, float(length), name="model the FRT-DS-ESSO layout assumes" if assumed else None)
     ang = None if args.zigzag_angle is None else np.radians(args.zigzag_angle)
     m = record_metrics(rec, args.kind, args.length, ang)
     print(f"{rec.name} ({m['kind']}, {rec.source})")

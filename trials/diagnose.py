@@ -106,10 +106,9 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from ekf.identify import Segmented, segment_resets
     from mmg.effects import Context
 
-    from .logio import read_record
     from .predict import measured_run
     from .records import TrialRecord
-    from .shipcheck import check_record_ship
+    from .shipcheck import read_for_ship
 
     L = ship.particulars.L
     seg_s = segment_s or 52.0 * math.sqrt(L / 9.80665)
@@ -118,11 +117,8 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
         if isinstance(it, Prepared):
             out.append(it)
             continue
-        if not isinstance(it, TrialRecord):
-            rec = read_record(it, length_m=L)
-            check_record_ship(rec, ship)      # a record of another ship is refused, not diagnosed
-        else:
-            rec = it
+        # a record of another ship is refused, not diagnosed
+        rec = it if isinstance(it, TrialRecord) else read_for_ship(it, ship)
         run = measured_run(ship, rec, wind=wind)
         bad = ~np.isfinite(run.meas).all(axis=1)
         if bad.any():

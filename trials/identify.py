@@ -66,14 +66,12 @@ def _log(msg: str) -> None:
 def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log) -> list[MeasuredRun]:
     """Read and prepare each record; one that cannot be used is skipped with one line saying why, but one
     of another ship (:func:`trials.shipcheck.check_record_ship`) raises its :class:`~trials.shipcheck.ShipMismatch`."""
-    from .logio import read_record
-    from .shipcheck import ShipMismatch, check_record_ship
+    from .shipcheck import ShipMismatch, read_for_ship
 
     runs = []
     for p in paths:
         try:
-            rec = read_record(p, length_m=ship.particulars.L)
-            check_record_ship(rec, ship)
+            rec = read_for_ship(p, ship)
             runs.append(measured_run(ship, rec, wind=wind))
         except ShipMismatch:              # a record of another ship: the call is wrong, not the record
             raise

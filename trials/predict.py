@@ -283,15 +283,10 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
     -------
     Prediction
     """
-    from .logio import read_record
-    from .shipcheck import check_record_ship
+    from .shipcheck import read_for_ship
 
-    def read(path):
-        rec = read_record(path, length_m=ship.particulars.L)
-        check_record_ship(rec, ship)          # a record of another ship: refused, not replayed as this one
-        return rec
-
-    measured = [measured_run(ship, read(path), start, wind) for path in paths]
+    # a record of another ship: refused, not replayed as this one
+    measured = [measured_run(ship, read_for_ship(path, ship), start, wind) for path in paths]
     packed = pack(ship)
     runs = []
     for i, (path, run) in enumerate(zip(paths, measured)):

@@ -169,3 +169,24 @@ def check_speed_option(rec, speed: float, L: float, src: str | None = None, opti
     if mid > 0 and not 0.5 <= speed / mid <= 2.0:
         raise InputError(option, f"{speed:g}", f"the record {src} runs at {mid:.3g} m/s (median): the speed given is "
                                                f"{speed / mid:.3g} times that")
+
+
+def read_for_ship(path, ship_or_length, name: str | None = None):
+    """:func:`trials.logio.read_record` with the ship's length (for a layout that does not state one), then
+    :func:`check_record_ship`: the one way a command reads a record it analyses with a ship.
+
+    A reader's refusal of speeds beyond Froude number 1 for this length (a full-scale record read
+    as a model) is raised as a :class:`ShipMismatch` that also names the ship.
+    """
+    from .logio import read_record
+
+    L, who = _ship_label(ship_or_length, name)
+    try:
+        rec = read_record(path, length_m=L)
+    except InputError as e:
+        if "Froude number" in e.message and f"{L:g} m ship" in e.message:
+            raise ShipMismatch(e.source, e.field, f"{e.message}; or a record of another ship than {who}? give the "
+                                                  f"record's ship with --ship or its length with --length") from None
+        raise
+    check_record_ship(rec, ship_or_length, name=name)
+    return rec
