@@ -159,8 +159,8 @@ def cmd_metrics(args) -> int:
         rec = read_record(args.log)
         length = rec.meta.get("length_m")
         if isinstance(length, (int, float)) and length > 0:          # none at all: record_metrics says so
-            assumed = rec.meta.get("format") == "frt-ds-esso"
-            check_record_ship(rec, float(length), name="model the FRT-DS-ESSO layout assumes" if assumed else None)
+            assumed = "model the FRT-DS-ESSO layout assumes when no --length is given"
+            check_record_ship(rec, float(length), name=assumed if rec.meta.get("format") == "frt-ds-esso" else None)
     ang = None if args.zigzag_angle is None else np.radians(args.zigzag_angle)
     m = record_metrics(rec, args.kind, args.length, ang)
     print(f"{rec.name} ({m['kind']}, {rec.source})")

@@ -46,7 +46,7 @@ MOVING_FRACTION = 0.25
 """Samples at a meaningful speed: at least this fraction of the record's 95th-percentile speed."""
 LENGTH_TOLERANCE = 0.05
 """Largest relative difference between a header's ``length_m`` and the ship's length."""
-HINT = "a record of another ship? give the record's ship with --ship or its length with --length"
+HINT = "a record of another ship? give the record's own ship or length"
 
 
 class ShipMismatch(InputError):
@@ -59,9 +59,9 @@ def _ship_label(ship_or_length, name: str | None = None) -> tuple[float, str]:
     parts = getattr(ship_or_length, "particulars", None)
     if parts is not None:
         L = float(parts.L)
-        return L, f"the {L:g} m {getattr(ship_or_length, 'name', '') or 'ship'}"
+        return L, f"the {getattr(ship_or_length, 'name', '') or 'ship'} (L = {L:g} m)"
     L = float(ship_or_length)
-    return L, f"the {L:g} m {name}" if name else f"a {L:g} m ship"
+    return L, f"the {name} (L = {L:g} m)" if name else f"a ship of L = {L:g} m"
 
 
 def record_statistics(rec, L: float) -> dict:
@@ -186,7 +186,7 @@ def read_for_ship(path, ship_or_length, name: str | None = None):
     except InputError as e:
         if "Froude number" in e.message and f"{L:g} m ship" in e.message:
             raise ShipMismatch(e.source, e.field, f"{e.message}; or a record of another ship than {who}? give the "
-                                                  f"record's ship with --ship or its length with --length") from None
+                                                  f"record's own ship or length") from None
         raise
     check_record_ship(rec, ship_or_length, name=name)
     return rec
