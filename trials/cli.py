@@ -170,7 +170,16 @@ def cmd_metrics(args) -> int:
 
     if args.json is not None:
         check_output_file(args.json)
-    rec = read_record(args.log)
+    from .shipcheck import check_record_ship, read_for_ship
+
+    if args.length is not None:
+        rec = read_for_ship(args.log, args.length)
+    else:                    # the header's length, or the FRT-DS-ESSO layout's 3 m model
+        rec = read_record(args.log)
+        length = rec.meta.get("length_m")
+        if isinstance(length, (int, float)) and length > 0:          # none at all: record_metrics says so
+            assumed = "model the FRT-DS-ESSO layout assumes when no --length is given"
+            check_record_ship(rec, float(length), name=assumed if rec.meta.get("format") == "frt-ds-esso" else None)
     ang = None if args.zigzag_angle is None else np.radians(args.zigzag_angle)
     m = record_metrics(rec, args.kind, args.length, ang)
     if args.json is not None:

@@ -109,11 +109,10 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from ekf.identify import Segmented, segment_resets
     from mmg.effects import Context
 
-    from .logio import read_record
     from .predict import measured_run
     from .records import TrialRecord
-
     from .output import record_labels
+    from .shipcheck import read_for_ship
 
     L = ship.particulars.L
     seg_s = segment_s or 52.0 * math.sqrt(L / 9.80665)
@@ -125,7 +124,8 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
         if isinstance(it, Prepared):
             out.append(it)
             continue
-        rec = it if isinstance(it, TrialRecord) else read_record(it, length_m=L)
+        # a record of another ship is refused, not diagnosed
+        rec = it if isinstance(it, TrialRecord) else read_for_ship(it, ship)
         run = replace(measured_run(ship, rec, wind=wind), name=label)     # named after its file, unique
         bad = ~np.isfinite(run.meas).all(axis=1)
         if bad.any():

@@ -199,16 +199,35 @@ def data_from_log(path: str | Path, cfg: dict, ship_path=None, truth_path: str |
 
     With a truth file the true values are the ship's coefficients (the truth file was simulated
     with it); the truth file must be of the same trial as the log (same header ``trial`` and
-    ``seed``, same time span), or it is refused.
+    ``seed``, same time span) and its header's ship the ship estimated with, or it is refused.
+    A log (or truth file) of another ship (:func:`trials.shipcheck.check_record_ship`) is refused.
     """
+    from .shipcheck import check_record_ship
+
     rec = read_record(path)
     truth = tv = None
     ship = _ship_of(rec, ship_path)
+    if rec.meta.get("format") == "log":          # another layout: data_from_record says it is not a log
+        check_record_ship(rec, ship)
     if truth_path is not None:
         truth = read_record(truth_path)
         _check_truth(rec, truth, str(truth_path))
+        check_record_ship(truth, ship)
+        _check_truth_ship(rec, truth, ship, str(truth_path))
         tv = ship.hull.as_dict()
     return data_from_record(rec, cfg, ship, truth, tv, names)
+
+
+def _check_truth_ship(rec, truth, ship: Ship, src: str) -> None:
+    """The true values are the ship's coefficients: refuse a truth file (or log) whose header names another ship."""
+    from .shipcheck import ShipMismatch
+
+    for r, where in ((truth, src), (rec, rec.source or "log")):
+        named = str(r.meta.get("ship", "") or "").strip()
+        if named and named != ship.name:
+            raise ShipMismatch(where, "ship", f"the header's ship is {named!r}, but the estimate uses {ship.name!r}, whose "
+                                              f"coefficients would be taken as the true values: give the log's own ship "
+                                              f"with --ship")
 
 
 def _check_truth(rec, truth, src: str) -> None:

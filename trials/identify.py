@@ -67,21 +67,24 @@ def _log(msg: str) -> None:
 
 
 def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log, names=None) -> list[MeasuredRun]:
-    """Read and prepare each record; one that cannot be used is skipped with one line saying why.
+    """Read and prepare each record; one that cannot be used is skipped with one line saying why, but one
+    of another ship (:func:`trials.shipcheck.check_record_ship`) raises its :class:`~trials.shipcheck.ShipMismatch`.
     Each is named after its file (:func:`trials.output.record_labels`: ``ST35``, or ``day1/ST35``
     and ``day2/ST35`` for two files of one stem), as the report and ship.yaml name it; ``names``:
     the names to give instead (labels made over the training and test records together)."""
     from dataclasses import replace
 
-    from .logio import read_record
     from .output import record_labels
+    from .shipcheck import ShipMismatch, read_for_ship
 
     paths = list(paths)
     runs = []
     for p, label in zip(paths, record_labels(paths) if names is None else names):
         try:
-            rec = read_record(p, length_m=ship.particulars.L)
+            rec = read_for_ship(p, ship)
             runs.append(replace(measured_run(ship, rec, wind=wind), name=label))
+        except ShipMismatch:              # a record of another ship: the call is wrong, not the record
+            raise
         except InputError as e:
             say(f"skipped: {e}")
     return runs

@@ -519,7 +519,13 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
     ship = str(meta.get("ship", ""))
     L = float(meta["length_m"]) if "length_m" in meta else None
     if "t [s]" in cols or "psi_hat [rad]" in cols:
-        return _read_frt(tab, src, Path(src), notes, length_m or FRT_LENGTH_M)
+        try:
+            return _read_frt(tab, src, Path(src), notes, length_m or FRT_LENGTH_M)
+        except InputError as e:       # the 3 m model assumed, not given: say how to give the record's length
+            if length_m or "Froude" not in e.message:
+                raise
+            raise InputError(e.source, e.field, f"{e.message}; the FRT-DS-ESSO layout's usual {FRT_LENGTH_M:g} m model "
+                                                f"was assumed: give the record's length (--length) or ship (--ship)") from None
     if "u_mps" in cols or "psi_rad" in cols:
         tab.require(TRUTH_COLUMNS)
         a = {c: tab.numeric(c) for c in TRUTH_COLUMNS}

@@ -51,13 +51,16 @@ def identify_log(path, length: float, speed: float | None = None, output_error: 
         The identification and a note when the rudder was rebuilt.
     """
     from trials import nomoto as nm
-    from trials.logio import read_record
 
     if length is None or not np.isfinite(length) or length <= 0:
         raise InputError("--length", "", f"ship length must be a positive number of metres, got {length}")
     if speed is not None and (not np.isfinite(speed) or speed <= 0):
         raise InputError("--speed", "", f"speed must be a positive number of m/s, got {speed}")
-    rec = read_record(path)
+    from trials.shipcheck import check_speed_option, read_for_ship
+
+    rec = read_for_ship(path, length)        # a length the record contradicts is refused
+    if speed is not None:
+        check_speed_option(rec, speed, length)
     note = None
     if rec.delta is None and rec.meta.get("format") == "log":
         from trials.rudder import with_rebuilt_rudder

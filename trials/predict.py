@@ -293,11 +293,12 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
     """
     from dataclasses import replace
 
-    from .logio import read_record
     from .output import record_labels
+    from .shipcheck import read_for_ship
 
     paths = list(paths)
-    measured = [replace(measured_run(ship, read_record(path, length_m=ship.particulars.L), start, wind), name=label)
+    # a record of another ship: refused, not replayed as this one
+    measured = [replace(measured_run(ship, read_for_ship(path, ship), start, wind), name=label)
                 for path, label in zip(paths, record_labels(paths))]
     packed = pack(ship)
     runs = []
