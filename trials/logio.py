@@ -423,8 +423,10 @@ def _check_heading_rate(tab: _Table, col: str, t: np.ndarray, psi: np.ndarray) -
     rate = np.abs(np.diff(psi)) / dt
     p99 = float(np.percentile(rate, 99))
     if p99 > MAX_YAW_RATE:
+        hint = " (degrees?)" if p99 * DEG <= MAX_YAW_RATE else ""
         raise InputError(tab.src, col, f"the heading changes by up to {p99 / DEG * np.median(dt):.3g} deg from sample to sample "
-                                       f"({p99:.3g} rad/s in 1 % of the samples): not a heading in radians")
+                                       f"({p99:.3g} rad/s in 1 % of the samples): the heading is "
+                                       f"not radians{hint}")
 
 
 def _check_heading_vs_yaw_rate(tab: _Table, psi_col: str, r_col: str, t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> None:
@@ -532,6 +534,8 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         U = np.hypot(a["u_mps"], a["v_mps"])
         _check_speed(tab, "u_mps", U, L)
         _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L, U, (0.2, 5.0), "u_mps")
+        _check_velocities_vs_track(tab, {"u": "u_mps", "v": "v_mps", "psi": "psi_rad", "track": "x_m, y_m"},
+                                   a["time_s"], a["x_m"], a["y_m"], a["psi_rad"], a["u_mps"], a["v_mps"])
         _check_rps(tab, "n_rps", a["n_rps"])
         wind = _apparent_wind(tab, cols, "wind_rel_mps", "wind_rel_rad", 1.0, 1.0)
         return TrialRecord(t=a["time_s"], name=name, ship=ship, source=src, x=a["x_m"], y=a["y_m"],
@@ -634,6 +638,14 @@ def _check_wind_consistency(tab: _Table, a: dict, psi: np.ndarray) -> None:
         return float(np.median(np.abs(calc - Vt / scale_true)))
 
     tol = 0.1 + 0.1 * float(np.median(Vt))
+    if "wind_dir_true" in a:
+        s, se, rms = wind_scale_fit(a["t"], Vr, a["wind_dir_rel"], Vt, a["wind_dir_true"], a["u"], a["v"], psi)
+        lo, hi = SCALE_OK["wind"]
+        good = np.isfinite(s) and rms <= 0.1 * abs(s) * float(np.sqrt(np.mean(a["u"] ** 2 + a["v"] ** 2)))
+        if good and (s + 3 * se < lo or s - 3 * se > hi):
+            raise InputError(tab.src, "wind_velo_relative_mid [m/s], wind_velo_true [m/s]",
+                             f"both wind speeds are {s:.3g} times what the ship's own velocity u, v implies "
+                             f"(the true wind minus the relative wind is the ship's velocity){_speed_unit_hint(s)}")
     if miss(1.0, 1.0) <= tol:
         return
     for f, unit in ((WIND_KMH, "km/h"), (1.0 / KNOT, "kn")):
@@ -654,12 +666,9 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
     a = {FRT_COLUMNS[c]: tab.numeric(c) for c in present}
     t = a["t"]
     _check_time(tab, "t [s]", t, None, "the FRT-DS-ESSO sampling step (10 Hz)", 0.0, FRT_STEP_RANGE)
-    raw = a.pop("psi")
-    lo, hi = float(raw.min()), float(raw.max())
-    if lo < -np.pi - 0.01 or hi > 2 * np.pi + 0.01:
-        raise InputError(src, "psi_hat [rad]", f"heading values from {lo:.4g} to {hi:.4g} are not radians wrapped to "
-                                               f"(-pi, pi] or [0, 2 pi){_angle_hint(max(abs(lo), abs(hi)), 360)}")
-    psi = unwrap_heading(raw)
+    # wrapped, cumulative (a gyro's count of turns) or offset by whole turns: all the same heading; degrees
+    # are told by the heading's rate against the sampling step, the yaw rate and the track, not by the range
+    psi = unwrap_heading(a.pop("psi"))
     _check_heading_rate(tab, "psi_hat [rad]", t, psi)
     if "delta" in a:
         _check_rudder(tab, "delta_rudder [rad]", a["delta"])
@@ -684,11 +693,140 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
             m = float(np.max(np.abs(w)))
             if m > 2 * np.pi + 0.01:
                 raise InputError(src, col, f"wind direction {m:.4g} is not radians (|value| <= 2 pi){_angle_hint(m, 360)}")
+    track = "x_position_mid [m], y_position_mid [m]"
+    _check_track(tab, track, t, a["x"], a["y"], L)
+    if "u" in a:
+        names = {"u": "u_velo [m/s]", "psi": "psi_hat [rad]", "track": track}
+        if "v" in a:
+            names["v"] = "vm_velo [m/s]"
+        _check_velocities_vs_track(tab, names, t, a["x"], a["y"], psi, a["u"], a.get("v"))
     _check_wind_consistency(tab, a, psi)
     u, v = a.get("u"), a.get("v")
     U = np.hypot(u, v) if u is not None and v is not None else None
-    _check_track(tab, "x_position_mid [m], y_position_mid [m]", t, a["x"], a["y"], L)
     meta = {"format": "frt-ds-esso", "ship": "Esso Osaka 3 m model" if L == FRT_LENGTH_M else "", "length_m": L,
             "interval_s": float(np.median(np.diff(t))), "notes": notes}
     return TrialRecord(t=a.pop("t"), name=path.stem, ship=meta["ship"], source=src,
                        psi=psi, U=U, meta=meta, **a)
+
+
+# --------------------------------------------------------------------------- channels against each other
+
+SPEED_UNITS = ((1.0 / KNOT, "kn"), (3.6, "km/h"), (100.0, "cm/s"), (1000.0, "mm/s"), (1.0 / 0.3048, "ft/s"),
+               (3600.0 / 1609.344, "mph"))
+"""Wrong units a column in m/s is most likely in: (value in that unit per m/s, unit)."""
+SCALE_OK = {"u": (0.8, 1.25), "v": (0.55, 1.8), "wind": (0.8, 1.25)}
+"""Range of a fitted factor (implied over logged for u, v; logged over implied for the wind) within which a
+channel is taken to be in its unit.  The real records (bench/channel_margins.py) fit u to 0.997-1.015, the
+wind to 0.997-1.002 and v, whose track is the least sure, to 0.76-1.00: the sway of a real zigzag in knots
+would fit 0.39.  A factor is judged only when its 3-sigma interval lies wholly outside the range."""
+
+
+def _speed_unit_hint(f: float) -> str:
+    """' in km/h, not m/s?' when ``f`` (logged over implied) is within 10 % of a known speed unit's factor."""
+    for k, unit in SPEED_UNITS:
+        if abs(f / k - 1.0) < 0.1:
+            return f": in {unit}, not m/s?"
+    if -1.8 <= f <= -0.55:
+        return ": the opposite sign of the format's axis?"
+    return ": not m/s?"
+
+
+def _block_starts(t: np.ndarray, seconds: float) -> np.ndarray:
+    """Indices of the samples starting consecutive blocks of about ``seconds`` (at least one step each)."""
+    med = float(np.median(np.diff(t)))
+    k = max(1, int(round(seconds / med)))
+    return np.arange(0, len(t), k)
+
+
+def _integral(t: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Cumulative trapezoidal integral of ``f`` over ``t``, starting at 0."""
+    return np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(t))])
+
+
+def velocity_track_fit(t, x, y, psi, u, v=None, block_s: float = 2.0):
+    """Factors by which the logged body-frame velocities must be multiplied to move the ship along its track.
+
+    Over blocks of about ``block_s`` seconds the track's displacement (x north, y east) is fitted by
+    least squares as ``k_u * integral(u (cos psi, sin psi)) + k_v * integral(v (-sin psi, cos psi))``.
+
+    Returns
+    -------
+    dict
+        ``k_u``, ``se_u`` and (with ``v``) ``k_v``, ``se_v``: the factors (1 when the channels are in
+        their units) and their standard errors; ``heading_miss_deg``: the median angle between the track's
+        displacement and the displacement the velocities and heading imply over the blocks that move,
+        with the fitted factors (NaN when none moves); ``blocks``: the number of blocks.
+    """
+    i = _block_starts(t, block_s)
+    c, s = np.cos(psi), np.sin(psi)
+    cols = [(_integral(t, u * c), _integral(t, u * s))]
+    if v is not None:
+        cols.append((_integral(t, -v * s), _integral(t, v * c)))
+    A = np.column_stack([np.concatenate([np.diff(ax[i]), np.diff(ay[i])]) for ax, ay in cols])
+    b = np.concatenate([np.diff(x[i]), np.diff(y[i])])
+    m = len(i) - 1
+    out = {"blocks": m, "k_u": np.nan, "se_u": np.inf, "k_v": np.nan, "se_v": np.inf, "heading_miss_deg": np.nan}
+    if m < 5:
+        return out
+    N = A.T @ A
+    k = np.linalg.lstsq(A, b, rcond=None)[0]
+    pred = A @ k if np.all(np.isfinite(k)) and np.all(k != 0) else A.sum(axis=1)   # any unit or sign of u, v
+    dp, dt_ = pred[:m] + 1j * pred[m:], b[:m] + 1j * b[m:]
+    moving = (np.abs(dp) > 0.05 * np.median(np.abs(dp))) & (np.abs(dt_) > 0) if np.any(dp) else np.zeros(m, bool)
+    if moving.sum() >= 5:
+        out["heading_miss_deg"] = float(np.degrees(np.median(np.abs(np.angle(dt_[moving] / dp[moving])))))
+    if np.linalg.cond(N) > 1e12:
+        return out
+    res = b - A @ k
+    dof = max(len(b) - len(k), 1)
+    cov = float(res @ res) / dof * np.linalg.inv(N)
+    out["k_u"], out["se_u"] = float(k[0]), float(np.sqrt(cov[0, 0]))
+    if v is not None:
+        out["k_v"], out["se_v"] = float(k[1]), float(np.sqrt(cov[1, 1]))
+    return out
+
+
+def _check_velocities_vs_track(tab: _Table, cols: dict, t, x, y, psi, u, v=None) -> None:
+    """The logged surge and sway against the track's own derivative rotated into the body frame
+    (:func:`velocity_track_fit`): a factor whose 3-sigma interval lies outside :data:`SCALE_OK` is a
+    wrong unit (named when it is a known one) or sign.
+    ``cols`` names the columns: ``{"u": ..., "v": ..., "psi": ..., "track": ...}``."""
+    fit = velocity_track_fit(t, x, y, psi, u, v)
+    miss = fit["heading_miss_deg"]
+    if np.isfinite(miss) and miss > 45.0:
+        raise InputError(tab.src, cols["psi"], f"the heading and the velocities point {miss:.3g} deg (median) away from "
+                                               f"the track {cols['track']}: not a heading in radians (degrees?)")
+    for key in ("u", "v"):
+        k, se = fit[f"k_{key}"], fit[f"se_{key}"]
+        lo, hi = SCALE_OK[key]
+        if key not in cols or not np.isfinite(k) or not (k + 3 * se < lo or k - 3 * se > hi):
+            continue
+        f = 1.0 / k if k != 0 else np.inf
+        raise InputError(tab.src, cols[key], f"the logged velocity is {f:.3g} times what the track {cols['track']} "
+                                             f"implies in the body frame (fit {k:.3g} +/- {se:.2g})"
+                                             f"{_speed_unit_hint(f)}")
+
+
+def wind_scale_fit(t, Vr, dir_rel, Vt, dir_true, u, v, psi):
+    """Common factor ``s`` by which both logged wind speeds exceed the m/s the ship's velocity implies.
+
+    The true air velocity is the apparent one plus the ship's (:func:`mmg.wind.true_wind_from_relative`);
+    both wind speeds in one wrong unit (``s`` times m/s) leave the directions alone and scale the
+    difference of the two wind vectors to ``s`` times the ship's velocity (u, v), which no wind unit
+    touches.  ``s`` is its least-squares factor in the ship's axes.
+
+    Returns
+    -------
+    (float, float, float)
+        ``s``, its standard error (over ~2 s blocks of samples) and the RMS residual [logged unit].
+    """
+    d = Vr * np.exp(1j * dir_rel) - Vt * np.exp(1j * (dir_true - psi))
+    B = u + 1j * v
+    bb = float(np.sum(np.abs(B) ** 2))
+    if bb <= 0:
+        return np.nan, np.inf, np.nan
+    s = float(np.real(np.sum(d * np.conj(B)))) / bb
+    res = d - s * B
+    rms = float(np.sqrt(np.mean(np.abs(res) ** 2)))
+    per_block = max(1, int(round(2.0 / float(np.median(np.diff(t))))))   # samples of one ~2 s block
+    return s, rms / np.sqrt(bb / per_block), rms
