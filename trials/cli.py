@@ -145,13 +145,15 @@ def cmd_simulate(args) -> int:
 def cmd_metrics(args) -> int:
     import numpy as np
 
-    from .logio import read_record
+    from .logio import read_record, require_finite
     from .metrics import record_metrics
     from .output import check_output_file, dump_json
+    from .records import CHANNELS
 
     if args.json:
         check_output_file(args.json)
     rec = read_record(args.log)
+    require_finite(rec, CHANNELS, "mmg metrics")      # the track, heading, speeds, rudder, rpm; not the wind
     ang = None if args.zigzag_angle is None else np.radians(args.zigzag_angle)
     m = record_metrics(rec, args.kind, args.length, ang)
     print(f"{rec.name} ({m['kind']}, {rec.source})")

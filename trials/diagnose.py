@@ -106,7 +106,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from ekf.identify import Segmented, segment_resets
     from mmg.effects import Context
 
-    from .logio import read_record
+    from .logio import read_record, require_finite
     from .predict import measured_run
     from .records import TrialRecord
 
@@ -118,6 +118,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
             out.append(it)
             continue
         rec = it if isinstance(it, TrialRecord) else read_record(it, length_m=L)
+        require_finite(rec, ("wind_speed_rel", "wind_dir_rel"), "mmg diagnose")     # the wind it diagnoses
         run = measured_run(ship, rec, wind=wind)
         bad = ~np.isfinite(run.meas).all(axis=1)
         if bad.any():

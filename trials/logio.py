@@ -293,11 +293,36 @@ def read_record(path: str | Path, length_m: float | None = None) -> TrialRecord:
     return record_from_frame(df, meta, src, default_name=path.stem, notes=notes, lines=rows, length_m=length_m)
 
 
+_MISSING = ("", "nan", "na", "n/a", "null", "none")
+"""Cells that say a value is missing (kept as NaN in an optional column)."""
+
+
+def require_finite(rec: TrialRecord, channels, command: str) -> None:
+    """Refuse a record whose ``channels`` (names of :data:`trials.records.CHANNELS` and
+    :data:`~trials.records.WIND_CHANNELS`) a command uses hold missing values.
+
+    The readers keep empty and NaN cells of a column the format does not need as NaN and note
+    where (``rec.meta["nan_channels"]``: channel -> (column, first such cell)), so that a command
+    that does not use the column reads the record; one that does calls this first.
+
+    Raises
+    ------
+    InputError
+        Naming the file, the column and the file line of its first missing value.
+    """
+    holes = rec.meta.get("nan_channels") or {}
+    for c in channels:
+        if c in holes and getattr(rec, c, None) is not None:
+            col, where = holes[c]
+            raise InputError(rec.source or rec.name, col, f"{where}: {command} uses this channel")
+
+
 class _Table:
     """A table being checked: numeric columns with messages that point at the file line."""
 
     def __init__(self, df: pd.DataFrame, src: str, lines=None):
         self.df, self.src, self.lines = df, src, lines
+        self.holes: dict[str, str] = {}     # optional column -> where its first missing value is
 
     def where(self, i: int) -> str:
         return f"line {int(self.lines[i])}" if self.lines is not None else f"data row {i + 1}"
@@ -307,7 +332,11 @@ class _Table:
             if c not in self.df.columns:
                 raise InputError(self.src, c, "missing column")
 
-    def numeric(self, c: str) -> np.ndarray:
+    def numeric(self, c: str, optional: bool = False) -> np.ndarray:
+        """Column ``c`` as floats; a cell that is not a finite number is refused, except that in an
+        ``optional`` column (one the format does not need) empty and NaN cells are kept as NaN and
+        noted in :attr:`holes`: only a command that uses the channel refuses them
+        (:func:`require_finite`)."""
         col = self.df[c]
         if col.dtype.kind in "fiu":
             vals = col.to_numpy(dtype=float)
@@ -318,7 +347,11 @@ class _Table:
             i = int(bad[0])
             raw = str(col.iloc[i]).strip()
             what = "empty cell" if raw == "" else (f"value {raw[:20]!r} is not a finite number")
-            raise InputError(self.src, c, f"{what} at {self.where(i)}" + (f" ({bad.size} such cells)" if bad.size > 1 else ""))
+            where = f"{what} at {self.where(i)}" + (f" ({bad.size} such cells)" if bad.size > 1 else "")
+            if optional and all(str(col.iloc[j]).strip().lower() in _MISSING for j in bad):
+                self.holes[c] = where
+                return vals
+            raise InputError(self.src, c, where)
         huge = np.flatnonzero(np.abs(vals) > MAX_MAGNITUDE)
         if huge.size:
             i = int(huge[0])
@@ -400,9 +433,10 @@ def _check_rudder(tab: _Table, col: str, d: np.ndarray) -> None:
 
 
 def _check_rudder_deg(tab: _Table, col: str, d: np.ndarray) -> None:
-    m = float(np.max(np.abs(d)))
+    ad = np.where(np.isfinite(d), np.abs(d), 0.0)       # missing values: refused by a command that uses them
+    m = float(np.max(ad))
     if m > MAX_RUDDER / DEG:
-        i = int(np.argmax(np.abs(d)))
+        i = int(np.argmax(ad))
         raise InputError(tab.src, col, f"rudder angle {d[i]:.4g} deg at {tab.where(i)} is beyond the +/-45 deg of any rudder")
 
 
@@ -541,7 +575,8 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         return TrialRecord(t=a["time_s"], name=name, ship=ship, source=src, x=a["x_m"], y=a["y_m"],
                            psi=a["psi_rad"], U=U, u=a["u_mps"],
                            v=a["v_mps"], r=a["r_radps"], delta=a["delta_rad"], n=a["n_rps"],
-                           meta={**meta, "format": "truth", "delta_order": a["delta_order_rad"], "notes": notes},
+                           meta={**meta, "format": "truth", "delta_order": a["delta_order_rad"], "notes": notes,
+                                 **_holes(tab, {"wind_rel_mps": "wind_speed_rel", "wind_rel_rad": "wind_dir_rel"})},
                            **wind)
     if "lat_deg" in cols or "heading_deg" in cols or "time_s" in cols:
         tab.require(LOG_COLUMNS)
@@ -566,13 +601,15 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         _check_track(tab, "lat_deg, lon_deg", t, x, y, L, U, (0.7, 1.4) if "interval_s" in meta else None, "speed_kn")
         extra = {}
         if "rudder_deg" in cols:
-            d = tab.numeric("rudder_deg")
+            d = tab.numeric("rudder_deg", optional=True)
             _check_rudder_deg(tab, "rudder_deg", d)
             extra["delta"] = d * DEG
         extra.update(_apparent_wind(tab, cols, "wind_rel_kn", "wind_rel_deg", KNOT, DEG))
         return TrialRecord(t=t, name=name, ship=ship, source=src, x=x, y=y,
                            psi=unwrap_heading(np.radians(a["heading_deg"])), U=U,
-                           n=a["rpm"] / 60.0, meta={**meta, "format": "log", "notes": notes}, **extra)
+                           n=a["rpm"] / 60.0, meta={**meta, "format": "log", "notes": notes, **_holes(
+                               tab, {"rudder_deg": "delta", "wind_rel_kn": "wind_speed_rel", "wind_rel_deg": "wind_dir_rel"})},
+                           **extra)
     missing = sorted(set(LOG_COLUMNS) - cols)
     raise InputError(src, missing[0] if missing else "", "missing column (not a project log, truth file or FRT-DS-ESSO CSV)")
 
@@ -588,17 +625,28 @@ def _apparent_wind(tab: _Table, cols, speed_col: str, dir_col: str, speed_si: fl
     if len(have) == 1:
         other = dir_col if have[0] == speed_col else speed_col
         raise InputError(tab.src, other, f"missing: {have[0]} needs {other} (the apparent wind is a speed and a direction)")
-    V = tab.numeric(speed_col) * speed_si
-    d = tab.numeric(dir_col)
-    if np.nanmin(V) < 0 or np.nanmax(V) > MAX_WIND_MPS:
-        bad = np.nanmax(np.abs(V)) / speed_si
+    V = tab.numeric(speed_col, optional=True) * speed_si
+    d = tab.numeric(dir_col, optional=True)
+    Vf, df_ = V[np.isfinite(V)], d[np.isfinite(d)]          # missing values: refused by a command that uses them
+    if Vf.size and (Vf.min() < 0 or Vf.max() > MAX_WIND_MPS):
+        bad = np.max(np.abs(Vf)) / speed_si
         raise InputError(tab.src, speed_col, f"{bad:.4g} is not an apparent wind speed in its column's unit "
                                              f"(0 to {MAX_WIND_MPS / speed_si:.4g})")
     turn = 2 * np.pi / dir_si
-    if np.nanmin(d) < -1e-9 or np.nanmax(d) > turn * (1 + 1e-9):
+    if df_.size and (df_.min() < -1e-9 or df_.max() > turn * (1 + 1e-9)):
         raise InputError(tab.src, dir_col, f"must lie in 0 to {turn:.6g} (one turn in its column's unit), "
-                                           f"got {np.nanmin(d):.4g} to {np.nanmax(d):.4g}")
+                                           f"got {df_.min():.4g} to {df_.max():.4g}")
     return {"wind_speed_rel": V, "wind_dir_rel": np.mod(d * dir_si, 2 * np.pi)}
+
+
+def _holes(tab: _Table, channels: dict) -> dict:
+    """``rec.meta["nan_channels"]`` of a table: channel -> (column, first missing value) for the
+    optional columns (``channels``: column -> channel) that hold missing values, said on the logger."""
+    out = {}
+    for c, where in tab.holes.items():
+        out[channels[c]] = (c, where)
+        _log.warning("note: %s: %s: %s (kept as NaN: only a command that uses the channel refuses it)", tab.src, c, where)
+    return {"nan_channels": out} if out else {}
 
 
 def _check_range(tab: _Table, col: str, v: np.ndarray, lo: float, hi: float, what: str) -> None:
@@ -663,12 +711,30 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
     df = tab.df
     tab.require(FRT_REQUIRED)
     present = [c for c in FRT_COLUMNS if c in df.columns]
-    a = {FRT_COLUMNS[c]: tab.numeric(c) for c in present}
+    a = {FRT_COLUMNS[c]: tab.numeric(c, optional=c not in FRT_REQUIRED) for c in present}
     t = a["t"]
     _check_time(tab, "t [s]", t, None, "the FRT-DS-ESSO sampling step (10 Hz)", 0.0, FRT_STEP_RANGE)
     # wrapped, cumulative (a gyro's count of turns) or offset by whole turns: all the same heading; degrees
     # are told by the heading's rate against the sampling step, the yaw rate and the track, not by the range
     psi = unwrap_heading(a.pop("psi"))
+    holes = {FRT_COLUMNS[c]: (c, where) for c, where in tab.holes.items()}
+    _check_frt_channels(tab, {k: w for k, w in a.items() if k not in holes}, t, psi, L)
+    u, v = a.get("u"), a.get("v")
+    U = np.hypot(u, v) if u is not None and v is not None else None
+    if U is not None and ("u" in holes or "v" in holes):
+        holes["U"] = holes.get("u") or holes["v"]
+    meta = {"format": "frt-ds-esso", "ship": "Esso Osaka 3 m model" if L == FRT_LENGTH_M else "", "length_m": L,
+            "interval_s": float(np.median(np.diff(t))), "notes": notes}
+    if holes:
+        meta["nan_channels"] = {**_holes(tab, FRT_COLUMNS)["nan_channels"], **holes}
+    return TrialRecord(t=a.pop("t"), name=path.stem, ship=meta["ship"], source=src,
+                       psi=psi, U=U, meta=meta, **a)
+
+
+def _check_frt_channels(tab: _Table, a: dict, t: np.ndarray, psi: np.ndarray, L: float) -> None:
+    """The units of the FRT-DS-ESSO channels ``a`` (those without missing values; by their keys in
+    :data:`FRT_COLUMNS`): each against its range and against the other channels."""
+    src = tab.src
     _check_heading_rate(tab, "psi_hat [rad]", t, psi)
     if "delta" in a:
         _check_rudder(tab, "delta_rudder [rad]", a["delta"])
@@ -701,12 +767,6 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
             names["v"] = "vm_velo [m/s]"
         _check_velocities_vs_track(tab, names, t, a["x"], a["y"], psi, a["u"], a.get("v"))
     _check_wind_consistency(tab, a, psi)
-    u, v = a.get("u"), a.get("v")
-    U = np.hypot(u, v) if u is not None and v is not None else None
-    meta = {"format": "frt-ds-esso", "ship": "Esso Osaka 3 m model" if L == FRT_LENGTH_M else "", "length_m": L,
-            "interval_s": float(np.median(np.diff(t))), "notes": notes}
-    return TrialRecord(t=a.pop("t"), name=path.stem, ship=meta["ship"], source=src,
-                       psi=psi, U=U, meta=meta, **a)
 
 
 # --------------------------------------------------------------------------- channels against each other

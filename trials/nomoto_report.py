@@ -51,13 +51,14 @@ def identify_log(path, length: float, speed: float | None = None, output_error: 
         The identification and a note when the rudder was rebuilt.
     """
     from trials import nomoto as nm
-    from trials.logio import read_record
+    from trials.logio import read_record, require_finite
 
     if length is None or not np.isfinite(length) or length <= 0:
         raise InputError("--length", "", f"ship length must be a positive number of metres, got {length}")
     if speed is not None and (not np.isfinite(speed) or speed <= 0):
         raise InputError("--speed", "", f"speed must be a positive number of m/s, got {speed}")
     rec = read_record(path)
+    require_finite(rec, ("psi", "delta", "r", "U", "u", "v"), "mmg nomoto")   # heading, rudder, yaw rate, speed
     note = None
     if rec.delta is None and rec.meta.get("format") == "log":
         from trials.rudder import with_rebuilt_rudder
