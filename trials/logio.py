@@ -646,10 +646,11 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         _check_heading_rate(tab, "psi_rad", a["time_s"], a["psi_rad"])
         _check_heading_vs_yaw_rate(tab, "psi_rad", "r_radps", a["time_s"], a["psi_rad"], a["r_radps"])
         U = np.hypot(a["u_mps"], a["v_mps"])
-        _check_speed(tab, "u_mps", U, L)
-        _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L, U, (0.2, 5.0), "u_mps")
+        _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L)
         _check_velocities_vs_track(tab, {"u": "u_mps", "v": "v_mps", "psi": "psi_rad", "track": "x_m, y_m"},
                                    a["time_s"], a["x_m"], a["y_m"], a["psi_rad"], a["u_mps"], a["v_mps"])
+        _check_speed(tab, "u_mps", U, L)
+        _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L, U, (0.2, 5.0), "u_mps")
         _check_rps(tab, "n_rps", a["n_rps"])
         wind = _apparent_wind(tab, cols, "wind_rel_mps", "wind_rel_rad", 1.0, 1.0)
         return TrialRecord(t=a["time_s"], name=name, ship=ship, source=src, x=a["x_m"], y=a["y_m"],
@@ -821,6 +822,13 @@ def _check_frt_channels(tab: _Table, a: dict, t: np.ndarray, psi: np.ndarray, L:
     if "r" in a:
         _check_yaw_rate(tab, "r_angvelo [rad/s]", a["r"])
         _check_heading_vs_yaw_rate(tab, "psi_hat [rad]", "r_angvelo [rad/s]", t, psi, a["r"])
+    track = "x_position_mid [m], y_position_mid [m]"
+    _check_track(tab, track, t, a["x"], a["y"], L)
+    if "u" in a:                            # first: it names the unit
+        names = {"u": "u_velo [m/s]", "psi": "psi_hat [rad]", "track": track}
+        if "v" in a:
+            names["v"] = "vm_velo [m/s]"
+        _check_velocities_vs_track(tab, names, t, a["x"], a["y"], psi, a["u"], a.get("v"))
     for key, col in (("u", "u_velo [m/s]"), ("v", "vm_velo [m/s]")):
         if key in a:
             _check_speed(tab, col, a[key], L)
@@ -839,13 +847,6 @@ def _check_frt_channels(tab: _Table, a: dict, t: np.ndarray, psi: np.ndarray, L:
             m = float(np.max(np.abs(w)))
             if m > 2 * np.pi + 0.01:
                 raise InputError(src, col, f"wind direction {m:.4g} is not radians (|value| <= 2 pi){_angle_hint(m, 360)}")
-    track = "x_position_mid [m], y_position_mid [m]"
-    _check_track(tab, track, t, a["x"], a["y"], L)
-    if "u" in a:
-        names = {"u": "u_velo [m/s]", "psi": "psi_hat [rad]", "track": track}
-        if "v" in a:
-            names["v"] = "vm_velo [m/s]"
-        _check_velocities_vs_track(tab, names, t, a["x"], a["y"], psi, a["u"], a.get("v"))
     _check_wind_consistency(tab, a, psi)
 
 
@@ -861,11 +862,16 @@ wind to 0.997-1.002 and v, whose track is the least sure, to 0.76-1.00: the sway
 would fit 0.39.  A factor is judged only when its 3-sigma interval lies wholly outside the range."""
 
 
-def _speed_unit_hint(f: float) -> str:
-    """' in km/h, not m/s?' when ``f`` (logged over implied) is within 10 % of a known speed unit's factor."""
-    for k, unit in SPEED_UNITS:
-        if abs(f / k - 1.0) < 0.1:
-            return f": in {unit}, not m/s?"
+SPEED_TOL = {"u": 0.1, "v": 0.3}
+"""How far (relative) a fitted factor may be from a unit's to name the unit: v's track is the least sure."""
+
+
+def _speed_unit_hint(f: float, tol: float = 0.1) -> str:
+    """': in km/h, not m/s?' when ``f`` (logged over implied) is within ``tol`` (relative) of a known
+    speed unit's factor; every such unit, nearest first (': in kn or mph, not m/s?')."""
+    near = sorted((abs(np.log(f / k)), unit) for k, unit in SPEED_UNITS if f > 0 and abs(np.log(f / k)) < np.log1p(tol))
+    if near:
+        return f": in {' or '.join(unit for _, unit in near)}, not m/s?"
     if -1.8 <= f <= -0.55:
         return ": the opposite sign of the format's axis?"
     return ": not m/s?"
@@ -944,7 +950,7 @@ def _check_velocities_vs_track(tab: _Table, cols: dict, t, x, y, psi, u, v=None)
         f = 1.0 / k if k != 0 else np.inf
         raise InputError(tab.src, cols[key], f"the logged velocity is {f:.3g} times what the track {cols['track']} "
                                              f"implies in the body frame (fit {k:.3g} +/- {se:.2g})"
-                                             f"{_speed_unit_hint(f)}")
+                                             f"{_speed_unit_hint(f, SPEED_TOL[key])} (or the positions are not in metres)")
 
 
 def wind_scale_fit(t, Vr, dir_rel, Vt, dir_true, u, v, psi):
