@@ -276,3 +276,41 @@ def test_text_in_an_unused_column_still_refused(tmp_path):
 def test_nan_in_a_required_column_still_refused(simulated, tmp_path):
     p, line = _with_nan(simulated, tmp_path / "nan.csv", "x_position_mid [m]")
     refused(p, "x_position_mid [m]", f"line {line}")
+
+
+@pytest.fixture(scope="module")
+def log_file(tmp_path_factory):
+    from dataclasses import replace
+
+    from trials.logio import write_csv
+    from trials.run import run_trial
+    from trials.trial import load_trial
+
+    from .conftest import CONFIGS
+
+    run = run_trial(replace(load_trial(CONFIGS / "trials" / "st35.yaml"), duration=900.0))
+    p = tmp_path_factory.mktemp("log") / "log.csv"
+    write_csv(p, run.log(), run.log_meta())
+    return p
+
+
+@pytest.mark.parametrize("fn", [lambda h: h - 720.0, lambda h: np.degrees(np.unwrap(np.radians(h))) + 720.0,
+                                lambda h: np.where(np.arange(len(h)) > len(h) // 3, h + 360.0, h)],
+                         ids=["-720", "cumulative", "one +360 step"])
+def test_log_heading_not_wrapped_is_read_like_the_wrapped_one(log_file, tmp_path, fn):
+    """A gyro's cumulative heading in a project log (a 35 deg turn: 2.5 turns in 900 s)."""
+    names = [ln for ln in log_file.read_text().splitlines() if not ln.startswith("#")][0].split(",")
+    k = names.index("heading_deg")
+
+    def rows(data):
+        h = fn(np.array([float(r[k]) for r in data]))
+        for r, v in zip(data, h):
+            r[k] = repr(float(v))
+        return data
+
+    _same(read_record(log_file), read_record(transformed(log_file, tmp_path / "h.csv", {}, rows=rows)))
+
+
+def test_log_heading_in_another_unit_refused(log_file, tmp_path):
+    refused(transformed(log_file, tmp_path / "x100.csv", {"heading_deg": times(100.0)}), "heading_deg",
+            "not a heading in degrees")

@@ -29,12 +29,25 @@ silently wrong record:
   times), a step other than the header's (logs, truth files), a record spanning more than
   ``mmg.limits.MAX_STEPS`` steps of 0.1 s (what the estimators would integrate); any number
   beyond 1e12;
-* units (plausibility): a rudder beyond 45 deg or a wrapped heading beyond 2 pi in a radian
-  column ("degrees?"), a yaw rate beyond 1 rad/s ("deg/s?") or disagreeing with the heading's
-  change (one of them in degrees), a heading jumping more than 1 rad/s sample after sample,
-  speeds or the track beyond Froude number 1 for the ship's length, a logged speed that is not
-  the speed along the track (a log with ``interval_s``), positions far from the header's start,
-  propeller speeds beyond 100 rps ("rpm?").
+* units (plausibility): a rudder beyond 45 deg in a radian column ("degrees?"), a yaw rate
+  beyond 1 rad/s ("deg/s?") or disagreeing with the heading's change (one of them in degrees), a
+  heading jumping more than 1 rad/s sample after sample, speeds or the track beyond Froude number 1
+  for the ship's length, a logged speed that is not the speed along the track (a log with
+  ``interval_s``), positions far from the header's start, propeller speeds beyond 100 rps ("rpm?");
+* channels against each other (issue 24): surge and sway against the track's derivative rotated
+  into the body frame (:func:`velocity_track_fit`; "in kn, not m/s?"), both wind speeds against
+  the ship's velocity (:func:`wind_scale_fit`: one common factor), relative against true wind,
+  a heading that does not point along the track.  ``bench/channel_margins.py`` prints what the
+  real records fit.
+
+A heading is not refused for its range: wrapped, cumulative (a gyro's count of turns) or offset
+by whole turns, it is unwrapped to the same record; degrees are told by its rate against the
+sampling step, the yaw rate and the track.
+
+Empty or NaN cells in a column the format does not need (FRT-DS-ESSO: all but time, positions and
+heading; a log's rudder and wind; a truth file's wind) do not refuse the record: they are kept as
+NaN and noted (``rec.meta["nan_channels"]``, the column and its first file line, and a warning); a
+command refuses them only in the channels it uses (:func:`require_finite`).
 
 Rows whose cells are all empty (e.g. the ~300 rows after the end of a real zigzag) carry no
 sample: they are ignored and said so (``rec.meta["notes"]`` and a warning on the
@@ -362,7 +375,9 @@ def read_record(path: str | Path, length_m: float | None = None) -> TrialRecord:
     (the header's ``interval_s`` / ``dt_s``, 10 Hz for FRT-DS-ESSO), a record longer than
     ``mmg.limits.MAX_STEPS`` steps of 0.1 s, and channels in a wrong unit (see
     :func:`record_from_frame`).  Empty rows (all cells empty) are ignored and said so in
-    ``rec.meta["notes"]`` and on the ``trials.logio`` logger.
+    ``rec.meta["notes"]`` and on the ``trials.logio`` logger; missing values in an optional column
+    are kept as NaN (``rec.meta["nan_channels"]``; a command calls :func:`require_finite`).
+    Peak memory is a few times the file's size (bench/bench_memory.py).
 
     ``length_m`` [m] is the ship's length where the file does not say it (FRT-DS-ESSO files):
     speeds and track are checked against it; the 3 m model's when omitted.
@@ -529,18 +544,38 @@ def _check_yaw_rate(tab: _Table, col: str, r: np.ndarray) -> None:
                                        f"ship (at most {MAX_YAW_RATE:g} rad/s){hint}")
 
 
-def _check_heading_rate(tab: _Table, col: str, t: np.ndarray, psi: np.ndarray) -> None:
-    """On a dense record (step <= 1 s) the heading cannot change faster than MAX_YAW_RATE sample after sample."""
+def _check_heading_rate(tab: _Table, col: str, t: np.ndarray, psi: np.ndarray, unit: str = "radians") -> None:
+    """On a dense record (step <= 1 s) the heading [rad, from a column in ``unit``] cannot change faster
+    than MAX_YAW_RATE sample after sample."""
     dt = np.diff(t)
     if len(dt) < 10 or np.median(dt) > 1.0:
         return
     rate = np.abs(np.diff(psi)) / dt
     p99 = float(np.percentile(rate, 99))
     if p99 > MAX_YAW_RATE:
-        hint = " (degrees?)" if p99 * DEG <= MAX_YAW_RATE else ""
+        hint = " (degrees?)" if unit == "radians" and p99 * DEG <= MAX_YAW_RATE else ""
         raise InputError(tab.src, col, f"the heading changes by up to {p99 / DEG * np.median(dt):.3g} deg from sample to sample "
                                        f"({p99:.3g} rad/s in 1 % of the samples): the heading is "
-                                       f"not radians{hint}")
+                                       f"not {unit}{hint}")
+
+
+def _check_heading_vs_track(tab: _Table, col: str, cols: str, t, x, y, psi, unit: str = "radians") -> None:
+    """A project log (a ship going ahead, no body-frame velocities): its heading must point along its
+    track (x north, y east) within 45 deg (median over ~2 s blocks that move; a turn's drift angle is
+    less).  A heading in another unit points anywhere."""
+    i = _block_starts(t, 2.0)
+    if len(i) < 6:
+        return
+    d = np.diff(x[i]) + 1j * np.diff(y[i])
+    moving = np.abs(d) > 0.25 * np.median(np.abs(d))
+    if moving.sum() < 5 or not np.any(np.abs(d) > 0):
+        return
+    h = 0.5 * (psi[i][1:] + psi[i][:-1])
+    miss = float(np.degrees(np.median(np.abs(np.angle(d[moving] * np.exp(-1j * h[moving]))))))
+    if miss > 45.0:
+        hint = " (degrees?)" if unit == "radians" else ""
+        raise InputError(tab.src, col, f"the heading points {miss:.3g} deg (median) away from the track {cols}: "
+                                       f"not a heading in {unit}{hint}")
 
 
 def _check_heading_vs_yaw_rate(tab: _Table, psi_col: str, r_col: str, t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> None:
@@ -616,11 +651,12 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
     directly, so a simulated record and the same record read back from its files agree.
 
     Besides the table's form (columns, numbers, time) it checks that the channels look like
-    their units: angles in radian columns within the radian range (a rudder beyond 45 deg or a
-    heading beyond 2 pi is in degrees), yaw rate within 1 rad/s and agreeing with the heading,
-    the sampling step equal to the header's (``interval_s`` for logs, ``dt_s`` for truth files,
-    0.1 s for FRT-DS-ESSO), speeds and track below Froude number 1 for the ship.  Each refusal
-    is an :class:`~mmg.errors.InputError` naming the channel and the likely unit.
+    their units: a rudder within 45 deg, yaw rate within 1 rad/s and agreeing with the heading,
+    the heading's rate and its direction against the track (degrees), the sampling step equal to
+    the header's (``interval_s`` for logs, ``dt_s`` for truth files, 0.1 s for FRT-DS-ESSO),
+    speeds and track below Froude number 1 for the ship, surge and sway against the track and
+    the wind speeds against the ship's velocity.  Each refusal is an
+    :class:`~mmg.errors.InputError` naming the channel and the likely unit.
     """
     src = source
     _check_meta(meta, src)
@@ -666,7 +702,9 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         _check_time(tab, "time_s", t, meta.get("interval_s"), "the header's interval_s", 1e-3)
         _check_range(tab, "lat_deg", a["lat_deg"], -90.0, 90.0, "a latitude in degrees")
         _check_range(tab, "lon_deg", a["lon_deg"], -180.0, 360.0, "a longitude in degrees")
-        _check_range(tab, "heading_deg", a["heading_deg"], -360.0, 360.0, "a heading in degrees (a gyro prints 0-360)")
+        # a gyro's 0-360, +-180, a cumulative count of turns: the same heading; its unit is told by the track
+        psi = unwrap_heading(np.radians(a["heading_deg"]))
+        _check_heading_rate(tab, "heading_deg", t, psi, "degrees")
         _check_rps(tab, "rpm", a["rpm"] / 60.0, "rpm", 60.0)
         lat0 = float(meta.get("start_lat_deg", a["lat_deg"][0]))
         lon0 = float(meta.get("start_lon_deg", a["lon_deg"][0]))
@@ -680,6 +718,7 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         _check_speed(tab, "speed_kn", a["speed_kn"], L, "kn", KNOT)
         # the track against the logged speed over ground, for a log that says it is a project log
         _check_track(tab, "lat_deg, lon_deg", t, x, y, L, U, (0.7, 1.4) if "interval_s" in meta else None, "speed_kn")
+        _check_heading_vs_track(tab, "heading_deg", "lat_deg, lon_deg", t, x, y, psi, "degrees")
         extra = {}
         if "rudder_deg" in cols:
             d = tab.numeric("rudder_deg", optional=True)
@@ -687,7 +726,7 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
             extra["delta"] = d * DEG
         extra.update(_apparent_wind(tab, cols, "wind_rel_kn", "wind_rel_deg", KNOT, DEG))
         return TrialRecord(t=t, name=name, ship=ship, source=src, x=x, y=y,
-                           psi=unwrap_heading(np.radians(a["heading_deg"])), U=U,
+                           psi=psi, U=U,
                            n=a["rpm"] / 60.0, meta={**meta, "format": "log", "notes": notes, **_holes(
                                tab, {"rudder_deg": "delta", "wind_rel_kn": "wind_speed_rel", "wind_rel_deg": "wind_dir_rel"})},
                            **extra)
