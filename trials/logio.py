@@ -42,7 +42,8 @@ silently wrong record:
 
 A heading is not refused for its range: wrapped, cumulative (a gyro's count of turns) or offset
 by whole turns, it is unwrapped to the same record; degrees are told by its rate against the
-sampling step, the yaw rate and the track.
+sampling step, the yaw rate and the track.  (A log without the project header's ``interval_s``
+is not checked against its track, as for its speed: its heading_deg keeps the gyro's range.)
 
 Empty or NaN cells in a column the format does not need (FRT-DS-ESSO: all but time, positions and
 heading; a log's rudder and wind; a truth file's wind) do not refuse the record: they are kept as
@@ -703,6 +704,9 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         _check_range(tab, "lat_deg", a["lat_deg"], -90.0, 90.0, "a latitude in degrees")
         _check_range(tab, "lon_deg", a["lon_deg"], -180.0, 360.0, "a longitude in degrees")
         # a gyro's 0-360, +-180, a cumulative count of turns: the same heading; its unit is told by the track
+        # in a log that says it is a project log (``interval_s``, as for the speed), else by the gyro's range
+        if "interval_s" not in meta:
+            _check_range(tab, "heading_deg", a["heading_deg"], -360.0, 360.0, "a heading in degrees (a gyro prints 0-360)")
         psi = unwrap_heading(np.radians(a["heading_deg"]))
         _check_heading_rate(tab, "heading_deg", t, psi, "degrees")
         _check_rps(tab, "rpm", a["rpm"] / 60.0, "rpm", 60.0)
@@ -718,7 +722,8 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
         _check_speed(tab, "speed_kn", a["speed_kn"], L, "kn", KNOT)
         # the track against the logged speed over ground, for a log that says it is a project log
         _check_track(tab, "lat_deg, lon_deg", t, x, y, L, U, (0.7, 1.4) if "interval_s" in meta else None, "speed_kn")
-        _check_heading_vs_track(tab, "heading_deg", "lat_deg, lon_deg", t, x, y, psi, "degrees")
+        if "interval_s" in meta:
+            _check_heading_vs_track(tab, "heading_deg", "lat_deg, lon_deg", t, x, y, psi, "degrees")
         extra = {}
         if "rudder_deg" in cols:
             d = tab.numeric("rudder_deg", optional=True)
