@@ -1,7 +1,16 @@
-"""Peak memory (maximum resident set size) of ``mmg estimate`` on a 3000 s log, and of the CLI
-refusing the pathological logs of issue 10, each command measured by ``/usr/bin/time -v``.
+"""Peak memory (maximum resident set size) of ``mmg estimate`` on a 3000 s log, of the CLI
+refusing the pathological logs of issue 10, and of ``mmg metrics`` / ``mmg nomoto`` on large
+records (issue 24), each command measured by ``/usr/bin/time -v``.
 
-    python bench/bench_memory.py [--keep DIR]
+    python bench/bench_memory.py [--keep DIR] [--no-large]
+
+Large records: a 110 000 s ZZ20 simulated with its log at 0.1 s (an 85 MB project log and a
+159 MB truth file) and, where ../shared/data/frt-ds-esso is present, a 162 MB FRT-DS-ESSO record
+made of 620 copies of a real zigzag laid end to end; each row prints the peak over the file's size
+(fails above LARGE_RATIO).  ``mmg nomoto`` refuses both as a zigzag (the copies are many zigzags; the
+long ZZ20's analysis finds no counter-rudder) after reading and analysing them: its peak is that
+of the reading and the analysis up to the refusal, as in the issue's report (1.79 GB on the 159 MB
+truth file before).
 
 Runs ``mmg simulate configs/trials/zz20.yaml`` (a 3000 s ZZ20 at 0.1 s; its 5 s log), then
 ``mmg estimate`` on that log, then ``mmg metrics`` / ``mmg estimate`` / ``mmg nomoto`` on logs
@@ -27,6 +36,9 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 TIME = "/usr/bin/time"
 LIMIT_MB = 1024.0
+LARGE_RATIO = 5.0
+"""Largest peak RSS over file size of mmg metrics / nomoto on a large record."""
+FRT_ZIGZAG = REPO.parent / "shared/data/frt-ds-esso/zigzag/zigzag_31-Jul-2020_13_22_52.csv"
 
 
 def run(argv: list[str], cwd: Path) -> dict:
@@ -61,9 +73,54 @@ def rewrite(src: Path, dst: Path, col: str | None = None, fn=None, keep_rows: in
     return dst
 
 
+def tiled_frt(src: Path, dst: Path, copies: int) -> Path:
+    """``copies`` of the FRT-DS-ESSO record ``src`` end to end: time and positions continued, so that
+    the result is one record at 10 Hz (its samples are the real ones)."""
+    import pandas as pd
+
+    df = pd.read_csv(src).dropna(how="all")
+    t, x, y = (df[c].to_numpy() for c in ("t [s]", "x_position_mid [m]", "y_position_mid [m]"))
+    span, dx, dy = t[-1] - t[0] + 0.1, x[-1] - x[0], y[-1] - y[0]
+    with open(dst, "w") as fh:
+        fh.write(",".join(df.columns) + "\n")
+        for k in range(copies):
+            part = df.copy()
+            part["t [s]"] = t - t[0] + k * span
+            part["x_position_mid [m]"] = x + k * dx
+            part["y_position_mid [m]"] = y + k * dy
+            part.to_csv(fh, header=False, index=False, float_format="%.10g")
+    return dst
+
+
+def large(record, work: Path) -> bool:
+    """mmg metrics and mmg nomoto on large records; True when every peak is within LARGE_RATIO of the file."""
+    ok = True
+    trial = work / "zz_long.yaml"
+    text = (REPO / "configs/trials/zz20.yaml").read_text()
+    trial.write_text(text.replace("duration: 3000 s", "duration: 110000 s").replace("interval: 5 s", "interval: 0.1 s"))
+    out = work / "zz_long"
+    shutil.rmtree(out, ignore_errors=True)
+    record("mmg simulate ZZ20, 110000 s, log at 0.1 s", ["simulate", str(trial), "--out", str(out)], expect=0)
+    files = [(out / "log.csv", "project log"), (out / "truth.csv", "project truth")]
+    if FRT_ZIGZAG.exists():
+        files.append((tiled_frt(FRT_ZIGZAG, work / "frt_long.csv", 620), "FRT-DS-ESSO"))
+    else:
+        print(f"(no {FRT_ZIGZAG}: no large FRT-DS-ESSO record)")
+    for path, what in files:
+        mb = path.stat().st_size / 1e6
+        for argv in (["metrics", str(path)], ["nomoto", str(path), "--length", "325" if "project" in what else "3"]):
+            r = record(f"mmg {argv[0]:7s} [{what}, {mb:.0f} MB]", argv)
+            ratio = r["rss_mb"] / mb
+            bad = ratio > LARGE_RATIO
+            ok &= not bad
+            print(f"{'':58s} peak / file size = {ratio:.2f}{'  FAIL' if bad else ''}")
+    return ok
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--keep", help="work in this folder and keep it (default: a temporary folder)")
+    ap.add_argument("--no-large", action="store_true", help="skip the large records (issue 24)")
     args = ap.parse_args()
     if not Path(TIME).exists():
         print(f"{TIME} not found: apt-get update && apt-get install -y time", file=sys.stderr)
@@ -117,6 +174,8 @@ def main() -> int:
         record(f"mmg nomoto   [{what}]", ["nomoto", str(path), "--length", "325", "--json", str(work / "nm.json")],
                expect=2)
     peak = max(r["rss_mb"] for label, r, _ in rows if "[" in label)
+    if not args.no_large:
+        ok &= large(record, work)
     print(f"\nestimate of the 3000 s log: {est['rss_mb']:.0f} MB peak (limit {LIMIT_MB:.0f} MB); "
           f"largest refusal: {peak:.0f} MB")
     if not args.keep:

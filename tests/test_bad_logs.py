@@ -172,7 +172,7 @@ def test_truth_channel_in_wrong_unit(zz20, tmp_path, col, fn, field, words):
     ("delta_rudder [rad]", np.degrees, ["beyond the +/-45 deg", "degrees?"]),
     ("r_angvelo [rad/s]", np.degrees, ["deg/s?"]),
     ("t [s]", lambda v: v * 1000, ["10 Hz", "milliseconds"]),
-    ("u_velo [m/s]", lambda v: v * 100, ["Froude number"]),
+    ("u_velo [m/s]", lambda v: v * 100, ["times what the track", "cm/s"]),   # named by the track (issue 24)
     ("x_position_mid [m]", lambda v: v * 1000, ["Froude number"]),
     ("n_prop [rps]", lambda v: v * 60, ["rpm"]),
 ])

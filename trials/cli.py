@@ -164,9 +164,10 @@ def cmd_simulate(args) -> int:
 def cmd_metrics(args) -> int:
     import numpy as np
 
-    from .logio import read_record
+    from .logio import read_record, require_finite
     from .metrics import record_metrics
     from .output import check_output_file, dump_json
+    from .records import CHANNELS
 
     if args.json is not None:
         check_output_file(args.json)
@@ -180,6 +181,7 @@ def cmd_metrics(args) -> int:
         if isinstance(length, (int, float)) and length > 0:          # none at all: record_metrics says so
             assumed = "model the FRT-DS-ESSO layout assumes when no --length is given"
             check_record_ship(rec, float(length), name=assumed if rec.meta.get("format") == "frt-ds-esso" else None)
+    require_finite(rec, CHANNELS, "mmg metrics")      # the track, heading, speeds, rudder, rpm; not the wind
     ang = None if args.zigzag_angle is None else np.radians(args.zigzag_angle)
     m = record_metrics(rec, args.kind, args.length, ang)
     if args.json is not None:

@@ -109,6 +109,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from ekf.identify import Segmented, segment_resets
     from mmg.effects import Context
 
+    from .logio import require_finite
     from .predict import measured_run
     from .records import TrialRecord
     from .output import record_labels
@@ -126,6 +127,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
             continue
         # a record of another ship is refused, not diagnosed
         rec = it if isinstance(it, TrialRecord) else read_for_ship(it, ship)
+        require_finite(rec, ("wind_speed_rel", "wind_dir_rel"), "mmg diagnose")     # the wind it diagnoses
         run = replace(measured_run(ship, rec, wind=wind), name=label)     # named after its file, unique
         bad = ~np.isfinite(run.meas).all(axis=1)
         if bad.any():
@@ -582,7 +584,6 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     :class:`trials.records.TrialRecord` with rudder, revolutions and, when wind is on, the relative
     and true wind channels."""
     import mmg.effects as E
-    from mmg.equilibrium import straight_run
     from mmg.integrate import CommandLaw
     from mmg.replay import ReplayInputs, replay_states
     from mmg.simulation import simulate

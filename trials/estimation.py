@@ -24,7 +24,8 @@ from mmg.ship import Ship, load_ship
 from mmg.simulation import prepare
 from mmg.units import DEG, KNOT, M_PER_DEG_LAT, M_PER_DEG_LON
 
-from .logio import as_written, read_record, record_from_frame
+from .logio import as_written, read_record, record_from_frame, require_finite
+from .records import CHANNELS
 from .rudder import manoeuvre_from_meta
 
 G = 9.80665
@@ -205,12 +206,14 @@ def data_from_log(path: str | Path, cfg: dict, ship_path=None, truth_path: str |
     from .shipcheck import check_record_ship
 
     rec = read_record(path)
+    require_finite(rec, CHANNELS, "mmg estimate")                 # not the wind: the EKF has no wind loads
     truth = tv = None
     ship = _ship_of(rec, ship_path)
     if rec.meta.get("format") == "log":          # another layout: data_from_record says it is not a log
         check_record_ship(rec, ship)
     if truth_path is not None:
         truth = read_record(truth_path)
+        require_finite(truth, CHANNELS, "mmg estimate")
         _check_truth(rec, truth, str(truth_path))
         check_record_ship(truth, ship)
         _check_truth_ship(rec, truth, ship, str(truth_path))

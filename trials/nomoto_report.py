@@ -51,6 +51,7 @@ def identify_log(path, length: float, speed: float | None = None, output_error: 
         The identification and a note when the rudder was rebuilt.
     """
     from trials import nomoto as nm
+    from trials.logio import require_finite
 
     if length is None or not np.isfinite(length) or length <= 0:
         raise InputError("--length", "", f"ship length must be a positive number of metres, got {length}")
@@ -61,6 +62,7 @@ def identify_log(path, length: float, speed: float | None = None, output_error: 
     rec = read_for_ship(path, length)        # a length the record contradicts is refused
     if speed is not None:
         check_speed_option(rec, speed, length)
+    require_finite(rec, ("psi", "delta", "r", "U", "u", "v"), "mmg nomoto")   # heading, rudder, yaw rate, speed
     note = None
     if rec.delta is None and rec.meta.get("format") == "log":
         from trials.rudder import with_rebuilt_rudder

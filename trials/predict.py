@@ -103,6 +103,9 @@ def _wind_loads(ship: Ship, rec: TrialRecord, es) -> tuple[np.ndarray | None, st
         return None, "off"
     if Wind.steady(w):
         return None, f"steady {w['true_speed_mps']:g} m/s from {w['true_from_deg']:g} deg (config)"
+    from .logio import require_finite
+
+    require_finite(rec, ("wind_speed_rel", "wind_dir_rel"), "the replay with the measured wind")
     from mmg.wind import angle_from_dataset, wind_forces
 
     X, Y, N = wind_forces(rec.wind_speed_rel, angle_from_dataset(rec.wind_dir_rel), ship.wind.particulars(),
@@ -122,8 +125,11 @@ def measured_run(ship: Ship, rec: TrialRecord, start: float | None = None, wind:
     wind : bool, optional
         Apply the wind loads; default: as the ship config says (``ship.wind.enabled``).
     """
+    from .logio import require_finite
+
     notes = []
     src = rec.source or rec.name
+    require_finite(rec, ("x", "y", "psi", "U", "u", "v", "r", "delta", "n"), "the replay")
     if rec.delta is None:
         from .rudder import with_rebuilt_rudder
 
