@@ -84,7 +84,10 @@ def module_path() -> Path:
     """Where the compiled module for the current sources is (or will be) cached."""
     from ._jit import cache_folder
 
-    return cache_folder(__name__) / (module_name() + importlib.machinery.EXTENSION_SUFFIXES[0])
+    folder = cache_folder(__name__)
+    if folder is None:
+        raise OSError("no writable cache folder for the compiled module")
+    return folder / (module_name() + importlib.machinery.EXTENSION_SUFFIXES[0])
 
 
 def _load(path: Path):
@@ -172,7 +175,11 @@ def kernels():
     with _lock:
         if _module is not None or _tried:
             return _module
-        path = module_path()
+        try:
+            path = module_path()
+        except OSError:                           # nowhere to keep it: the JIT it is
+            _tried = True
+            return None
         if _deferred and not path.is_file():
             return None                           # not now, and not marked as tried: built later
         _tried = True

@@ -105,10 +105,11 @@ def _dispatcher(func, options: dict):
     function's cache folder when its dispatcher is made, from ``numba.config.CACHE_DIR``."""
     import numba
 
-    if not options.get("cache"):
-        return numba.njit(**options)(func)
+    folder = cache_folder(func.__module__) if options.get("cache") else None
+    if folder is None:                           # not cached (rather than cached under a stale key)
+        return numba.njit(**dict(options, cache=False))(func)
     old = numba.config.CACHE_DIR
-    numba.config.CACHE_DIR = str(cache_folder(func.__module__))
+    numba.config.CACHE_DIR = str(folder)
     try:
         return numba.njit(**options)(func)
     finally:
@@ -118,14 +119,16 @@ def _dispatcher(func, options: dict):
 _IMPORTS = re.compile(rb"^[ \t]*(?:from|import)[ \t]+([A-Za-z_]\w*)", re.M)
 
 
-def _sources(top: str) -> list[Path]:
-    """The ``.py`` files of top-level package (or script module) ``top``, found by walking its folders."""
+def _sources(top: str) -> list[tuple[str, Path]]:
+    """The ``.py`` files of top-level package (or script module) ``top``, found by walking its folders,
+    with their paths in the package."""
     mod = sys.modules.get(top)
-    folders = list(getattr(mod, "__path__", None) or ())
+    folders = [Path(d) for d in getattr(mod, "__path__", None) or ()]
     if folders:
-        return sorted(f for d in folders for f in Path(d).rglob("*.py") if "__pycache__" not in f.parts)
+        return sorted((f.relative_to(d).as_posix(), f) for d in folders for f in d.rglob("*.py")
+                      if "__pycache__" not in f.parts)
     file = getattr(mod, "__file__", None)
-    return [Path(file)] if file else []
+    return [(Path(file).name, Path(file))] if file else []
 
 
 def source_key(module: str) -> str:
@@ -140,18 +143,19 @@ def source_key(module: str) -> str:
                 if pkg in seen:
                     continue
                 seen.add(pkg)
-                for f in _sources(pkg):
+                for name, f in _sources(pkg):
                     data = f.read_bytes()
-                    h.update(f"{pkg}:{f.name}:{len(data)}:".encode() + data)
+                    h.update(f"{pkg}/{name}:{len(data)}:".encode() + data)
                     todo += [n for n in dict.fromkeys(m.decode() for m in _IMPORTS.findall(data)) if n in _packages]
             _keys[top] = f"{top}-{h.hexdigest()[:16]}"
         return _keys[top]
 
 
-def cache_folder(module: str) -> Path:
+def cache_folder(module: str) -> Path | None:
     """Where the compiled code of ``module`` is cached: ``<root>/<source_key>``, the root being
     ``$NUMBA_CACHE_DIR/mmg-toolkit``, else ``mmg/__pycache__/compiled`` when writable, else
-    ``~/.cache/mmg-toolkit``.  Folders of other sources of the same package not used for a week are removed."""
+    ``~/.cache/mmg-toolkit`` (None where it cannot be made).  Folders of other sources of the same
+    package not used for a week are removed."""
     env = os.environ.get("NUMBA_CACHE_DIR")
     root = Path(env) / "mmg-toolkit" if env else Path(__file__).resolve().parent / "__pycache__" / "compiled"
     try:
@@ -162,10 +166,15 @@ def cache_folder(module: str) -> Path:
         root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "mmg-toolkit"
     key = source_key(module)
     folder = root / key
-    if not folder.is_dir():
-        folder.mkdir(parents=True, exist_ok=True)
-        _prune(root, key)
-    os.utime(folder)                               # in use: not pruned
+    try:
+        if not folder.is_dir():
+            folder.mkdir(parents=True)
+            _prune(root, key)
+        os.utime(folder)                           # in use: not pruned
+    except FileExistsError:                        # made by another process just now
+        pass
+    except OSError:
+        return None
     return folder
 
 

@@ -70,6 +70,35 @@ def _edit(root, new: str, old: str, edited: str) -> None:
     f.write_text(text.replace(old, edited))
 
 
+def test_the_key_covers_every_file_of_a_package_and_of_the_compiled_packages_it_imports(tmp_path, monkeypatch):
+    from mmg import _jit
+
+    for name, code in (("kq_lib", "X = 1\n"), ("kq_app", "import kq_lib\nimport kq_other\n"), ("kq_other", "")):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "__init__.py").write_text(code)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import kq_app  # noqa: F401
+
+    monkeypatch.setattr(_jit, "_packages", _jit._packages | {"kq_lib", "kq_app"})    # kq_other: no compiled code
+
+    def keys():
+        monkeypatch.setattr(_jit, "_keys", {})
+        return _jit.source_key("kq_lib.sub"), _jit.source_key("kq_app")
+
+    lib, app = keys()
+    assert lib.startswith("kq_lib-") and app.startswith("kq_app-")
+    (tmp_path / "kq_lib" / "physics.py").write_text("def f(x):\n    return x\n")        # a new file
+    lib2, app2 = keys()
+    assert lib2 != lib and app2 != app
+    (tmp_path / "kq_lib" / "physics.py").write_text("def f(x):\n    return -x\n")       # an edit (same size)
+    lib3, app3 = keys()
+    assert lib3 != lib2 and app3 != app2
+    (tmp_path / "kq_other" / "more.py").write_text("Y = 2\n")                           # not compiled code's
+    assert keys() == (lib3, app3)
+    (tmp_path / "kq_app" / "__init__.py").write_text("import kq_lib\nimport kq_other  # edited\n")
+    assert keys()[0] == lib3 and keys()[1] != app3                                        # the app only
+
+
 SCALES = """
 import json
 from mmg.model import hull_scales, pack
