@@ -178,5 +178,6 @@ def test_simulation_replay_and_ekf_use_an_edit_in_a_new_module(tmp_path):
         np.testing.assert_allclose(moved[what], ref["1.0"][what], rtol=1e-12, atol=1e-12, err_msg=what)
     _edit(root, "rudder_force.py", "FN = 0.5 * p[P_RHO]", "FN = 1.0 * p[P_RHO]")    # the normal force doubled
     edited = _run(root, WORK, "1.0")["1.0"]
-    for what in ("simulate", "replay", "ekf"):                     # as a rudder of twice the area
-        np.testing.assert_allclose(edited[what], ref["2.0"][what], rtol=1e-9, atol=1e-12, err_msg=what)
+    stale = [what for what in ("simulate", "replay", "ekf")       # each as with a rudder of twice the area
+             if not np.allclose(edited[what], ref["2.0"][what], rtol=1e-9, atol=1e-12)]
+    assert stale == []
