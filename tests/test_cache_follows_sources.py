@@ -181,3 +181,19 @@ def test_simulation_replay_and_ekf_use_an_edit_in_a_new_module(tmp_path):
     stale = [what for what in ("simulate", "replay", "ekf")       # each as with a rudder of twice the area
              if not np.allclose(edited[what], ref["2.0"][what], rtol=1e-9, atol=1e-12)]
     assert stale == []
+
+
+def test_folders_of_other_sources_unused_for_a_week_are_removed(tmp_path, monkeypatch):
+    import time
+
+    from mmg import _jit
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    root = tmp_path / "mmg-toolkit"
+    week = time.time() - 8 * 86400
+    for name, when in (("mmg-old", week), ("mmg-recent", time.time() - 3600), ("ekf-old", week)):
+        (root / name).mkdir(parents=True)
+        os.utime(root / name, (when, when))
+    monkeypatch.setitem(_jit._keys, "mmg", "mmg-new")
+    assert _jit.cache_folder("mmg.model") == root / "mmg-new"
+    assert sorted(p.name for p in root.iterdir()) == ["ekf-old", "mmg-new", "mmg-recent"]
