@@ -15,9 +15,9 @@ one.  Where it cannot be built (no C compiler, ``Python.h`` missing) a marker fi
 the JIT is used from then on; ``MMG_AOT=0`` in the environment always uses the JIT.
 
 ``numba.pycc`` is marked pending deprecation by numba; it is kept because without it a fresh
-process's 35 deg turn takes 2.5x as long (numba imported and the JIT's cache loaded: 2.1-2.6 s
-against 0.8-1.0 s on a loaded machine, 1.6-2x shipmmg's turn, whose speed is the target;
-``bench/bench_startup.py``, 2026-12-04).  Where a numba has dropped it, the build fails, the
+process's 35 deg turn takes 2.3-2.5x as long (numba imported and the JIT's cache loaded: 0.96 s
+against 0.41 s, 1.65x shipmmg's 0.58 s turn, whose speed is the target; 2.1-2.6 s against 0.8-1.0 s
+on a loaded machine; ``bench/bench_startup.py``, 2026-12-04).  Where a numba has dropped it, the build fails, the
 marker is written and the JIT runs (same numbers).
 
 The compiled module holds the GIL while it runs (``pycc`` exports cannot release it), so calls from
