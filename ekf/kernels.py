@@ -21,7 +21,6 @@ from __future__ import annotations
 import numpy as np
 from mmg._jit import njit
 
-from mmg._inlining import source_stamp
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_, dynamics, inverse_mass, rhs, rhs_hull_jacobian, track
 
 CSTEP = 1e-30               # complex-step size: F = Im(step(z + i h e_j)) / h, exact to rounding
@@ -94,24 +93,13 @@ def _held_rows(z, ns, z_next, F):
             F[i, j] = 1.0 if i == j else 0.0
 
 
-def _compile_dynamics_complex(stamp: int):
-    """:func:`mmg.model.dynamics` compiled as its own, called function (a closure over ``stamp``,
-    :func:`mmg._inlining.source_stamp`, so its cached code follows the model's sources)."""
-
-    @njit(cache=True, error_model="numpy")
-    def dynamics_complex(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef, out):
-        """:func:`mmg.model.dynamics` (inlined here), called with all-complex states."""
-        if stamp < 0:                     # never true: ties the cache entry to the inlined sources
-            return
-        dynamics(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef, out)
-
-    return dynamics_complex
-
-
-_dynamics_complex = _compile_dynamics_complex(source_stamp())
-"""The one :func:`mmg.model.dynamics`, compiled once for all-complex states and called (not inlined):
-every column of :func:`jacobian_step` goes through this one specialisation, where inlining a copy per
-column (each with its own mix of real and complex arguments) tripled the kernel's compile time."""
+@njit(cache=True, error_model="numpy")
+def _dynamics_complex(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef, out):
+    """:func:`mmg.model.dynamics` (inlined here), called with all-complex states: compiled once for
+    all-complex states and called (not inlined), every column of :func:`jacobian_step` goes through
+    this one specialisation, where inlining a copy per column (each with its own mix of real and
+    complex arguments) tripled the kernel's compile time."""
+    dynamics(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef, out)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -151,158 +139,149 @@ def _take_column(kc, slots, mask, c, have_real, A, kr):
 # _nrt=False: no reference counting in this kernel (it allocates nothing; the work arrays live in
 # ws).  The inlined model code otherwise increfs / decrefs every array argument at every inlined
 # call, ~20 % of this kernel's time.
-def _compile_jacobian_step(stamp: int):
-    """Compile :func:`jacobian_step` as a closure over ``stamp`` (:func:`mmg._inlining.source_stamp`): it
-    inlines the model's dynamics and track, so its cached code must follow the model's sources."""
+@njit(cache=True, error_model="numpy", _nrt=False)
+def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hull_term, idx, ws):
+    """One RK4 step of the real state z and its exact Jacobian F = d z_next / d z (tangent-linear RK4).
 
-    @njit(cache=True, error_model="numpy", _nrt=False)
-    def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hull_term, idx, ws):
-        """One RK4 step of the real state z and its exact Jacobian F = d z_next / d z (tangent-linear RK4).
+    Same step as :func:`rk4_step` and the same F as :func:`jacobian_step_reference` (to
+    rounding), differentiating the RK4 stages instead of the whole step.  With
+    x_s = z + a_s dt k_{s-1} (a = 0, 1/2, 1/2, 1) the stage state, k_s = f(x_s) and
+    theta = z, for every stage
 
-        Same step as :func:`rk4_step` and the same F as :func:`jacobian_step_reference` (to
-        rounding), differentiating the RK4 stages instead of the whole step.  With
-        x_s = z + a_s dt k_{s-1} (a = 0, 1/2, 1/2, 1) the stage state, k_s = f(x_s) and
-        theta = z, for every stage
+        d k_s / d theta = A_s (E + a_s dt d k_{s-1} / d theta) + a_delta,s d delta_s / d theta + B_s,
 
-            d k_s / d theta = A_s (E + a_s dt d k_{s-1} / d theta) + a_delta,s d delta_s / d theta + B_s,
+    F = E + dt/6 (dk_1 + 2 dk_2 + 2 dk_3 + dk_4) on the propagated rows (E = [I 0]).
 
-        F = E + dt/6 (dk_1 + 2 dk_2 + 2 dk_3 + dk_4) on the propagated rows (E = [I 0]).
+    * A_s = d f / d x over the propagated slots, by complex step of the two parts of
+      :func:`mmg.model.rhs`, each along its own arguments only: :func:`mmg.model.dynamics`
+      (u, v, r, n rows; in u, v, r, n) and, when x0, y0 or psi are propagated,
+      :func:`mmg.model.track` (x0, y0, psi rows; in u, v, r, psi).  One complex evaluation per
+      argument, the others left real (so e.g. the hull force stays real under a step in n);
+      the real parts give k_s.  Nothing depends on x0, y0: their columns are zero.
+    * a_delta,s = d f / d delta (with itau >= 0 only; one more evaluation of the dynamics): the
+      rudder at stage s is d_s + z[itau] g_s, so d delta_s / d z[itau] = g_s.
+    * B_s = d f / d c for the coefficients z[c0 + j] = hull_coef[idx[j]]: analytic
+      (:func:`mmg.model.rhs_hull_jacobian`; the hull forces are linear in them).
 
-        * A_s = d f / d x over the propagated slots, by complex step of the two parts of
-          :func:`mmg.model.rhs`, each along its own arguments only: :func:`mmg.model.dynamics`
-          (u, v, r, n rows; in u, v, r, n) and, when x0, y0 or psi are propagated,
-          :func:`mmg.model.track` (x0, y0, psi rows; in u, v, r, psi).  One complex evaluation per
-          argument, the others left real (so e.g. the hull force stays real under a step in n);
-          the real parts give k_s.  Nothing depends on x0, y0: their columns are zero.
-        * a_delta,s = d f / d delta (with itau >= 0 only; one more evaluation of the dynamics): the
-          rudder at stage s is d_s + z[itau] g_s, so d delta_s / d z[itau] = g_s.
-        * B_s = d f / d c for the coefficients z[c0 + j] = hull_coef[idx[j]]: analytic
-          (:func:`mmg.model.rhs_hull_jacobian`; the hull forces are linear in them).
-
-        Paper filter: 16 complex evaluations of the dynamics a step instead of 64 of rhs; raw-log
-        filter 20 (and 16 cheap ones of the track) instead of 80.
-        Arguments and outputs as :func:`jacobian_step_reference`: rudder [rad] d0 -> d1 over the
-        step, with itau >= 0 it is d + z[itau] g (g0 -> g1 [rad/s]); slots from U_, V_, R_, N_, X_,
-        Y_, PSI_; the states from len(slots) on are held (rows of F the identity).  ws from
-        :func:`make_workspace`: z_next = ws[8], F = ws[9].
-        """
-        if stamp < 0:                     # never true: ties the cache entry to the inlined sources
-            return
-        z_next, F, hc, xr, kc, kr, ks, A, dK, dKn, B, w = ws[8], ws[9], ws[10], ws[11], ws[12], ws[13], ws[14], \
-            ws[15], ws[16], ws[17], ws[18], ws[19]
-        nz = z.shape[0]
-        ns = slots.shape[0]
-        m = idx.shape[0]
-        for j in range(m):
-            hc[idx[j]] = z[c0 + j]
-        iu = -1
-        iv = -1
-        ir = -1
-        tmask = 0                   # bit i: row i is a track state (x0, y0, psi)
-        dmask = 0                   # bit i: row i is a dynamic state (u, v, r, n)
+    Paper filter: 16 complex evaluations of the dynamics a step instead of 64 of rhs; raw-log
+    filter 20 (and 16 cheap ones of the track) instead of 80.
+    Arguments and outputs as :func:`jacobian_step_reference`: rudder [rad] d0 -> d1 over the
+    step, with itau >= 0 it is d + z[itau] g (g0 -> g1 [rad/s]); slots from U_, V_, R_, N_, X_,
+    Y_, PSI_; the states from len(slots) on are held (rows of F the identity).  ws from
+    :func:`make_workspace`: z_next = ws[8], F = ws[9].
+    """
+    z_next, F, hc, xr, kc, kr, ks, A, dK, dKn, B, w = ws[8], ws[9], ws[10], ws[11], ws[12], ws[13], ws[14], \
+        ws[15], ws[16], ws[17], ws[18], ws[19]
+    nz = z.shape[0]
+    ns = slots.shape[0]
+    m = idx.shape[0]
+    for j in range(m):
+        hc[idx[j]] = z[c0 + j]
+    iu = -1
+    iv = -1
+    ir = -1
+    tmask = 0                   # bit i: row i is a track state (x0, y0, psi)
+    dmask = 0                   # bit i: row i is a dynamic state (u, v, r, n)
+    for i in range(ns):
+        sl = slots[i]
+        if sl == U_:
+            iu = i
+        elif sl == V_:
+            iv = i
+        elif sl == R_:
+            ir = i
+        if sl == X_ or sl == Y_ or sl == PSI_:
+            tmask |= 1 << i
+        elif sl == U_ or sl == V_ or sl == R_ or sl == N_:
+            dmask |= 1 << i
+        else:
+            raise ValueError("slots: the rudder angle is an input, not a propagated state")
+    minv = inverse_mass(p, w)
+    tau = z[itau] if itau >= 0 else 0.0
+    e0 = d0 + tau * g0
+    e1 = d1 + tau * g1
+    for i in range(8):
+        xr[i] = 0.0
+    c6 = dt / 6.0
+    for i in range(ns):
+        ks[i] = 0.0
+        for j in range(nz):
+            F[i, j] = 1.0 if i == j else 0.0
+    for st in range(4):
+        if st == 0:
+            a, wst, e, ge = 0.0, 1.0, e0, g0
+        elif st == 3:
+            a, wst, e, ge = dt, 1.0, e1, g1
+        else:
+            a, wst, e, ge = 0.5 * dt, 2.0, 0.5 * (e0 + e1), 0.5 * (g0 + g1)
+        # stage state x_s = z + a k_{s-1} (a = a_s dt; its tangent E + a dk_{s-1} enters below)
         for i in range(ns):
-            sl = slots[i]
-            if sl == U_:
-                iu = i
-            elif sl == V_:
-                iv = i
-            elif sl == R_:
-                ir = i
-            if sl == X_ or sl == Y_ or sl == PSI_:
-                tmask |= 1 << i
-            elif sl == U_ or sl == V_ or sl == R_ or sl == N_:
-                dmask |= 1 << i
+            xr[slots[i]] = z[i] + a * kr[i] if st > 0 else z[i]
+        xr[DELTA_] = e
+        u, v, r, psi, n = xr[U_], xr[V_], xr[R_], xr[PSI_], xr[N_]
+        # A_s (column ns: d f / d delta) by complex step; the first evaluations' real parts are k_s
+        dyn_real = dmask == 0
+        trk_real = tmask == 0
+        for c in range(ns + 1):
+            if c < ns:
+                k = slots[c]
+            elif itau >= 0:
+                k = DELTA_
             else:
-                raise ValueError("slots: the rudder angle is an input, not a propagated state")
-        minv = inverse_mass(p, w)
-        tau = z[itau] if itau >= 0 else 0.0
-        e0 = d0 + tau * g0
-        e1 = d1 + tau * g1
-        for i in range(8):
-            xr[i] = 0.0
-        c6 = dt / 6.0
+                break
+            for i in range(ns):
+                A[i, c] = 0.0
+            if dmask != 0 and (k == U_ or k == V_ or k == R_ or k == N_ or k == DELTA_):
+                _dynamics_column(k, u, v, r, e, n, p, poly, hull_axis, hull_term, hc, kc)
+                _take_column(kc, slots, dmask, c, dyn_real, A, kr)
+                dyn_real = True
+            if tmask != 0 and (k == U_ or k == V_ or k == R_ or k == PSI_):
+                _track_column(k, u, v, r, psi, p, kc)
+                _take_column(kc, slots, tmask, c, trk_real, A, kr)
+                trk_real = True
+        if not dyn_real:                # no dynamic state to differentiate in: k_s alone
+            dynamics(u, v, r, e, n, p, poly, hull_axis, hull_term, hc, w)
+            for i in range(ns):
+                if (dmask >> i) & 1:
+                    kr[i] = w[slots[i]]
+        if not trk_real:
+            track(u, v, r, psi, p, w)
+            for i in range(ns):
+                if (tmask >> i) & 1:
+                    kr[i] = w[slots[i]]
+        # B_s, analytic
+        rhs_hull_jacobian(xr, p, hull_axis, hull_term, idx, minv, B)
+        # dk_s = A_s (E + a dt dk_{s-1}) + a_delta g_s e_tau + B_s (into dKn; rows of dK contiguous)
         for i in range(ns):
-            ks[i] = 0.0
             for j in range(nz):
-                F[i, j] = 1.0 if i == j else 0.0
-        for st in range(4):
-            if st == 0:
-                a, wst, e, ge = 0.0, 1.0, e0, g0
-            elif st == 3:
-                a, wst, e, ge = dt, 1.0, e1, g1
-            else:
-                a, wst, e, ge = 0.5 * dt, 2.0, 0.5 * (e0 + e1), 0.5 * (g0 + g1)
-            # stage state x_s = z + a k_{s-1} (a = a_s dt; its tangent E + a dk_{s-1} enters below)
-            for i in range(ns):
-                xr[slots[i]] = z[i] + a * kr[i] if st > 0 else z[i]
-            xr[DELTA_] = e
-            u, v, r, psi, n = xr[U_], xr[V_], xr[R_], xr[PSI_], xr[N_]
-            # A_s (column ns: d f / d delta) by complex step; the first evaluations' real parts are k_s
-            dyn_real = dmask == 0
-            trk_real = tmask == 0
-            for c in range(ns + 1):
-                if c < ns:
-                    k = slots[c]
-                elif itau >= 0:
-                    k = DELTA_
-                else:
-                    break
-                for i in range(ns):
-                    A[i, c] = 0.0
-                if dmask != 0 and (k == U_ or k == V_ or k == R_ or k == N_ or k == DELTA_):
-                    _dynamics_column(k, u, v, r, e, n, p, poly, hull_axis, hull_term, hc, kc)
-                    _take_column(kc, slots, dmask, c, dyn_real, A, kr)
-                    dyn_real = True
-                if tmask != 0 and (k == U_ or k == V_ or k == R_ or k == PSI_):
-                    _track_column(k, u, v, r, psi, p, kc)
-                    _take_column(kc, slots, tmask, c, trk_real, A, kr)
-                    trk_real = True
-            if not dyn_real:                # no dynamic state to differentiate in: k_s alone
-                dynamics(u, v, r, e, n, p, poly, hull_axis, hull_term, hc, w)
-                for i in range(ns):
-                    if (dmask >> i) & 1:
-                        kr[i] = w[slots[i]]
-            if not trk_real:
-                track(u, v, r, psi, p, w)
-                for i in range(ns):
-                    if (tmask >> i) & 1:
-                        kr[i] = w[slots[i]]
-            # B_s, analytic
-            rhs_hull_jacobian(xr, p, hull_axis, hull_term, idx, minv, B)
-            # dk_s = A_s (E + a dt dk_{s-1}) + a_delta g_s e_tau + B_s (into dKn; rows of dK contiguous)
-            for i in range(ns):
-                for j in range(nz):
-                    dKn[i, j] = 0.0
-                if st > 0:
-                    for c in range(ns):
-                        aic = a * A[i, c]
-                        for j in range(nz):
-                            dKn[i, j] += aic * dK[c, j]
-                for j in range(ns):
-                    dKn[i, j] += A[i, j]
-                if itau >= 0:
-                    dKn[i, itau] += A[i, ns] * ge
-            dK, dKn = dKn, dK
-            for j in range(m):
-                if iu >= 0:
-                    dK[iu, c0 + j] += B[0, j]
-                if iv >= 0:
-                    dK[iv, c0 + j] += B[1, j]
-                if ir >= 0:
-                    dK[ir, c0 + j] += B[2, j]
-            cw = c6 * wst
-            for i in range(ns):
-                ks[i] += wst * kr[i]
-                for j in range(nz):
-                    F[i, j] += cw * dK[i, j]
+                dKn[i, j] = 0.0
+            if st > 0:
+                for c in range(ns):
+                    aic = a * A[i, c]
+                    for j in range(nz):
+                        dKn[i, j] += aic * dK[c, j]
+            for j in range(ns):
+                dKn[i, j] += A[i, j]
+            if itau >= 0:
+                dKn[i, itau] += A[i, ns] * ge
+        dK, dKn = dKn, dK
+        for j in range(m):
+            if iu >= 0:
+                dK[iu, c0 + j] += B[0, j]
+            if iv >= 0:
+                dK[iv, c0 + j] += B[1, j]
+            if ir >= 0:
+                dK[ir, c0 + j] += B[2, j]
+        cw = c6 * wst
         for i in range(ns):
-            z_next[i] = z[i] + c6 * ks[i]
-        _held_rows(z, ns, z_next, F)
+            ks[i] += wst * kr[i]
+            for j in range(nz):
+                F[i, j] += cw * dK[i, j]
+    for i in range(ns):
+        z_next[i] = z[i] + c6 * ks[i]
+    _held_rows(z, ns, z_next, F)
 
-    return jacobian_step
 
-
-jacobian_step = _compile_jacobian_step(source_stamp())
 
 
 @njit(cache=True)

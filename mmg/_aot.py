@@ -8,12 +8,17 @@ module imports only numpy, so a process that simulates and does nothing else nev
 ``bench/bench_startup.py``).
 
 The module is a cache entry like numba's own: built on first use (about 8 s, instead of the JIT's
-compile of the same functions), into ``$NUMBA_CACHE_DIR/mmg_aot`` when that is set, else
-``mmg/__pycache__`` when writable, else the user's cache folder (``$XDG_CACHE_HOME`` or
-``~/.cache``, ``mmg-toolkit``).  Its name carries a hash of the sources it compiles, numba's
-version and the interpreter's extension suffix, so an edit of the model or an upgrade builds a new
+compile of the same functions), into the folder of :mod:`mmg`'s compiled code
+(:func:`mmg._jit.cache_folder`, named by a hash of every source file of the package), under a name
+that also carries numba's version, so an edit of any file of the model or an upgrade builds a new
 one.  Where it cannot be built (no C compiler, ``Python.h`` missing) a marker file records why and
 the JIT is used from then on; ``MMG_AOT=0`` in the environment always uses the JIT.
+
+``numba.pycc`` is marked pending deprecation by numba; it is kept because without it a fresh
+process's 35 deg turn takes 2.3-2.5x as long (numba imported and the JIT's cache loaded: 0.96 s
+against 0.41 s, 1.65x shipmmg's 0.58 s turn, whose speed is the target; 2.1-2.6 s against 0.8-1.0 s
+on a loaded machine; ``bench/bench_startup.py``, 2026-12-04).  Where a numba has dropped it, the build fails, the
+marker is written and the JIT runs (same numbers).
 
 The compiled module holds the GIL while it runs (``pycc`` exports cannot release it), so calls from
 threads other than the main one use the JIT kernels (``nogil``: a thread pool's runs go on in
@@ -33,10 +38,6 @@ from pathlib import Path
 from mmg._signals import deferred as signals_deferred
 
 __all__ = ["kernels", "enabled", "module_path", "module_name", "build", "simulate_kernel", "build_deferred"]
-
-SOURCES = ("_inlining.py", "_jit.py", "_aot.py", "model.py", "nondim.py", "rudder.py", "terms.py", "wind.py",
-           "kernel.py")
-"""The files of :mod:`mmg` whose code the compiled module holds (or that say how it is built)."""
 
 # C-contiguous arrays: the layout the JIT's own callers pass, so the callees the build compiles are
 # the JIT's specialisations (shared through numba's cache) and not a second, any-layout set
@@ -78,42 +79,21 @@ def _numba_version() -> str:
         return "none"
 
 
-def _stamp() -> str:
-    h = hashlib.sha256()
-    here = Path(__file__).resolve().parent
-    for name in SOURCES:
-        f = here / name
-        if f.is_file():
-            h.update(name.encode())
-            h.update(f.read_bytes())
-    h.update(_numba_version().encode())
-    return h.hexdigest()[:16]
-
-
-def _cache_dir() -> Path:
-    env = os.environ.get("NUMBA_CACHE_DIR")
-    if env:
-        return Path(env) / "mmg_aot"
-    here = Path(__file__).resolve().parent / "__pycache__"
-    try:
-        here.mkdir(exist_ok=True)
-        if os.access(here, os.W_OK):
-            return here
-    except OSError:
-        pass
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "mmg-toolkit"
-
-
 def module_name() -> str:
     """The extension module's name for the current sources and numba."""
-    return f"_mmg_aot_{_stamp()}"
+    from ._jit import source_key
+
+    return "_mmg_aot_" + hashlib.sha256(f"{source_key(__name__)} {_numba_version()}".encode()).hexdigest()[:16]
 
 
 def module_path() -> Path:
     """Where the compiled module for the current sources is (or will be) cached."""
-    suffix = importlib.machinery.EXTENSION_SUFFIXES[0]
-    return _cache_dir() / (module_name() + suffix)
+    from ._jit import cache_folder
+
+    folder = cache_folder(__name__)
+    if folder is None:
+        raise OSError("no writable cache folder for the compiled module")
+    return folder / (module_name() + importlib.machinery.EXTENSION_SUFFIXES[0])
 
 
 def _load(path: Path):
@@ -159,10 +139,6 @@ def build(path: Path | None = None) -> Path:
         _defer_signals_in_toolchain(cc)
         cc.compile()
         os.replace(tmp / cc.output_file, path)
-        if path.parent == Path(__file__).resolve().parent / "__pycache__":
-            for old_module in path.parent.glob("_mmg_aot_*"):     # earlier sources' modules in our own cache
-                if old_module.name.split(".")[0] != name:
-                    old_module.unlink(missing_ok=True)
     finally:
         tempfile.tempdir = old
         shutil.rmtree(tmp, ignore_errors=True)
@@ -205,7 +181,11 @@ def kernels():
     with _lock:
         if _module is not None or _tried:
             return _module
-        path = module_path()
+        try:
+            path = module_path()
+        except OSError:                           # nowhere to keep it: the JIT it is
+            _tried = True
+            return None
         if _deferred and not path.is_file():
             return None                           # not now, and not marked as tried: built later
         _tried = True

@@ -11,15 +11,30 @@ recorded function, in the order they were declared, and puts each dispatcher in 
 stand-in in the namespaces of the loaded modules, so that compiled code referring to another
 compiled function by its global name sees a numba dispatcher, as it would have without this
 module.  Numba's on-disk cache is keyed by the Python function, so cached code is the same.
+
+Numba keys a cached function by its own file alone: an edit of a function it calls or inlines from
+another file leaves the old code in the cache, served without a word (an edit of the model once left
+the replay returning NaN).  So every compiled function of the project is cached in a folder named
+by :func:`source_key`, a hash of every ``.py`` file of its package and of the packages with compiled
+code that package imports, found by walking their folders (no list of files to keep): any edit of
+their sources, a new file too, compiles into a new folder (:func:`cache_folder`).
 """
 from __future__ import annotations
 
+import hashlib
+import os
+import re
 import sys
 import threading
+import time
+from pathlib import Path
 
-__all__ = ["njit", "LazyJit", "materialize", "materialized", "interpreted", "carray", "readonly"]
+__all__ = ["njit", "LazyJit", "materialize", "materialized", "interpreted", "carray", "readonly", "source_key",
+           "cache_folder"]
 
 _registry: list["LazyJit"] = []
+_packages: set[str] = {__name__.split(".")[0]}   # top-level packages that declare compiled code
+_keys: dict[str, str] = {}
 _lock = threading.RLock()
 _done = False
 
@@ -68,10 +83,9 @@ def njit(*args, **options):
     """``numba.njit`` with the same options, made when compiled code is first needed (module docstring)."""
     def wrap(func):
         with _lock:
+            _packages.add(func.__module__.split(".")[0])
             if _done:                              # numba is in use already: the dispatcher itself
-                import numba
-
-                return numba.njit(**options)(func)
+                return _dispatcher(func, options)
             lj = LazyJit(func, options)
             _registry.append(lj)
         return lj
@@ -82,10 +96,97 @@ def njit(*args, **options):
 
 
 def _make(lj: LazyJit) -> None:
+    if lj._dispatcher is None:
+        lj._dispatcher = _dispatcher(lj.py_func, lj.options)
+
+
+def _dispatcher(func, options: dict):
+    """``numba.njit(**options)(func)``, cached (``cache=True``) in :func:`cache_folder`: numba picks a
+    function's cache folder when its dispatcher is made, from ``numba.config.CACHE_DIR``."""
     import numba
 
-    if lj._dispatcher is None:
-        lj._dispatcher = numba.njit(**lj.options)(lj.py_func)
+    folder = cache_folder(func.__module__) if options.get("cache") else None
+    if folder is None:                           # not cached (rather than cached under a stale key)
+        return numba.njit(**dict(options, cache=False))(func)
+    old = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = str(folder)
+    try:
+        return numba.njit(**options)(func)
+    finally:
+        numba.config.CACHE_DIR = old             # other libraries' code keeps its own cache
+
+
+_IMPORTS = re.compile(rb"^[ \t]*(?:from|import)[ \t]+([A-Za-z_]\w*)", re.M)
+
+
+def _sources(top: str) -> list[tuple[str, Path]]:
+    """The ``.py`` files of top-level package (or script module) ``top``, found by walking its folders,
+    with their paths in the package."""
+    mod = sys.modules.get(top)
+    folders = [Path(d) for d in getattr(mod, "__path__", None) or ()]
+    if folders:
+        return sorted((f.relative_to(d).as_posix(), f) for d in folders for f in d.rglob("*.py")
+                      if "__pycache__" not in f.parts)
+    file = getattr(mod, "__file__", None)
+    return [(Path(file).name, Path(file))] if file else []
+
+
+def source_key(module: str) -> str:
+    """``"<package>-<hash>"``: a hash of every source file of ``module``'s top-level package and,
+    recursively, of the packages declaring compiled code that its files import (read once per process)."""
+    top = module.split(".")[0]
+    with _lock:
+        if top not in _keys:
+            h, todo, seen = hashlib.sha256(), [top], set()
+            while todo:
+                pkg = todo.pop()
+                if pkg in seen:
+                    continue
+                seen.add(pkg)
+                for name, f in _sources(pkg):
+                    data = f.read_bytes()
+                    h.update(f"{pkg}/{name}:{len(data)}:".encode() + data)
+                    todo += [n for n in dict.fromkeys(m.decode() for m in _IMPORTS.findall(data)) if n in _packages]
+            _keys[top] = f"{top}-{h.hexdigest()[:16]}"
+        return _keys[top]
+
+
+def cache_folder(module: str) -> Path | None:
+    """Where the compiled code of ``module`` is cached: ``<root>/<source_key>``, the root being
+    ``$NUMBA_CACHE_DIR/mmg-toolkit``, else ``mmg/__pycache__/compiled`` when writable, else
+    ``~/.cache/mmg-toolkit`` (None where it cannot be made).  Folders of other sources of the same
+    package not used for a week are removed."""
+    env = os.environ.get("NUMBA_CACHE_DIR")
+    root = Path(env) / "mmg-toolkit" if env else Path(__file__).resolve().parent / "__pycache__" / "compiled"
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+        if not os.access(root, os.W_OK):
+            raise OSError(root)
+    except OSError:
+        root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "mmg-toolkit"
+    key = source_key(module)
+    folder = root / key
+    try:
+        if not folder.is_dir():
+            folder.mkdir(parents=True)
+            _prune(root, key)
+        os.utime(folder)                           # in use: not pruned
+    except FileExistsError:                        # made by another process just now
+        pass
+    except OSError:
+        return None
+    return folder
+
+
+def _prune(root: Path, key: str) -> None:
+    import shutil
+
+    for old in root.glob(key.rsplit("-", 1)[0] + "-*"):
+        try:
+            if old.name != key and time.time() - old.stat().st_mtime > 7 * 86400:
+                shutil.rmtree(old, ignore_errors=True)
+        except OSError:
+            pass
 
 
 def _substitute() -> None:

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._inlining import source_stamp
 from ._jit import njit
 from .model import DELTA_, ENGINE_CONSTANT_RPM, N_, P_ENGINE, PSI_, R_, U_, V_, rhs_of
 from .rudder import switch_side
@@ -42,70 +41,60 @@ def _axpy(a, c, b):
             a[4] + c * b[4], a[5] + c * b[5], a[6] + c * b[6], a[7] + c * b[7])
 
 
-def _compile_simulate_kernel(stamp: int):
-    """Compile the kernel below as a closure over ``stamp`` (:func:`mmg._inlining.source_stamp`, a hash of
-    the sources it inlines): numba keys its on-disk cache by the function's own file and its closure,
-    so an edit of the inlined model (another file) then recompiles it instead of loading stale code."""
+@njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
+def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
+                    kind, cpar, st, sd, sn, states, orders):
+    """Integrate ``nsteps`` RK4 steps from ``x0``; fill ``states`` (nsteps+1, 8) and ``orders``.
 
-    @njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
-    def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
-                        kind, cpar, st, sd, sn, states, orders):
-        """Integrate ``nsteps`` RK4 steps from ``x0``; fill ``states`` (nsteps+1, 8) and ``orders``.
-
-        The state and the four RK4 stages are tuples of scalars (:func:`mmg.model.rhs_of`, inlined), which
-        the compiler keeps in registers: an earlier version staged them through a (6, 8) work
-        array, 1.27-1.33x the hand-specialised kernel against 1.20-1.23x now
-        (``bench/bench_kernel.py``).  The kernel allocates nothing, so it is compiled without
-        reference counting (``_nrt=False``: no atomic increment / decrement of the arrays' counts in the right-hand side, several per
-        evaluation otherwise).  Releases the GIL (it touches no Python object): runs of different
-        threads go on in parallel.  Returns the number of valid rows (< nsteps+1 when the run
-        stopped because the surge speed fell below 1 % of its initial value or a value became NaN).
-        """
-        if stamp < 0:                     # never true: ties the cache entry to the inlined sources
-            return 0
-        xs = (x0[0], x0[1], x0[2], x0[3], x0[4], x0[5], x0[6], x0[7])   # the state, as scalars
-        side = cpar[HS_FIRST]
-        ptr = 0
-        ptrn = 0
-        u_min = 0.01 * abs(x0[U_])
-        constant_rpm = p[P_ENGINE] == ENGINE_CONSTANT_RPM
-        half_dt, dt6 = 0.5 * dt, dt / 6.0
-        for i in range(nsteps + 1):
-            t = i * dt
-            if kind == SCHEDULE:
-                dcmd, ptr = _interp(t, st, sd, ptr)
-                ncmd, ptrn = _interp(t, st, sn, ptrn)
-                if constant_rpm and not np.isnan(ncmd):
-                    xs = xs[:N_] + (ncmd,)
+    The state and the four RK4 stages are tuples of scalars (:func:`mmg.model.rhs_of`, inlined), which
+    the compiler keeps in registers: an earlier version staged them through a (6, 8) work
+    array, 1.27-1.33x the hand-specialised kernel against 1.20-1.23x now
+    (``bench/bench_kernel.py``).  The kernel allocates nothing, so it is compiled without
+    reference counting (``_nrt=False``: no atomic increment / decrement of the arrays' counts in the right-hand side, several per
+    evaluation otherwise).  Releases the GIL (it touches no Python object): runs of different
+    threads go on in parallel.  Returns the number of valid rows (< nsteps+1 when the run
+    stopped because the surge speed fell below 1 % of its initial value or a value became NaN).
+    """
+    xs = (x0[0], x0[1], x0[2], x0[3], x0[4], x0[5], x0[6], x0[7])   # the state, as scalars
+    side = cpar[HS_FIRST]
+    ptr = 0
+    ptrn = 0
+    u_min = 0.01 * abs(x0[U_])
+    constant_rpm = p[P_ENGINE] == ENGINE_CONSTANT_RPM
+    half_dt, dt6 = 0.5 * dt, dt / 6.0
+    for i in range(nsteps + 1):
+        t = i * dt
+        if kind == SCHEDULE:
+            dcmd, ptr = _interp(t, st, sd, ptr)
+            ncmd, ptrn = _interp(t, st, sn, ptrn)
+            if constant_rpm and not np.isnan(ncmd):
+                xs = xs[:N_] + (ncmd,)
+        else:
+            if t < cpar[HS_TSTART]:
+                dcmd = cpar[HS_TRIM]
             else:
-                if t < cpar[HS_TSTART]:
-                    dcmd = cpar[HS_TRIM]
-                else:
-                    side = switch_side(side, xs[PSI_] - cpar[HS_PSI0], cpar[HS_HI], cpar[HS_LO])
-                    dcmd = side * cpar[HS_AMP]
-            for j in range(8):
-                states[i, j] = xs[j]
-            orders[i] = dcmd
-            if not (xs[U_] > u_min) or np.isnan(xs[PSI_]):
-                return i
-            if i == nsteps:
-                break
-            # the four RK4 stages through one inlined copy of the right-hand side, the state and
-            # the stage derivatives in scalars (registers), summed with the RK4 weights as they come
-            k = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-            acc = k
-            for s in range(4):
-                c = 0.0 if s == 0 else (half_dt if s < 3 else dt)
-                y = _axpy(xs, c, k)
-                k = rhs_of(y[U_], y[V_], y[R_], y[PSI_], y[DELTA_], y[N_], dcmd, p, poly, hull_axis, hull_term,
-                           hull_coef)
-                acc = _axpy(acc, 1.0 if (s == 0 or s == 3) else 2.0, k)
-            xs = _axpy(xs, dt6, acc)
-        return nsteps + 1
-
-    return simulate_kernel
+                side = switch_side(side, xs[PSI_] - cpar[HS_PSI0], cpar[HS_HI], cpar[HS_LO])
+                dcmd = side * cpar[HS_AMP]
+        for j in range(8):
+            states[i, j] = xs[j]
+        orders[i] = dcmd
+        if not (xs[U_] > u_min) or np.isnan(xs[PSI_]):
+            return i
+        if i == nsteps:
+            break
+        # the four RK4 stages through one inlined copy of the right-hand side, the state and
+        # the stage derivatives in scalars (registers), summed with the RK4 weights as they come
+        k = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        acc = k
+        for s in range(4):
+            c = 0.0 if s == 0 else (half_dt if s < 3 else dt)
+            y = _axpy(xs, c, k)
+            k = rhs_of(y[U_], y[V_], y[R_], y[PSI_], y[DELTA_], y[N_], dcmd, p, poly, hull_axis, hull_term,
+                       hull_coef)
+            acc = _axpy(acc, 1.0 if (s == 0 or s == 3) else 2.0, k)
+        xs = _axpy(xs, dt6, acc)
+    return nsteps + 1
 
 
-simulate_kernel = _compile_simulate_kernel(source_stamp())
 
 

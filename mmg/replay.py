@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 from ._jit import carray, njit
 
-from ._inlining import source_stamp
 from .model import P_L, P_WIND_V, PackedShip, accelerations_of, forces_of, inverse_mass, track_of, wind_loads
 
 __all__ = ["ReplayInputs", "replay", "replay_states", "default_dt_max", "STATE"]
@@ -90,65 +89,56 @@ def _axpy(a, c, b):
             a[5] + c * b[5])
 
 
-def _compile_replay(stamp: int):
-    """Compile the replay below as a closure over ``stamp`` (:func:`mmg._inlining.source_stamp`; see
-    :func:`mmg.kernel._compile_simulate_kernel`)."""
-
-    @njit(cache=True, error_model="numpy", nogil=True)
-    def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis, hull_term, hull_coef, out):
-        """RK4 of the dynamics along a record: sub-steps of at most ``dt_max`` between samples, inputs linear
-        within a sample interval, the state reset to ``meas`` where ``reset``; fills ``out`` (N, 6), returns the
-        number of valid rows."""
-        if stamp < 0:                     # never true: ties the cache entry to the inlined sources
-            return 0
-        N = t.shape[0]
-        # the state and the RK4 stages as 6-tuples of scalars: kept in registers across the stages
-        s = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5])
+@njit(cache=True, error_model="numpy", nogil=True)
+def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis, hull_term, hull_coef, out):
+    """RK4 of the dynamics along a record: sub-steps of at most ``dt_max`` between samples, inputs linear
+    within a sample interval, the state reset to ``meas`` where ``reset``; fills ``out`` (N, 6), returns the
+    number of valid rows."""
+    N = t.shape[0]
+    # the state and the RK4 stages as 6-tuples of scalars: kept in registers across the stages
+    s = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5])
+    for j in range(6):
+        out[0, j] = s[j]
+    for i in range(N - 1):
+        if reset[i]:
+            s = (meas[i, 0], meas[i, 1], meas[i, 2], meas[i, 3], meas[i, 4], meas[i, 5])
+        h = t[i + 1] - t[i]
+        m = int(np.ceil(h / dt_max - 1e-9))
+        if m < 1:
+            m = 1
+        dt = h / m
+        for k in range(m):
+            a0 = k / m
+            a5 = (k + 0.5) / m
+            a1 = (k + 1.0) / m
+            kst = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+            acc = kst
+            for st in range(4):                  # the RK4 stages: one inlined copy of the model
+                a = a0 if st == 0 else (a5 if st < 3 else a1)
+                c = 0.0 if st == 0 else (0.5 * dt if st < 3 else dt)
+                d = delta[i] + a * (delta[i + 1] - delta[i])
+                nn = n[i] + a * (n[i + 1] - n[i])
+                fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
+                fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
+                fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
+                kst = _deriv(_axpy(s, c, kst), d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term,
+                             hull_coef)
+                acc = _axpy(acc, 1.0 if (st == 0 or st == 3) else 2.0, kst)
+            s = _axpy(s, dt / 6.0, acc)
+        ok = True
         for j in range(6):
-            out[0, j] = s[j]
-        for i in range(N - 1):
-            if reset[i]:
-                s = (meas[i, 0], meas[i, 1], meas[i, 2], meas[i, 3], meas[i, 4], meas[i, 5])
-            h = t[i + 1] - t[i]
-            m = int(np.ceil(h / dt_max - 1e-9))
-            if m < 1:
-                m = 1
-            dt = h / m
-            for k in range(m):
-                a0 = k / m
-                a5 = (k + 0.5) / m
-                a1 = (k + 1.0) / m
-                kst = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-                acc = kst
-                for st in range(4):                  # the RK4 stages: one inlined copy of the model
-                    a = a0 if st == 0 else (a5 if st < 3 else a1)
-                    c = 0.0 if st == 0 else (0.5 * dt if st < 3 else dt)
-                    d = delta[i] + a * (delta[i + 1] - delta[i])
-                    nn = n[i] + a * (n[i + 1] - n[i])
-                    fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
-                    fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
-                    fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
-                    kst = _deriv(_axpy(s, c, kst), d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term,
-                                 hull_coef)
-                    acc = _axpy(acc, 1.0 if (st == 0 or st == 3) else 2.0, kst)
-                s = _axpy(s, dt / 6.0, acc)
-            ok = True
-            for j in range(6):
-                if not np.isfinite(s[j]):
-                    ok = False
-            if not ok:
-                for ii in range(i + 1, N):
-                    for j in range(6):
-                        out[ii, j] = np.nan
-                return i + 1
-            for j in range(6):
-                out[i + 1, j] = s[j]
-        return N
-
-    return _replay
+            if not np.isfinite(s[j]):
+                ok = False
+        if not ok:
+            for ii in range(i + 1, N):
+                for j in range(6):
+                    out[ii, j] = np.nan
+            return i + 1
+        for j in range(6):
+            out[i + 1, j] = s[j]
+    return N
 
 
-_replay = _compile_replay(source_stamp())
 
 
 def replay_states(packed: PackedShip, inputs: ReplayInputs, s0, *, meas=None, reset=None,

@@ -172,16 +172,15 @@ def test_a_failed_build_leaves_a_marker_and_the_jit_runs(no_compiler, monkeypatc
 
 
 def test_module_name_follows_the_sources(tmp_path, monkeypatch):
-    """An edit of a compiled source gives another module (no stale kernel is loaded)."""
-    a = _aot.module_name()
-    real = _aot.Path.read_bytes
+    """The module is named by the sources' key (mmg._jit.source_key) and lives in their cache folder:
+    another key, another module (no stale kernel is loaded)."""
+    from mmg import _jit
 
-    def edited(self):
-        data = real(self)
-        return data + b"\n# edited\n" if self.name == "model.py" else data
-
-    monkeypatch.setattr(_aot.Path, "read_bytes", edited)
-    assert _aot.module_name() != a
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    a, folder = _aot.module_name(), _aot.module_path().parent
+    assert folder.name == _jit.source_key("mmg")
+    monkeypatch.setitem(_jit._keys, "mmg", "mmg-0000000000000000")
+    assert _aot.module_name() != a and _aot.module_path().parent.name == "mmg-0000000000000000"
 
 
 FRESH = """
