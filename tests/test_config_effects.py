@@ -253,8 +253,13 @@ def test_effect_given_twice_refused(tmp_path):
 def test_wind_effect_needs_a_wind_section(tmp_path):
     from trials.trial import load_trial
 
+    from mmg.resources import config_path
+
+    text = config_path("ships", "esso_osaka.yaml").read_text()
+    assert "\nwind:" in text
+    (tmp_path / "nowind.yaml").write_text(text[:text.index("\nwind:")])     # the ship without its wind section
     p = tmp_path / "t.yaml"
-    p.write_text(yaml.safe_dump({"name": "st", "ship": "esso_osaka", "approach": {"speed": "10 kn"},
+    p.write_text(yaml.safe_dump({"name": "st", "ship": "nowind.yaml", "approach": {"speed": "10 kn"},
                                  "duration": "100 s", "dt": "0.5 s",
                                  "manoeuvre": {"kind": "turning", "rudder": "35 deg", "execute": "10 s"},
                                  "effects": {"wind": {"true_speed_mps": 10.0}}}))
