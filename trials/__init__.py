@@ -1,4 +1,4 @@
-"""Sea trials: trial definitions (:mod:`trials.trial`), runs (:mod:`trials.run`), logs,
+"""Sea trials: trial definitions (:mod:`trials.runs.trial`), runs (:mod:`trials.runs.run`), logs,
 metrics, figures and the ``mmg`` command line (:mod:`trials.cli`).
 
 The everyday entry points are re-exported by the :mod:`mmg` facade
