@@ -6,6 +6,14 @@ or option and the field; nothing written) or bad arguments; 3 a diverging filter
 interrupted by SIGINT / SIGTERM (one line, nothing left behind).  Library code never calls
 :func:`main`.
 
+Layout: one module per subcommand (:mod:`.simulate`, :mod:`.metrics`, :mod:`.reproduce`,
+:mod:`.nomoto` with ``nomoto-paper``, :mod:`.estimate`, :mod:`.sensitivity`, :mod:`.montecarlo` with
+``log-filter`` and ``output-error``, :mod:`.predict`, :mod:`.identify`, :mod:`.diagnose`), each
+holding its ``cmd_*`` function and its ``add_parser``; :mod:`.common` the argument types they share;
+this module the entry point (:func:`main`, :func:`build_parser` over :data:`COMMANDS`), the exit
+codes and the signal and console handling; :mod:`.warmup` the numba cache warm-up
+(``python -m trials.cli.warmup``).  The top layer: may import everything below it.
+
 Outputs: every command that writes checks its target first (``--out`` a folder that exists
 or can be created, ``--json`` a file whose folder can be written; :func:`trials.files.output.check_output_dir`,
 :func:`trials.files.output.check_output_file`) and refuses an unusable one in one line before any

@@ -32,17 +32,17 @@ Identification methods (all work on the *integrated* model, eqs. (5)/(14)):
 Modules, each importing only from those listed before it:
 
 =============================================  ==========================================================
-:mod:`~trials.analysis.nomoto.models`                   :class:`NomotoModel`, :func:`first_order`, YAML loading
-:mod:`~trials.analysis.nomoto.points`                   :class:`ZigzagPoints`, the values at CR1, OS1, CR2, OS2
-:mod:`~trials.analysis.nomoto.response`                 :func:`simulate_response`, exact response to a sampled rudder
-:mod:`~trials.analysis.nomoto.simulation`               trapezoidal zigzag rudder, :func:`simulate_zigzag`
-:mod:`~trials.analysis.nomoto.smoothing`                :func:`smooth_derivatives`, the spline differentiator
-:mod:`~trials.analysis.nomoto.zigzag`                   :func:`zigzag_data`, a record's zigzag in s'
-:mod:`~trials.analysis.nomoto.fourpoint`                :func:`four_point` and :class:`FourPointResult`
-:mod:`~trials.analysis.nomoto.classical`                :func:`classical_first_order` and :class:`ClassicalResult`
-:mod:`~trials.analysis.nomoto.least_squares`            :func:`fit_least_squares` and :class:`FitResult`
-:mod:`~trials.analysis.nomoto.output_error`             :func:`fit_output_error`
-:mod:`~trials.analysis.nomoto.identification`           :func:`identify`, :func:`heading_rms`, :class:`NomotoIdentification`
+:mod:`~trials.analysis.nomoto.models`          :class:`NomotoModel`, :func:`first_order`, YAML loading
+:mod:`~trials.analysis.nomoto.points`          :class:`ZigzagPoints`, the values at CR1, OS1, CR2, OS2
+:mod:`~trials.analysis.nomoto.response`        :func:`simulate_response`, exact response to a sampled rudder
+:mod:`~trials.analysis.nomoto.simulation`      trapezoidal zigzag rudder, :func:`simulate_zigzag`
+:mod:`~trials.analysis.nomoto.smoothing`       :func:`smooth_derivatives`, the spline differentiator
+:mod:`~trials.analysis.nomoto.zigzag`          :func:`zigzag_data`, a record's zigzag in s'
+:mod:`~trials.analysis.nomoto.fourpoint`       :func:`four_point` and :class:`FourPointResult`
+:mod:`~trials.analysis.nomoto.classical`       :func:`classical_first_order` and :class:`ClassicalResult`
+:mod:`~trials.analysis.nomoto.least_squares`   :func:`fit_least_squares` and :class:`FitResult`
+:mod:`~trials.analysis.nomoto.output_error`    :func:`fit_output_error`
+:mod:`~trials.analysis.nomoto.identification`  :func:`identify`, :func:`heading_rms`, :class:`NomotoIdentification`
 =============================================  ==========================================================
 
 The package is pure numerics: it imports neither matplotlib nor the CLI (the plot
