@@ -3,7 +3,7 @@
 Each case runs with ``NUMBA_CACHE_DIR`` pointing at a fresh temporary folder (cold: every
 compiled function is compiled, as on a fresh install or a CI run), then again with the same
 folder (warm: everything loaded from the cache), and, with ``--warmup``, cold again after
-``python -m trials.warmup`` (the warm-up's wall time counted in).  Prints wall times, the ratios
+``python -m trials.cli.warmup`` (the warm-up's wall time counted in).  Prints wall times, the ratios
 and the number of specialisations compiled in the cold run (cache index entries written).
 Run from the repository root:
 
@@ -68,7 +68,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cases", nargs="+", default=["simulate", "estimate"], choices=sorted(CASES))
     ap.add_argument("--suite", action="store_true", help="add the fast test suite")
-    ap.add_argument("--warmup", action="store_true", help="also: cold after python -m trials.warmup")
+    ap.add_argument("--warmup", action="store_true", help="also: cold after python -m trials.cli.warmup")
     a = ap.parse_args()
     cases = list(a.cases) + (["suite"] if a.suite and "suite" not in a.cases else [])
     with tempfile.TemporaryDirectory(prefix="bench_cold_") as td:
@@ -82,7 +82,7 @@ def main():
                     f"cold / warm {cold / warm:.2f}")
             if a.warmup:
                 cache2 = td / f"cache_{name}_w"
-                wu = run(["-m", "trials.warmup", "--quiet"], cache2, td)
+                wu = run(["-m", "trials.cli.warmup", "--quiet"], cache2, td)
                 after = run(CASES[name], cache2, td)
                 line += (f"; warmup {wu:.1f} s + cold-after-warmup {after:.1f} s = {wu + after:.1f} s, "
                          f"(warmup + run) / warm {(wu + after) / warm:.2f}")

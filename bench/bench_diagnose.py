@@ -43,7 +43,7 @@ def perturbed(ship, rng):
 
 
 def records(ship, truth, eff, seed, wind):
-    from trials.diagnose import synthetic_record
+    from trials.measured.diagnose import synthetic_record
 
     return [synthetic_record(ship, "turning", eff, truth_ship=truth, true_wind=wind, seed=2 * seed),
             synthetic_record(ship, "zigzag", eff, truth_ship=truth, true_wind=wind, seed=2 * seed + 1)]
@@ -51,7 +51,7 @@ def records(ship, truth, eff, seed, wind):
 
 def timing():
     import mmg
-    from trials.diagnose import diagnose, synthetic_record
+    from trials.measured.diagnose import diagnose, synthetic_record
 
     ship = mmg.load_ship("esso_osaka")
     rec = synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.3, "direction_deg": 120.0}}, dt=1.0,
@@ -84,7 +84,7 @@ def main(argv=None):
     import json
 
     import mmg
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     ship = mmg.load_ship("esso_osaka_3m")
     seeds = 2 if a.quick else a.seeds

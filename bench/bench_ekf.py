@@ -33,7 +33,7 @@ import ekf.filter as ekf_filter  # noqa: E402
 from ekf.estimate import P0_for, R_for, initial_state, load_config  # noqa: E402
 from ekf.filter import NS, SLOTS, run_filter, workspace  # noqa: E402
 from ekf.kernels import jacobian_step, jacobian_step_reference  # noqa: E402
-from trials.estimation import data_from_trial  # noqa: E402
+from trials.estimates.estimation import data_from_trial  # noqa: E402
 
 REPEATS = 5
 
@@ -128,7 +128,7 @@ def main() -> None:
               f"whole history {rel_hist:.1e} (per state, of its largest value), final P {rel_P:.1e} "
               f"(of sqrt(P_ii P_jj))")
         if not a.skip_reproduce:
-            from trials.rhee_kim import reproduce_rhee_kim
+            from trials.estimates.rhee_kim import reproduce_rhee_kim
 
             t0 = time.perf_counter()
             reproduce_rhee_kim(Path(td) / "rk", plots=False, verbose=False)

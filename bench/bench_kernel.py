@@ -27,7 +27,7 @@ from kernel_reference import check_ship, reference_kernel  # noqa: E402
 
 from mmg.integrate import simulate_kernel  # noqa: E402
 from mmg.simulation import prepare  # noqa: E402
-from trials.trial import load_trial  # noqa: E402
+from trials.runs.trial import load_trial  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 

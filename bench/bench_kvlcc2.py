@@ -53,7 +53,7 @@ from mmg.nondim import inertia_scale, mass_scale
 from mmg.ship import Ship, load_ship
 from mmg.simulation import prepare, simulate
 from mmg.units import DEG
-from trials.metrics import turning_metrics, zigzag_metrics
+from trials.analysis.metrics import turning_metrics, zigzag_metrics
 
 REPO = Path(__file__).resolve().parents[1]
 SHIP_YAML = REPO / "configs" / "ships" / "kvlcc2_l7.yaml"

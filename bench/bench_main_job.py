@@ -24,7 +24,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 TARGET_S = 60.0
 sys.path.insert(0, str(ROOT))
-from trials.reproduce import frt_data_dir  # noqa: E402
+from trials.papers.reproduce import frt_data_dir  # noqa: E402
 
 FRT = frt_data_dir()
 

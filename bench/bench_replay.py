@@ -2,7 +2,7 @@
 
 A real FRT-DS-ESSO record when the data folder is there ($MMG_FRT_DATA, else ../shared/data/frt-ds-esso
 beside the repository): the longest one, cut to its first 600 s, replayed with the 3 m model and the wind
-loads on, through trials.predict (the record's inputs and wind loads made once, the replay timed).
+loads on, through trials.measured.predict (the record's inputs and wind loads made once, the replay timed).
 Without the data, a simulated 600 s record (rudder steps, constant revolutions) of the same model.
 Prints the median of ``--repeat`` replays (7), the best, and the ratio to the target.
 
@@ -25,12 +25,12 @@ SPAN_S = 600.0
 
 
 def _record(ship):
-    from trials.records import TrialRecord
+    from trials.files.records import TrialRecord
 
     data = Path(os.environ.get("MMG_FRT_DATA") or REPO.parent / "shared" / "data" / "frt-ds-esso")
     files = sorted(data.glob("*/*.csv")) if data.is_dir() else []
     if files:
-        from trials.logio import read_record
+        from trials.files.logio import read_record
 
         recs = [read_record(f, length_m=ship.particulars.L) for f in files]
         rec = max(recs, key=lambda r: r.t[-1] - r.t[0])
@@ -54,7 +54,7 @@ def main(argv=None) -> int:
 
     import mmg
     from mmg.model import pack
-    from trials.predict import measured_run, replay_record
+    from trials.measured.predict import measured_run, replay_record
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=7, help="replays timed (median and best printed)")

@@ -17,9 +17,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from trials.sensitivity import sensitivity, trial_differences  # noqa: E402
-from trials.sweep import default_jobs  # noqa: E402
-from trials.trial import load_trial  # noqa: E402
+from trials.planning.sensitivity import sensitivity, trial_differences  # noqa: E402
+from trials.runs.sweep import default_jobs  # noqa: E402
+from trials.runs.trial import load_trial  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 STEMS = ("st35", "zz10", "zz20", "stype60", "stype120")

@@ -3,8 +3,8 @@
     python bench/channel_margins.py [DIR ...]
 
 Reads every CSV under the folders given (default: ../shared/data/frt-ds-esso and
-../shared/data/diagnose-dev/data beside the repository) with :func:`trials.logio.read_record`
-and prints, per record, what the checks of :mod:`trials.logio` fit and the limits they are judged
+../shared/data/diagnose-dev/data beside the repository) with :func:`trials.files.logio.read_record`
+and prints, per record, what the checks of :mod:`trials.files.logio` fit and the limits they are judged
 against: the surge and sway factors against the track (``velocity_track_fit``, accepted within
 ``SCALE_OK`` = 0.8 to 1.25 where the standard error is below ``SCALE_SE``), the angle between the
 track and the heading plus velocities (refused beyond 45 deg), the common wind-speed factor
@@ -33,7 +33,7 @@ def slope(rec) -> float:
 
 def main() -> int:
     from mmg.errors import InputError
-    from trials.logio import velocity_track_fit, wind_scale_fit, read_record
+    from trials.files.logio import velocity_track_fit, wind_scale_fit, read_record
 
     dirs = [Path(a) for a in sys.argv[1:]] or DEFAULT
     files = sorted(f for d in dirs if d.is_dir() for f in d.rglob("*.csv"))

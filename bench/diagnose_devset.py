@@ -45,7 +45,7 @@ TRUE_KEYS = {("current", "speed_m_s"): "speed_mps", ("current", "set_towards_deg
 def _one(path: str, ship: str) -> dict:
     from mmg.resources import ship_path
     from mmg.ship import load_ship
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     t0 = time.perf_counter()
     d = diagnose(load_ship(ship_path(ship)), [path], wind=False)

@@ -22,8 +22,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import mmg  # noqa: E402
-from trials.identify import cross_validate, load_runs  # noqa: E402
-from trials.reproduce import frt_data_dir  # noqa: E402
+from trials.measured.identify import cross_validate, load_runs  # noqa: E402
+from trials.papers.reproduce import frt_data_dir  # noqa: E402
 
 
 SHIP = "esso_osaka_3m"
@@ -37,12 +37,12 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--wind", choices=["on", "off", "both"], default="both")
     ap.add_argument("--folds", type=int, default=4)
-    ap.add_argument("--free", nargs="+", default=None, help="free parameters (default: trials.identify.DEFAULT_FREE)")
+    ap.add_argument("--free", nargs="+", default=None, help="free parameters (default: trials.measured.identify.DEFAULT_FREE)")
     ap.add_argument("--prior", type=float, default=0.5, help="prior std relative to the config value")
     ap.add_argument("--ship", default=SHIP, help=f"prior ship: the form identified and its starting values (default {SHIP})")
     ap.add_argument("--initial", default=INITIAL, help=f"the model the identified one is compared with (default {INITIAL})")
     ap.add_argument("--weighting", choices=["samples", "equal", "relative"], default=None,
-                    help="record weighting in the fit (default: trials.identify.DEFAULT_WEIGHTING)")
+                    help="record weighting in the fit (default: trials.measured.identify.DEFAULT_WEIGHTING)")
     ap.add_argument("--loss", default="linear", help="least_squares loss of the whole-record stage")
     ap.add_argument("--f-scale", type=float, default=1.0, help="the robust loss's residual scale")
     ap.add_argument("--nuisance", nargs="+", default=(), metavar="EFFECT",
@@ -50,7 +50,7 @@ def main() -> None:
     ap.add_argument("--folds-by", choices=["order", "revolutions"], default="order",
                     help="deal the records into folds in file order or stratified by propeller revolutions")
     ap.add_argument("--max-nfev", type=int, default=None,
-                    help="evaluation limit of each fit stage (default: trials.identify.DEFAULT_MAX_NFEV)")
+                    help="evaluation limit of each fit stage (default: trials.measured.identify.DEFAULT_MAX_NFEV)")
     ap.add_argument("--velocity-weight", type=float, default=1.0,
                     help="weight of the u, v, r residuals beside the heading's (identify(velocity_weight=))")
     ap.add_argument("--offset-spread", type=float, default=0.0, metavar="DEG",
@@ -103,8 +103,8 @@ def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> None:
     """Per kept-out record: the heading RMS [deg] of the initial and the identified model under rudder
     offsets in [-spread_deg, +spread_deg] (``n`` values): the range each spans and the offset each
     prefers; then the comparison with each model at its own preferred offset (an oracle, both alike)."""
-    from trials.identify import _ship_with, with_ship_effects
-    from trials.predict import replay_record
+    from trials.measured.identify import _ship_with, with_ship_effects
+    from trials.measured.predict import replay_record
 
     by_name = {r.name: r for r in runs}
     offs = np.linspace(-spread_deg, spread_deg, n)

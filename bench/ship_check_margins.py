@@ -1,4 +1,4 @@
-"""The record-against-ship check (:mod:`trials.shipcheck`) on every record class, valid and crossed.
+"""The record-against-ship check (:mod:`trials.files.shipcheck`) on every record class, valid and crossed.
 
 Valid: the real FRT-DS-ESSO 3 m model records (turning, zigzag, random, berthing) with the 3 m
 ships, the full-scale diagnose-dev logs (another simulator) with ``esso_osaka``, the project's
@@ -24,8 +24,8 @@ sys.path.insert(0, str(REPO))
 
 from mmg.errors import InputError  # noqa: E402
 from mmg.ship import load_ship  # noqa: E402
-from trials import shipcheck as sc  # noqa: E402
-from trials.logio import read_record  # noqa: E402
+from trials.files import shipcheck as sc  # noqa: E402
+from trials.files.logio import read_record  # noqa: E402
 
 SHARED = REPO.parent / "shared" / "data"
 
@@ -42,9 +42,9 @@ def simulated(out: Path) -> dict:
     """Simulate every configs/trials/*.yaml into ``out``: {trial stem: (ship name, [log, truth])}."""
     import yaml
 
-    from trials.logwrite import log_columns, truth_columns, write_table
-    from trials.run import run_trial
-    from trials.trial import load_trial
+    from trials.files.logwrite import log_columns, truth_columns, write_table
+    from trials.runs.run import run_trial
+    from trials.runs.trial import load_trial
 
     sims = {}
     for cfg in sorted((REPO / "configs" / "trials").glob("*.yaml")):

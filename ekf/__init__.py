@@ -2,7 +2,7 @@
 (1999), the EKF on the raw log, and the joint output-error fit.
 
 They work on arrays and the physics model (:mod:`mmg`) and know no file format: the trials
-layer (:mod:`trials.estimation`) builds their input, a :class:`TrialData`, from a log file or
+layer (:mod:`trials.estimates.estimation`) builds their input, a :class:`TrialData`, from a log file or
 a simulated trial.  The coefficients they free are named from the ship's hull table
 (:func:`estimable_names`).
 

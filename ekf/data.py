@@ -1,7 +1,7 @@
 """What every estimator takes: one trial's measurements, its ship and how it was run.
 
 The estimators work on arrays and the physics model; they know no file format.  The
-trials layer (:mod:`trials.estimation`) reads a log or simulates a trial and fills a
+trials layer (:mod:`trials.estimates.estimation`) reads a log or simulates a trial and fills a
 :class:`TrialData`; everything an estimator needs from a log's header arrives here as
 plain SI values in :class:`RecordInfo`, so no estimator parses a header.
 

@@ -6,7 +6,7 @@ for names it does not list); :func:`estimate` runs the filter on a
 :class:`ekf.data.TrialData` and returns an :class:`Estimate` (``.final``, ``.to_pandas()``,
 ``.plot()``, ``.warnings()``, ``.free_run``); :func:`joint_estimate` runs it through several
 trials in turn.  Building a TrialData from a log file or a trial YAML, and writing the
-reports, is the trials layer's job (:mod:`trials.estimation`).
+reports, is the trials layer's job (:mod:`trials.estimates.estimation`).
 """
 from __future__ import annotations
 

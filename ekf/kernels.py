@@ -1,5 +1,5 @@
 """Compiled kernels shared by the paper EKF (:mod:`ekf.filter`), the raw-log EKF
-(:mod:`ekf.log_filter`) and the Fisher information (:mod:`trials.fisher`).
+(:mod:`ekf.log_filter`) and the Fisher information (:mod:`trials.planning.fisher`).
 
 The filters differ only in which :mod:`mmg.model` state slots they propagate and where the
 estimated hull derivatives sit in their state z:

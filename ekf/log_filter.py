@@ -3,7 +3,7 @@
 The paper-style filter (:mod:`ekf.filter`) measures u, v, r, n *recovered* at 0.1 s from
 the 5 s log by 3-point parabolas, with Table 8's R (10^2-10^5 x the real error variance,
 and blind to the strong correlation of the interpolated samples); its Monte Carlo spread is
-up to 12 x the Cramer-Rao bound of :mod:`trials.fisher` (noise model "log").  This filter
+up to 12 x the Cramer-Rao bound of :mod:`trials.planning.fisher` (noise model "log").  This filter
 measures what the log actually holds, so its information matches the CRB's:
 
 State (8 + m), ordered so that the measured states come first (H = [I_4 0], so the Joseph
@@ -30,7 +30,7 @@ Rudder timing
     u, v, r, x, y, psi) and restarted at 0 with std ``sigma_tau`` (0.15 s; the rebuilt
     movements are off by 0.05-0.07 s rms).  Marginalising these nuisances costs information
     on the sway derivatives: the CRB with the same per-movement nuisances
-    (:func:`trials.fisher.fisher`, ``rudder_timing=0.15``) is 2.2 x the rudder-known one for
+    (:func:`trials.planning.fisher.fisher`, ``rudder_timing=0.15``) is 2.2 x the rudder-known one for
     ZZ20 Y_beta, 1.1-1.4 x for the N derivatives - the price of a log without a rudder
     channel.  ``rudder="true"`` runs the filter on the truth file's rudder instead, to check
     it against the rudder-known bound.
@@ -46,7 +46,7 @@ Start
     same data, the derivatives starting at the first pass's estimates with 100 x its final
     covariance as prior (relinearisation; see :func:`run_log_filter`).
 
-Monte Carlo: ``mmg log-filter OUT --seeds 20`` (:func:`trials.montecarlo.log_filter_monte_carlo`)
+Monte Carlo: ``mmg log-filter OUT --seeds 20`` (:func:`trials.estimates.montecarlo.log_filter_monte_carlo`)
 writes ``OUT/runs.csv``; ``mmg sensitivity --crb-vs-mc OUT --out DIR`` compares it with the CRB.
 """
 from __future__ import annotations

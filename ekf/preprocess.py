@@ -91,7 +91,7 @@ def quadratic3(ts: np.ndarray, ys: np.ndarray, tq: np.ndarray):
 
 def recover(record, p: np.ndarray, dt: float = 0.1, kind: str | None = None, manoeuvre: dict | None = None,
             delta0: float | None = None) -> Measurements:
-    """Rhee & Kim section 4.2 on a record (a :class:`trials.records.TrialRecord` or anything with its arrays).
+    """Rhee & Kim section 4.2 on a record (a :class:`trials.files.records.TrialRecord` or anything with its arrays).
 
     Parameters
     ----------

@@ -2,7 +2,7 @@
 
 One helper for every layer: the simulator's ahead-of-time build (:mod:`mmg._aot`: a C compiler
 writing into a folder an interrupt would remove) and the staged outputs of the commands
-(:mod:`trials.output`: a commit's moves, a clean-up's removals) use the same two blocks.
+(:mod:`trials.files.output`: a commit's moves, a clean-up's removals) use the same two blocks.
 
 * :func:`held`: the signals blocked in this thread's mask and delivered when the block ends.
   Processes started inside inherit the mask.

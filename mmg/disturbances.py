@@ -7,7 +7,7 @@ m/s, angles in rad) and write the effect's parameter-vector slots (:mod:`mmg.mod
 :meth:`Disturbance.slots`, so the compiled right-hand side (simulator and estimators) sees them
 without a second copy.  :meth:`Disturbance.effect` gives the named effect and values (the
 form the replay, :mod:`ekf.identify` and ``mmg diagnose`` use).  Sensor biases act on logs
-(:class:`SensorBias`, read by :func:`trials.logio.log_frame`); the heading part is the
+(:class:`SensorBias`, read by :func:`trials.files.logio.log_frame`); the heading part is the
 ``heading_bias`` effect of a logged heading.
 
 Conventions: directions are the direction a flow goes *towards*, clockwise from

@@ -98,7 +98,7 @@ def movement_starts(order: np.ndarray, dt: float, lead: float = MOVEMENT_LEAD_S)
     each change of the rudder ``order`` sampled every ``dt`` [s] (at least step 1).
 
     The one segmentation of the raw-log EKF's per-movement timing offset
-    (:mod:`ekf.log_filter`) and of the matching Cramer-Rao bound (:mod:`trials.fisher`).
+    (:mod:`ekf.log_filter`) and of the matching Cramer-Rao bound (:mod:`trials.planning.fisher`).
     """
     sw = np.nonzero(np.diff(np.asarray(order, float)) != 0)[0] + 1
     return np.unique(np.r_[0, np.maximum(sw - int(round(lead / dt)), 1)]).astype(np.int64)

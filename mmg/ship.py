@@ -216,7 +216,7 @@ class Ship:
     stated: tuple = field(default=(), compare=False, repr=False)
     """The effect values the ship file states itself, ``(effect, parameter, file, field, value)``
     (``wind.scale``, ``effects.current.speed_mps``, ...): a trial on this ship may not give them
-    again (:func:`trials.trial.trial_from_dict`)."""
+    again (:func:`trials.runs.trial.trial_from_dict`)."""
 
     def effect_set(self):
         """:attr:`effects` as an :class:`mmg.effects.EffectSet` (an empty one when None)."""

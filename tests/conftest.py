@@ -33,8 +33,8 @@ def needs_frt():
 # A fresh install or a CI run starts with numba's on-disk cache empty, and the first test to call
 # each compiled pass compiles it, on one core, while the other core idles.  When the cache is cold,
 # the filters', replay's and sensitivities' specialisations are compiled by
-# ``python -m trials.warmup --serial`` on the second core while the first tests run (they build the
-# simulator's own module; trials.warmup.SUITE_GROUPS, in the order the tests need them): a later
+# ``python -m trials.cli.warmup --serial`` on the second core while the first tests run (they build the
+# simulator's own module; trials.cli.warmup.SUITE_GROUPS, in the order the tests need them): a later
 # test loads them from the cache.  It writes only into numba's cache and is stopped when the run
 # ends; MMG_TEST_WARMUP=0 turns it off.
 _warmup = None
@@ -44,11 +44,11 @@ def pytest_configure(config):
     global _warmup
     if os.environ.get("MMG_TEST_WARMUP", "1") == "0" or config.option.collectonly:
         return
-    from trials.warmup import SUITE_GROUPS, filter_cache_cold
+    from trials.cli.warmup import SUITE_GROUPS, filter_cache_cold
 
     if not filter_cache_cold():
         return
-    cmd = [sys.executable, "-m", "trials.warmup", "--serial", "--quiet"]
+    cmd = [sys.executable, "-m", "trials.cli.warmup", "--serial", "--quiet"]
     for g in SUITE_GROUPS:
         cmd += ["--group", g]
     _warmup = subprocess.Popen(cmd, cwd=REPO, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,

@@ -252,7 +252,7 @@ def test_plot(zz20):
     assert isinstance(fig, Figure) and len(fig.axes) == 5
     assert fig.axes[0].get_ylabel().startswith("heading")
     track = zz20.plot("track", show=False)
-    # a long track comes in stacked same-scale parts (trials.plots.track_layout), each drawing the track
+    # a long track comes in stacked same-scale parts (trials.files.plots.track_layout), each drawing the track
     assert isinstance(track, Figure) and track.axes and all(a.lines for a in track.axes)
     f, ax = plt.subplots()
     assert zz20.plot(kind="track", ax=ax) is f and ax.lines

@@ -15,7 +15,7 @@ from mmg.limits import MAX_STEPS
 from mmg.ship import load_ship, ship_from_dict
 from mmg.units import to_si
 from trials.cli import main
-from trials.trial import load_trial, make_trial
+from trials.runs.trial import load_trial, make_trial
 
 from .conftest import CONFIGS
 

@@ -10,10 +10,10 @@ import pytest
 from mmg.errors import InputError
 from mmg.limits import MAX_STEPS
 from trials.cli import main
-from trials.logio import read_record, write_csv
-from trials.metrics import record_metrics
-from trials.run import run_trial
-from trials.trial import load_trial
+from trials.files.logio import read_record, write_csv
+from trials.analysis.metrics import record_metrics
+from trials.runs.run import run_trial
+from trials.runs.trial import load_trial
 
 from .conftest import CONFIGS, FRT, needs_frt
 

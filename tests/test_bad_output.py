@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from trials import output
+from trials.files import output
 from trials.cli import main
-from trials.output import StagedFile, StagedOutput, check_output_dir, check_output_file, dump_json
+from trials.files.output import StagedFile, StagedOutput, check_output_dir, check_output_file, dump_json
 
 from .conftest import CONFIGS
 
@@ -47,22 +47,22 @@ def tree(p: Path) -> list:
 @pytest.fixture
 def no_computation(monkeypatch):
     """Every expensive entry point of the commands raises: a refusal must come before them."""
-    import trials.artyszuk
-    import trials.estimation
-    import trials.montecarlo
-    import trials.nomoto_report
-    import trials.reproduce
-    import trials.run
-    import trials.sensitivity_report
+    import trials.papers.artyszuk
+    import trials.estimates.estimation
+    import trials.estimates.montecarlo
+    import trials.analysis.nomoto_report
+    import trials.papers.reproduce
+    import trials.runs.run
+    import trials.planning.sensitivity_report
 
     def boom(*a, **k):
         raise AssertionError("computation started before the output target was checked")
 
-    for mod, names in [(trials.run, ["run_trial"]), (trials.reproduce, ["reproduce"]), (trials.artyszuk, ["reproduce"]),
-                       (trials.estimation, ["load_inputs", "estimate_and_report"]),
-                       (trials.nomoto_report, ["identify_log"]),
-                       (trials.sensitivity_report, ["trial_sensitivities", "paper_figures", "crb_table", "design"]),
-                       (trials.montecarlo, ["monte_carlo", "log_filter_monte_carlo", "output_error_monte_carlo",
+    for mod, names in [(trials.runs.run, ["run_trial"]), (trials.papers.reproduce, ["reproduce"]), (trials.papers.artyszuk, ["reproduce"]),
+                       (trials.estimates.estimation, ["load_inputs", "estimate_and_report"]),
+                       (trials.analysis.nomoto_report, ["identify_log"]),
+                       (trials.planning.sensitivity_report, ["trial_sensitivities", "paper_figures", "crb_table", "design"]),
+                       (trials.estimates.montecarlo, ["monte_carlo", "log_filter_monte_carlo", "output_error_monte_carlo",
                                             "summarise"])]:
         for n in names:
             monkeypatch.setattr(mod, n, boom)

@@ -14,7 +14,7 @@ import pytest
 from mmg.errors import InputError
 from mmg.units import KNOT
 from trials.cli import main
-from trials.logio import read_record
+from trials.files.logio import read_record
 
 from .conftest import FRT, needs_frt
 
@@ -94,7 +94,7 @@ def test_full_scale_record_channel_in_wrong_unit(tmp_path, case):
 def simulated(tmp_path_factory):
     """A zigzag of the 3 m model with a 1.5 m/s true wind, logged in the FRT-DS-ESSO layout at 10 Hz."""
     from mmg.ship import load_ship
-    from trials.diagnose import synthetic_record, write_frt_csv
+    from trials.measured.diagnose import synthetic_record, write_frt_csv
 
     rec = synthetic_record(load_ship("esso_osaka_3m"), "zigzag", {"wind": {"scale": 1.0}}, true_wind=(1.5, 1.0),
                            dt=0.1, seed=3, name="sim")
@@ -114,9 +114,9 @@ def test_simulated_record_channel_in_wrong_unit(simulated, tmp_path, case):
 def truth_file(tmp_path_factory):
     from dataclasses import replace
 
-    from trials.logio import write_csv
-    from trials.run import run_trial
-    from trials.trial import load_trial
+    from trials.files.logio import write_csv
+    from trials.runs.run import run_trial
+    from trials.runs.trial import load_trial
 
     from .conftest import CONFIGS
 
@@ -180,7 +180,7 @@ def test_real_unwrapped_heading_same_record_and_metrics(tmp_path, how, capsys):
     ref = read_record(src)
     p = _heading_rewrite(src, tmp_path / "h.csv", HEADINGS[how])
     _same(ref, read_record(p))
-    from trials.metrics import record_metrics
+    from trials.analysis.metrics import record_metrics
 
     a, b = record_metrics(ref, None, 3.0), record_metrics(read_record(p), None, 3.0)
     assert a.keys() == b.keys()
@@ -282,9 +282,9 @@ def test_nan_in_a_required_column_still_refused(simulated, tmp_path):
 def log_file(tmp_path_factory):
     from dataclasses import replace
 
-    from trials.logio import write_csv
-    from trials.run import run_trial
-    from trials.trial import load_trial
+    from trials.files.logio import write_csv
+    from trials.runs.run import run_trial
+    from trials.runs.trial import load_trial
 
     from .conftest import CONFIGS
 

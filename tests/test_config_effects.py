@@ -23,7 +23,7 @@ THREE_M = {"name": "turn", "ship": "esso_osaka_3m", "approach": {"speed": "0.4 m
 
 
 def _trial(**extra):
-    from trials.trial import trial_from_dict
+    from trials.runs.trial import trial_from_dict
 
     return trial_from_dict({**THREE_M, **extra})
 
@@ -121,7 +121,7 @@ def test_logged_apparent_wind_gives_back_the_configured_true_wind(tmp_path):
     """mmg simulate writes the apparent wind; the true wind follows back from it, the ship's
     velocity over ground and its heading (the dataset's convention, mmg.wind)."""
     from mmg.wind import true_wind_from_relative
-    from trials.logio import read_record
+    from trials.files.logio import read_record
 
     eff = {"wind": {"true_speed_mps": 2.0, "true_from_deg": 45.0}, "current": {"speed_mps": 0.05, "direction_deg": 90.0}}
     r = subprocess.run([sys.executable, "-m", "trials.cli", "simulate", _write(tmp_path, {**THREE_M, "effects": eff}),
@@ -179,7 +179,7 @@ def _ship_with_effects(effects):
 
 
 def _on(ship, **extra):
-    from trials.trial import trial_from_dict
+    from trials.runs.trial import trial_from_dict
 
     return trial_from_dict({**{k: v for k, v in THREE_M.items() if k != "ship"}, **extra}, source="<t>", ship=ship)
 
@@ -205,7 +205,7 @@ def test_shallow_water_widens_the_turning_circle():
 def test_replay_applies_the_ship_configs_effects():
     """A record simulated with a current, a rudder offset and a compass bias in the ship config
     replays against that config to the integration error, and badly against the config without them."""
-    from trials.predict import replay_record
+    from trials.measured.predict import replay_record
 
     eff = {"current": {"speed_mps": 0.06, "direction_deg": 120.0}, "rudder_offset": {"offset_deg": 1.0},
            "heading_bias": {"bias_deg": 1.5}}
@@ -231,7 +231,7 @@ def test_replay_applies_the_ship_configs_effects():
     ({"rudder_offset": {"offset_deg": float("nan")}}, "effects.rudder_offset.offset_deg"),
 ])
 def test_bad_effects_refused_naming_file_and_field(tmp_path, effects, field):
-    from trials.trial import load_trial
+    from trials.runs.trial import load_trial
 
     p = tmp_path / "t.yaml"
     p.write_text(yaml.safe_dump({**THREE_M, "effects": effects}))
@@ -241,7 +241,7 @@ def test_bad_effects_refused_naming_file_and_field(tmp_path, effects, field):
 
 
 def test_effect_given_twice_refused(tmp_path):
-    from trials.trial import load_trial
+    from trials.runs.trial import load_trial
 
     p = tmp_path / "t.yaml"
     p.write_text(yaml.safe_dump({**THREE_M, "disturbances": {"rudder_offset": "1 deg"},
@@ -251,7 +251,7 @@ def test_effect_given_twice_refused(tmp_path):
 
 
 def test_wind_effect_needs_a_wind_section(tmp_path):
-    from trials.trial import load_trial
+    from trials.runs.trial import load_trial
 
     from mmg.resources import config_path
 
@@ -298,7 +298,7 @@ def _hidden_records(effects):
     them, with ``effects`` in the trial configs, logged as the FRT-DS-ESSO files log (TrialRun.record)."""
     from mmg.resources import config_path
     from mmg.ship import ship_from_dict
-    from trials.trial import trial_from_dict
+    from trials.runs.trial import trial_from_dict
 
     data = yaml.safe_load(Path(config_path("ships", "esso_osaka_3m.yaml")).read_text())
     data["mass"]["m_x_prime"] *= 1.08
@@ -316,7 +316,7 @@ def _hidden_records(effects):
 
 
 def test_diagnose_names_current_and_offset_hidden_in_trial_configs():
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     d = diagnose(mmg.load_ship("esso_osaka_3m"), _hidden_records(
         {"current": {"speed_mps": 0.03, "direction_deg": 200.0}, "rudder_offset": {"offset_deg": 1.0}}))
@@ -331,7 +331,7 @@ def test_diagnose_names_current_and_offset_hidden_in_trial_configs():
 
 @pytest.mark.slow
 def test_diagnose_names_a_steady_wind_of_a_trial_config_from_the_logged_apparent_wind():
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     d = diagnose(mmg.load_ship("esso_osaka_3m"), _hidden_records(
         {"wind": {"true_speed_mps": 2.0, "true_from_deg": 60.0}}))       # the scale: the ship's wind.scale, 1

@@ -21,7 +21,7 @@ from mmg.limits import MAX_STEPS
 from mmg.resources import bundled
 from mmg.ship import Ship, load_ship, parse_yaml, ship_from_dict
 from mmg.units import UNITS, to_si
-from trials.trial import Trial, load_trial, trial_from_dict
+from trials.runs.trial import Trial, load_trial, trial_from_dict
 
 from .conftest import CONFIGS
 

@@ -32,7 +32,7 @@ def truth(ship):
 
 
 def _records(ship, truth, effects, wind=(0.0, 0.0)):
-    from trials.diagnose import synthetic_record
+    from trials.measured.diagnose import synthetic_record
 
     return [synthetic_record(ship, "turning", effects, truth_ship=truth, true_wind=wind, seed=1, name="turn"),
             synthetic_record(ship, "zigzag", effects, truth_ship=truth, true_wind=wind, seed=2, name="zigzag")]
@@ -47,7 +47,7 @@ def _check_fall(d, effect):
 
 @pytest.fixture(scope="module")
 def clean(ship, truth):
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     return diagnose(ship, _records(ship, truth, {}))
 
@@ -63,7 +63,7 @@ def test_candidate_without_channels_skipped_with_reason(clean):
 
 
 def test_current_found(ship, truth):
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     d = diagnose(ship, _records(ship, truth, {"current": {"speed_mps": 0.04, "direction_deg": 60.0}}))
     assert d.named == ["current"]
@@ -81,7 +81,7 @@ def test_shallow_water_found(ship, truth):
     determined (the baseline frees Y_beta, Y_r, N_beta, N_r, which the shallow-water factors scale):
     a 1.55 estimate for 1.3, so only 'clearly shallow' (below 2) is asserted.  Milder depths (1.6 x
     draft) are absorbed by the freed coefficients and not named."""
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     d = diagnose(ship, _records(ship, truth, {"shallow_water": {"depth_to_draft": 1.3}}))
     assert d.named == ["shallow_water"]
@@ -91,7 +91,7 @@ def test_shallow_water_found(ship, truth):
 
 @pytest.mark.slow
 def test_rudder_offset_found(ship, truth):
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     d = diagnose(ship, _records(ship, truth, {"rudder_offset": {"offset_deg": 1.0}}))
     assert d.named == ["rudder_offset"]
@@ -101,7 +101,7 @@ def test_rudder_offset_found(ship, truth):
 
 @pytest.mark.slow
 def test_heading_bias_found(ship, truth):
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     d = diagnose(ship, _records(ship, truth, {"heading_bias": {"bias_deg": 1.0}}))
     assert d.named == ["heading_bias"]
@@ -111,7 +111,7 @@ def test_heading_bias_found(ship, truth):
 
 @pytest.mark.slow
 def test_wind_found(ship, truth):
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     d = diagnose(ship, _records(ship, truth, {"wind": {"scale": 1.0}}, wind=(2.0, 1.0)), wind=False)
     assert d.named == ["wind"]
@@ -121,7 +121,7 @@ def test_wind_found(ship, truth):
 
 @pytest.mark.slow
 def test_current_and_rudder_offset_both(ship, truth):
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     d = diagnose(ship, _records(ship, truth, {"current": {"speed_mps": 0.03, "direction_deg": 200.0},
                                               "rudder_offset": {"offset_deg": -1.0}}))
@@ -138,7 +138,7 @@ def _mmg(*args):
 def test_records_named_after_their_files(tmp_path, ship, clean):
     """Issue 24: records are named after their files in the JSON and the plots (DIR/<name>.png): two
     files of one stem (one trial recorded on two days) told apart by their folders, not ``x`` twice."""
-    from trials.diagnose import prepare, synthetic_record, write_frt_csv
+    from trials.measured.diagnose import prepare, synthetic_record, write_frt_csv
 
     paths = []
     for day in ("day1", "day2"):
@@ -160,7 +160,7 @@ def test_cli_malformed_record_one_line(tmp_path):
 
 @pytest.mark.slow
 def test_cli_on_frt_format_file(tmp_path, ship):
-    from trials.diagnose import synthetic_record, write_frt_csv
+    from trials.measured.diagnose import synthetic_record, write_frt_csv
 
     p = tmp_path / "zz.csv"
     write_frt_csv(synthetic_record(ship, "zigzag", {"rudder_offset": {"offset_deg": 1.0}}), p)
@@ -188,7 +188,7 @@ def test_real_slice_with_zero_wind_and_constant_rpm(tmp_path, ship):
     """A real zigzag slice with its wind columns zeroed: wind skipped with the reason, no crash."""
     import pandas as pd
 
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     src = sorted((FRT / "zigzag").glob("*.csv"))[0]
     df = pd.read_csv(src).dropna().iloc[:600]

@@ -12,7 +12,7 @@ from ekf.data import PAPER_DERIVATIVES as DERIVATIVES, estimable_names, hull_slo
 from ekf.filter import AugmentedEKF, FilterDivergence, is_pd, propagate_jacobian, run_filter
 from mmg.simulation import prepare
 from trials.cli import main
-from trials.trial import load_trial
+from trials.runs.trial import load_trial
 
 REPO = Path(__file__).resolve().parents[1]
 ZZ20 = REPO / "configs" / "trials" / "zz20.yaml"
@@ -22,8 +22,8 @@ NZ = 4 + len(DERIVATIVES)
 @pytest.fixture(scope="module")
 def short_zz(tmp_path_factory):
     """ZZ20 shortened to 600 s, simulated once, log and truth written."""
-    from trials.logio import write_csv
-    from trials.run import run_trial
+    from trials.files.logio import write_csv
+    from trials.runs.run import run_trial
 
     tr = replace(load_trial(ZZ20), duration=600.0)
     run = run_trial(tr)
@@ -96,11 +96,11 @@ def test_filterpy_update_is_joseph_and_matches_compiled(packed):
 
 def test_preprocessing_recovers_uvr(short_zz, packed):
     from ekf.preprocess import compare_with_truth, recover
-    from trials.logio import read_record
+    from trials.files.logio import read_record
 
     tr, d = short_zz
     _, pk, _ = packed
-    from trials.estimation import record_info
+    from trials.estimates.estimation import record_info
 
     rec = read_record(d / "log.csv")
     info = record_info(rec)
@@ -206,7 +206,7 @@ def test_free_run_catches_a_filter_that_converged_to_the_wrong_model(short_zz, t
 
 def test_free_run_with_the_true_derivatives_reproduces_the_log(short_zz):
     from ekf.estimate import free_run, load_config
-    from trials.estimation import data_from_log
+    from trials.estimates.estimation import data_from_log
 
     _, d = short_zz
     data = data_from_log(d / "log.csv", load_config(), truth_path=d / "truth.csv")
@@ -223,9 +223,9 @@ def test_free_run_judges_heading_not_a_current_drifted_track(tmp_path):
     """An unmodelled current moves the track, not the heading: the true derivatives still pass."""
     from ekf.estimate import free_run, load_config
     from mmg.disturbances import UniformCurrent
-    from trials.logio import write_csv
-    from trials.estimation import data_from_log
-    from trials.run import run_trial
+    from trials.files.logio import write_csv
+    from trials.estimates.estimation import data_from_log
+    from trials.runs.run import run_trial
 
     tr = replace(load_trial(ZZ20), duration=600.0)
     tr = replace(tr, disturbances=(UniformCurrent(speed=0.3 * 0.5144, direction=np.radians(90.0)),))
@@ -242,7 +242,7 @@ def test_free_run_judges_heading_not_a_current_drifted_track(tmp_path):
 def test_estimate_filterpy_engine_gives_the_compiled_numbers(short_zz):
     """The filterpy class a user can step is the same filter as the compiled fast path."""
     from ekf.estimate import estimate, load_config
-    from trials.estimation import data_from_log
+    from trials.estimates.estimation import data_from_log
 
     _, d = short_zz
     cfg = load_config(None, ["divergence.nis_max=0"])

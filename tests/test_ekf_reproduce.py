@@ -6,7 +6,7 @@ import pytest
 
 @pytest.mark.slow
 def test_reproduce_rhee_kim(tmp_path):
-    from trials.rhee_kim import reproduce_rhee_kim
+    from trials.estimates.rhee_kim import reproduce_rhee_kim
 
     df = reproduce_rhee_kim(tmp_path, plots=False, verbose=False)
     assert set(df.trial) == {"ST35", "ZZ10", "ZZ20", "S-type 120", "joint"}

@@ -9,8 +9,8 @@ import mmg
 from ekf.identify import Scales, Segmented, free_parameters, identify_segments, segment_resets
 from mmg.model import pack
 from mmg.replay import ReplayInputs, replay
-from trials.identify import identify, ship_yaml, write_identification
-from trials.predict import MeasuredRun
+from trials.measured.identify import identify, ship_yaml, write_identification
+from trials.measured.predict import MeasuredRun
 
 SHIP = "esso_osaka_3m"
 
@@ -168,7 +168,7 @@ def test_rudder_constants_and_added_masses_can_be_freed_and_are_written_back(tmp
 
 def _fake_run(name, rps, n_rows=50, seed=0, meas=None):
     from mmg.replay import ReplayInputs
-    from trials.predict import MeasuredRun
+    from trials.measured.predict import MeasuredRun
 
     rng = np.random.default_rng(seed)
     t = np.arange(n_rows) * 0.1
@@ -179,7 +179,7 @@ def _fake_run(name, rps, n_rows=50, seed=0, meas=None):
 def test_a_cut_copy_of_a_record_stays_in_its_records_fold():
     """The FRT set's turn_cut_* files are the first minutes of another file: kept out, a record's copy
     must not be in its training set (the CV would then score partly in-sample)."""
-    from trials.identify import fold_of, same_run_groups
+    from trials.measured.identify import fold_of, same_run_groups
 
     runs = [_fake_run(f"r{i}", 10, seed=i) for i in range(7)]
     runs.append(_fake_run("r3_cut", 10, n_rows=20, meas=runs[3].meas[:20].copy()))
@@ -192,7 +192,7 @@ def test_a_cut_copy_of_a_record_stays_in_its_records_fold():
 
 
 def test_folds_by_revolutions_spread_every_revolution_band_over_the_folds():
-    from trials.identify import fold_of
+    from trials.measured.identify import fold_of
 
     rps = [8, 8, 8, 8, 10, 10, 10, 10, 12, 12, 15, 16.7, 16.7, 10, 10, 10]
     runs = [_fake_run(f"r{i}", n, seed=i) for i, n in enumerate(rps)]
@@ -212,7 +212,7 @@ def test_a_rudder_offset_is_recovered_and_written_back_as_the_effect(tmp_path):
     finds it, ship.yaml carries it as the ``rudder_offset`` effect, and that config replays the
     records as the identification scored them (what ``mmg predict --ship DIR/ship.yaml`` does)."""
     from mmg.model import P_RUDDER_OFFSET
-    from trials.predict import replay_record
+    from trials.measured.predict import replay_record
 
     ship = mmg.load_ship(SHIP)
     pk = pack(ship)

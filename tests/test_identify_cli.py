@@ -95,7 +95,7 @@ def test_cv_with_one_independent_run_is_refused_before_any_fit(tmp_path, capsys)
 def test_cv_narrowed_to_the_independent_runs(tmp_path, capsys):
     """--cv 4 over two runs uses two folds (each record kept out once, said in a note), not four fits
     of which two keep nothing out."""
-    from trials.identify import cv_folds, load_runs
+    from trials.measured.identify import cv_folds, load_runs
 
     import mmg
 
@@ -189,7 +189,7 @@ def test_max_nfev_stages_labelled_and_explained(tmp_path, capsys):
     stopped = re.findall(r"^note: (.+) stopped at its evaluation limit \(2\)", err, flags=re.M)
     assert stopped == re.findall(r"^\d\. ([\w-]+ fit): .*stopped at its evaluation limit", rep, flags=re.M)
     # the limit reaches the fit (the library's stages record it) and more evaluations are allowed
-    from trials.identify import identify, load_runs
+    from trials.measured.identify import identify, load_runs
 
     import mmg
 
@@ -202,7 +202,7 @@ def test_max_nfev_stages_labelled_and_explained(tmp_path, capsys):
 def test_records_named_after_their_files_in_the_report(tmp_path, capsys):
     """Two records of one stem (two days' zz.csv) are two rows of the report, told apart by their folders
     (a test record of that stem too)."""
-    from trials.identify import load_runs
+    from trials.measured.identify import load_runs
 
     import mmg
 

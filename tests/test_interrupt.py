@@ -1,7 +1,7 @@
 """SIGTERM and SIGINT while a command works: one line ``interrupted``, exit 143 / 130, nothing left.
 
 The commands run as real processes (the installed ``mmg`` script); the signal is sent at a point the
-test controls, whatever the machine's speed: ``MMG_TEST_PAUSE`` (:mod:`trials.pausepoint`) makes the
+test controls, whatever the machine's speed: ``MMG_TEST_PAUSE`` (:mod:`trials.files.pausepoint`) makes the
 command wait at a named point (its staging folder made, a file of its output written, a sweep worker
 started, ...) and say so with a marker file; the test signals once the marker is there, while the command
 is known to wait (it would go on after 120 s).
@@ -29,7 +29,7 @@ def mmg_argv() -> list:
 
 
 def start_paused(args, point: str, markers: Path, cwd=None, group: bool = True):
-    """Start ``mmg args`` told to wait at ``point`` (:mod:`trials.pausepoint`); returns the process."""
+    """Start ``mmg args`` told to wait at ``point`` (:mod:`trials.files.pausepoint`); returns the process."""
     markers.mkdir(parents=True, exist_ok=True)
     env = {**os.environ, "PYTHONUNBUFFERED": "1", "MMG_TEST_PAUSE": f"{point}:{markers}"}
     return subprocess.Popen(mmg_argv() + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd,
@@ -155,7 +155,7 @@ def _group(pgid: int, running_only=False) -> list:
 
 def test_pause_point_is_inert_without_the_variable(monkeypatch, tmp_path):
     """The hook does nothing unless MMG_TEST_PAUSE names the point (it returns at once)."""
-    from trials import pausepoint
+    from trials.files import pausepoint
 
     monkeypatch.delenv(pausepoint.ENV, raising=False)
     monkeypatch.setattr(pausepoint, "_done", set())
@@ -216,14 +216,14 @@ def test_interrupt_wrapped_by_a_library_is_recognised():
 
 def test_pool_workers_started_in_children_ignore_sigint_miss_ctrl_c():
     """A terminal's Ctrl-C goes to the whole process group: workers started inside
-    :func:`trials.output.children_ignore_sigint` never see it (no traceback from each of them);
+    :func:`trials.files.output.children_ignore_sigint` never see it (no traceback from each of them);
     the main process gets it, and with mmg's handler nothing else is printed (joblib's warning
     and logged callback errors as the pool is shut down)."""
     r = _python("""
         import os, signal, sys, time
         from joblib import Parallel, delayed, parallel_backend
         from trials import cli
-        from trials.output import children_ignore_sigint
+        from trials.files.output import children_ignore_sigint
 
         def work(i):
             time.sleep(0.5)

@@ -24,8 +24,8 @@ from ekf.kernels import jacobian_step, jacobian_step_reference, make_workspace
 from mmg._jit import readonly
 from mmg.model import N_, PSI_, R_, U_, V_, X_, Y_, inverse_mass, rhs, rhs_hull_jacobian
 from mmg.simulation import prepare
-from trials.estimation import data_from_trial
-from trials.trial import load_trial
+from trials.estimates.estimation import data_from_trial
+from trials.runs.trial import load_trial
 
 REPO = Path(__file__).resolve().parents[1]
 TRIALS = {"esso_osaka": REPO / "configs" / "trials" / "zz20.yaml",

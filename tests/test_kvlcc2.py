@@ -23,7 +23,7 @@ from mmg.integrate import CommandLaw
 from mmg.ship import load_ship
 from mmg.simulation import simulate
 from mmg.units import DEG
-from trials.metrics import turning_metrics
+from trials.analysis.metrics import turning_metrics
 
 REPO = Path(__file__).resolve().parents[1]
 YAML = REPO / "configs" / "ships" / "kvlcc2_l7.yaml"

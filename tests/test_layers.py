@@ -1,6 +1,12 @@
 """The layers, checked from the source's import statements (those inside functions included).
 
 physics (``mmg.*``) < estimators (``ekf.*``) < trials, data, reports and the CLI (``trials.*``).
+Inside ``trials`` every module belongs to a sub-package, and each sub-package may import only the
+ones :data:`MAY_IMPORT` names for it (as its ``__init__`` docstring says):
+
+    files < analysis < runs < estimates < planning < papers < cli, with measured above analysis
+    (beside runs: it needs no simulated trial) and below cli; ekf only from measured upwards.
+
 No module imports from a layer above its own, no module imports a top-level package facade
 (``import mmg``: that ``__init__`` re-exports from every layer, so it is for users, not for the
 library's own modules), and there is no import cycle between modules (a sub-package's
@@ -17,6 +23,25 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("mmg", "ekf", "trials")
 LAYER = {"mmg": 0, "ekf": 1, "trials": 2}
+
+# what each trials sub-package may import besides itself (mmg, ekf: the layers below trials)
+_LOW = {"mmg"}
+MAY_IMPORT = {
+    "files": _LOW,
+    "analysis": _LOW | {"files"},
+    "runs": _LOW | {"files", "analysis"},
+    "measured": _LOW | {"ekf", "files", "analysis"},
+    "estimates": _LOW | {"ekf", "files", "analysis", "runs"},
+    "planning": _LOW | {"ekf", "files", "analysis", "runs", "estimates"},
+    "papers": _LOW | {"ekf", "files", "analysis", "runs", "estimates", "planning"},
+    "cli": _LOW | {"ekf", "files", "analysis", "runs", "measured", "estimates", "planning", "papers"},
+}
+
+
+def _part(name: str) -> str:
+    """``mmg``, ``ekf``, or the trials sub-package (``files``, ``runs``, ...) module ``name`` is in."""
+    parts = name.split(".")
+    return parts[1] if parts[0] == "trials" and len(parts) > 1 else parts[0]
 
 
 def modules(root: Path) -> dict[str, Path]:
@@ -73,6 +98,13 @@ def violations(root: Path) -> list[str]:
                 out.append(f"{m} imports the package facade {d} (import the module that defines the name)")
             elif LAYER[d.split(".")[0]] > LAYER[m.split(".")[0]]:
                 out.append(f"{m} (layer {m.split('.')[0]}) imports {d} from a layer above")
+            elif m.startswith("trials.") and _part(m) in MAY_IMPORT and _part(d) != _part(m) \
+                    and _part(d) not in MAY_IMPORT[_part(m)]:
+                out.append(f"{m} (trials.{_part(m)}) imports {d}: trials.{_part(m)} may import only "
+                           f"{', '.join(sorted(MAY_IMPORT[_part(m)]))}")
+    for m in mods:
+        if m.startswith("trials.") and _part(m) not in MAY_IMPORT:
+            out.append(f"{m} is in no trials sub-package of MAY_IMPORT (put it in the one it belongs to)")
     # cycles among the non-facade modules (depth-first search; each cycle reported once)
     inner = {m: {d for d in deps if d not in facades} for m, deps in edges.items() if m not in facades}
     state, stack, seen = {}, [], set()
@@ -115,11 +147,20 @@ def _tree(tmp_path: Path, files: dict) -> Path:
 
 
 @pytest.mark.parametrize("files, expect", [
-    ({"mmg/a.py": "def f():\n    from trials.b import g\n", "trials/b.py": "g = 1\n"}, "from a layer above"),
-    ({"ekf/a.py": "from trials import b\n", "trials/b.py": ""}, "from a layer above"),
-    ({"trials/a.py": "from .b import x\n", "trials/b.py": "def h():\n    from . import a\n"}, "import cycle"),
-    ({"trials/a.py": "import mmg\n", "mmg/b.py": ""}, "package facade"),
-    ({"ekf/sub/__init__.py": "", "ekf/sub/a.py": "from ...trials import c\n", "trials/c.py": ""}, "from a layer above"),
+    ({"mmg/a.py": "def f():\n    from trials.runs.b import g\n", "trials/runs/b.py": "g = 1\n"}, "from a layer above"),
+    ({"ekf/a.py": "from trials.files import b\n", "trials/files/b.py": ""}, "from a layer above"),
+    ({"trials/runs/a.py": "from .b import x\n", "trials/runs/b.py": "def h():\n    from . import a\n"},
+     "import cycle"),
+    ({"trials/files/a.py": "import mmg\n", "mmg/b.py": ""}, "package facade"),
+    ({"ekf/sub/__init__.py": "", "ekf/sub/a.py": "from ...trials.files import c\n", "trials/files/c.py": ""},
+     "from a layer above"),
+    # inside trials: a sub-package importing one above it or beside it, or ekf below measured
+    ({"trials/files/a.py": "def f():\n    from ..runs.b import g\n", "trials/runs/b.py": ""}, "may import only"),
+    ({"trials/analysis/nomoto/a.py": "from trials.planning import b\n", "trials/planning/b.py": ""},
+     "may import only"),
+    ({"trials/measured/a.py": "from trials.runs.b import g\n", "trials/runs/b.py": ""}, "may import only"),
+    ({"trials/runs/a.py": "from ekf import b\n", "ekf/b.py": ""}, "may import only"),
+    ({"trials/a.py": ""}, "in no trials sub-package"),
 ])
 def test_the_checker_catches(tmp_path, files, expect):
     """The checker itself: an upward import (also inside a function or relative), a cycle and a facade
@@ -130,6 +171,11 @@ def test_the_checker_catches(tmp_path, files, expect):
 
 def test_the_checker_accepts_downward_imports(tmp_path):
     root = _tree(tmp_path, {"mmg/a.py": "", "ekf/b.py": "from mmg.a import x\n",
-                            "trials/c.py": "from ekf import b\nfrom mmg import a\n",
-                            "mmg/__init__.py": "def __getattr__(n):\n    from trials import c\n"})
+                            "trials/estimates/c.py": "from ekf import b\nfrom mmg import a\n"
+                                                     "from ..runs import d\nfrom trials.files.e import y\n",
+                            "trials/runs/d.py": "from ..analysis.nomoto.f import z\n", "trials/files/e.py": "",
+                            "trials/analysis/nomoto/f.py": "from trials.files import e\n",
+                            "trials/cli/g.py": "from ..measured import h\nfrom ..papers import i\n",
+                            "trials/measured/h.py": "", "trials/papers/i.py": "",
+                            "mmg/__init__.py": "def __getattr__(n):\n    from trials.runs import d\n"})
     assert violations(root) == []

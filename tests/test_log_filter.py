@@ -9,7 +9,7 @@ from ekf.estimate import load_config
 from ekf.filter import is_pd
 from ekf.log_filter import ND, log_measurements, run_log_filter
 from mmg.rudder import reversal_timing_errors
-from trials.estimation import data_from_trial
+from trials.estimates.estimation import data_from_trial
 
 REPO = Path(__file__).resolve().parents[1]
 NZ = ND + len(DERIVATIVES)

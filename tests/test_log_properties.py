@@ -15,11 +15,11 @@ from dataclasses import replace
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from mmg.errors import InputError
-from trials.logio import FLOAT_FORMAT, read_record
-from trials.metrics import record_metrics
-from trials.records import TrialRecord
-from trials.run import run_trial
-from trials.trial import load_trial
+from trials.files.logio import FLOAT_FORMAT, read_record
+from trials.analysis.metrics import record_metrics
+from trials.files.records import TrialRecord
+from trials.runs.run import run_trial
+from trials.runs.trial import load_trial
 
 from .conftest import CONFIGS, FRT
 

@@ -5,9 +5,9 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from mmg.errors import InputError
-from trials.logio import LOG_COLUMNS, read_record, write_csv
-from trials.run import run_trial
-from trials.trial import load_trial
+from trials.files.logio import LOG_COLUMNS, read_record, write_csv
+from trials.runs.run import run_trial
+from trials.runs.trial import load_trial
 
 from .conftest import CONFIGS, FRT, needs_frt
 

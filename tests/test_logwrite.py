@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from trials.logwrite import FLOAT_FORMAT, format_table, formattable, header, write_table
+from trials.files.logwrite import FLOAT_FORMAT, format_table, formattable, header, write_table
 
 floats = st.floats(allow_nan=False, allow_infinity=True, width=64)
 

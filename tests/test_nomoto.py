@@ -1,4 +1,4 @@
-"""Nomoto models and zigzag identification (trials/nomoto/, artyszuk.py, the ``mmg nomoto`` commands)."""
+"""Nomoto models and zigzag identification (trials/analysis/nomoto/, artyszuk.py, the ``mmg nomoto`` commands)."""
 from __future__ import annotations
 
 import dataclasses
@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from mmg.errors import InputError
-from trials import artyszuk as a
-from trials import nomoto as nm
+from trials.papers import artyszuk as a
+from trials.analysis import nomoto as nm
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "frt-ds-esso"
 CONFIGS = Path(__file__).resolve().parents[1] / "configs" / "nomoto"
@@ -199,7 +199,7 @@ def _write_log(path, rec):
 
 
 def test_cli_on_simulated_log_writes_json_and_png(tmp_path, sim2, capsys):
-    pytest.importorskip("trials.logio")
+    pytest.importorskip("trials.files.logio")
     log = tmp_path / "zz.csv"
     _write_log(log, a.sim_record(sim2, ds=0.02))
     from trials.cli import main
@@ -235,7 +235,7 @@ def test_nan_in_record(sim2):
 
 
 def test_cli_bad_input_exit_2(tmp_path, sim2, capsys):
-    pytest.importorskip("trials.logio")
+    pytest.importorskip("trials.files.logio")
     from trials.cli import main
 
     log = tmp_path / "turn.csv"
@@ -249,7 +249,7 @@ def test_cli_bad_input_exit_2(tmp_path, sim2, capsys):
 # ---- acceptance 5: real data ------------------------------------------------------------
 @pytest.mark.skipif(not (DATA / "zigzag").is_dir(), reason="FRT-DS-ESSO data not present")
 def test_real_zigzag_identifies_without_error():
-    logio = pytest.importorskip("trials.logio")
+    logio = pytest.importorskip("trials.files.logio")
     f = sorted((DATA / "zigzag").glob("*13_04_24.csv"))[0]
     ident = nm.identify(logio.read_record(f), 3.0, output_error=False)
     assert ident.zigzag.s_os and ident.classical.K > 0

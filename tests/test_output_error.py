@@ -12,10 +12,10 @@ from ekf.data import PAPER_DERIVATIVES as DERIVATIVES
 from ekf.estimate import load_config
 from ekf.output_error.fit import _Problem
 from mmg.model import PSI_, V_, X_, Y_
-from trials.estimation import data_from_log, noise_half_widths
-from trials.logio import write_csv
-from trials.run import run_trial
-from trials.trial import load_trial
+from trials.estimates.estimation import data_from_log, noise_half_widths
+from trials.files.logio import write_csv
+from trials.runs.run import run_trial
+from trials.runs.trial import load_trial
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -84,8 +84,8 @@ def test_standard_errors_positive_and_shrink_with_more_data(st35_short):
 def test_joint_information_of_the_paper_trials(tmp_path):
     """Cramér-Rao standard errors of the joint four-trial fit at the paper's noise: all but N_bb well below 5 %."""
     cfg = load_config()
-    from trials.estimation import data_from_trial
-    from trials.rhee_kim import TRIALS
+    from trials.estimates.estimation import data_from_trial
+    from trials.estimates.rhee_kim import TRIALS
     datas = [data_from_trial(REPO / "configs" / "trials" / f, cfg) for f in TRIALS.values()]
     tv = np.array([datas[0].true_values[n] for n in DERIVATIVES])
     _, se = oe.information([oe.trial_from_data(d) for d in datas], tv)

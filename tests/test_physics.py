@@ -7,7 +7,7 @@ from mmg.integrate import CommandLaw
 from mmg.kijima import compare
 from mmg.simulation import prepare, simulate
 from mmg.units import DEG, KNOT
-from trials.metrics import turning_metrics
+from trials.analysis.metrics import turning_metrics
 
 U0 = 10 * KNOT
 

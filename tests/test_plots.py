@@ -1,4 +1,4 @@
-"""Saved figures draw long lines through a min-max decimation (``trials.plots.min_max_decimate``):
+"""Saved figures draw long lines through a min-max decimation (``trials.files.plots.min_max_decimate``):
 properties that make it lossless at the drawn resolution, on arbitrary series (hypothesis)."""
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from trials.plots import min_max_decimate
+from trials.files.plots import min_max_decimate
 
 matplotlib.use("Agg")                      # no window (as tests/test_api.py)
 
@@ -40,7 +40,7 @@ def test_every_bucket_keeps_its_extremes_in_time_order(n, buckets, seed, spikes)
 
 
 def test_a_saved_histories_figure_draws_decimated_lines_a_shown_one_every_sample():
-    from trials.plots import histories_figure
+    from trials.files.plots import histories_figure
 
     t = np.arange(30000) * 0.1
     z = np.sin(t / 50.0)

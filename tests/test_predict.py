@@ -1,8 +1,8 @@
-"""Replay of records against their own inputs (``trials.predict``, ``mmg predict``): issue 11.
+"""Replay of records against their own inputs (``trials.measured.predict``, ``mmg predict``): issue 11.
 
 * Acceptance 4: the full-scale simulator's own truth files replayed with their true rudder and
   revolutions reproduce the truth (heading RMS < 0.05 deg), through the project's writers and
-  :func:`trials.logio.read_record`, so the replay, the readers and the conventions are checked
+  :func:`trials.files.logio.read_record`, so the replay, the readers and the conventions are checked
   end to end; a project sea-trial log (no rudder channel, the rudder rebuilt) to a justified
   tolerance.
 * ``mmg predict`` end to end on small slices of the real FRT-DS-ESSO files (``../shared``,
@@ -50,7 +50,7 @@ def ship3m():
 def simulated(tmp_path_factory):
     """ST35 and ZZ20 of the full-scale ship simulated once, truth and log written by the project's writer."""
     import mmg
-    from trials.logio import write_csv
+    from trials.files.logio import write_csv
 
     d = tmp_path_factory.mktemp("simulated")
     out = {}
@@ -70,8 +70,8 @@ def test_replay_of_the_simulators_truth_file_reproduces_it(simulated, name):
     The simulator integrates the steering gear and the shaft inside its RK4 step; the replay
     interpolates the rudder and revolutions linearly between the 0.1 s samples, which costs
     ~1e-5 deg of heading over 3000 s, far inside the issue's 0.05 deg."""
-    from trials.logio import read_record
-    from trials.predict import replay_record
+    from trials.files.logio import read_record
+    from trials.measured.predict import replay_record
 
     res, truth, _ = simulated[name]
     ship = res.trial.ship
@@ -98,8 +98,8 @@ def test_replay_of_a_project_sea_trial_log(simulated, name):
     the spline through the heading), the rpm noise (0.2 rpm) prescribed as n(t) and the spline
     interpolation of 5 s samples; measured: ST35 0.38 deg over 3000 s of turning, ZZ20 0.09 deg.
     Position: 0.1 L after 3000 s (measured 0.02-0.04 L)."""
-    from trials.logio import read_record
-    from trials.predict import replay_record
+    from trials.files.logio import read_record
+    from trials.measured.predict import replay_record
 
     res, _, log = simulated[name]
     ship = res.trial.ship
@@ -152,7 +152,7 @@ def _run_cli(argv, capsys):
 @needs_frt
 def test_cli_predict_end_to_end(slices, tmp_path, ship3m, capsys):
     """``mmg predict`` on two slices: exact JSON layout, the library's numbers, one line per run, the plots."""
-    from trials.predict import predict
+    from trials.measured.predict import predict
 
     js, plots = tmp_path / "out" / "pred.json", tmp_path / "plots"
     rc, out, err = _run_cli(["predict", "--ship", "esso_osaka_3m", *slices, "--json", js, "--plots", plots], capsys)
@@ -200,7 +200,7 @@ def test_two_records_of_one_trial_are_named_after_their_files(tmp_path, capsys):
 
 
 def test_record_labels_are_unique_and_deterministic(tmp_path):
-    from trials.output import record_labels
+    from trials.files.output import record_labels
 
     paths = [tmp_path / "x" / "a" / "ST35.csv", tmp_path / "y" / "a" / "ST35.csv", tmp_path / "ST35_2.csv",
              tmp_path / "z" / "ZZ.csv", tmp_path / "z" / "ZZ.txt", tmp_path / "x" / "a" / "ST35.csv"]
@@ -213,7 +213,7 @@ def test_record_labels_are_unique_and_deterministic(tmp_path):
 @needs_frt
 def test_cli_predict_wind_switch_and_start(slices, tmp_path, ship3m, capsys):
     """--wind off and --start S reach the library: the JSON equals predict(..., start, wind=False)."""
-    from trials.predict import predict
+    from trials.measured.predict import predict
 
     js = tmp_path / "p.json"
     rc, out, err = _run_cli(["predict", "--ship", "esso_osaka_3m", slices[0], "--json", js, "--wind", "off",
@@ -275,7 +275,7 @@ def test_wind_speed_in_kmh_is_refused(tmp_path, capsys):
 def test_wrapped_heading_is_unwrapped(tmp_path, ship3m):
     """The heading wrapped to [0, 2 pi) instead of (-pi, pi]: the reader unwraps it, the replay's scores are
     the same (the zigzag slice crosses psi = 0, so the [0, 2 pi) copy jumps by 2 pi there)."""
-    from trials.predict import predict
+    from trials.measured.predict import predict
 
     col = "psi_hat [rad]"
     ref = _slice(FRT / ZIGZAG, tmp_path / "ref.csv", rows=1400, edit=lambda df: None)
@@ -313,7 +313,7 @@ def _synthetic_record(ship, wind: bool):
     with a constant 2 m/s relative wind from 30 deg off the starboard bow when ``wind``."""
     from mmg.model import pack
     from mmg.replay import ReplayInputs, replay_states
-    from trials.records import TrialRecord
+    from trials.files.records import TrialRecord
 
     t = np.round(np.arange(0.0, 60.0 + 1e-9, 0.1), 10)
     delta = np.where(t >= 20.0, np.radians(20.0), 0.0)
@@ -327,7 +327,7 @@ def _synthetic_record(ship, wind: bool):
 
 
 def test_wind_changes_the_replay_only_with_wind_channels(ship3m):
-    from trials.predict import replay_record
+    from trials.measured.predict import replay_record
 
     with_w, without = _synthetic_record(ship3m, True), _synthetic_record(ship3m, False)
     on, off = replay_record(ship3m, with_w, wind=True), replay_record(ship3m, with_w, wind=False)
@@ -349,7 +349,7 @@ def test_wind_changes_the_replay_only_with_wind_channels(ship3m):
 def test_wind_on_and_off_on_a_real_slice(tmp_path, ship3m):
     """The same on a real slice: wind channels present -> wind on differs; the wind columns removed -> the
     run says 'no wind channels' and wind on equals wind off exactly."""
-    from trials.predict import predict
+    from trials.measured.predict import predict
 
     wind_cols = ("wind_velo_relative_mid [m/s]", "wind_dir_relative_mid [rad]", "wind_velo_true [m/s]",
                  "wind_dir_true [rad]")
@@ -370,9 +370,9 @@ def test_a_diverged_replay_says_where_and_scores_null(simulated, tmp_path, capsy
     ``mmg predict`` says where in one line, writes null scores and leaves it out of the mean.  The
     unchanged ship replays the same record to the end (``diverged_at`` None)."""
     from mmg.resources import ship_path
-    from trials.identify import ship_yaml
-    from trials.logio import read_record
-    from trials.predict import replay_record
+    from trials.measured.identify import ship_yaml
+    from trials.files.logio import read_record
+    from trials.measured.predict import replay_record
 
     res, truth, _ = simulated["zz20"]
     ship = res.trial.ship

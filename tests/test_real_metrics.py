@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from trials.cli import main
-from trials.logio import read_record
-from trials.metrics import record_metrics
+from trials.files.logio import read_record
+from trials.analysis.metrics import record_metrics
 
 from .conftest import FRT, needs_frt
 

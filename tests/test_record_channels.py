@@ -63,8 +63,8 @@ def test_measured_run_drops_the_wind_it_cannot_feed_and_keeps_the_rest(records):
     import mmg
     from mmg.effects import effect_set
     from dataclasses import replace
-    from trials.logio import read_record
-    from trials.predict import measured_run
+    from trials.files.logio import read_record
+    from trials.measured.predict import measured_run
 
     windy, calm = records
     ship = mmg.load_ship("esso_osaka_3m")
@@ -82,7 +82,7 @@ def test_diagnose_with_wind_on_gives_the_same_baseline_as_without_wind(records):
     """A record without wind columns: wind on (skipped) and wind off are the same model, so the same
     baseline residuals (before the fix the wind stayed in the model as NaN loads and the baseline
     came out 100 times smaller than the record's misfit)."""
-    from trials.diagnose import diagnose
+    from trials.measured.diagnose import diagnose
 
     import mmg
 
@@ -98,7 +98,7 @@ def test_identify_mixed_records_fits_the_wind_scale_on_the_windy_one(records):
     """Records with and without wind given together: each is replayed with the wind it has (the
     windy one with its measured loads, the calm one without), and the wind scale stays free."""
     import mmg
-    from trials.identify import identify
+    from trials.measured.identify import identify
 
     windy, calm = records
     said = []

@@ -6,9 +6,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from trials import artyszuk
-from trials.output import fmt, numerical_zeros
-from trials.reproduce import Report, nomoto_section, table
+from trials.papers import artyszuk
+from trials.files.output import fmt, numerical_zeros
+from trials.papers.reproduce import Report, nomoto_section, table
 
 
 def md_tables(text: str) -> list[list[list[str]]]:

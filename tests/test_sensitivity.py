@@ -8,10 +8,10 @@ import pytest
 from mmg.integrate import integrate
 from mmg.simulation import prepare
 from trials.cli import main
-from trials.fisher import _tangent_kernel, crb, criteria, fisher, movements, tangent
-from trials.sensitivity import (DERIVATIVES, LINEAR, NONLINEAR, efficiency, group_sums, normalise,
+from trials.planning.fisher import _tangent_kernel, crb, criteria, fisher, movements, tangent
+from trials.planning.sensitivity import (DERIVATIVES, LINEAR, NONLINEAR, efficiency, group_sums, normalise,
                                 sensitivity, trial_differences)
-from trials.trial import load_trial
+from trials.runs.trial import load_trial
 
 from .conftest import CONFIGS
 
@@ -229,7 +229,7 @@ def test_rudder_timing_nuisances_can_only_widen_the_bound(zigzag_tangent):
 
 
 def test_timing_bound_without_prior_drops_a_movement_the_log_never_saw():
-    from trials.fisher import trial_crb
+    from trials.planning.fisher import trial_crb
 
     tr = short("zz10", 129.95)                          # the first reversal's movement starts at 128.9 s
     tan = tangent(tr, rudder_timing=True)
@@ -294,7 +294,7 @@ def test_bad_trial_yaml_exit_2(tmp_path, capsys):
 
 
 def test_design_search_rows_carry_both_criteria():
-    from trials.design import CRITERION, TIMING, best, search
+    from trials.planning.design import CRITERION, TIMING, best, search
 
     base = short("stype120", 600.0)
     df = search(base, {"S-type psi_S": [60, 120]}, references=[short("sine", 600.0)], backend="serial")
@@ -319,9 +319,9 @@ def test_bad_rudder_timing_exits_2_naming_the_option(tmp_path, capsys, value):
 
 
 def test_crb_table_finds_a_non_paper_trial_through_its_trial_file(tmp_path):
-    """runs.csv of trials.montecarlo.log_filter_monte_carlo names each run's trial YAML, so any trial can be compared."""
+    """runs.csv of trials.estimates.montecarlo.log_filter_monte_carlo names each run's trial YAML, so any trial can be compared."""
     from mmg.errors import InputError
-    from trials.sensitivity_report import crb_table
+    from trials.planning.sensitivity_report import crb_table
 
     yml = tmp_path / "zz35_90_short.yaml"
     yml.write_text((CONFIGS / "trials" / "zz35_90.yaml").read_text().replace("duration: 3000 s", "duration: 400 s")

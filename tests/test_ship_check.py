@@ -1,4 +1,4 @@
-"""Records checked against their ship (issue 24; :mod:`trials.shipcheck`).
+"""Records checked against their ship (issue 24; :mod:`trials.files.shipcheck`).
 
 * Every command that reads a record and analyses it with a ship or a length (predict, identify,
   diagnose, metrics, nomoto, estimate with --truth) refuses a record of another ship in one line
@@ -48,10 +48,10 @@ def _refused(rc, err, path, ship_words):
 
 
 def write_frt(rec, path, scale_length: float = 1.0, scale_speed: float = 1.0) -> Path:
-    """``rec`` in the FRT-DS-ESSO column layout (:data:`trials.logio.FRT_COLUMNS`), heading wrapped to
+    """``rec`` in the FRT-DS-ESSO column layout (:data:`trials.files.logio.FRT_COLUMNS`), heading wrapped to
     (-pi, pi]; optionally moved to another ship: lengths x ``scale_length``, speeds x ``scale_speed``
     (time x scale_length / scale_speed, yaw rate / that), so r L / U is unchanged."""
-    from trials.logio import FRT_COLUMNS
+    from trials.files.logio import FRT_COLUMNS
 
     col = {v: k for k, v in FRT_COLUMNS.items()}
     ts = scale_length / scale_speed
@@ -67,7 +67,7 @@ def write_frt(rec, path, scale_length: float = 1.0, scale_speed: float = 1.0) ->
 def sims(tmp_path_factory):
     """ZZ20 (325 m Esso Osaka) and KVLCC2 ZZ20 (7 m model) simulated, log and truth written by the project."""
     import mmg
-    from trials.logio import write_csv
+    from trials.files.logio import write_csv
 
     d = tmp_path_factory.mktemp("sims")
     out = {}
@@ -84,7 +84,7 @@ def sims(tmp_path_factory):
 def model3m(tmp_path_factory, sims):
     """3 m model records in the FRT layout: a real zigzag where ../shared has it, and ZZ20's truth
     Froude-scaled to 3 m (always)."""
-    from trials.logio import read_record
+    from trials.files.logio import read_record
 
     d = tmp_path_factory.mktemp("model3m")
     lam = 3.0 / 325.0
@@ -95,7 +95,7 @@ def model3m(tmp_path_factory, sims):
 @pytest.fixture(scope="module")
 def full_frt(tmp_path_factory, sims):
     """ZZ20's truth (325 m, 5.14 m/s) in the FRT layout, and moved to a 120 m ship at 6 m/s (the issue's record)."""
-    from trials.logio import read_record
+    from trials.files.logio import read_record
 
     d = tmp_path_factory.mktemp("full_frt")
     rec = read_record(sims["zz20"][1])
@@ -189,7 +189,7 @@ def test_estimate_refuses_truth_of_another_ship(tmp_path, capsys):
     the Esso Osaka's N_r as the truth."""
     import mmg
     import yaml
-    from trials.logio import write_csv
+    from trials.files.logio import write_csv
 
     ship = yaml.safe_load((REPO / "configs" / "ships" / "esso_osaka.yaml").read_text())
     ship["name"] = "Esso Osaka sister"
@@ -210,7 +210,7 @@ def test_estimate_refuses_truth_of_another_ship(tmp_path, capsys):
     assert not (tmp_path / "est").exists()
     # with the log's own ship the header agrees: read and checked without complaint
     from ekf.estimate import load_config
-    from trials.estimation import load_inputs
+    from trials.estimates.estimation import load_inputs
 
     d = load_inputs([log], load_config(None), ship=str(ship_file), truth=str(truth))
     assert d[0].ship.name == "Esso Osaka sister"
@@ -219,7 +219,7 @@ def test_estimate_refuses_truth_of_another_ship(tmp_path, capsys):
 def test_estimate_refuses_kvlcc2_log_with_esso(sims):
     from ekf.estimate import load_config
     from mmg.errors import InputError
-    from trials.estimation import load_inputs
+    from trials.estimates.estimation import load_inputs
 
     log, truth = sims["kvlcc2_zz20"]
     for ship in ("esso_osaka", "esso_osaka_3m"):
@@ -233,7 +233,7 @@ def test_estimate_refuses_kvlcc2_log_with_esso(sims):
 
 
 def _check(path, ship):
-    from trials.shipcheck import read_for_ship
+    from trials.files.shipcheck import read_for_ship
 
     return read_for_ship(path, ship)
 
@@ -243,7 +243,7 @@ def _check(path, ship):
 def test_real_3m_records_accepted(ship):
     """Every real record (turning, zigzag, random, berthing: low speed and astern included) with the 3 m ships."""
     import mmg
-    from trials.shipcheck import ShipMismatch
+    from trials.files.shipcheck import ShipMismatch
 
     s = mmg.load_ship(ship)
     files = sorted(FRT.glob("*/*.csv"))
@@ -260,7 +260,7 @@ def test_real_3m_records_accepted(ship):
 @needs_frt
 def test_real_3m_records_refused_as_full_scale():
     import mmg
-    from trials.shipcheck import ShipMismatch
+    from trials.files.shipcheck import ShipMismatch
 
     s = mmg.load_ship("esso_osaka")
     for p in sorted(FRT.glob("*/*.csv")):
@@ -272,7 +272,7 @@ def test_real_3m_records_refused_as_full_scale():
 def test_full_scale_dev_logs_accepted_and_refused_as_models():
     """The independent simulator's full-scale logs: accepted with esso_osaka, refused with the 3 m and 7 m models."""
     import mmg
-    from trials.shipcheck import ShipMismatch
+    from trials.files.shipcheck import ShipMismatch
 
     files = sorted(DEV.glob("*.csv"))
     assert len(files) >= 30
@@ -297,7 +297,7 @@ def test_project_records_accepted_with_their_ship(sims):
 def test_project_records_refused_with_another_ship(sims, full_frt):
     """Crossed by header and, without a header (the FRT copy of ZZ20), by the kinematics alone."""
     import mmg
-    from trials.shipcheck import ShipMismatch
+    from trials.files.shipcheck import ShipMismatch
 
     esso, kv, m3 = (mmg.load_ship(k) for k in ("esso_osaka", "kvlcc2_l7", "esso_osaka_3m"))
     for p in sims["zz20"]:
@@ -320,7 +320,7 @@ def test_nomoto_frt_layout_equals_project_format(full_frt, sims, tmp_path, capsy
     (-pi, pi] which leaves it unchanged) read to the same record bit for bit, so every identification
     (the output-error fit included: a deterministic function of the record) gives the same K, T1, T2, T3;
     the CLI is run on both without the slow output-error fit and its JSON compared exactly."""
-    from trials.logio import read_record
+    from trials.files.logio import read_record
 
     truth, frt = sims["zz20"][1], full_frt[0]
     a, b = read_record(truth), read_record(frt, length_m=325.0)

@@ -4,9 +4,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from trials.sensitivity import _task
-from trials.sweep import run_sweep
-from trials.trial import load_trial
+from trials.planning.sensitivity import _task
+from trials.runs.sweep import run_sweep
+from trials.runs.trial import load_trial
 
 from .conftest import CONFIGS
 

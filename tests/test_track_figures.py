@@ -8,9 +8,9 @@ import matplotlib
 import numpy as np
 import pytest
 
-from trials.diagnose_plots import diagnose_figure
-from trials.plots import track_figure
-from trials.predict_plots import replay_figure
+from trials.measured.diagnose_plots import diagnose_figure
+from trials.files.plots import track_figure
+from trials.measured.predict_plots import replay_figure
 
 matplotlib.use("Agg")
 

@@ -4,9 +4,9 @@ import pytest
 import yaml
 
 from mmg.units import DEG
-from trials.metrics import fit_circle, turning_metrics, zigzag_metrics
-from trials.run import run_trial
-from trials.trial import load_trial, periodic_order
+from trials.analysis.metrics import fit_circle, turning_metrics, zigzag_metrics
+from trials.runs.run import run_trial
+from trials.runs.trial import load_trial, periodic_order
 
 from .conftest import CONFIGS, FRT, needs_frt
 
@@ -79,8 +79,8 @@ def test_turning_metrics_on_a_circle():
 
 @needs_frt()
 def test_real_turn_metrics_match_fact_sheet():
-    from trials.metrics import record_metrics
-    from trials.logio import read_record
+    from trials.analysis.metrics import record_metrics
+    from trials.files.logio import read_record
 
     m = record_metrics(read_record(FRT / "turning" / "turn_14-Sep-2020_13_39_32.csv"), kind="turning")
     # reduced independently in the fact sheet: 2.73 L, 1.08 L, 2.43 L
@@ -100,8 +100,8 @@ def test_reproduce_main_job(tmp_path):
 
 @needs_frt()
 def test_real_zigzag_ignores_small_approach_rudder_motions():
-    from trials.metrics import record_metrics
-    from trials.logio import read_record
+    from trials.analysis.metrics import record_metrics
+    from trials.files.logio import read_record
 
     rec = read_record(FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv")
     m = record_metrics(rec, kind="zigzag", length=3.0)

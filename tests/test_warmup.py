@@ -1,4 +1,4 @@
-"""The warm-up of numba's cache (:mod:`trials.warmup`): each group must compile the specialisation
+"""The warm-up of numba's cache (:mod:`trials.cli.warmup`): each group must compile the specialisation
 the real work then uses (a warm-up that compiles another one only costs time), and the compiled
 passes must not split into several specialisations by how they are called (a literal constant, a
 read-only or strided array each compile the whole pass again on a cold cache)."""
@@ -12,10 +12,10 @@ from mmg.ship import load_ship
 
 def test_filter_warmup_compiles_the_specialisation_a_real_pass_uses():
     """``mmg estimate`` with a cold cache compiles the filter in a child from a dummy record
-    (trials.warmup.warm_filter); that is only worth it if a real pass then needs no other one."""
+    (trials.cli.warmup.warm_filter); that is only worth it if a real pass then needs no other one."""
     from ekf.filter import filter_kernel
     from mmg import estimate, simulate, zigzag
-    from trials.warmup import warm_filter
+    from trials.cli.warmup import warm_filter
 
     def passes():              # the compiled pass itself (reference=None), not the tests' reference=True one
         return {sig for sig in filter_kernel.signatures if "omitted" in str(sig[-1])}
@@ -28,7 +28,7 @@ def test_filter_warmup_compiles_the_specialisation_a_real_pass_uses():
 
 
 def test_background_compile_is_stopped_when_the_work_fails():
-    from trials.warmup import compiling_in_background
+    from trials.cli.warmup import compiling_in_background
 
     with pytest.raises(RuntimeError):
         with compiling_in_background("filter") as compiled:
@@ -45,7 +45,7 @@ def test_replay_warmup_covers_read_only_and_strided_inputs():
     specialisation the warm-up compiled."""
     from mmg.model import pack
     from mmg.replay import ReplayInputs, _replay, replay
-    from trials.warmup import warm_replay
+    from trials.cli.warmup import warm_replay
 
     warm_replay()
     before = set(_replay.signatures)
@@ -62,7 +62,7 @@ def test_replay_warmup_covers_read_only_and_strided_inputs():
 def test_join_waits_for_one_group_and_the_exit_for_all():
     """join(group) returns once that group is compiled (the child goes on with the next); a group
     the child never reports (here: not asked for) does not hang the caller; the with-exit waits."""
-    from trials.warmup import compiling_in_background
+    from trials.cli.warmup import compiling_in_background
 
     with compiling_in_background("replay", "replay", when=True) as compiled:
         compiled("replay")

@@ -38,7 +38,7 @@ simulations of one Jacobian run on ``n_jobs`` threads (the compiled integration 
 Modules: :mod:`~ekf.output_error.trial` (one trial: start, rudder command, simulated
 residuals), :mod:`~ekf.output_error.switches` (whole-step switch search of a rebuilt
 rudder), :mod:`~ekf.output_error.fit` (the joint least-squares problem, its Jacobian and
-the EKF start).  The Monte Carlo is :func:`trials.montecarlo.output_error_monte_carlo`
+the EKF start).  The Monte Carlo is :func:`trials.estimates.montecarlo.output_error_monte_carlo`
 (``mmg output-error OUT --seeds 20``).
 """
 from __future__ import annotations

@@ -3,7 +3,7 @@
 An effect is defined once here and used by the simulator (through the parameter-vector slots
 of :mod:`mmg.model`), the replay (:mod:`mmg.replay`: packed ship, external loads, measured
 states), the estimators (:mod:`ekf.identify` frees its parameters) and the discrepancy workflow
-(:mod:`trials.diagnose`).  It declares
+(:mod:`trials.measured.diagnose`).  It declares
 
 * its named parameters (:class:`Parameter`: unit, default, bounds, the prior width used when
   it is fitted), in the units their names carry (``speed_mps``, ``direction_deg``, ...);
@@ -255,7 +255,7 @@ class EffectSet:
         """(this set without the effects a record with ``channels`` cannot feed, [(name, why), ...]).
 
         The one rule every command applies to a record (``mmg predict``, ``mmg identify``, ``mmg
-        diagnose`` through :func:`trials.predict.measured_run`): an effect whose logged channels
+        diagnose`` through :func:`trials.measured.predict.measured_run`): an effect whose logged channels
         (:meth:`Effect.needs`, e.g. the measured relative wind) the record lacks is left out, and
         why is said, instead of being applied to channels that are not there."""
         keep, gone = [], []

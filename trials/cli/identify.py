@@ -1,0 +1,137 @@
+"""``mmg identify``: identify a ship model from measured records (:func:`trials.measured.identify.identify`)."""
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+from mmg.errors import InputError
+
+from .common import _finite_positive, _output_path, _positive_int, _whole
+
+
+def _check_free(ship, names) -> None:
+    """Refuse (one line, exit 2) a --free name that is neither a hull coefficient of ``ship`` nor a constant."""
+    from ekf.identify import SHIP_CONSTANTS
+
+    known = set(ship.hull.names) | set(SHIP_CONSTANTS) | {"hull", "hull-except-constants"}
+    for n in names:
+        if n not in known:
+            raise InputError("--free", n, f"not a hull coefficient of {ship.name} nor one of "
+                                          f"hull, hull-except-constants, {', '.join(SHIP_CONSTANTS)}")
+
+
+def cmd_identify(args) -> int:
+    import numpy as np
+
+    from mmg.resources import ship_path
+    from mmg.ship import load_ship
+
+    from ..measured.identify import DEFAULT_MAX_NFEV, cross_validate, cv_folds, identify, load_runs, write_identification
+    from ..files.output import StagedOutput, check_output_dir, record_labels
+
+    check_output_dir(args.out)
+    for log in args.train + (args.test or []):
+        if not Path(log).is_file():
+            raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
+    src = ship_path(args.ship)
+    ship = load_ship(src)
+    if args.free:
+        _check_free(ship, args.free)
+    wind = None if args.wind is None else args.wind == "on"
+    t0 = time.perf_counter()
+    names = record_labels(args.train + (args.test or []))   # training and test records told apart together
+    runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)])   # an unusable one: one line, skipped
+    if not runs:
+        raise InputError("--train", "", "no usable training record")
+    print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
+    if args.cv:                                          # refused or narrowed before any fit
+        try:
+            folds = cv_folds(runs, args.cv)
+        except ValueError as e:
+            raise InputError("--cv", "", f"{e} (a record and its cut copies count once)") from None
+        if folds < args.cv:
+            print(f"note: --cv {args.cv}: {folds} independent records, so {folds} folds (each kept out once)",
+                  file=sys.stderr, flush=True)
+    tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):])   # a bad one: one line, before the fit
+             if args.test else None)
+    if args.test and not tests:
+        raise InputError("--test", "", "no usable record")
+
+    shown = [None]
+
+    def progress(k, cost, stage):            # a header per fit stage, then its iterations labelled by it
+        if stage != shown[0]:
+            shown[0] = stage
+            print(f"{stage}; at most {kw['max_nfev']} evaluations", file=sys.stderr, flush=True)
+        print(f"  {stage.split(':')[0]}, iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)",
+              file=sys.stderr, flush=True)
+
+    initial = load_ship(ship_path(args.initial)) if args.initial else None
+    kw = {"record_weighting": args.weighting} if args.weighting else {}
+    kw["max_nfev"] = args.max_nfev or DEFAULT_MAX_NFEV
+    if args.velocity_weight is not None:
+        kw["velocity_weight"] = args.velocity_weight
+    if args.free:
+        kw["free"] = tuple(args.free)
+    ident = identify(ship, runs, wind=wind, progress=progress, initial=initial, **kw)
+    cv = None
+    if args.cv:
+        cv = cross_validate(ship, runs, folds=folds, wind=wind, initial=initial, folds_by=args.folds_by, **kw,
+                            progress=lambda k, n: print(f"cross-validation fold {k}/{n} ({time.perf_counter() - t0:.0f} s)",
+                                                        file=sys.stderr, flush=True))
+    with StagedOutput(args.out) as stage:
+        write_identification(ident, src, stage.dir, cv, tests)
+    a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
+    b = np.mean([x["heading_rms_deg"] for x in ident.scores()])
+    print(f"identified {len(ident.fit.free)} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
+          f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
+    print(f"wrote {Path(args.out) / 'ship.yaml'} and {Path(args.out) / 'report.md'}")
+    for st in ident.stages:
+        if st["status"] == 0:
+            print(f"note: {st['description'].split(':')[0]} stopped at its evaluation limit ({st['max_nfev']}) before "
+                  f"converging; --max-nfev raises it", file=sys.stderr)
+    warn = ident.fit.warnings()
+    if warn:
+        print(f"warning: {len(warn)} finding(s) on where the identified values should not be read as the ship's "
+              f"physics (sign changes, bounds, no convergence): {Path(args.out) / 'report.md'}, 'Warnings'",
+              file=sys.stderr)
+    return 0
+
+
+def add_parser(sub) -> None:
+    """The identify subcommand of ``mmg`` (its options, help and function)."""
+    p = sub.add_parser("identify", help="identify hull coefficients and model-scale constants jointly over measured "
+                                        "records (segment-wise output error); writes DIR/ship.yaml and DIR/report.md")
+    p.add_argument("--ship", required=True, help="initial ship YAML or bundled name (the prior)")
+    p.add_argument("--train", required=True, nargs="+", metavar="LOG", help="training records")
+    p.add_argument("--out", required=True, metavar="DIR", type=_output_path, help="output folder")
+    p.add_argument("--wind", choices=("on", "off"), default=None,
+                   help="wind loads from the measured relative wind (default: as the ship config says)")
+    p.add_argument("--initial", default=None, metavar="SHIP",
+                   help="the model the identified one is compared with in the report (default: --ship); e.g. "
+                        "--ship esso_osaka_3m_crossflow --initial esso_osaka_3m fits the cross-flow form of the "
+                        "Kijima ship and scores it against the Kijima one")
+    p.add_argument("--cv", type=_whole(2, "--cv"), default=None, metavar="FOLDS",
+                   help="also cross-validate in FOLDS folds (each record kept out once) and report it")
+    p.add_argument("--test", nargs="+", default=None, metavar="LOG",
+                   help="records never trained on, predicted with the initial and the identified model in the report")
+    p.add_argument("--weighting", choices=("samples", "equal", "relative"), default=None,
+                   help="how each training record counts in the fit: samples (every sample alike: long records count "
+                        "more), equal (every record alike), relative (every record alike relative to its own misfit); "
+                        "default trials.measured.identify.DEFAULT_WEIGHTING")
+    p.add_argument("--free", nargs="+", default=None, metavar="NAME",
+                   help="the parameters to fit: hull coefficient names, 'hull' (all of them), 'hull-except-constants', "
+                        "w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, rudder_offset, wind_scale, m_x, m_y, "
+                        "J_z (default trials.measured.identify.DEFAULT_FREE)")
+    p.add_argument("--velocity-weight", type=_finite_positive, default=None, metavar="W",
+                   help="factor on the u, v, r residuals beside the heading's (default 1; 0.1: their squares weigh a "
+                        "hundredth, so the fit follows the heading; docs/identify_cv.md)")
+    p.add_argument("--max-nfev", type=_positive_int, default=None, metavar="N",
+                   help="most evaluations of the residuals in each fit stage (segment-wise, then whole-record; "
+                        "default trials.measured.identify.DEFAULT_MAX_NFEV); a stage that reaches it stops unconverged, "
+                        "and the report and a note say so")
+    p.add_argument("--folds-by", choices=("order", "revolutions"), default="order",
+                   help="with --cv: deal the records into folds in the order given or stratified by their propeller "
+                        "revolutions (a record and its cut copies always share a fold)")
+    p.set_defaults(func=cmd_identify)

@@ -1,0 +1,75 @@
+"""``mmg predict``: replay records against their own inputs (:func:`trials.measured.predict.predict`)."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from mmg.errors import InputError
+
+from .common import _output_path
+
+
+def cmd_predict(args) -> int:
+    from contextlib import nullcontext
+
+    from mmg.ship import load_ship
+
+    from ..files.output import StagedFile, StagedOutput, check_output_dir, check_output_file, dumps_json
+    from ..measured.predict import predict
+
+    check_output_file(args.json)
+    if args.plots is not None:
+        check_output_dir(args.plots, "--plots")
+    for log in args.logs:                  # every record there before the first is replayed
+        if not Path(log).is_file():
+            raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
+    ship = load_ship(args.ship)
+    wind = None if args.wind is None else args.wind == "on"
+
+    def progress(i, n, name):
+        print(f"replayed {i}/{n}: {name}", file=sys.stderr, flush=True)
+
+    pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)   # runs named after their files
+    text = dumps_json(pred.to_json())
+    names = [f"{r.run.name}.png" for r in pred.runs]
+    with StagedFile(args.json) as tmp:     # the files first (renamed last, after the plots), then the console
+        with StagedOutput(args.plots) if args.plots is not None else nullcontext() as stage:
+            for r, name in zip(pred.runs, names if args.plots is not None else ()):
+                r.plot(pyplot=False).savefig(stage.path(name))
+        tmp.write_text(text)
+    for r in pred.runs:
+        s = r.scores()
+        if r.diverged_at is not None:      # NaN scores (null in the JSON): say where and why
+            print(f"{r.run.name}: the replay diverged at t = {r.diverged_at:.1f} s (the predicted state is not "
+                  f"finite from there; scores null), wind {r.run.wind}")
+            continue
+        print(f"{r.run.name}: heading {s['heading_rms_deg']:.4g} deg RMS, yaw rate {s['yaw_rate_rms_degps']:.4g} deg/s RMS, "
+              f"speed {s['speed_rms_mps']:.4g} m/s RMS, final position {s['final_position_error_m']:.4g} m "
+              f"({s['final_position_error_L']:.4g} L), wind {r.run.wind}")
+    if len(pred.runs) > 1:                 # the figure a comparison of two configs quotes
+        sc = [r.scores() for r in pred.runs if r.diverged_at is None]
+        mean = lambda k: sum(x[k] for x in sc) / len(sc)  # noqa: E731
+        left = len(pred.runs) - len(sc)
+        if sc:
+            print(f"mean over {len(sc)} runs{f' ({left} diverged, left out)' if left else ''}: heading "
+                  f"{mean('heading_rms_deg'):.4g} deg RMS, final position {mean('final_position_error_L'):.4g} L")
+    print(f"wrote {args.json}" + (f" and {len(names)} plot{'s' if len(names) != 1 else ''} to {args.plots}"
+                                  if args.plots is not None else ""))
+    return 0
+
+
+def add_parser(sub) -> None:
+    """The predict subcommand of ``mmg`` (its options, help and function)."""
+    p = sub.add_parser("predict", help="replay records open-loop against their own rudder and propeller history: "
+                                       "heading, yaw-rate, speed RMS and final position error per run")
+    p.add_argument("logs", nargs="+", metavar="LOG", help="FRT-DS-ESSO CSVs, project logs or truth files")
+    p.add_argument("--ship", required=True, help="ship YAML or bundled name (esso_osaka_3m, esso_osaka, ...)")
+    p.add_argument("--json", required=True, type=_output_path, help="write the scores of every run to this JSON file")
+    p.add_argument("--plots", default=None, metavar="DIR", type=_output_path,
+                   help="also one figure per run, DIR/<name>.png (<name>: the record's file name; two files of one "
+                        "name told apart by their folders, DIR/<folder>/<name>.png)")
+    p.add_argument("--start", type=float, default=None, metavar="S",
+                   help="start time [s] of every replay (default: each record's first sample)")
+    p.add_argument("--wind", choices=("on", "off"), default=None,
+                   help="wind loads from the measured relative wind (default: as the ship config says)")
+    p.set_defaults(func=cmd_predict)

@@ -1,0 +1,668 @@
+"""The discrepancy workflow (``mmg diagnose``): which effect is the model missing, how large, how
+much closer it comes with it.
+
+For the records given (every layout :func:`trials.files.logio.read_record` reads, the ship's length
+checking the scale) and the ship config:
+
+1. **Replay** each record against its measured rudder and revolutions (:mod:`mmg.replay`) in
+   segments of ``segment_s`` (default 52 sqrt(L/g): 29 s for the 3 m model, 300 s at 325 m),
+   each restarting from the measured state, and form the residuals of u, v, r, heading and the
+   track (x, y) in the record's own (logged) quantities.  ``rms_config`` is this with the
+   config as it is.
+2. **Baseline**: fit the ship coefficients the records inform (:data:`SHIP_FREE_TERMS`: the
+   resistance, the linear sway/yaw derivatives and the yaw damping r|r| term, the wake
+   w_P0 and the added masses and moment, :data:`MASS_FREE`; :func:`ekf.identify.identify_segments`
+   with its prior) with no effect: constants of the
+   config that are merely a bit off (added mass, wake, hull) are absorbed here, so they do not
+   pass for an effect.  ``rms_before`` is this model's residual.
+3. **Candidates**: each registered effect (:mod:`mmg.effects`) not yet in the model and
+   applicable to every record (a wind candidate needs the relative-wind channels, non-zero, and a
+   ship wind section; otherwise it is skipped with that reason) is fitted together with the same
+   ship coefficients.  Score: the Bayesian information criterion with per-channel unknown noise
+   variances and an effective sample count per channel, N_eff = N / tau, tau the integrated
+   autocorrelation time of the current model's residual in that channel (the residuals of a
+   10 Hz record are far from independent; BIC with the raw N would name an effect for every
+   smooth misfit):
+
+       dBIC = sum_c N_eff,c ln(RSS_c,before / RSS_c,with) - k ln(sum_c N_eff,c)
+
+   An effect is **named** when dBIC > :data:`BIC_THRESHOLD` (20: twice Kass & Raftery's "very
+   strong", calibrated on clean records by the bench) and its parameters differ from their neutral values by more than
+   :data:`Z_THRESHOLD` standard errors (Gauss-Newton, inflated by sqrt(tau)).  The best named
+   candidate is added and the search repeats over the rest until none clears the threshold.
+4. **Report**: ``rms_after`` with the named effects; each effect's parameters and standard
+   errors; ``unexplained`` when a channel's residual stays above :data:`UNEXPLAINED_FACTOR` times
+   its noise level (estimated from the record's own second differences) and
+   ``unexplained_description`` saying which channel and what it correlates with (heading: an
+   earth-fixed cause; rudder; relative wind; body-fixed constant).
+
+Residual frames.  FRT-DS-ESSO u, v are GNSS velocities over ground resolved in the logged
+heading; the replay's hydrodynamics need the velocity through the water.  Every replay (its
+start and each segment restart) therefore begins from the *model* state of the logged one
+(:meth:`mmg.effects.EffectSet.to_model`: minus the candidate current, heading minus the candidate
+bias) and its states are mapped back to logged ones (:meth:`~mmg.effects.EffectSet.to_logged`)
+before the residuals are formed: u, v compare over-ground velocities, positions are over ground
+on both sides.  Without a current the model takes the logged over-ground u, v as through the
+water, which is exactly the discrepancy a current leaves.
+"""
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mmg.errors import InputError
+from mmg.model import pack
+from mmg.ship import Ship
+
+__all__ = ["diagnose", "Diagnosis", "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
+           "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
+
+SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
+"""Hull terms whose coefficients the diagnosis fits with every model (plus ``w_P0``)."""
+BIC_THRESHOLD = 20.0
+"""dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
+for independent samples; with the tau-corrected counts the largest candidate dBIC on 20 clean
+perturbed record pairs (bench/bench_diagnose.py, seeds 0-19) was 15.4, 10.9, 9.5, 7.6, ... (2 of 20
+above 10), so the threshold is set at 20 and the false-alarm rate checked on fresh seeds."""
+Z_THRESHOLD = 3.0
+"""|parameter - neutral| / standard error an effect's fit must exceed to be named."""
+RESTART_SMOOTH = 6.0
+"""Every segment restarts from the logged state smoothed over this many sqrt(L/g) (quadratic
+Savitzky-Golay: 3.3 s for the 3 m model, 35 s at 325 m): a restart from one noisy sample leaves a
+transient through the segment that a current or heading bias (which shift the restart states)
+would partly fit (clean records: 3/20 named an effect with single-sample restarts)."""
+SCREEN_NFEV = 6
+"""Evaluation budget of a candidate's first (screening) fit; see :func:`diagnose`."""
+UNEXPLAINED_FACTOR = 5.0
+"""A residual RMS above this many times the channel's noise level is reported as unexplained."""
+CHANNELS = ("u", "v", "r", "heading", "position")
+"""Channels of ``rms_*``: u, v [m/s], r [deg/s], heading [deg], position [m] (RMS of the distance)."""
+_COLS = ("u", "v", "r", "x", "y", "heading")
+
+
+def _say(msg):
+    print(msg, file=sys.stderr, flush=True)
+
+
+# --------------------------------------------------------------------------- records
+
+
+@dataclass
+class Prepared:
+    """One record made ready: the segmented record (with its effect context) and notes."""
+
+    name: str
+    source: str
+    seg: object
+    notes: list = field(default_factory=list)
+
+
+def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | None = None) -> list[Prepared]:
+    """Read and prepare the records (paths, :class:`trials.files.records.TrialRecord` or ready
+    :class:`Prepared`); a malformed one raises :class:`~mmg.errors.InputError` naming it.  Each is
+    named after its file (:func:`trials.files.output.record_labels`), in the JSON and the plots."""
+    from dataclasses import replace
+
+    from ekf.identify import Segmented, segment_resets
+    from mmg.effects import Context
+
+    from ..files.logio import require_finite
+    from .predict import measured_run
+    from ..files.records import TrialRecord
+    from ..files.output import record_labels
+    from ..files.shipcheck import read_for_ship
+
+    L = ship.particulars.L
+    seg_s = segment_s or 52.0 * math.sqrt(L / 9.80665)
+    items = list(items)
+    labels = record_labels([it.source if isinstance(it, Prepared) else
+                            (it.source or it.name) if isinstance(it, TrialRecord) else it for it in items])
+    out = []
+    for it, label in zip(items, labels):
+        if isinstance(it, Prepared):
+            out.append(it)
+            continue
+        # a record of another ship is refused, not diagnosed
+        rec = it if isinstance(it, TrialRecord) else read_for_ship(it, ship)
+        require_finite(rec, ("wind_speed_rel", "wind_dir_rel"), "mmg diagnose")     # the wind it diagnoses
+        run = replace(measured_run(ship, rec, wind=wind), name=label)     # named after its file, unique
+        bad = ~np.isfinite(run.meas).all(axis=1)
+        if bad.any():
+            raise InputError(run.source or run.name, "", f"{int(bad.sum())} rows with NaN: not usable")
+        ch = {c: getattr(rec, c) for c in ("wind_speed_rel", "wind_dir_rel")}
+        if run.inputs.delta is not None and len(run.inputs.t) != len(rec.t):     # rebuilt rudder: resampled
+            ch = {c: None for c in ch}
+        ctx = Context(t=run.t, delta=run.inputs.delta, n=run.inputs.n, channels=ch, ship=ship)
+        seg = Segmented(run.name, run.meas, run.inputs, segment_resets(run.t, seg_s), context=ctx,
+                        start=_smoothed(run.t, run.meas, RESTART_SMOOTH * math.sqrt(L / 9.80665)),
+                        fixed=run.effects)
+        out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes)))
+    return out
+
+
+def _smoothed(t: np.ndarray, meas: np.ndarray, window_s: float) -> np.ndarray:
+    """The logged states smoothed by a quadratic Savitzky-Golay filter over ``window_s`` (heading
+    unwrapped, on its logged branch): the states the segments restart from."""
+    from scipy.signal import savgol_filter
+
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
+    w = int(round(window_s / dt)) | 1
+    w = min(w, (len(t) - 1) | 1 if len(t) % 2 == 0 else len(t))
+    if w < 5:
+        return meas
+    out = savgol_filter(meas, w, 2, axis=0, mode="interp")
+    psi = np.unwrap(meas[:, 5])
+    out[:, 5] = meas[:, 5] + savgol_filter(psi, w, 2, mode="interp") - psi
+    return out
+
+
+# --------------------------------------------------------------------------- statistics
+
+
+def _tau(x: np.ndarray) -> float:
+    """Integrated autocorrelation time (samples) of x: 1 + 2 sum rho_k over the initial positive run."""
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    n = len(x)
+    if n < 8 or not np.any(x):
+        return 1.0
+    x = x - x.mean()
+    f = np.fft.rfft(x, 2 * n)
+    ac = np.fft.irfft(f * np.conj(f))[:n]
+    if ac[0] <= 0:
+        return 1.0
+    rho = ac / ac[0]
+    s = 0.0
+    for k in range(1, n // 2):
+        if rho[k] <= 0:
+            break
+        s += rho[k]
+    return float(min(max(1.0 + 2.0 * s, 1.0), n / 4.0))
+
+
+def _noise(meas: np.ndarray) -> np.ndarray:
+    """Noise level per column of the logged (N, 6) states: std of the 2nd difference / sqrt(6)
+    (white noise on a smooth signal), robust (MAD)."""
+    d2 = np.diff(meas, 2, axis=0)
+    mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0) * 1.4826
+    return mad / math.sqrt(6.0)
+
+
+def _diffs(pred: np.ndarray, meas: np.ndarray) -> np.ndarray:
+    """Residual columns u, v, r, x, y, heading (logged minus replayed, SI)."""
+    d = pred - meas
+    return d[:, [0, 1, 2, 3, 4, 5]]
+
+
+def _rms(diffs: list) -> dict:
+    D = np.vstack(diffs)
+    ok = np.isfinite(D).all(axis=1)
+    D = D[ok] if ok.any() else np.zeros((1, 6))
+    m = lambda a: float(np.sqrt(np.mean(a * a)))  # noqa: E731
+    return {"u": m(D[:, 0]), "v": m(D[:, 1]), "r": math.degrees(m(D[:, 2])), "heading": math.degrees(m(D[:, 5])),
+            "position": float(np.sqrt(np.mean(D[:, 3] ** 2 + D[:, 4] ** 2)))}
+
+
+# --------------------------------------------------------------------------- fitting
+
+
+@dataclass
+class _Model:
+    effects: list
+    free: list
+    fit: object
+    diffs: list          # per record (N, 6)
+
+    @property
+    def theta(self):
+        return self.fit.theta
+
+
+MASS_FREE = ("m_x", "m_y", "J_z")
+"""Added masses and the added moment of inertia the diagnosis fits with every model (prior:
+the config value, relative std :data:`MASS_PRIOR_REL`): an added mass a few % off leaves a
+residual (surge speed loss in the turn, sway and yaw lag) that an effect would otherwise take."""
+MASS_PRIOR_REL = 0.2
+
+
+def _mass_free(packed, names):
+    from ekf.identify import FreeParameter
+    from mmg import model as M
+
+    slot = {"m_x": M.P_MX, "m_y": M.P_MY, "J_z": M.P_JZ}
+    out = []
+    for nm in names:
+        v = float(packed.p[slot[nm]])
+        out.append(FreeParameter(nm, "p", slot[nm], v, MASS_PRIOR_REL * v, 0.0, 3.0 * v))
+    return out
+
+
+def _ship_values(ship: Ship, free, theta) -> dict:
+    """Fitted ship values by config name: hull coefficients, ``w_P0``, and the added masses as the
+    config's primed ``m_x_prime``, ``m_y_prime``, ``J_z_prime``."""
+    from mmg.nondim import inertia_scale, mass_scale
+
+    pa = ship.particulars
+    out = {}
+    for f, v in zip(free, theta):
+        if f.name in MASS_FREE:
+            sc = inertia_scale(pa.rho, pa.L, pa.T) if f.name == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
+            out[f"{f.name}_prime"] = float(v) / sc
+        else:
+            out[f.name] = float(v)
+    return out
+
+
+def _ship_free(ship: Ship, packed, names=None):
+    from ekf.identify import free_parameters
+
+    if names is None:
+        names = [n for n, t in zip(ship.hull.names, ship.hull.terms) if t in SHIP_FREE_TERMS] + ["w_P0"]
+        mass = list(MASS_FREE)
+    else:
+        mass = [n for n in names if n in MASS_FREE]
+        names = [n for n in names if n not in MASS_FREE]
+    return free_parameters(packed, ship.hull.names, names) + _mass_free(packed, mass)
+
+
+class _Fitter:
+    def __init__(self, ship, packed, recs, scales, stride, max_nfev, ship_free):
+        self.ship, self.packed, self.recs, self.scales = ship, packed, recs, scales
+        self.stride, self.max_nfev, self.ship_free = stride, max_nfev, ship_free
+
+    def diffs(self, effects, free, theta):
+        from ekf.identify import predict_logged
+
+        return [_diffs(predict_logged(self.packed, r.seg, effects, free, theta, self.ship), r.seg.meas)
+                for r in self.recs]
+
+    def fit(self, effects, start_ship=None, start_eff=None, max_nfev=None, start=None) -> _Model:
+        """Fit the ship terms and ``effects``' parameters; ``start`` (the whole vector) or
+        ``start_ship`` and ``start_eff`` (a prefix of the effects' parameters) warm-start it."""
+        from ekf.identify import effect_parameters, identify_segments
+
+        free = list(self.ship_free) + effect_parameters(effects)
+        if start is None:
+            x_ship = [f.prior for f in self.ship_free] if start_ship is None else list(start_ship)
+            eff_start = []
+            for e in effects:
+                for q in e.fit_parameters():
+                    eff_start.append(q.default if q.start is None else q.start)
+            if start_eff is not None:
+                eff_start[:len(start_eff)] = list(start_eff)
+            start = x_ship + eff_start
+        x0 = np.array(start, float)
+        fit = identify_segments(self.packed, [r.seg for r in self.recs], free, self.scales, stride=self.stride,
+                                max_nfev=max_nfev or self.max_nfev, start=x0, effects=list(effects) or None,
+                                ship=self.ship)
+        return _Model(list(effects), free, fit, self.diffs(effects, free, fit.theta))
+
+
+def _stack(diffs, stride):
+    D = np.vstack([d[::stride] for d in diffs])
+    D[~np.isfinite(D)] = 0.0
+    return D
+
+
+def _scores(model_diffs, taus, stride):
+    D = _stack(model_diffs, stride)
+    N = D.shape[0]
+    rss = np.maximum(np.sum(D * D, axis=0), 1e-300)
+    neff = N / taus
+    return rss, neff
+
+
+def _delta_bic(before, after, k, taus, stride):
+    rss0, neff = _scores(before.diffs, taus, stride)
+    rss1, _ = _scores(after.diffs, taus, stride)
+    return float(np.sum(neff * np.log(rss0 / rss1)) - k * math.log(float(np.sum(neff))))
+
+
+def _effect_report(model: _Model, effect, inflate: float):
+    idx = [i for i, f in enumerate(model.free) if f.kind == "effect" and f.name.split(".")[0] == effect.name]
+    th = model.fit.theta[idx]
+    std = model.fit.std[idx] * inflate
+    corr = np.nan_to_num(model.fit.corr[np.ix_(idx, idx)], nan=0.0)
+    np.fill_diagonal(corr, 1.0)
+    cov = corr * np.outer(std, std)
+    vals, se = effect.report(th, cov)
+    neutral = np.array([q.default for q in effect.fit_parameters()])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = float(np.sqrt(np.sum(((th - neutral) / np.where(std > 0, std, np.inf)) ** 2)))
+    return vals, se, z
+
+
+# --------------------------------------------------------------------------- description of what is left
+
+
+def _describe(recs, diffs, noise, rms_after) -> tuple[bool, str, dict]:
+    """Unexplained flag, description and per-channel ratio residual / noise."""
+    D = np.vstack(diffs)
+    M = np.vstack([r.seg.meas for r in recs])
+    delta = np.concatenate([r.seg.inputs.delta for r in recs])
+    ok = np.isfinite(D).all(axis=1)
+    D, M, delta = D[ok], M[ok], delta[ok]
+    names = ("u", "v", "r", "x", "y", "heading")
+    ratio = {}
+    for j, c in enumerate(names):
+        ratio[c] = float(np.sqrt(np.mean(D[:, j] ** 2)) / max(noise[j], 1e-12))
+    # position: the track's own growth within segments is not noise; judge u, v, r, heading
+    big = [c for c in ("u", "v", "r", "heading") if ratio[c] > UNEXPLAINED_FACTOR]
+    if not big:
+        return False, "", ratio
+    parts = []
+    psi = M[:, 5]
+    for c in big:
+        j = names.index(c)
+        e = D[:, j] - D[:, j].mean()
+        desc = [f"{c} residual {ratio[c]:.1f} x its noise level"]
+        # earth-fixed: explained by cos/sin of heading; rudder: by delta
+        A = np.column_stack([np.cos(psi), np.sin(psi), np.ones_like(psi)])
+        r2_h = _r2(A, D[:, j])
+        r2_d = _r2(np.column_stack([delta, np.abs(delta), np.ones_like(delta)]), D[:, j])
+        r2_c = 1.0 - float(np.var(e)) / max(float(np.mean(D[:, j] ** 2)), 1e-300)
+        desc.append(f"body-fixed constant {r2_c:.0%}")
+        desc.append(f"correlated with heading (earth-fixed) R2 {r2_h:.2f}")
+        desc.append(f"with rudder R2 {r2_d:.2f}")
+        ws = [r.seg.context.channels.get("wind_speed_rel") if r.seg.context else None for r in recs]
+        if all(w is not None for w in ws):
+            wd = [r.seg.context.channels.get("wind_dir_rel") for r in recs]
+            w = np.concatenate(ws)[ok]
+            g = np.concatenate(wd)[ok]
+            q = w * w
+            r2_w = _r2(np.column_stack([q * np.cos(g), q * np.sin(g), q * np.sin(2 * g), np.ones_like(q)]), D[:, j])
+            desc.append(f"with relative wind R2 {r2_w:.2f}")
+        parts.append(", ".join(desc))
+    return True, "; ".join(parts) + ": no candidate effect explains it", ratio
+
+
+def _r2(A, y):
+    y = np.asarray(y, float)
+    if not np.any(y):
+        return 0.0
+    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+    res = y - A @ coef
+    v = float(np.var(y))
+    return float(max(0.0, 1.0 - np.var(res) / v)) if v > 0 else 0.0
+
+
+# --------------------------------------------------------------------------- the workflow
+
+
+@dataclass
+class Diagnosis:
+    """The result of :func:`diagnose` (see :meth:`to_json`)."""
+
+    named: list
+    parameters: dict
+    standard_errors: dict
+    rms_config: dict
+    rms_before: dict
+    rms_after: dict
+    unexplained: bool
+    unexplained_description: str
+    candidates: list
+    rounds: list
+    ship_values: dict
+    records: list
+    pred_before: list
+    pred_after: list
+    seconds: float
+    runs: list = field(default_factory=list)
+    effects: list = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        out = {"named_effects": list(self.named), "parameters": self.parameters,
+               "standard_errors": self.standard_errors,
+               "rms_before": self.rms_before, "rms_after": self.rms_after, "rms_config": self.rms_config,
+               "rms_units": {"u": "m/s", "v": "m/s", "r": "deg/s", "heading": "deg", "position": "m"},
+               "unexplained": bool(self.unexplained), "unexplained_description": self.unexplained_description,
+               "candidates": self.candidates, "rounds": self.rounds,
+               "threshold": {"delta_bic": BIC_THRESHOLD, "z": Z_THRESHOLD},
+               "ship_coefficients": self.ship_values,
+               "files": [r.source for r in self.records], "names": [r.name for r in self.records],
+               "seconds": round(self.seconds, 2)}
+        if self.runs:
+            out["runs"] = [dict(r.to_json(), name=r.records[0].name, file=r.records[0].source) for r in self.runs]
+        return out
+
+
+def diagnose(ship: Ship, items, wind: bool | None = False, candidates=None, segment_s: float | None = None,
+             stride: int | None = None, max_nfev: int = 12, per_run: bool = False, ship_free=None,
+             say=None, screen_nfev: int = SCREEN_NFEV) -> Diagnosis:
+    """Diagnose the records ``items`` against ``ship`` (module docstring).
+
+    Parameters
+    ----------
+    ship : Ship
+    items : list of paths, TrialRecord or Prepared
+    wind : bool or None
+        Wind loads in the model from the start: ``False`` (default: wind is then a candidate),
+        ``True``, or ``None`` as the ship config says.
+    candidates : list of str, optional
+        Effect names to try (default: every registered effect).
+    segment_s : float, optional
+        Segment length [s] (default 52 sqrt(L/g)).
+    stride : int, optional
+        Use every ``stride``-th sample in the fits (default: samples 0.36 sqrt(L/g) apart, 0.2 s
+        for the 3 m model, 2 s at 325 m; at least 1).
+    per_run : bool
+        With several records, also diagnose each alone (``runs``).
+    max_nfev, screen_nfev : int
+        Evaluation budgets of a fit: every candidate is first fitted (warm, from the current
+        model) with ``screen_nfev``; one the budget stopped whose dBIC is positive or whose z
+        clears the threshold is fitted on, up to ``max_nfev`` in all.
+    """
+    import time
+
+    from ekf.identify import Scales
+
+    import mmg.effects as E
+
+    t0 = time.perf_counter()
+    say = say or (lambda m: None)
+    recs = prepare(ship, items, wind=wind, segment_s=segment_s)
+    if not recs:
+        raise InputError("diagnose", "", "no record")
+    L = ship.particulars.L
+    packed = pack(ship)
+    if stride is None:
+        dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
+        stride = max(1, int(round(0.36 * math.sqrt(L / 9.80665) / dt)))
+    U = float(np.median(np.concatenate([np.hypot(r.seg.meas[:, 0], r.seg.meas[:, 1]) for r in recs])))
+    U = max(U, 0.05 * math.sqrt(9.80665 * L))
+    noise = np.median(np.vstack([_noise(r.seg.meas) for r in recs]), axis=0)
+    names = list(candidates) if candidates is not None else E.names()
+    cand = []
+    cand_log = []
+    for nm in names:
+        cls = E.get(nm, "--candidates")
+        why = None
+        if nm == "wind" and recs[0].seg.inputs.ext is not None:
+            why = "wind loads are already in the model (ship config wind on)"
+        for r in recs:
+            why = why or cls.unavailable(r.seg.context)
+            if why:
+                why = f"{r.name}: {why}" if len(recs) > 1 and not why.startswith("wind loads") else why
+                break
+        if why:
+            cand_log.append({"effect": nm, "skipped": why})
+            say(f"candidate {nm} skipped: {why}")
+        else:
+            cand.append(cls)
+
+    sfree = _ship_free(ship, packed, ship_free)
+    sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
+    fitter = _Fitter(ship, packed, recs, sc0, stride, max_nfev, sfree)
+    d_config = fitter.diffs([], [], [])
+    base = fitter.fit([])
+    # rescale every channel by the baseline's own residual (floored at the noise), refit
+    D = _stack(base.diffs, 1)
+    rm = np.sqrt(np.mean(D * D, axis=0))
+    fl = np.maximum(rm, np.maximum(noise, 1e-9))
+    fitter.scales = Scales(u=fl[0], v=fl[1], r=fl[2], psi=fl[5], pos=float(np.hypot(fl[3], fl[4])) / math.sqrt(2))
+    base = fitter.fit([], start_ship=base.theta)
+    say(f"baseline: {_rms(base.diffs)}")
+    current = base
+    named = []
+    rounds = []
+    remaining = list(cand)
+    while remaining:
+        taus = np.array([np.median([_tau(d[::stride, j]) for d in current.diffs]) for j in range(6)])
+        inflate = math.sqrt(float(np.mean(taus)))
+        results = []
+        ns = len(sfree)
+        for cls in remaining:
+            eff_prev = current.theta[ns:]
+            effs = current.effects + [cls]
+            m = fitter.fit(effs, start_ship=current.theta[:ns], start_eff=list(eff_prev), max_nfev=screen_nfev)
+            k = len(cls.fit_parameters())
+            dbic = _delta_bic(current, m, k, taus, stride)
+            vals, se, z = _effect_report(m, cls, inflate)
+            if m.fit.iterations >= screen_nfev and max_nfev > screen_nfev and (dbic > 0 or z > Z_THRESHOLD):
+                # a promising candidate the screening budget stopped: fit it on to convergence
+                m = fitter.fit(effs, start=m.theta, max_nfev=max_nfev - screen_nfev)
+                dbic = _delta_bic(current, m, k, taus, stride)
+                vals, se, z = _effect_report(m, cls, inflate)
+            ok = dbic > BIC_THRESHOLD and z > Z_THRESHOLD
+            results.append((dbic, ok, cls, m, vals, se, z))
+            say(f"  {cls.name}: dBIC {dbic:.1f}, z {z:.1f}, {vals}")
+        rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
+                       "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
+                       "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
+                                       "clears_threshold": bool(o), "parameters": v, "standard_errors": s}
+                                      for d, o, c, m, v, s, z in results]})
+        ok = [r for r in results if r[1]]
+        if not ok:
+            break
+        best = max(ok, key=lambda r: r[0])
+        named.append(best[2].name)
+        current = best[3]
+        remaining.remove(best[2])
+    taus = np.array([np.median([_tau(d[::stride, j]) for d in current.diffs]) for j in range(6)])
+    inflate = math.sqrt(float(np.mean(taus)))
+    params, ses = {}, {}
+    for cls in current.effects:
+        v, s, _ = _effect_report(current, cls, inflate)
+        params[cls.name] = v
+        ses[cls.name] = s
+    for c in cand:
+        entry = {"effect": c.name, "named": c.name in named}
+        cand_log.append(entry)
+    unexpl, desc, _ = _describe(recs, current.diffs, noise, None)
+    ns = len(sfree)
+    ship_vals = _ship_values(ship, current.free[:ns], current.theta[:ns])
+    res = Diagnosis(named=named, parameters=params, standard_errors=ses, rms_config=_rms(d_config),
+                    rms_before=_rms(base.diffs), rms_after=_rms(current.diffs), unexplained=unexpl,
+                    unexplained_description=desc, candidates=cand_log, rounds=rounds, ship_values=ship_vals,
+                    records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
+                    pred_after=[r.seg.meas + d for r, d in zip(recs, current.diffs)],
+                    seconds=time.perf_counter() - t0, effects=current.effects)
+    if per_run and len(recs) > 1:
+        res.runs = [diagnose(ship, [r], wind=wind, candidates=candidates, segment_s=segment_s, stride=stride,
+                             max_nfev=max_nfev, ship_free=ship_free, screen_nfev=screen_nfev) for r in recs]
+        res.seconds = time.perf_counter() - t0
+    return res
+
+
+# --------------------------------------------------------------------------- synthetic records
+
+
+def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | None = None, speed: float | None = None,
+                     duration: float | None = None, dt: float = 0.5, rudder_deg: float = 20.0,
+                     true_wind=(0.0, 0.0), noise=None, seed: int = 0, name: str | None = None):
+    """A record as a trial would log it, with hidden effects: a turning or zigzag of ``truth_ship``
+    (default ``ship``) simulated closed loop (the rudder orders from its own heading), then
+    replayed with its rudder and revolutions and the ``effects`` (an :class:`mmg.effects.EffectSet`
+    or a ``{name: {parameter: value}}`` mapping; wind from the constant ``true_wind`` (speed
+    [m/s], direction it comes from [rad]) by a fixed-point iteration on the relative wind) and
+    logged (u, v over ground resolved in the logged heading, heading with its bias) with white
+    noise (``noise``: std per column u, v, r, x, y, psi; default small).  Returns a
+    :class:`trials.files.records.TrialRecord` with rudder, revolutions and, when wind is on, the relative
+    and true wind channels."""
+    import mmg.effects as E
+    from mmg.integrate import CommandLaw
+    from mmg.replay import ReplayInputs, replay_states
+    from mmg.simulation import simulate
+    from mmg.wind import relative_wind_from_true, true_wind_from_relative
+
+    from ..files.records import TrialRecord
+
+    es = effects if isinstance(effects, E.EffectSet) else E.effect_set(effects or {})
+    truth = truth_ship or ship
+    L = truth.particulars.L
+    s = math.sqrt(L / 9.80665)
+    U0 = speed or 0.09 * math.sqrt(9.80665 * L)
+    a = math.radians(rudder_deg)
+    if kind == "turning":
+        T = duration or 120.0 * s
+        law = CommandLaw.schedule([0.0, 5.0 * s, 5.0 * s + 1e-6, T], [0.0, 0.0, a, a])
+    elif kind == "zigzag":
+        T = duration or 160.0 * s
+        law = CommandLaw.heading_switch(a, a, -a, 1.0, psi0=0.0)
+    else:
+        raise ValueError(kind)
+    slots = {}
+    for cls, v in es.items:
+        slots.update(cls.slots(v))
+    sim = simulate(truth, law, T, min(dt, 0.05 * s), U0, trim=False, disturbances=[_Slots(slots)])
+    t = np.arange(0.0, T + 1e-9, dt)
+    idx = np.searchsorted(sim.t, t - 1e-9)
+    idx = np.minimum(idx, len(sim.t) - 1)
+    delta, n = sim.states[idx, 6], sim.states[idx, 7]
+    s0 = sim.states[0, :6].copy()
+    pk = es.pack(pack(truth, sim.equilibrium.power_W), truth)
+    wind_on = any(c.name == "wind" for c, _ in es.items)
+    Vt, dt_ = true_wind
+    ch = {}
+    if wind_on:
+        wind_eff = [(c, v) for c, v in es.items if c.name == "wind"]
+        rest = E.EffectSet(tuple(it for it in es.items if it[0].name != "wind"))
+        states = replay_states(pk, ReplayInputs(t, delta, n), s0)
+        for _ in range(4):
+            lg = rest.to_logged(states)
+            # the anemometer is aboard: the relative wind from the true one and the true motion over ground
+            og = E.EffectSet(tuple(it for it in rest.items if it[0].kind != "measurement")).to_logged(states)
+            Vr, ang = relative_wind_from_true(Vt, dt_, og[:, 0], og[:, 1], states[:, 5])
+            ch = {"wind_speed_rel": Vr, "wind_dir_rel": np.mod(ang, 2 * np.pi)}
+            ctx = E.Context(t=t, delta=delta, n=n, channels=ch, ship=truth)
+            ext = wind_eff[0][0].external(wind_eff[0][1], ctx)
+            states = replay_states(pk, ReplayInputs(t, delta, n, ext), s0)
+        ch["wind_speed_true"], ch["wind_dir_true"] = true_wind_from_relative(ch["wind_speed_rel"], ch["wind_dir_rel"],
+                                                                             og[:, 0], og[:, 1], states[:, 5])
+    else:
+        states = replay_states(pk, ReplayInputs(t, delta, n), s0)
+    lg = es.to_logged(states)
+    rng = np.random.default_rng(seed)
+    sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(9.80665 / L), 0.002 * L,
+                                                    0.002 * L, math.radians(0.05)])
+    lg = lg + rng.standard_normal(lg.shape) * sd
+    return TrialRecord(t=t, name=name or f"synthetic_{kind}", source=name or f"synthetic_{kind}",
+                       u=lg[:, 0], v=lg[:, 1], r=lg[:, 2], x=lg[:, 3], y=lg[:, 4], psi=lg[:, 5],
+                       U=np.hypot(lg[:, 0], lg[:, 1]), delta=delta, n=n, meta={"format": "synthetic"}, **ch)
+
+
+@dataclass(frozen=True)
+class _Slots:
+    """Parameter-vector slots as a disturbance for :func:`mmg.simulation.simulate`."""
+
+    values: dict
+
+    def slots(self):
+        return dict(self.values)
+
+
+def write_frt_csv(rec, path) -> None:
+    """Write a record in the FRT-DS-ESSO column layout (what :func:`trials.files.logio.read_record` reads)."""
+    import pandas as pd
+
+    cols = {"t [s]": rec.t, "x_position_mid [m]": rec.x, "u_velo [m/s]": rec.u, "y_position_mid [m]": rec.y,
+            "vm_velo [m/s]": rec.v, "psi_hat [rad]": np.mod(rec.psi, 2 * np.pi), "r_angvelo [rad/s]": rec.r,
+            "n_prop [rps]": rec.n, "delta_rudder [rad]": rec.delta}
+    if rec.wind_speed_rel is not None:
+        cols.update({"wind_velo_relative_mid [m/s]": rec.wind_speed_rel, "wind_dir_relative_mid [rad]": rec.wind_dir_rel,
+                     "wind_velo_true [m/s]": rec.wind_speed_true, "wind_dir_true [rad]": rec.wind_dir_true})
+    pd.DataFrame(cols).to_csv(path, index=False)

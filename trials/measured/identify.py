@@ -1,0 +1,572 @@
+"""Identify a ship model from measured records (``mmg identify``) and cross-validate it.
+
+:func:`identify` reads the training records (every layout :func:`trials.files.logio.read_record`
+reads, checked against the ship's length), skips a record it cannot use with one line naming it
+and why, and fits the hull coefficients and the model-scale constants jointly over all of them
+with their measured inputs (:func:`ekf.identify.identify_segments`: segment-wise output error with
+a prior).  :func:`write_identification` writes ``ship.yaml`` (the ship config with the fitted
+values: usable by every other command) and ``report.md`` (values, standard errors, correlations,
+training fits).  :func:`cross_validate` keeps each record out once (k folds) and compares the
+open-loop replay of the kept-out records with the initial and the identified model.
+
+Freed by default (:data:`DEFAULT_FREE`): every hull coefficient, the constants Y_0, N_0 included
+(the single-screw model's port-starboard asymmetry: with the wind scale freed and 16+ records of
+both rudder signs they are no longer confounded with the wind; freeing them took the four-fold
+cross-validated heading RMS of the Kijima 3 m model from 17.1 to 15.5 deg with wind), the wake
+fraction's constant term ``w_P0`` (the model-scale wake is the largest scale effect, see the 3 m
+config), the rudder inflow ratio ``epsilon`` and the slipstream share ``kappa`` (at model scale
+the propeller runs heavily loaded, so how much of its slipstream reaches the rudder sets the
+rudder force: the Osaka set has kappa = 0.20 against the ship's 0.595), the rudder's flow
+straightening ``gamma_R_pos``, ``gamma_R_neg`` (the inflow angle at the rudder), and the wind-load
+scale.  The rudder's lever ``l_R_prime`` stays at its config value (it can be freed): fits that
+freed it ran it to its bound (-2.0, twice the textbook 2 x_R'), and with folds that keep a run
+together keeping it fixed predicts the kept-out records as well or better in all four
+cross-validations (wind on / off, folds in file order / by revolutions; docs/identify_cv.md).  Each training record counts alike
+(:data:`DEFAULT_WEIGHTING` ``"equal"``): with every sample alike a 400 s turn outweighed a
+140 s zigzag three times.
+The propeller curve, masses and rudder geometry stay at the config values: the records (n
+constant over most of each run) cannot separate them from the freed ones.
+
+The hull form is the prior's: ``esso_osaka_3m`` (Kijima polynomials in beta) or
+``esso_osaka_3m_crossflow`` (the low-speed cross-flow form, :mod:`mmg.terms`), whose fitted
+values stay physical (w_P0 0.61 as the Osaka identification's 0.614, N_r within 10 % of its prior)
+where the Kijima ones do not (Y_bb changes sign, N_r falls to a fifth); ``initial=`` scores the
+fit against another model (the Kijima ship the cross-flow prior was converted from).
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mmg.errors import InputError
+from mmg.model import pack
+from mmg.ship import Ship
+
+from .predict import MeasuredRun, measured_run, replay_record
+
+__all__ = ["identify", "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
+           "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
+           "stage_description"]
+
+DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale")
+DEFAULT_MAX_NFEV = 30
+"""Default limit of the residual evaluations of each fit stage (:func:`identify`'s ``max_nfev``)."""
+DEFAULT_WEIGHTING = "equal"
+"""Default weighting of the training records in the fit (:func:`ekf.identify.record_weights`)."""
+DEFAULT_SEGMENTS_L = (52.0, np.inf)
+"""Segment lengths of the successive fits, in units of sqrt(L/g): 29 s for a 3 m model, 300 s at
+325 m (about one zigzag half-period: short enough that a poor start does not diverge), then the
+whole record open-loop from the first fit's values (the objective the replay is judged by)."""
+
+
+def _log(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
+def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log, names=None) -> list[MeasuredRun]:
+    """Read and prepare each record; one that cannot be used is skipped with one line saying why, but one
+    of another ship (:func:`trials.files.shipcheck.check_record_ship`) raises its :class:`~trials.files.shipcheck.ShipMismatch`.
+    Each is named after its file (:func:`trials.files.output.record_labels`: ``ST35``, or ``day1/ST35``
+    and ``day2/ST35`` for two files of one stem), as the report and ship.yaml name it; ``names``:
+    the names to give instead (labels made over the training and test records together)."""
+    from dataclasses import replace
+
+    from ..files.output import record_labels
+    from ..files.shipcheck import ShipMismatch, read_for_ship
+
+    paths = list(paths)
+    runs = []
+    for p, label in zip(paths, record_labels(paths) if names is None else names):
+        try:
+            rec = read_for_ship(p, ship)
+            runs.append(replace(measured_run(ship, rec, wind=wind), name=label))
+        except ShipMismatch:              # a record of another ship: the call is wrong, not the record
+            raise
+        except InputError as e:
+            say(f"skipped: {e}")
+    return runs
+
+
+def _free_names(ship: Ship, free) -> list[str]:
+    names = []
+    for f in free:
+        if f == "hull-except-constants":
+            names += [n for n, t in zip(ship.hull.names, ship.hull.terms) if t != "1"]
+        elif f == "hull":
+            names += list(ship.hull.names)
+        else:
+            names.append(f)
+    return names
+
+
+def _scales(runs: list[MeasuredRun], L: float, velocity_weight: float = 1.0):
+    """Residual scales: 5 % of the records' median speed for u and v (and that over L for r), 2 deg for
+    the heading; the velocities' residuals multiplied by ``velocity_weight`` (their scales divided by
+    it, their squares' weight in the cost ``velocity_weight**2``)."""
+    from ekf.identify import Scales
+
+    U = float(np.median(np.concatenate([np.hypot(r.meas[:, 0], r.meas[:, 1]) for r in runs])))
+    k = 1.0 / velocity_weight
+    return Scales(u=0.05 * U * k, v=0.05 * U * k, r=0.05 * U / L * k, psi=np.radians(2.0))
+
+
+@dataclass(frozen=True)
+class Identification:
+    """The identified model: the ship with fitted values, the fit, the training records and scores."""
+
+    ship: Ship
+    initial: Ship
+    fit: object
+    runs: list
+    segment_s: float
+    prior: Ship | None = None
+    """The prior (starting) model when it is not ``initial`` (another hull form of it)."""
+    record_weighting: str = DEFAULT_WEIGHTING
+    """How the training records counted (:func:`ekf.identify.record_weights`)."""
+    velocity_weight: float = 1.0
+    """How much the u, v, r residuals counted beside the heading's (:func:`identify`)."""
+    stages: tuple = ()
+    """One dict per fit stage, in order: ``segment_s`` (segment length [s]; ``inf``: the whole record,
+    no cut), ``description`` (:func:`stage_description`), ``evaluations`` (residual evaluations used),
+    ``max_nfev`` (the limit), ``cost_initial``, ``cost_final``, ``status``, ``message`` (scipy's)."""
+
+    def scores(self, runs=None, model: str = "identified") -> list[dict]:
+        """Open-loop replay scores (:meth:`trials.measured.predict.Replayed.scores`) of ``runs`` (the training
+        records when omitted) with the identified or the initial model."""
+        return [{"name": r.name, **self.replay(r, model).scores()} for r in (runs or self.runs)]
+
+    def replay(self, run: MeasuredRun, model: str = "identified"):
+        """:func:`trials.measured.predict.replay_record` of ``run`` with the identified (its wind scale too) or initial model."""
+        if model == "identified":
+            return replay_record(self.ship, with_ship_effects(with_fitted_wind(run, self.fit.values()), self.ship))
+        return replay_record(self.initial, run)
+
+
+METRIC_COLUMNS = (("advance_L", "advance [L]"), ("tactical_diameter_L", "tactical diameter [L]"),
+                  ("overshoots_deg", "overshoots [deg]"))
+
+
+def manoeuvre_metrics(rep) -> tuple[dict | None, dict | None]:
+    """Turning / zigzag metrics (:func:`trials.analysis.metrics.record_metrics`) of the measured record and of
+    its replay (a :class:`trials.measured.predict.Replayed`); ``None`` where the record is neither manoeuvre."""
+    from ..analysis.metrics import record_metrics
+    from ..files.records import TrialRecord
+
+    run = rep.run
+    out = []
+    for s in (run.meas, rep.pred):
+        rec = TrialRecord(t=run.t, name=run.name, source=run.source, x=s[:, 3], y=s[:, 4], psi=s[:, 5],
+                          u=s[:, 0], v=s[:, 1], r=s[:, 2], U=np.hypot(s[:, 0], s[:, 1]), delta=run.inputs.delta,
+                          n=run.inputs.n, meta={"length_m": rep.L})
+        try:
+            out.append(record_metrics(rec) if np.all(np.isfinite(s)) else None)
+        except (InputError, ValueError):
+            out.append(None)
+    return out[0], out[1]
+
+
+def _fmt_metric(m: dict | None, key: str) -> str:
+    if m is None or m.get(key) is None:
+        return "-"
+    v = m[key]
+    if isinstance(v, (list, tuple)):
+        return ", ".join(f"{x:.1f}" for x in v[:3]) if len(v) else "-"
+    return f"{v:.2f}" if np.isfinite(v) else "-"
+
+
+def with_ship_effects(run: MeasuredRun, ship: Ship) -> MeasuredRun:
+    """``run`` with the effects of ``ship``'s config other than the wind (in the run's loads) added, as
+    :func:`trials.measured.predict.measured_run` of that ship would have them (a fitted ``rudder_offset``)."""
+    from dataclasses import replace
+
+    own = ship.effect_set().without("wind")
+    if not own.items:
+        return run
+    es = own if run.effects is None else run.effects.merged(own)
+    return replace(run, effects=es)
+
+
+def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
+    """``run`` with its wind loads scaled by a fitted ``wind_scale`` (as the identified ship computes them)."""
+    from dataclasses import replace
+
+    if "wind_scale" not in values or run.inputs.ext is None:
+        return run
+    return replace(run, inputs=replace(run.inputs, ext=run.inputs.ext * values["wind_scale"]))
+
+
+def _ship_with(ship: Ship, values: dict) -> Ship:
+    from dataclasses import replace
+
+    hull = {k: v for k, v in values.items() if k in ship.hull.names}
+    s = ship.with_hull(hull) if hull else ship
+    if "w_P0" in values:
+        w = list(s.propeller.w_P0)
+        w[0] = values["w_P0"]
+        s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
+    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
+    from mmg.nondim import inertia_scale, mass_scale
+
+    pa = s.particulars
+    mass = {f"{k}_prime": values[k] / (inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T))
+            for k in MASS_CONSTANTS if k in values}
+    if mass:
+        s = replace(s, mass=replace(s.mass, **mass))
+    rud = {k: values[k] for k in ("epsilon", "kappa", *RUDDER_CONSTANTS) if k in values}
+    if rud:
+        s = replace(s, rudder=replace(s.rudder, **rud))
+    if "rudder_offset" in values:                 # the rudder_offset effect of mmg.effects, in degrees
+        import mmg.effects as E
+
+        s = replace(s, effects=s.effect_set().merged(
+            E.effect_set({"rudder_offset": {"offset_deg": float(np.degrees(values["rudder_offset"]))}})))
+    if "wind_scale" in values and s.wind is not None:
+        scale = s.wind.scale * values["wind_scale"]
+        s = replace(s, wind=replace(s.wind, scale=scale))
+        w = s.effect_set().get("wind")
+        if w is not None:
+            import mmg.effects as E
+
+            s = replace(s, effects=s.effect_set().merged(E.effect_set({"wind": {**w, "scale": scale}})))
+    return s
+
+
+def stage_description(segment_s: float) -> str:
+    """What a fit stage with segments of ``segment_s`` [s] fits, in words (an infinite length: the
+    whole record, not cut)."""
+    if not np.isfinite(segment_s):
+        return "whole-record fit: each record replayed open-loop from its first sample (not cut into segments)"
+    return f"segment-wise fit: {segment_s:.3g} s segments, each restarted from the measured state"
+
+
+def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | None = None, wind: bool | None = None,
+             max_nfev: int = DEFAULT_MAX_NFEV, progress=None, say=_log, prior_rel_std: float = 0.5,
+             initial: Ship | None = None, record_weighting: str = DEFAULT_WEIGHTING, loss: str = "linear",
+             f_scale: float = 1.0, record_nuisance=(), velocity_weight: float = 1.0) -> Identification:
+    """Identify ``free`` jointly over the training records (module docstring).
+
+    Parameters
+    ----------
+    ship : Ship
+        The initial model (the prior).
+    paths_or_runs : list of paths or of MeasuredRun
+    free : sequence of str
+        Hull coefficient names, ``"hull-except-constants"``, ``"hull"`` (every hull coefficient),
+        ``"w_P0"``, ``"epsilon"``, ``"kappa"``, ``"wind_scale"``.
+    segment_s : float or sequence of float, optional
+        Segment length(s) [s] of successive fits; :data:`DEFAULT_SEGMENTS_L` when omitted.
+    wind : bool, optional
+        Override the ship config's wind switch.
+    max_nfev : int
+        Most evaluations of the residuals in each stage (:func:`scipy.optimize.least_squares`'s
+        ``max_nfev``; ``mmg identify --max-nfev``); a stage that reaches it stops there
+        (:attr:`Identification.stages`: its ``status`` 0).
+    progress : callable, optional
+        ``progress(iteration, cost, stage)`` after each Jacobian; ``stage`` names the stage:
+        ``"stage 1/2: segment-wise fit: ..."`` (:func:`stage_description`).
+    prior_rel_std : float
+        Prior std of each freed coefficient relative to its config value (:func:`ekf.identify.free_parameters`).
+    initial : Ship, optional
+        The model the identified one is compared with in the scores and the report ("initial");
+        ``ship`` (the prior) when omitted.  Given when the prior is the initial model rewritten in
+        another hull form (e.g. ``esso_osaka_3m_crossflow`` for the Kijima ``esso_osaka_3m``).
+    record_weighting : str
+        How each training record's residuals count in every stage (:func:`ekf.identify.record_weights`):
+        ``"samples"`` (each sample alike: long records count more), ``"equal"`` (each record alike),
+        ``"relative"`` (each record alike, relative to its own misfit at the stage's start).
+    loss, f_scale : str, float
+        Robust loss of the last (whole-record) stage (:func:`scipy.optimize.least_squares`): ``"linear"``
+        (least squares), ``"soft_l1"``, ``"cauchy"``; ``f_scale`` in units of the scaled residuals.
+    record_nuisance : sequence of str
+        Effects of :mod:`mmg.effects` (e.g. ``("current",)``) fitted once per training record, as a
+        nuisance: each record gets its own values (a pond's wind-driven drift differs from run to run),
+        so the shared parameters need not absorb one record's disturbance.  They are not part of the
+        identified ship: a record it has not seen is predicted without them.
+    velocity_weight : float
+        Factor on the u, v and r residuals beside the heading's (1: their scales are 5 % of the
+        median speed, the heading's 2 deg; 0.1: their squares weigh a hundredth in the cost, so the
+        fit follows the heading, the score a replay is judged by).  docs/identify_cv.md: 0.1
+        predicts the kept-out records better without wind and worse with it.
+    """
+    from ekf.identify import Segmented, free_parameters, identify_segments, record_residual_rms, record_weights, \
+        segment_resets
+
+    try:
+        vw_ok = bool(np.isfinite(float(velocity_weight)) and float(velocity_weight) > 0)
+    except (TypeError, ValueError):
+        vw_ok = False
+    if not vw_ok:                                           # before any record is read
+        raise ValueError(f"velocity_weight: a positive finite number, got {velocity_weight!r}")
+    items = list(paths_or_runs)
+    runs = [r for r in items if isinstance(r, MeasuredRun)]
+    paths = [r for r in items if not isinstance(r, MeasuredRun)]
+    runs += load_runs(ship, paths, wind=wind, say=say) if paths else []
+    if not runs:
+        raise InputError("--train", "", "no usable training record")
+    L = ship.particulars.L
+    stages = DEFAULT_SEGMENTS_L if segment_s is None else np.atleast_1d(segment_s) / np.sqrt(L / 9.80665)
+    packed = pack(ship)
+    names = _free_names(ship, free)
+    if not any(r.inputs.ext is not None for r in runs):
+        names = [n for n in names if n != "wind_scale"]       # no wind loads to scale
+    fp = free_parameters(packed, ship.hull.names, names, prior_rel_std)
+    nuisance = None
+    if record_nuisance:
+        import mmg.effects as E
+        from ekf.identify import record_effect_parameters
+
+        nuisance = [E.get(n, "record_nuisance") for n in record_nuisance]
+        fp = fp + record_effect_parameters(nuisance, len(runs), names=[r.name for r in runs])
+    fit = None
+    done = []
+    for k, st in enumerate(stages):
+        seg = float(st) * float(np.sqrt(L / 9.80665))
+        label = f"stage {k + 1}/{len(stages)}: {stage_description(seg)}"
+        stage_progress = None if progress is None else (lambda i, c, _l=label: progress(i, c, _l))
+        segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects) for r in runs]
+        sc = _scales(runs, L, velocity_weight)
+        theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
+        rms = (record_residual_rms(packed, segs, fp, theta, sc, effects=nuisance, ship=ship)
+               if record_weighting == "relative" else None)
+        last = k == len(stages) - 1
+        fit = identify_segments(packed, segs, fp, sc, max_nfev=max_nfev, progress=stage_progress, effects=nuisance,
+                                ship=ship, start=None if fit is None else fit.theta,
+                                weights=record_weights(segs, record_weighting, rms=rms),
+                                loss=loss if last else "linear", f_scale=f_scale)
+        done.append({"segment_s": seg, "description": stage_description(seg), "evaluations": fit.iterations,
+                     "max_nfev": int(max_nfev), "cost_initial": fit.cost_initial, "cost_final": fit.cost_final,
+                     "status": fit.status, "message": fit.message})
+    return Identification(ship=_ship_with(ship, fit.values()), initial=ship if initial is None else initial, fit=fit,
+                          runs=runs, segment_s=seg, prior=None if initial is None else ship,
+                          record_weighting=record_weighting, velocity_weight=float(velocity_weight), stages=tuple(done))
+
+
+FOLD_ASSIGNMENTS = ("order", "revolutions")
+"""How :func:`cross_validate` deals the records into folds (:func:`fold_of`)."""
+
+
+def cv_folds(runs: list[MeasuredRun], folds: int) -> int:
+    """The number of folds a cross-validation of ``runs`` uses: ``folds``, or fewer when there are
+    fewer independent runs (:func:`same_run_groups`: a record and its cuts count once), since a fold
+    with nothing to keep out would only repeat the fit on all records.  Raises ValueError below two
+    runs, where nothing can be kept out and still leave a training set."""
+    n = len(set(same_run_groups(runs)))
+    if n < 2:
+        raise ValueError(f"cross-validation needs 2 or more independent records, got {n}")
+    return min(int(folds), n)
+
+
+def fold_of(runs: list[MeasuredRun], folds: int, by: str = "order") -> np.ndarray:
+    """The fold (0 .. folds-1) of each record.
+
+    ``"order"``: record i in fold i mod k, in the order given.  ``"revolutions"``: stratified by the
+    record's median propeller revolutions: the records sorted by them (ties by order) are dealt
+    round-robin, so every fold's training set spans the revolutions of all the records and a kept-out
+    record is not outside its training set's operating range by the luck of the file order (with
+    "order" over the sorted FRT files, the 16.7 and 15 rps zigzags fell into one fold, whose training
+    set then held one zigzag above 12 rps)."""
+    if by not in FOLD_ASSIGNMENTS:
+        raise ValueError(f"fold assignment {by!r}: one of {FOLD_ASSIGNMENTS}")
+    group = same_run_groups(runs)
+    firsts = sorted(set(group))                           # a group's first record stands for it
+    if by == "order":
+        key = {g: g for g in firsts}
+    else:
+        rps = {g: float(np.nanmedian(np.abs(runs[g].inputs.n))) for g in firsts}
+        key = {g: (rps[g], g) for g in firsts}
+    deal = {g: k % folds for k, g in enumerate(sorted(firsts, key=lambda g: key[g]))}
+    return np.array([deal[g] for g in group], dtype=int)
+
+
+def same_run_groups(runs: list[MeasuredRun]) -> list[int]:
+    """For each record, the index of the first record of the same run: a record whose first measured
+    sample (position, heading, velocities) is a sample of an earlier one is a copy or a cut of it
+    (the FRT set's ``turn_cut_*`` files are the first minutes of another file).  Cross-validation keeps
+    a run's records in one fold: a kept-out record must not be in its own training set."""
+    out = list(range(len(runs)))
+    for j in range(len(runs)):
+        s0 = runs[j].meas[0]
+        for i in range(j):
+            if out[i] != i:
+                continue
+            m = runs[i].meas
+            if m.shape[1] == s0.shape[0] and np.any(np.all(np.abs(m - s0) <= 1e-9 * (1.0 + np.abs(s0)), axis=1)):
+                out[j] = i
+                break
+    return out
+
+
+def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress=None, initial: Ship | None = None,
+                   folds_by: str = "order", **kw) -> list[dict]:
+    """k-fold cross-validation: each record kept out once; per record the open-loop heading RMS [deg]
+    (and the other scores) of the initial model (``initial``, the prior ``ship`` when omitted) and of
+    the model identified from ``ship`` without it (``kw``: :func:`identify`'s options); ``folds_by``:
+    how records are dealt into folds (:func:`fold_of`).  Each record's dict also holds ``"ship"``,
+    the model identified without it (for further replays of the kept-out record)."""
+    ref = ship if initial is None else initial
+    out = []
+    idx = np.arange(len(runs))
+    folds = cv_folds(runs, folds)
+    fold = fold_of(runs, folds, folds_by)
+    for k in range(folds):
+        test = idx[fold == k]
+        train = [runs[i] for i in idx if i not in set(test)]
+        ident = identify(ship, train, **kw)
+        for i in test:
+            a = replay_record(ref, runs[i]).scores()
+            b = ident.replay(runs[i]).scores()
+            out.append({"name": runs[i].name, "fold": k, "initial": a, "identified": b, "ship": ident.ship})
+        if progress:
+            progress(k + 1, folds)
+    return out
+
+
+def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
+    """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
+    ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``."""
+    import yaml
+
+    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
+    from mmg.nondim import inertia_scale, mass_scale
+
+    data = yaml.safe_load(Path(ship_path).read_text())
+    ship = None
+    for k, v in values.items():
+        if k in data["hull"]["coefficients"]:
+            data["hull"]["coefficients"][k]["value"] = float(f"{v:.6g}")
+        elif k == "w_P0":
+            data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
+        elif k in ("epsilon", "kappa", *RUDDER_CONSTANTS):
+            data["rudder"][k] = float(f"{v:.6g}")
+        elif k in MASS_CONSTANTS:
+            if ship is None:
+                from mmg.ship import load_ship
+
+                ship = load_ship(ship_path)
+            pa = ship.particulars
+            sc = inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
+            data["mass"][f"{k}_prime"] = float(f"{v / sc:.6g}")
+        elif k == "rudder_offset":
+            data.setdefault("effects", {})
+            data["effects"] = dict(data["effects"] or {})
+            data["effects"]["rudder_offset"] = {"offset_deg": float(f"{np.degrees(v):.6g}")}
+        elif k == "wind_scale" and "wind" in data:
+            eff = (data.get("effects") or {}).get("wind")
+            if isinstance(eff, dict) and "scale" in eff:           # the scale given in the effects section
+                eff["scale"] = float(f"{float(eff['scale']) * v:.6g}")
+                data["wind"].pop("scale", None)
+            else:
+                data["wind"]["scale"] = float(f"{float(data['wind'].get('scale', 1.0)) * v:.6g}")
+    data["name"] = f"{data['name']} (identified)"
+    data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
+    head = "".join(f"# {ln}\n" for ln in note.splitlines())
+    return head + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+
+
+def _stage_lines(ident: Identification) -> list[str]:
+    """The report's account of the fit stages: what each fitted, how many evaluations of its limit it
+    used and why it stopped (a stage at its limit says how to raise it)."""
+    st = ident.stages or ({"description": stage_description(ident.segment_s), "evaluations": ident.fit.iterations,
+                           "max_nfev": None, "status": ident.fit.status, "message": ident.fit.message},)
+    out = [f"Fitted in {len(st)} stage{'s' if len(st) > 1 else ''}, each starting from the previous one's values:"]
+    for k, s in enumerate(st):
+        lim = "" if s.get("max_nfev") is None else f" of at most {s['max_nfev']}"
+        stop = (" (stopped at its evaluation limit, not converged: mmg identify --max-nfev raises it)"
+                if s["status"] == 0 else f" ({s['message']})")
+        out.append(f"{k + 1}. {s['description']}; {s['evaluations']} evaluations{lim}{stop}.")
+    if len(st) > 1:
+        out += ["", "Each stage has its own cost (segments restarted from the record, or the whole record open loop): "
+                    "a stage's cost is not comparable with the one before it (the whole record usually costs more)."]
+    return out
+
+
+def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
+    """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
+
+    ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
+    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given;
+    ``test_runs`` (records never trained on) are predicted with both models and reported."""
+    out_dir = Path(out_dir)
+    fit = ident.fit
+    note = (f"segment-wise output error over {len(ident.runs)} records "
+            f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
+    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note))
+    a = ident.scores(model="initial")
+    b = ident.scores()
+    lines = [f"# Identification of {ident.initial.name}", ""]
+    if ident.prior is not None:
+        lines += [f"Fitted in the form of {ident.prior.name} (the prior, 'config' below); 'initial' scores are "
+                  f"{ident.initial.name}'s.", ""]
+    lines += [
+             f"Records: {len(ident.runs)}; free parameters: {len(fit.free)}; residuals {fit.n_residuals}; "
+             f"records weighted {ident.record_weighting!r}; velocity residuals weighted {ident.velocity_weight:g} "
+             f"beside the heading's.", "", *_stage_lines(ident), "",
+             "## Values and standard errors", "",
+             "Standard errors from the Gauss-Newton covariance scaled by the residual variance; the 10 Hz "
+             "residuals are correlated, so they are optimistic.", "",
+             "| parameter | config | identified | std | change |", "|---|---|---|---|---|"]
+    for name, row in fit.to_pandas().iterrows():
+        lines.append(f"| {name} | {row.prior:.5g} | {row.estimate:.5g} | {row['std']:.2g} | {row.change_pct:+.0f} % |")
+    warn = fit.warnings()
+    if warn:
+        lines += ["", "## Warnings", "",
+                  "The identified values predict the training records (below); these say where they should not "
+                  "be read as the ship's physics:", ""] + [f"- {w}" for w in warn]
+    names = [f.name for f in fit.free]
+    lines += ["", "## Correlations (|rho| >= 0.8)", ""]
+    strong = [(names[i], names[j], fit.corr[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
+              if np.isfinite(fit.corr[i, j]) and abs(fit.corr[i, j]) >= 0.8]
+    lines += [f"- {x} / {y}: {c:+.2f}" for x, y, c in strong] or ["- none"]
+    lines += ["", "## Training fits (open-loop replay from each record's first state)", "",
+              "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] |",
+              "|---|---|---|---|---|"]
+    for x, y in zip(a, b):
+        lines.append(f"| {x['name']} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | "
+                     f"{x['speed_rms_mps']:.3f} | {y['speed_rms_mps']:.3f} |")
+    ha, hb = np.nanmean([x["heading_rms_deg"] for x in a]), np.nanmean([y["heading_rms_deg"] for y in b])
+    lines.append(f"| **mean** | {ha:.2f} | {hb:.2f} | | |")
+    lines += ["", "## Manoeuvre metrics: measured, initial model, identified model", "",
+              "From each record and from its open-loop replays (same inputs); '-' where the record or the "
+              "replay is not a complete turn / zigzag.", "",
+              "| record | " + " | ".join(f"{h} meas / init / ident" for _, h in METRIC_COLUMNS) + " |",
+              "|---|" + "---|" * len(METRIC_COLUMNS)]
+    for r in ident.runs:
+        m0, mi = manoeuvre_metrics(replay_record(ident.initial, r))
+        _, mf = manoeuvre_metrics(ident.replay(r))
+        lines.append(f"| {r.name} | " + " | ".join(f"{_fmt_metric(m0, k)} / {_fmt_metric(mi, k)} / {_fmt_metric(mf, k)}"
+                                                    for k, _ in METRIC_COLUMNS) + " |")
+    if test_runs:
+        lines += ["", "## Predictions of records never trained on", "",
+                  "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
+                  "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
+        gone = []
+        for r in test_runs:
+            ri, rf = ident.replay(r, "initial"), ident.replay(r)
+            x, y = ri.scores(), rf.scores()
+            gone += [f"{r.name} ({who}, at t = {g.diverged_at:.1f} s)" for who, g in (("initial", ri), ("identified", rf))
+                     if g.diverged_at is not None]
+            lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
+                         f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
+        if gone:
+            lines += ["", f"'nan': the replay diverged (its state stopped being finite): {', '.join(gone)}."]
+    if cv:
+        lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
+                  "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]
+        for c in cv:
+            x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
+            lines.append(f"| {c['name']} | {c['fold']} | {x:.2f} | {y:.2f} | {x / y:.2f} |")
+        ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
+        xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
+        xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
+        better = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
+        lines.append(f"| **mean** | | {xa:.2f} | {xb:.2f} | {xa / xb:.2f} |")
+        lines += ["", f"Identified better on {better} of {len(cv)} kept-out records; mean ratio {xa / xb:.2f}."]
+        diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
+        if diverged:
+            lines += ["", f"The identified model's replay diverged on {len(diverged)} kept-out record(s) "
+                          f"({', '.join(diverged)}): counted as not better, left out of both means."]
+    (out_dir / "report.md").write_text("\n".join(lines) + "\n")
+    return {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}

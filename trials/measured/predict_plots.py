@@ -1,0 +1,117 @@
+"""Figures of a replay: measured against predicted track (ship outlines) and time histories."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..files.plots import TURN_RATIO, TrackView, _figure, ship_outline
+
+__all__ = ["replay_figure", "replay_layout"]
+
+WIDE_RATIO = 2.5
+"""A track longer than this many times its width goes across the top of a replay figure."""
+
+
+def replay_layout(north, east, pad: float = 0.6) -> tuple:
+    """Where a replay figure puts a track (in L): (view, across the top?, track height [in]).
+
+    A track within ``WIDE_RATIO`` of square goes in the tall left column, turned a quarter when it is long
+    east-west (its long side along the column); a longer one across the top of the figure, turned when
+    long north-south, its box as tall as its shape asks (2.8-5 in; the data limits fill the box, to scale).
+    """
+    n_span = float(np.nanmax(north) - np.nanmin(north)) + 2 * pad + 1e-12
+    e_span = float(np.nanmax(east) - np.nanmin(east)) + 2 * pad + 1e-12
+    ratio = max(n_span, e_span) / min(n_span, e_span)
+    if ratio <= WIDE_RATIO:
+        return TrackView(e_span > TURN_RATIO * n_span), False, 0.0
+    view = TrackView(n_span > e_span)
+    return view, True, float(np.clip(13.0 / ratio, 2.8, 5.0))
+
+
+def replay_figure(rep, title: str | None = None, pyplot: bool = True):
+    """Track with ship outlines (left, or across the top for a long track: :func:`replay_layout`) and
+    heading, yaw rate, speed, rudder and revolutions of a :class:`trials.measured.predict.Replayed`, measured
+    (black) against predicted (red).  The track is to scale, its start marked, the legend below it.
+
+    A replay that diverged (:attr:`~trials.measured.predict.Replayed.diverged_at`) is marked by a dotted
+    line at that time and in the titles, and every panel keeps the measured record's range (its span
+    again on each side), so the run-away prediction leaves the axes instead of squashing the record
+    to a flat line.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    run, p, L, B = rep.run, rep.pred, rep.L, rep.B
+    m, t = run.meas, run.t
+    title = title or run.name
+    t_div = rep.diverged_at
+    div = "" if t_div is None else f"\nreplay diverged at t = {t_div:.1f} s"
+
+    def keep_measured_range(x):
+        lo, hi = float(np.nanmin(x)), float(np.nanmax(x))
+        pad = max(hi - lo, 1e-6 * max(abs(lo), abs(hi), 1.0))
+        return lo - pad, hi + pad
+
+    shown = m if t_div is not None else np.vstack([m, p[np.all(np.isfinite(p[:, 3:5]), axis=1)]])
+    view, wide, track_h = replay_layout(shown[:, 3] / L, shown[:, 4] / L)      # the track as drawn
+    if wide:                     # a long track across the top, turned so its long side runs across
+        fig = _figure((14, 8 + track_h), pyplot)
+        gs = fig.add_gridspec(6, 1, height_ratios=[track_h / 1.4] + [1.0] * 5)
+        ax = fig.add_subplot(gs[0, 0])
+        cell = lambda k: gs[k + 1, 0]                                     # noqa: E731
+    else:
+        fig = _figure((14, 8), pyplot)
+        gs = fig.add_gridspec(5, 2, width_ratios=[1.0, 1.2])
+        ax = fig.add_subplot(gs[:, 0])
+        cell = lambda k: gs[k, 1]                                         # noqa: E731
+    ax.plot(*view.hv(m[:, 3] / L, m[:, 4] / L), "k-", lw=1.2, label="measured")
+    ax.plot(*view.hv(p[:, 3] / L, p[:, 4] / L), "r--", lw=1.2, label="predicted")
+    ax.plot(*view.hv(m[:1, 3] / L, m[:1, 4] / L), "o", color="g", ms=6, zorder=3, label="start")
+    every = max((t[-1] - t[0]) / 12, 1e-9)
+    first = True
+    for tk in np.arange(t[0], t[-1] + 1e-9, every):
+        i = min(int(np.searchsorted(t, tk)), len(t) - 1)
+        for s, ec, lab in ((m, "k", "outline, measured"), (p, "r", "outline, predicted")):
+            if np.all(np.isfinite(s[i])):
+                px, py = ship_outline(s[i, 3], s[i, 4], s[i, 5], L, B)
+                ax.fill(*view.hv(px / L, py / L), fc="none", ec=ec, lw=0.6,
+                        label=f"{lab} (to scale), every {every:.0f} s" if first else None)
+        first = False
+    if t_div is not None:
+        hlim, vlim = view.hv(keep_measured_range(m[:, 3] / L), keep_measured_range(m[:, 4] / L))
+        ax.set_xlim(*hlim)
+        ax.set_ylim(*vlim)
+    view.finish(ax)
+    ax.set_title(f"{title}: track (L = {L:g} m, wind {run.wind}){div}")
+    if wide:                     # the legend beside the track, off the data
+        ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=8, frameon=False)
+    else:                        # ... or below it, under the axis label
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=8, frameon=False)
+    rows = [("heading (deg)", np.degrees(m[:, 5]), np.degrees(p[:, 5])),
+            ("yaw rate (deg/s)", np.degrees(m[:, 2]), np.degrees(p[:, 2])),
+            ("speed (m/s)", np.hypot(m[:, 0], m[:, 1]), np.hypot(p[:, 0], p[:, 1])),
+            ("sway v (m/s)", m[:, 1], p[:, 1])]
+    axs = []
+    for k, (lab, a, b) in enumerate(rows):
+        a_ = fig.add_subplot(cell(k), sharex=axs[0] if axs else None)
+        a_.plot(t, a, "k-", lw=1, label="measured")
+        a_.plot(t, b, "r--", lw=1, label="predicted")
+        if t_div is not None:
+            a_.axvline(t_div, color="r", ls=":", lw=1.2, label=f"replay diverged (t = {t_div:.1f} s)")
+            a_.set_ylim(*keep_measured_range(a))
+        a_.set_ylabel(lab)
+        a_.grid(True, alpha=0.3)
+        axs.append(a_)
+    axs[0].legend(loc="best", fontsize=8)
+    axs[0].set_title(f"{title}: time histories{div}")
+    a_ = fig.add_subplot(cell(4), sharex=axs[0])
+    a_.plot(t, np.degrees(run.inputs.delta), "b-", lw=1, label="rudder (deg)")
+    a_.plot(t, run.inputs.n, "g-", lw=1, label="revolutions (rps)")
+    a_.set_ylabel("inputs")
+    a_.set_xlabel("t (s)")
+    a_.grid(True, alpha=0.3)
+    a_.legend(loc="best", fontsize=8)
+    for a in axs:
+        a.tick_params(labelbottom=False)
+    fig.tight_layout()
+    return fig
