@@ -197,7 +197,7 @@ def test_rudder_timing_sensitivities_are_the_raw_log_filters_tau(zigzag_tangent)
     s = np.zeros(LNS)
     got = np.zeros((len(tan.t), 4))
     for k in range(1, len(tan.t)):
-        propagate_log(z, tan.delta[k - 1], tan.delta[k], g[k - 1], g[k], tr.dt, *pk.args()[:4], idx, ws)
+        propagate_log(z, (tan.delta[k - 1], tan.delta[k], g[k - 1], g[k]), tr.dt, pk.args()[:4], idx, ws)
         F = ws[9]
         s = F[:LNS, :LNS] @ s + (F[:LNS, TAU] if seg[k - 1] == j else 0.0)
         z[:LNS] = ws[8][:LNS]

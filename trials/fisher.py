@@ -90,7 +90,7 @@ def _tangent_kernel(z0, delta, dt, p, poly, hull_axis, hull_term, hull_coef, idx
         for j in range(nz):
             S[0, i, j] = 1.0 if i == j else 0.0
     for k in range(1, N):
-        propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
+        propagate_step(z, delta[k - 1], delta[k], dt, (p, poly, hull_axis, hull_term), idx, ws)
         for i in range(nz):
             z[i] = zn[i]
         for i in range(NS):
@@ -113,7 +113,9 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
     N = delta.shape[0]
     h = CSTEP
     ws = make_workspace(np.int64(LOG_NZ), np.int64(LOG_NS), hull_coef)
-    coef, xs, k1, k2, k3, k4, nxt = ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
+    nxt = ws[7]
+    layout = (LOG_SLOTS, np.int64(LOG_ND), idx, np.int64(-1))
+    ship = (p, poly, hull_axis, hull_term)
     z = np.empty(z0.shape[0], dtype=np.complex128)
     for i in range(z0.shape[0]):
         z[i] = z0[i]
@@ -122,8 +124,7 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
     for i in range(LOG_NS):           # element-wise (a slice assignment compiles numba's shape-mismatch message)
         zh[0, i] = z[i]
     for k in range(1, N):
-        rk4_step(z, LOG_SLOTS, np.int64(LOG_ND), delta[k - 1] + 0.0j, delta[k] + 0.0j, dt, p, poly, hull_axis, hull_term,
-                 coef, idx, xs, k1, k2, k3, k4, nxt)
+        rk4_step(z, delta[k - 1] + 0.0j, delta[k] + 0.0j, dt, layout, ship, ws)
         for i in range(LOG_NS):
             z[i] = nxt[i]
             zh[k, i] = nxt[i]
@@ -139,8 +140,7 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
         for k in range(k0 + 1, N):
             a0 = 1j * h * g[k - 1] if seg[k - 1] == j else 0.0j
             a1 = 1j * h * g[k] if seg[k - 1] == j else 0.0j
-            rk4_step(z, LOG_SLOTS, np.int64(LOG_ND), delta[k - 1] + a0, delta[k] + a1, dt, p, poly, hull_axis, hull_term,
-                     coef, idx, xs, k1, k2, k3, k4, nxt)
+            rk4_step(z, delta[k - 1] + a0, delta[k] + a1, dt, layout, ship, ws)
             for i in range(LOG_NS):
                 z[i] = nxt[i]
             out[k, 0, j] = z[4].imag / h
