@@ -645,6 +645,24 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--version", action="version", version=f"mmg-toolkit {_version()}")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
+    for add in (_add_simulate, _add_metrics, _add_reproduce, _add_nomoto, _add_nomoto_paper, _add_estimate,
+                _add_sensitivity, _add_montecarlo, _add_log_filter, _add_output_error, _add_predict, _add_identify,
+                _add_diagnose):
+        add(sub)
+    return ap
+
+
+def _mc_common(p, what) -> None:
+    """The arguments the Monte Carlo commands share."""
+    p.add_argument("out", type=_output_path, help="output folder (runs.csv, summary.csv/.md)")
+    p.add_argument("--seeds", type=_positive_int, default=20, help="noise seeds per trial (default 20)")
+    p.add_argument("--first-seed", type=_seed, default=1000, help="noise seed of the first run of each trial")
+    p.add_argument("--jobs", type=_positive_int, default=2, help="workers (default 2)")
+    p.add_argument("--config", default=None, help=f"estimation YAML for the {what}")
+
+
+def _add_simulate(sub) -> None:
+    """``mmg simulate``'s arguments."""
     p = sub.add_parser("simulate", help="simulate a trial from its YAML config")
     p.add_argument("config", help="trial YAML (configs/trials/*.yaml) or a bundled trial name (st35, zz20, ...)")
     p.add_argument("--out", required=True, type=_output_path,
@@ -652,6 +670,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--show", action="store_true", help="also show the figures on screen")
     p.set_defaults(func=cmd_simulate)
 
+
+def _add_metrics(sub) -> None:
+    """``mmg metrics``'s arguments."""
     p = sub.add_parser("metrics", help="manoeuvre metrics from a log (project log, truth file or FRT-DS-ESSO CSV)")
     p.add_argument("log")
     p.add_argument("--kind", choices=["turning", "zigzag", "stype"], help="override the manoeuvre kind")
@@ -661,12 +682,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", type=_output_path, help="also write the metrics to this JSON file")
     p.set_defaults(func=cmd_metrics)
 
+
+def _add_reproduce(sub) -> None:
+    """``mmg reproduce``'s arguments."""
     p = sub.add_parser("reproduce", help="the main job: reproduce the papers on the default Esso Osaka configs")
     p.add_argument("--out", default="out", type=_output_path, help="output folder (default: out)")
     p.add_argument("--full", action="store_true",
                    help="also the Monte Carlo runs (EKF and output error, 20 seeds) and the full Nomoto Table 8 (~25 min)")
     p.set_defaults(func=cmd_reproduce)
 
+
+def _add_nomoto(sub) -> None:
+    """``mmg nomoto``'s arguments."""
     p = sub.add_parser("nomoto", help="identify 1st/2nd-order Nomoto K, T (T1, T2, T3) from a zigzag log")
     p.add_argument("log", help="zigzag record (project log/truth CSV or FRT-DS-ESSO CSV)")
     p.add_argument("--length", type=float, required=True, help="ship length L [m]")
@@ -675,11 +702,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-output-error", action="store_true", help="skip the output-error fit")
     p.set_defaults(func=cmd_nomoto)
 
+
+def _add_nomoto_paper(sub) -> None:
+    """``mmg nomoto-paper``'s arguments."""
     p = sub.add_parser("nomoto-paper", help="reproduce Artyszuk (2018) Tables 1-8 (CSV + Markdown)")
     p.add_argument("--out", default="out/nomoto-paper", type=_output_path, help="output folder")
     p.add_argument("--fast", action="store_true", help="skip the output-error fits of the extended Table 8")
     p.set_defaults(func=cmd_nomoto_paper)
 
+
+def _add_estimate(sub) -> None:
+    """``mmg estimate``'s arguments."""
     p = sub.add_parser("estimate", help="estimate the ship's sway/yaw hull coefficients from trial logs (augmented EKF)")
     p.add_argument("inputs", nargs="+", metavar="LOG_OR_TRIAL.yaml",
                    help="project logs (log.csv) or trial YAMLs / bundled trial names (simulated first)")
@@ -699,6 +732,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "output-error fit of the raw logs over all inputs")
     p.set_defaults(func=cmd_estimate)
 
+
+def _add_sensitivity(sub) -> None:
+    """``mmg sensitivity``'s arguments."""
     p = sub.add_parser("sensitivity", help="derivative sensitivities (Rhee & Kim eqs. 21-22), Fisher information, "
                                            "trial design")
     p.add_argument("trials", nargs="*", help="trial YAMLs to compare (their sensitivities are normalised together)")
@@ -719,20 +755,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=_positive_int, default=None, help="workers (default: all cores)")
     p.set_defaults(func=cmd_sensitivity)
 
-    def mc_common(p, what):
-        p.add_argument("out", type=_output_path, help="output folder (runs.csv, summary.csv/.md)")
-        p.add_argument("--seeds", type=_positive_int, default=20, help="noise seeds per trial (default 20)")
-        p.add_argument("--first-seed", type=_seed, default=1000, help="noise seed of the first run of each trial")
-        p.add_argument("--jobs", type=_positive_int, default=2, help="workers (default 2)")
-        p.add_argument("--config", default=None, help=f"estimation YAML for the {what}")
 
+def _add_montecarlo(sub) -> None:
+    """``mmg montecarlo``'s arguments."""
     p = sub.add_parser("montecarlo", help="Monte Carlo of the paper EKF over noise seeds (ST35, ZZ10, ZZ20, S-type 120)")
-    mc_common(p, "EKF")
+    _mc_common(p, "EKF")
     p.add_argument("--summarise-only", action="store_true", help="print the group table of OUT/summary.csv, no runs")
     p.set_defaults(func=cmd_montecarlo)
 
+
+def _add_log_filter(sub) -> None:
+    """``mmg log-filter``'s arguments."""
     p = sub.add_parser("log-filter", help="Monte Carlo of the EKF on the raw 5 s log (near the Cramer-Rao bound)")
-    mc_common(p, "raw-log EKF")
+    _mc_common(p, "raw-log EKF")
     p.add_argument("--trials", nargs="*", default=None,
                    help="trial names (default ST35 ZZ10 ZZ20 'S-type 120') or turning/zigzag/S-type trial YAMLs")
     p.add_argument("--sigma-tau", type=_finite_positive, default=None,
@@ -742,8 +777,11 @@ def build_parser() -> argparse.ArgumentParser:
                         "with the rudder known)")
     p.set_defaults(func=cmd_log_filter)
 
+
+def _add_output_error(sub) -> None:
+    """``mmg output-error``'s arguments."""
     p = sub.add_parser("output-error", help="Monte Carlo of the joint output-error fit (EKF start) over noise seeds")
-    mc_common(p, "EKF start and the fit")
+    _mc_common(p, "EKF start and the fit")
     p.add_argument("--trials", nargs="+", default=["ST35", "ZZ10", "ZZ20", "S-type 120"],
                    help="trial names (ST35 ZZ10 ZZ20 'S-type 120')")
     p.add_argument("--rudder", choices=("ramp", "law", "reconstructed"), default="ramp")
@@ -752,6 +790,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--summarise-only", action="store_true", help="rewrite the table from OUT/runs.csv, no runs")
     p.set_defaults(func=cmd_output_error)
 
+
+def _add_predict(sub) -> None:
+    """``mmg predict``'s arguments."""
     p = sub.add_parser("predict", help="replay records open-loop against their own rudder and propeller history: "
                                        "heading, yaw-rate, speed RMS and final position error per run")
     p.add_argument("logs", nargs="+", metavar="LOG", help="FRT-DS-ESSO CSVs, project logs or truth files")
@@ -766,6 +807,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="wind loads from the measured relative wind (default: as the ship config says)")
     p.set_defaults(func=cmd_predict)
 
+
+def _add_identify(sub) -> None:
+    """``mmg identify``'s arguments."""
     p = sub.add_parser("identify", help="identify hull coefficients and model-scale constants jointly over measured "
                                         "records (segment-wise output error); writes DIR/ship.yaml and DIR/report.md")
     p.add_argument("--ship", required=True, help="initial ship YAML or bundled name (the prior)")
@@ -801,6 +845,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "revolutions (a record and its cut copies always share a fold)")
     p.set_defaults(func=cmd_identify)
 
+
+def _add_diagnose(sub) -> None:
+    """``mmg diagnose``'s arguments."""
     p = sub.add_parser("diagnose", help="find where the model and the records disagree, name the missing effect "
                                         "(current, wind, rudder_offset, heading_bias, shallow_water) and show the gap shrink")
     p.add_argument("logs", nargs="+", metavar="LOG", help="FRT-DS-ESSO CSVs, project logs or truth files")
@@ -813,7 +860,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--wind", choices=("on", "off"), default=None,
                    help="wind loads in the model from the start (default off: wind is then a candidate effect)")
     p.set_defaults(func=cmd_diagnose)
-    return ap
 
 
 def _listing(names) -> str:
