@@ -52,6 +52,7 @@ writes ``OUT/runs.csv``; ``mmg sensitivity --crb-vs-mc OUT --out DIR`` compares 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from mmg._jit import carray, njit, readonly
@@ -246,11 +247,21 @@ def run_log_filter(data, record, cfg: dict, q=None, duration: float | None = Non
         rudder known; use a tiny ``sigma_tau`` with it).
     Raises FilterDivergence.
     """
-    res = _run_once(data, record, cfg, q, duration, None, sigma_tau, uvr_std, rudder=rudder)
+    opts = _PassOptions(q, duration, sigma_tau, uvr_std, rudder)
+    res = _run_once(data, record, cfg, opts)
     for _ in range(passes - 1):
-        res = _run_once(data, record, cfg, q, duration, res.z[-1, ND:], sigma_tau, uvr_std,
-                        P_der=inflate * res.P[ND:, ND:], rudder=rudder)
+        res = _run_once(data, record, cfg, opts, (res.z[-1, ND:], inflate * res.P[ND:, ND:]))
     return res
+
+
+class _PassOptions(NamedTuple):
+    """:func:`run_log_filter`'s options of every pass (its parameters of the same names)."""
+
+    q: dict | None
+    duration: float | None
+    sigma_tau: float
+    uvr_std: object
+    rudder: str
 
 
 def _true_rudder(data, t: np.ndarray) -> np.ndarray:
@@ -259,12 +270,15 @@ def _true_rudder(data, t: np.ndarray) -> np.ndarray:
     return np.interp(t, np.asarray(data.truth.t, float), np.asarray(data.truth.delta, float))
 
 
-def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=None, P_der=None,
-              rudder: str = "rebuilt") -> LogFilterResult:
+def _run_once(data, record, cfg, opts: _PassOptions, start=None) -> LogFilterResult:
+    """One pass; start = (the derivatives' start values, their covariance), the config's and Table 7's
+    when None."""
     from mmg.rudder import movement_starts, reconstruct_rudder
 
     from .estimate import P0_for, initial_state
 
+    q, duration, sigma_tau, uvr_std, rudder = opts
+    start_derivs, P_der = (None, None) if start is None else start
     m = data.meas
     t = np.asarray(m.t, float)
     dt = float(t[1] - t[0])

@@ -166,7 +166,7 @@ def test_rudder_timing_sensitivities_match_finite_differences(zigzag_tangent):
         for sgn in (+1, -1):
             d = np.ascontiguousarray(tan.delta + sgn * h * g * (seg == j))
             Y, S = np.empty((N, 4)), np.empty((N, 4, 16))
-            _tangent_kernel(z0, d, tr.dt, *pk.args(), idx, Y, S)
+            _tangent_kernel(z0, d, tr.dt, pk.args()[:4], pk.hull_coef, idx, Y, S)
             runs.append(Y)
         fd = (runs[0] - runs[1]) / (2 * h)
         ex = tan.S_tau[:, :, j]
