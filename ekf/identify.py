@@ -39,7 +39,8 @@ from mmg.model import P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
-           "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights", "record_residual_rms",
+           "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
+           "record_residual_rms",
            "RECORD_WEIGHTINGS", "effect_parameters", "record_effect_parameters", "effect_set_of",
            "predict_logged"]
 

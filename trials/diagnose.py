@@ -57,7 +57,8 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-__all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
+__all__ = ["diagnose", "DiagnoseOptions", "Diagnosis",
+           "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")

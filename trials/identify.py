@@ -47,7 +47,8 @@ from mmg.ship import Ship
 
 from .predict import MeasuredRun, measured_run, replay_record
 
-__all__ = ["identify", "IdentifyOptions", "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
+__all__ = ["identify", "IdentifyOptions",
+           "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description"]
 
