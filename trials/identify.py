@@ -536,19 +536,9 @@ def _stage_lines(ident: Identification) -> list[str]:
     return out
 
 
-def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
-    """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
-
-    ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
-    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given;
-    ``test_runs`` (records never trained on) are predicted with both models and reported."""
-    out_dir = Path(out_dir)
+def _report_fit(ident: Identification) -> list:
+    """The report's title, stages, values with standard errors, warnings and strong correlations."""
     fit = ident.fit
-    note = (f"segment-wise output error over {len(ident.runs)} records "
-            f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
-    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note))
-    a = ident.scores(model="initial")
-    b = ident.scores()
     lines = [f"# Identification of {ident.initial.name}", ""]
     if ident.prior is not None:
         lines += [f"Fitted in the form of {ident.prior.name} (the prior, 'config' below); 'initial' scores are "
@@ -573,6 +563,14 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     strong = [(names[i], names[j], fit.corr[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
               if np.isfinite(fit.corr[i, j]) and abs(fit.corr[i, j]) >= 0.8]
     lines += [f"- {x} / {y}: {c:+.2f}" for x, y, c in strong] or ["- none"]
+    return lines
+
+
+def _report_training(ident: Identification) -> list:
+    """The report's training fits (heading and speed RMS) and manoeuvre metrics, measured and replayed."""
+    a = ident.scores(model="initial")
+    b = ident.scores()
+    lines = []
     lines += ["", "## Training fits (open-loop replay from each record's first state)", "",
               "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] |",
               "|---|---|---|---|---|"]
@@ -591,35 +589,64 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
         _, mf = manoeuvre_metrics(ident.replay(r))
         lines.append(f"| {r.name} | " + " | ".join(f"{_fmt_metric(m0, k)} / {_fmt_metric(mi, k)} / {_fmt_metric(mf, k)}"
                                                     for k, _ in METRIC_COLUMNS) + " |")
+    return lines
+
+
+def _report_test(ident: Identification, test_runs) -> list:
+    """The report's predictions of the records never trained on."""
+    lines = []
+    lines += ["", "## Predictions of records never trained on", "",
+              "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
+              "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
+    gone = []
+    for r in test_runs:
+        ri, rf = ident.replay(r, "initial"), ident.replay(r)
+        x, y = ri.scores(), rf.scores()
+        gone += [f"{r.name} ({who}, at t = {g.diverged_at:.1f} s)" for who, g in (("initial", ri), ("identified", rf))
+                 if g.diverged_at is not None]
+        lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
+                     f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
+    if gone:
+        lines += ["", f"'nan': the replay diverged (its state stopped being finite): {', '.join(gone)}."]
+    return lines
+
+
+def _report_cv(cv: list) -> list:
+    """The report's cross-validation table and summary."""
+    lines = []
+    lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
+              "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]
+    for c in cv:
+        x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
+        lines.append(f"| {c['name']} | {c['fold']} | {x:.2f} | {y:.2f} | {x / y:.2f} |")
+    ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
+    xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
+    xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
+    better = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
+    lines.append(f"| **mean** | | {xa:.2f} | {xb:.2f} | {xa / xb:.2f} |")
+    lines += ["", f"Identified better on {better} of {len(cv)} kept-out records; mean ratio {xa / xb:.2f}."]
+    diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
+    if diverged:
+        lines += ["", f"The identified model's replay diverged on {len(diverged)} kept-out record(s) "
+                      f"({', '.join(diverged)}): counted as not better, left out of both means."]
+    return lines
+
+
+def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
+    """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
+
+    ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
+    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given;
+    ``test_runs`` (records never trained on) are predicted with both models and reported."""
+    out_dir = Path(out_dir)
+    fit = ident.fit
+    note = (f"segment-wise output error over {len(ident.runs)} records "
+            f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
+    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note))
+    lines = _report_fit(ident) + _report_training(ident)
     if test_runs:
-        lines += ["", "## Predictions of records never trained on", "",
-                  "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
-                  "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
-        gone = []
-        for r in test_runs:
-            ri, rf = ident.replay(r, "initial"), ident.replay(r)
-            x, y = ri.scores(), rf.scores()
-            gone += [f"{r.name} ({who}, at t = {g.diverged_at:.1f} s)" for who, g in (("initial", ri), ("identified", rf))
-                     if g.diverged_at is not None]
-            lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
-                         f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
-        if gone:
-            lines += ["", f"'nan': the replay diverged (its state stopped being finite): {', '.join(gone)}."]
+        lines += _report_test(ident, test_runs)
     if cv:
-        lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
-                  "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]
-        for c in cv:
-            x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
-            lines.append(f"| {c['name']} | {c['fold']} | {x:.2f} | {y:.2f} | {x / y:.2f} |")
-        ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
-        xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
-        xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
-        better = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
-        lines.append(f"| **mean** | | {xa:.2f} | {xb:.2f} | {xa / xb:.2f} |")
-        lines += ["", f"Identified better on {better} of {len(cv)} kept-out records; mean ratio {xa / xb:.2f}."]
-        diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
-        if diverged:
-            lines += ["", f"The identified model's replay diverged on {len(diverged)} kept-out record(s) "
-                          f"({', '.join(diverged)}): counted as not better, left out of both means."]
+        lines += _report_cv(cv)
     (out_dir / "report.md").write_text("\n".join(lines) + "\n")
     return {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
