@@ -55,11 +55,11 @@ def _jacobians(zs, delta, dt, p, poly, hull_axis, hull_term, idx, ws, reference)
     """F at each state zs[k - 1] of a pass (as the filter's predict computes it)."""
     for k in range(1, zs.shape[0]):
         if reference:
-            jacobian_step_reference(zs[k - 1], delta[k - 1], delta[k], 0.0, 0.0, -1, SLOTS, NS, dt, p, poly,
-                                    hull_axis, hull_term, idx, ws)
+            jacobian_step_reference(zs[k - 1], (delta[k - 1], delta[k], 0.0, 0.0), (SLOTS, NS, idx, -1), dt,
+                                    (p, poly, hull_axis, hull_term), ws)
         else:
-            jacobian_step(zs[k - 1], delta[k - 1], delta[k], 0.0, 0.0, -1, SLOTS, NS, dt, p, poly, hull_axis,
-                          hull_term, idx, ws)
+            jacobian_step(zs[k - 1], (delta[k - 1], delta[k], 0.0, 0.0), (SLOTS, NS, idx, -1), dt,
+                          (p, poly, hull_axis, hull_term), ws)
 
 
 def timed_jacobians(res, data, reference: bool) -> float:

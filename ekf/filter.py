@@ -157,20 +157,28 @@ def _check(z, P):
 
 
 @njit(cache=True)
-def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, hull_axis, hull_term, hull_coef, idx, zs, pdiag,
-                  ws, uw, reference=None):
+def filter_kernel(prior, record, noise, ship, idx, out, work, reference=None):
     """The whole pass: predict (RK4 + exact F), P = F P F^T, Joseph update, checks.
 
-    meas (N, 4) u, v, r, n at times k*dt; delta (N,); zs (N, nz) and pdiag (N, nz) are filled
-    (row 0 the initial values); q: Q = q I (0 in the paper); ws and uw the work arrays of
-    :func:`propagate_step` (:func:`workspace`) and of the update (:func:`make_update_workspace`),
-    made by :func:`run_filter`.  Returns (status, step index, final P).
+    prior = (z0, P0) the initial state and covariance; record = (meas, delta, dt): meas (N, 4)
+    u, v, r, n at times k*dt, delta (N,) the rudder [rad]; noise = (R, q, nis_window, nis_max):
+    R (4, 4), Q = q I (0 in the paper), divergence when the NIS averaged over nis_window steps
+    exceeds nis_max (nis_window 0: never); ship = (p, poly, hull_axis, hull_term) of the packed
+    ship, idx the estimated coefficients' slots in its hull_coef; out = (zs, pdiag), both (N, nz),
+    filled (row 0 the initial values); work = (ws, uw) the work arrays of :func:`propagate_step`
+    (:func:`workspace`) and of the update (:func:`make_update_workspace`), made by
+    :func:`run_filter`.  Returns (status, step index, final P).
     reference: the previous implementation, for tests and ``bench/bench_ekf.py``: F by the
     brute-force complex step (:func:`ekf.kernels.jacobian_step_reference`, one complex RK4 step
     per column) instead of the tangent-linear RK4 of :func:`propagate_step`, and the update by
     :func:`joseph_update` instead of its allocation-free form :func:`ekf.kernels.joseph_update_ws`;
     the same numbers to rounding.  Left out (None), that path is not compiled at all.
     """
+    z0, P0 = prior
+    meas, delta, dt = record
+    R, q, nis_window, nis_max = noise
+    zs, pdiag = out
+    ws, uw = work
     nz = z0.shape[0]
     N = meas.shape[0]
     z = z0.copy()
@@ -184,10 +192,10 @@ def filter_kernel(z0, P0, meas, delta, dt, R, q, nis_window, nis_max, p, poly, h
     nis_sum = 0.0
     for k in range(1, N):
         if reference is not None and reference:
-            jacobian_step_reference(z, delta[k - 1], delta[k], 0.0, 0.0, np.int64(-1), SLOTS, np.int64(NS), dt, p, poly, hull_axis,
-                                    hull_term, idx, ws)
+            jacobian_step_reference(z, (delta[k - 1], delta[k], 0.0, 0.0), (SLOTS, np.int64(NS), idx, np.int64(-1)), dt,
+                                    ship, ws)
         else:
-            propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
+            propagate_step(z, delta[k - 1], delta[k], dt, ship, idx, ws)
         for i in range(nz):             # element-wise: a slice assignment compiles numba's shape-mismatch message (~7 s cold)
             z[i] = zn[i]
         fpft(F, P, np.int64(NS), FP, P)
@@ -281,9 +289,10 @@ def run_filter(packed: PackedShip, slots, t, meas, delta, z0, P0, R, trial: str 
     # makers cost a cold cache 1.5-2 s for a few allocations a pass
     ws = interpreted(workspace)(nz, hull_coef)
     uw = interpreted(make_update_workspace)(nz, meas.shape[1])
-    st, k, P = filter_kernel(c(z0), c(P0), meas, c(delta), dt, c(R), float(q),
-                             int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max), c(packed.p), c(packed.poly), c(packed.hull_axis, np.int64),
-                             c(packed.hull_term, np.int64), hull_coef, c(slots, np.int64), zs, pd_, ws, uw)
+    noise = (c(R), float(q), int(round(nis_window_s / dt)) if nis_max > 0 else 0, float(nis_max))
+    ship = (c(packed.p), c(packed.poly), c(packed.hull_axis, np.int64), c(packed.hull_term, np.int64))
+    st, k, P = filter_kernel((c(z0), c(P0)), (meas, c(delta), dt), noise, ship, c(slots, np.int64), (zs, pd_),
+                             (ws, uw))
     if st != OK:
         raise FilterDivergence(trial, t[k], _REASON[st])
     return FilterResult(t, zs, pd_, P, tuple(names))

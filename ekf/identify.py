@@ -39,7 +39,8 @@ from mmg.model import P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
-           "segment_resets", "identify_segments", "SHIP_CONSTANTS", "record_weights", "record_residual_rms",
+           "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
+           "record_residual_rms",
            "RECORD_WEIGHTINGS", "effect_parameters", "record_effect_parameters", "effect_set_of",
            "predict_logged"]
 
@@ -347,30 +348,22 @@ def record_residual_rms(packed: PackedShip, records: list[Segmented], free: list
                                                           ship, scales.pos, k) ** 2))) for k, rec in enumerate(records)])
 
 
-def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
-                      stride: int = 2, n_jobs: int | None = None, max_nfev: int = 40, progress=None,
-                      start=None, effects=None, ship=None, weights=None, loss: str = "linear",
-                      f_scale: float = 1.0) -> IdentifyResult:
-    """Fit ``free`` jointly over ``records`` (module docstring).
+@dataclass(frozen=True)
+class FitOptions:
+    """How :func:`identify_segments` fits (each field also a keyword argument of it).
 
-    Parameters
+    Attributes
     ----------
-    packed : PackedShip
-        The ship with its config values (the prior and the starting point).
-    records : list of Segmented
-    free : list of FreeParameter
-    scales : Scales
-        Residual scales of u, v, r, heading.
     stride : int
         Use every ``stride``-th sample in the residuals.
     n_jobs : int, optional
         Threads for the Jacobian columns; all cores when omitted.
     max_nfev : int
         Most trust-region iterations.
-    start : array_like, optional
-        Starting values (a previous fit's); the priors when omitted.
     progress : callable, optional
         ``progress(iteration, cost)`` after each Jacobian.
+    start : array_like, optional
+        Starting values (a previous fit's); the priors when omitted.
     effects : list of mmg.effects classes, optional
         Effects in the model; their parameters are the ``free`` ones of kind ``"effect"``
         (:func:`effect_parameters`).
@@ -382,88 +375,140 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
         :func:`scipy.optimize.least_squares`'s loss ("linear": least squares; "soft_l1", "cauchy":
         robust) and its residual scale (in units of the scaled residuals).
     """
-    from scipy.optimize import least_squares
 
-    sc = scales.array()
-    theta0 = np.array([f.prior for f in free])
-    sig0 = np.array([f.sigma for f in free])
-    n_jobs = n_jobs or os.cpu_count() or 1
-    pool = ThreadPoolExecutor(max_workers=n_jobs)
+    stride: int = 2
+    n_jobs: int | None = None
+    max_nfev: int = 40
+    progress: object = None
+    start: object = None
+    effects: object = None
+    ship: object = None
+    weights: object = None
+    loss: str = "linear"
+    f_scale: float = 1.0
 
-    pos = scales.pos
-    by_columns = effects is not None or pos is not None      # few records: the columns in parallel
-    wts = np.ones(len(records)) if weights is None else np.asarray(weights, float)
-    if wts.shape != (len(records),):
-        raise ValueError(f"weights: one per record ({len(records)}), got {wts.shape}")
 
-    own = [f.record for f in free]                            # a record's own (nuisance) parameter, or None
+class _SegmentFit:
+    """The residuals and forward-difference Jacobian of one :func:`identify_segments` fit."""
 
-    def block(theta, k, pk=None):
-        pk = apply_parameters(packed, free, theta) if pk is None else pk
-        return wts[k] * _residual_one(pk, records[k], sc, stride, effects, free, theta, ship, pos, k)
+    def __init__(self, packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
+                 opts: FitOptions, pool: ThreadPoolExecutor):
+        self.packed, self.records, self.free, self.opts, self.pool = packed, records, free, opts, pool
+        self.sc, self.pos = scales.array(), scales.pos
+        self.theta0 = np.array([f.prior for f in free])
+        self.sig0 = np.array([f.sigma for f in free])
+        self.by_columns = opts.effects is not None or self.pos is not None   # few records: the columns in parallel
+        n = len(records)
+        self.wts = np.ones(n) if opts.weights is None else np.asarray(opts.weights, float)
+        if self.wts.shape != (n,):
+            raise ValueError(f"weights: one per record ({n}), got {self.wts.shape}")
+        self.own = [f.record for f in free]                   # a record's own (nuisance) parameter, or None
+        nch = 4 if self.pos is None else 6
+        self.start = np.cumsum([0] + [len(r.meas[::opts.stride]) * nch for r in records])   # each record's block
+        self.count = 0
 
-    def resid(theta, parallel=True):
-        pk = apply_parameters(packed, free, theta)
-        one = lambda k: block(theta, k, pk)  # noqa: E731
-        ks = range(len(records))
-        parts = list(pool.map(one, ks)) if parallel else [one(k) for k in ks]
-        return np.concatenate(parts + [(theta - theta0) / sig0])
+    def block(self, theta, k, pk=None):
+        """Record k's weighted residuals."""
+        o = self.opts
+        pk = apply_parameters(self.packed, self.free, theta) if pk is None else pk
+        return self.wts[k] * _residual_one(pk, self.records[k], self.sc, o.stride, o.effects, self.free, theta, o.ship,
+                                           self.pos, k)
 
-    count = [0]
+    def resid(self, theta, parallel=True):
+        """Every record's residuals, then the prior's."""
+        pk = apply_parameters(self.packed, self.free, theta)
+        one = lambda k: self.block(theta, k, pk)  # noqa: E731
+        ks = range(len(self.records))
+        parts = list(self.pool.map(one, ks)) if parallel else [one(k) for k in ks]
+        return np.concatenate(parts + [(theta - self.theta0) / self.sig0])
 
-    def jac(theta):
-        r0 = resid(theta)
-        h = 1e-6 * np.maximum(np.abs(theta), sig0)
+    def _steps(self, theta):
+        """(step sizes, stepped parameter vectors), stepping down at an upper bound."""
+        h = 1e-6 * np.maximum(np.abs(theta), self.sig0)
         steps = []
         for j in range(len(theta)):
             th = theta.copy()
-            if th[j] + h[j] > free[j].upper:                 # at an upper bound: step down
+            if th[j] + h[j] > self.free[j].upper:
                 h[j] = -h[j]
             th[j] += h[j]
             steps.append(th)
-        shared = [j for j in range(len(theta)) if own[j] is None]
-        if by_columns:
-            res = dict(zip(shared, pool.map(lambda j: resid(steps[j], parallel=False), shared)))
+        return h, steps
+
+    def _own_column(self, j, step, h, r0):
+        """A record's own parameter moves only its record's block (and its prior residual): that record alone."""
+        col = np.zeros_like(r0)
+        k, s = self.own[j], self.start
+        col[s[k]:s[k + 1]] = (self.block(step, k) - r0[s[k]:s[k + 1]]) / h
+        col[s[-1] + j] = 1.0 / self.sig0[j]
+        return col
+
+    def jac(self, theta):
+        """Forward-difference Jacobian, its columns on the pool."""
+        r0 = self.resid(theta)
+        h, steps = self._steps(theta)
+        n = len(theta)
+        shared = [j for j in range(n) if self.own[j] is None]
+        owned = [j for j in range(n) if self.own[j] is not None]
+        if self.by_columns:
+            cols = dict(zip(shared, self.pool.map(lambda j: (self.resid(steps[j], parallel=False) - r0) / h[j],
+                                                  shared)))
         else:
-            res = {j: resid(steps[j]) for j in shared}
-        # a record's own parameter moves only its record's block (and its prior residual): replay that record alone
-        nch = 4 if pos is None else 6
-        start = np.cumsum([0] + [len(r.meas[::stride]) * nch for r in records])
+            cols = {j: (self.resid(steps[j]) - r0) / h[j] for j in shared}
+        cols.update(zip(owned, self.pool.map(lambda j: self._own_column(j, steps[j], h[j], r0), owned)))
+        self.count += 1
+        if self.opts.progress:
+            self.opts.progress(self.count, 0.5 * float(r0 @ r0))
+        return np.column_stack([cols[j] for j in range(n)])
 
-        def own_column(j):
-            col = np.zeros_like(r0)
-            k = own[j]
-            col[start[k]:start[k + 1]] = (block(steps[j], k) - r0[start[k]:start[k + 1]]) / h[j]
-            col[start[-1] + j] = 1.0 / sig0[j]
-            return col
 
-        own_cols = dict(zip([j for j in range(len(theta)) if own[j] is not None],
-                            pool.map(own_column, [j for j in range(len(theta)) if own[j] is not None])))
-        cols = [(res[j] - r0) / h[j] if j in res else own_cols[j] for j in range(len(theta))]
-        count[0] += 1
-        if progress:
-            progress(count[0], 0.5 * float(r0 @ r0))
-        return np.column_stack(cols)
-
-    try:
-        r_init = resid(theta0)
-        lo = np.array([f.lower for f in free])
-        hi = np.array([f.upper for f in free])
-        x0 = theta0 if start is None else np.asarray(start, float)
-        sol = least_squares(resid, np.clip(x0, lo, hi), jac=jac, method="trf", x_scale=sig0, max_nfev=max_nfev,
-                            bounds=(lo, hi), loss=loss, f_scale=f_scale)
-    finally:
-        pool.shutdown()
+def _result(free, sol, cost_initial: float) -> IdentifyResult:
+    """The fit with its Gauss-Newton covariance scaled by the residual variance per degree of freedom."""
     J = sol.jac
-    dof = max(len(sol.fun) - len(theta0), 1)
+    n = len(free)
+    dof = max(len(sol.fun) - n, 1)
     s2 = float(sol.fun @ sol.fun) / dof
     try:
         cov = np.linalg.inv(J.T @ J) * s2
     except np.linalg.LinAlgError:
-        cov = np.full((len(theta0), len(theta0)), np.nan)
+        cov = np.full((n, n), np.nan)
     std = np.sqrt(np.abs(np.diag(cov)))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(std, std)
-    return IdentifyResult(free=free, theta=sol.x, std=std, corr=corr, cost_initial=0.5 * float(r_init @ r_init),
+    return IdentifyResult(free=free, theta=sol.x, std=std, corr=corr, cost_initial=cost_initial,
                           cost_final=float(sol.cost), n_residuals=len(sol.fun), iterations=int(sol.nfev),
                           message=str(sol.message), status=int(sol.status))
+
+
+def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
+                      options: FitOptions | None = None, **kwargs) -> IdentifyResult:
+    """Fit ``free`` jointly over ``records`` (module docstring).
+
+    Parameters
+    ----------
+    packed : PackedShip
+        The ship with its config values (the prior and the starting point).
+    records : list of Segmented
+    free : list of FreeParameter
+    scales : Scales
+        Residual scales of u, v, r, heading.
+    options : FitOptions, optional
+        How to fit; defaults when omitted.
+    **kwargs
+        Any :class:`FitOptions` field by name (``stride``, ``n_jobs``, ``max_nfev``, ``progress``,
+        ``start``, ``effects``, ``ship``, ``weights``, ``loss``, ``f_scale``), over ``options``.
+    """
+    from scipy.optimize import least_squares
+
+    o = FitOptions(**kwargs) if options is None else replace(options, **kwargs)
+    pool = ThreadPoolExecutor(max_workers=o.n_jobs or os.cpu_count() or 1)
+    try:
+        fit = _SegmentFit(packed, records, free, scales, o, pool)
+        r_init = fit.resid(fit.theta0)
+        lo = np.array([f.lower for f in free])
+        hi = np.array([f.upper for f in free])
+        x0 = fit.theta0 if o.start is None else np.asarray(o.start, float)
+        sol = least_squares(fit.resid, np.clip(x0, lo, hi), jac=fit.jac, method="trf", x_scale=fit.sig0,
+                            max_nfev=o.max_nfev, bounds=(lo, hi), loss=o.loss, f_scale=o.f_scale)
+    finally:
+        pool.shutdown()
+    return _result(free, sol, 0.5 * float(r_init @ r_init))

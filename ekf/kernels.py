@@ -27,7 +27,7 @@ CSTEP = 1e-30               # complex-step size: F = Im(step(z + i h e_j)) / h, 
 
 
 @njit(cache=True)
-def rk4_step(z, slots, c0, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2, k3, k4, out):
+def rk4_step(z, d0, d1, dt, layout, ship, ws):
     """One RK4 step of the dynamic states of z over ``dt`` [s]; real or complex z.
 
     z[i] (i < len(slots)) is the mmg state ``slots[i]`` (SI units: m/s, rad/s, m, rad, rps);
@@ -36,8 +36,13 @@ def rk4_step(z, slots, c0, d0, d1, dt, p, poly, hull_axis, hull_term, coef, idx,
     d0, d1: rudder angle [rad] at the start and end of the step (real, or complex to carry a
     complex-step perturbation), linear over the step: it enters as the DELTA_ state (d0 for
     stage 1, the mid value for stages 2-3, d1 for stage 4) and its real part as the command.
-    xs, k1..k4: complex work arrays (8,); out[:len(slots)] <- z_next of the dynamic states.
+    layout = (slots, c0, idx, itau) (itau not used: the rudder d0, d1 comes whole), ship = (p, poly,
+    hull_axis, hull_term); ws from :func:`make_workspace`: its complex work arrays coef = ws[1],
+    xs, k1..k4 = ws[2:7] and out = ws[7]: out[:len(slots)] <- z_next of the dynamic states.
     """
+    slots, c0, idx, _ = layout
+    p, poly, hull_axis, hull_term = ship
+    coef, xs, k1, k2, k3, k4, out = ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
     ns = slots.shape[0]
     for j in range(idx.shape[0]):
         coef[idx[j]] = z[c0 + j]
@@ -136,11 +141,119 @@ def _take_column(kc, slots, mask, c, have_real, A, kr):
                 kr[i] = kc[slots[i]].real
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _slot_roles(slots):
+    """(iu, iv, ir, tmask, dmask) of the propagated slots: the rows of u, v, r (-1 when absent);
+    bit i of tmask: row i is a track state (x0, y0, psi), of dmask: a dynamic state (u, v, r, n)."""
+    iu = -1
+    iv = -1
+    ir = -1
+    tmask = 0
+    dmask = 0
+    for i in range(slots.shape[0]):
+        sl = slots[i]
+        if sl == U_:
+            iu = i
+        elif sl == V_:
+            iv = i
+        elif sl == R_:
+            ir = i
+        if sl == X_ or sl == Y_ or sl == PSI_:
+            tmask |= 1 << i
+        elif sl == U_ or sl == V_ or sl == R_ or sl == N_:
+            dmask |= 1 << i
+        else:
+            raise ValueError("slots: the rudder angle is an input, not a propagated state")
+    return iu, iv, ir, tmask, dmask
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _stage(st, dt, e0, e1, g0, g1):
+    """(a_s dt, RK4 weight, rudder [rad], its d / d tau [rad/s]) of RK4 stage st (0..3)."""
+    if st == 0:
+        return 0.0, 1.0, e0, g0
+    if st == 3:
+        return dt, 1.0, e1, g1
+    return 0.5 * dt, 2.0, 0.5 * (e0 + e1), 0.5 * (g0 + g1)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _stage_columns(xr, layout, roles, ship, ws):
+    """A_s (column ns: d f / d delta) at the stage state xr by complex step, and k_s (the real parts
+    of the first evaluations) into kr = ws[13]; A = ws[15]."""
+    slots, _, _, itau = layout
+    _, _, _, tmask, dmask = roles
+    p, poly, hull_axis, hull_term = ship
+    hc, kc, kr, A, w = ws[10], ws[12], ws[13], ws[15], ws[19]
+    ns = slots.shape[0]
+    u, v, r, psi, n, e = xr[U_], xr[V_], xr[R_], xr[PSI_], xr[N_], xr[DELTA_]
+    dyn_real = dmask == 0
+    trk_real = tmask == 0
+    for c in range(ns + 1):
+        if c < ns:
+            k = slots[c]
+        elif itau >= 0:
+            k = DELTA_
+        else:
+            break
+        for i in range(ns):
+            A[i, c] = 0.0
+        if dmask != 0 and (k == U_ or k == V_ or k == R_ or k == N_ or k == DELTA_):
+            _dynamics_column(k, u, v, r, e, n, p, poly, hull_axis, hull_term, hc, kc)
+            _take_column(kc, slots, dmask, c, dyn_real, A, kr)
+            dyn_real = True
+        if tmask != 0 and (k == U_ or k == V_ or k == R_ or k == PSI_):
+            _track_column(k, u, v, r, psi, p, kc)
+            _take_column(kc, slots, tmask, c, trk_real, A, kr)
+            trk_real = True
+    if not dyn_real:                # no dynamic state to differentiate in: k_s alone
+        dynamics(u, v, r, e, n, p, poly, hull_axis, hull_term, hc, w)
+        for i in range(ns):
+            if (dmask >> i) & 1:
+                kr[i] = w[slots[i]]
+    if not trk_real:
+        track(u, v, r, psi, p, w)
+        for i in range(ns):
+            if (tmask >> i) & 1:
+                kr[i] = w[slots[i]]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _stage_tangent(first, a, ge, itau, A, dK, dKn):
+    """dKn = A_s (E + a dK) + a_delta g_s e_tau (dK = dk_{s-1}, not used at the first stage)."""
+    ns, nz = dKn.shape
+    for i in range(ns):
+        for j in range(nz):
+            dKn[i, j] = 0.0
+        if not first:
+            for c in range(ns):
+                aic = a * A[i, c]
+                for j in range(nz):
+                    dKn[i, j] += aic * dK[c, j]
+        for j in range(ns):
+            dKn[i, j] += A[i, j]
+        if itau >= 0:
+            dKn[i, itau] += A[i, ns] * ge
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _add_hull_columns(B, roles, c0, m, dK):
+    """dK[u, v, r rows, c0 + j] += B_s[:, j], j < m (the analytic d f / d c)."""
+    iu, iv, ir, _, _ = roles
+    for j in range(m):
+        if iu >= 0:
+            dK[iu, c0 + j] += B[0, j]
+        if iv >= 0:
+            dK[iv, c0 + j] += B[1, j]
+        if ir >= 0:
+            dK[ir, c0 + j] += B[2, j]
+
+
 # _nrt=False: no reference counting in this kernel (it allocates nothing; the work arrays live in
 # ws).  The inlined model code otherwise increfs / decrefs every array argument at every inlined
 # call, ~20 % of this kernel's time.
 @njit(cache=True, error_model="numpy", _nrt=False)
-def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hull_term, idx, ws):
+def jacobian_step(z, rudder, layout, dt, ship, ws):
     """One RK4 step of the real state z and its exact Jacobian F = d z_next / d z (tangent-linear RK4).
 
     Same step as :func:`rk4_step` and the same F as :func:`jacobian_step_reference` (to
@@ -157,7 +270,8 @@ def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hu
       (u, v, r, n rows; in u, v, r, n) and, when x0, y0 or psi are propagated,
       :func:`mmg.model.track` (x0, y0, psi rows; in u, v, r, psi).  One complex evaluation per
       argument, the others left real (so e.g. the hull force stays real under a step in n);
-      the real parts give k_s.  Nothing depends on x0, y0: their columns are zero.
+      the real parts give k_s (:func:`_stage_columns`).  Nothing depends on x0, y0: their
+      columns are zero.
     * a_delta,s = d f / d delta (with itau >= 0 only; one more evaluation of the dynamics): the
       rudder at stage s is d_s + z[itau] g_s, so d delta_s / d z[itau] = g_s.
     * B_s = d f / d c for the coefficients z[c0 + j] = hull_coef[idx[j]]: analytic
@@ -165,37 +279,20 @@ def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hu
 
     Paper filter: 16 complex evaluations of the dynamics a step instead of 64 of rhs; raw-log
     filter 20 (and 16 cheap ones of the track) instead of 80.
-    Arguments and outputs as :func:`jacobian_step_reference`: rudder [rad] d0 -> d1 over the
-    step, with itau >= 0 it is d + z[itau] g (g0 -> g1 [rad/s]); slots from U_, V_, R_, N_, X_,
-    Y_, PSI_; the states from len(slots) on are held (rows of F the identity).  ws from
+    Arguments and outputs as :func:`jacobian_step_reference`: rudder = (d0, d1, g0, g1), layout =
+    (slots, c0, idx, itau), ship = (p, poly, hull_axis, hull_term); ws from
     :func:`make_workspace`: z_next = ws[8], F = ws[9].
     """
-    z_next, F, hc, xr, kc, kr, ks, A, dK, dKn, B, w = ws[8], ws[9], ws[10], ws[11], ws[12], ws[13], ws[14], \
-        ws[15], ws[16], ws[17], ws[18], ws[19]
+    d0, d1, g0, g1 = rudder
+    slots, c0, idx, itau = layout
+    p, _, hull_axis, hull_term = ship
+    z_next, F, hc, xr, kr, ks, dK, dKn, B, w = ws[8], ws[9], ws[10], ws[11], ws[13], ws[14], ws[16], ws[17], \
+        ws[18], ws[19]
     nz = z.shape[0]
     ns = slots.shape[0]
-    m = idx.shape[0]
-    for j in range(m):
+    for j in range(idx.shape[0]):
         hc[idx[j]] = z[c0 + j]
-    iu = -1
-    iv = -1
-    ir = -1
-    tmask = 0                   # bit i: row i is a track state (x0, y0, psi)
-    dmask = 0                   # bit i: row i is a dynamic state (u, v, r, n)
-    for i in range(ns):
-        sl = slots[i]
-        if sl == U_:
-            iu = i
-        elif sl == V_:
-            iv = i
-        elif sl == R_:
-            ir = i
-        if sl == X_ or sl == Y_ or sl == PSI_:
-            tmask |= 1 << i
-        elif sl == U_ or sl == V_ or sl == R_ or sl == N_:
-            dmask |= 1 << i
-        else:
-            raise ValueError("slots: the rudder angle is an input, not a propagated state")
+    roles = _slot_roles(slots)
     minv = inverse_mass(p, w)
     tau = z[itau] if itau >= 0 else 0.0
     e0 = d0 + tau * g0
@@ -208,70 +305,17 @@ def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hu
         for j in range(nz):
             F[i, j] = 1.0 if i == j else 0.0
     for st in range(4):
-        if st == 0:
-            a, wst, e, ge = 0.0, 1.0, e0, g0
-        elif st == 3:
-            a, wst, e, ge = dt, 1.0, e1, g1
-        else:
-            a, wst, e, ge = 0.5 * dt, 2.0, 0.5 * (e0 + e1), 0.5 * (g0 + g1)
+        a, wst, e, ge = _stage(st, dt, e0, e1, g0, g1)
         # stage state x_s = z + a k_{s-1} (a = a_s dt; its tangent E + a dk_{s-1} enters below)
         for i in range(ns):
             xr[slots[i]] = z[i] + a * kr[i] if st > 0 else z[i]
         xr[DELTA_] = e
-        u, v, r, psi, n = xr[U_], xr[V_], xr[R_], xr[PSI_], xr[N_]
-        # A_s (column ns: d f / d delta) by complex step; the first evaluations' real parts are k_s
-        dyn_real = dmask == 0
-        trk_real = tmask == 0
-        for c in range(ns + 1):
-            if c < ns:
-                k = slots[c]
-            elif itau >= 0:
-                k = DELTA_
-            else:
-                break
-            for i in range(ns):
-                A[i, c] = 0.0
-            if dmask != 0 and (k == U_ or k == V_ or k == R_ or k == N_ or k == DELTA_):
-                _dynamics_column(k, u, v, r, e, n, p, poly, hull_axis, hull_term, hc, kc)
-                _take_column(kc, slots, dmask, c, dyn_real, A, kr)
-                dyn_real = True
-            if tmask != 0 and (k == U_ or k == V_ or k == R_ or k == PSI_):
-                _track_column(k, u, v, r, psi, p, kc)
-                _take_column(kc, slots, tmask, c, trk_real, A, kr)
-                trk_real = True
-        if not dyn_real:                # no dynamic state to differentiate in: k_s alone
-            dynamics(u, v, r, e, n, p, poly, hull_axis, hull_term, hc, w)
-            for i in range(ns):
-                if (dmask >> i) & 1:
-                    kr[i] = w[slots[i]]
-        if not trk_real:
-            track(u, v, r, psi, p, w)
-            for i in range(ns):
-                if (tmask >> i) & 1:
-                    kr[i] = w[slots[i]]
-        # B_s, analytic
-        rhs_hull_jacobian(xr, p, hull_axis, hull_term, idx, minv, B)
+        _stage_columns(xr, layout, roles, ship, ws)          # A_s and k_s
+        rhs_hull_jacobian(xr, p, hull_axis, hull_term, idx, minv, B)     # B_s, analytic
         # dk_s = A_s (E + a dt dk_{s-1}) + a_delta g_s e_tau + B_s (into dKn; rows of dK contiguous)
-        for i in range(ns):
-            for j in range(nz):
-                dKn[i, j] = 0.0
-            if st > 0:
-                for c in range(ns):
-                    aic = a * A[i, c]
-                    for j in range(nz):
-                        dKn[i, j] += aic * dK[c, j]
-            for j in range(ns):
-                dKn[i, j] += A[i, j]
-            if itau >= 0:
-                dKn[i, itau] += A[i, ns] * ge
+        _stage_tangent(st == 0, a, ge, itau, ws[15], dK, dKn)
         dK, dKn = dKn, dK
-        for j in range(m):
-            if iu >= 0:
-                dK[iu, c0 + j] += B[0, j]
-            if iv >= 0:
-                dK[iv, c0 + j] += B[1, j]
-            if ir >= 0:
-                dK[ir, c0 + j] += B[2, j]
+        _add_hull_columns(B, roles, c0, idx.shape[0], dK)
         cw = c6 * wst
         for i in range(ns):
             ks[i] += wst * kr[i]
@@ -282,20 +326,24 @@ def jacobian_step(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hu
     _held_rows(z, ns, z_next, F)
 
 
-
-
 @njit(cache=True)
-def jacobian_step_reference(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hull_axis, hull_term, idx, ws):
+def jacobian_step_reference(z, rudder, layout, dt, ship, ws):
     """:func:`jacobian_step` by brute force: column j of F is Im(step(z + i h e_j)) / h, h = 1e-30.
 
     One complex RK4 step (:func:`rk4_step`) per column of F (4 nz complex evaluations of f a
     step; complex step: exact to rounding).  The reference for :func:`jacobian_step` (tests,
     ``bench/bench_ekf.py``); same arguments and outputs.
-    Rudder [rad] d0 -> d1 over the step; with itau >= 0 it is d + z[itau] g (g0 -> g1 [rad/s]),
-    z[itau] a timing offset [s] (g = -d(delta)/dt: the rudder moved by -tau in time); itau < 0:
-    the rudder is d alone (g ignored).  ws from :func:`make_workspace`: z_next = ws[8], F = ws[9].
+    rudder = (d0, d1, g0, g1): the rudder [rad] d0 -> d1 over the step; with itau >= 0 it is
+    d + z[itau] g (g0 -> g1 [rad/s]), z[itau] a timing offset [s] (g = -d(delta)/dt: the rudder
+    moved by -tau in time); itau < 0: the rudder is d alone (g ignored).
+    layout = (slots, c0, idx, itau): z[i] (i < len(slots)) is the mmg state slots[i], the states
+    from len(slots) on are held (rows of F the identity), z[c0 + j] the hull coefficient
+    hull_coef[idx[j]].  ship = (p, poly, hull_axis, hull_term) of the packed ship
+    (:meth:`mmg.model.PackedShip.args`).  ws from :func:`make_workspace`: z_next = ws[8], F = ws[9].
     """
-    zc, coef, xs, k1, k2, k3, k4, out, z_next, F = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7], ws[8], ws[9]
+    d0, d1, g0, g1 = rudder
+    slots, _, _, itau = layout
+    zc, out, z_next, F = ws[0], ws[7], ws[8], ws[9]
     nz = z.shape[0]
     ns = slots.shape[0]
     for j in range(nz):
@@ -308,7 +356,7 @@ def jacobian_step_reference(z, d0, d1, g0, g1, itau, slots, c0, dt, p, poly, hul
         else:
             e0 = d0 + 0j
             e1 = d1 + 0j
-        rk4_step(zc, slots, c0, e0, e1, dt, p, poly, hull_axis, hull_term, coef, idx, xs, k1, k2, k3, k4, out)
+        rk4_step(zc, e0, e1, dt, layout, ship, ws)
         for i in range(ns):
             F[i, j] = out[i].imag / CSTEP
         if j == 0:

@@ -52,6 +52,7 @@ writes ``OUT/runs.csv``; ``mmg sensitivity --crb-vs-mc OUT --out DIR`` compares 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from mmg._jit import carray, njit, readonly
@@ -81,16 +82,17 @@ _REASON = {NONFINITE: "a state or covariance became non-finite",
 
 
 @njit(cache=True, inline="always")
-def propagate_log(z, d0, d1, g0, g1, dt, p, poly, hull_axis, hull_term, idx, ws):
+def propagate_log(z, rudder, dt, ship, idx, ws):
     """One RK4 step of z (nz,) and its exact Jacobian: z_next = ws[8], F = ws[9] (the tangent-linear
     RK4 of :func:`ekf.kernels.jacobian_step`: 20 complex evaluations of the dynamics and 16 of the
     track a step, not 80 of the whole model).
 
-    The rudder [rad] over the step (dt [s]) is d + tau g (d0 -> d1, g0 -> g1 [rad/s]): the
-    rebuilt rudder moved by -tau in time, g = -d(delta)/dt, so the timing offset tau [s] is
-    estimated like the rest.  ws from :func:`ekf.kernels.make_workspace` (nz, NS, hull_coef).
+    The rudder [rad] over the step (dt [s]) is d + tau g, rudder = (d0, d1, g0, g1) (d0 -> d1,
+    g0 -> g1 [rad/s]): the rebuilt rudder moved by -tau in time, g = -d(delta)/dt, so the timing
+    offset tau [s] is estimated like the rest.  ship = (p, poly, hull_axis, hull_term); idx the
+    derivatives' slots in hull_coef; ws from :func:`ekf.kernels.make_workspace` (nz, NS, hull_coef).
     """
-    jacobian_step(z, d0, d1, g0, g1, np.int64(TAU), SLOTS, np.int64(ND), dt, p, poly, hull_axis, hull_term, idx, ws)
+    jacobian_step(z, rudder, (SLOTS, np.int64(ND), idx, np.int64(TAU)), dt, ship, ws)
 
 
 @njit(cache=True)
@@ -110,14 +112,17 @@ def _check_log(z, P):
 
 
 @njit(cache=True)
-def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q, p, poly, hull_axis, hull_term,
-                      hull_coef, idx, zs, pdiag, nis, reference=None):
+def log_filter_kernel(prior, record, noise, ship, hull_coef, idx, out, reference=None):
     """The whole pass on the 0.1 s grid of ``delta`` (N,): predict every step, update at steps ``meas_k``.
 
-    meas (M, 4) x, y, psi, n at grid steps meas_k (M,) (increasing; a sample at step 0 is taken
-    to be in z0, P0); g (N,) = -d(delta)/dt; at the steps reset_k (before each rudder movement)
-    tau is marginalised out (its effect already lives in the other states) and restarted at 0
-    with variance var_tau; q (nz,) diagonal of Q per step; zs, pdiag (N, nz) filled; nis (M,).
+    prior = (z0, P0); record = (delta, g, dt, meas, meas_k, reset_k): the rudder [rad] on the grid
+    of step dt [s], g (N,) = -d(delta)/dt, meas (M, 4) x, y, psi, n at grid steps meas_k (M,)
+    (increasing; a sample at step 0 is taken to be in z0, P0); at the steps reset_k (before each
+    rudder movement) tau is marginalised out (its effect already lives in the other states) and
+    restarted at 0 with variance var_tau; noise = (R, q, var_tau): R (4, 4), q (nz,) diagonal of Q
+    per step; ship = (p, poly, hull_axis, hull_term), hull_coef and idx the packed ship's
+    coefficients and the estimated ones' slots; out = (zs, pdiag, nis): zs, pdiag (N, nz), nis (M,)
+    filled.
     reference: the previous implementation (tests): F by the brute-force complex step
     (:func:`ekf.kernels.jacobian_step_reference`) instead of the tangent-linear RK4 of
     :func:`propagate_log`, the update by :func:`ekf.filter.joseph_update` instead of
@@ -125,6 +130,10 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
     is not compiled at all.
     Returns (status, step index, final P).
     """
+    z0, P0 = prior
+    delta, g, dt, meas, meas_k, reset_k = record
+    R, q, var_tau = noise
+    zs, pdiag, nis = out
     N = delta.shape[0]
     M = meas_k.shape[0]
     NZ = z0.shape[0]
@@ -149,11 +158,11 @@ def log_filter_kernel(z0, P0, meas, meas_k, delta, g, reset_k, var_tau, dt, R, q
                 P[i, TAU] = 0.0
             P[TAU, TAU] = var_tau
             r += 1
+        rudder = (delta[k - 1], delta[k], g[k - 1], g[k])
         if reference is not None and reference:
-            jacobian_step_reference(z, delta[k - 1], delta[k], g[k - 1], g[k], np.int64(TAU), SLOTS, np.int64(ND), dt, p, poly,
-                                    hull_axis, hull_term, idx, ws)
+            jacobian_step_reference(z, rudder, (SLOTS, np.int64(ND), idx, np.int64(TAU)), dt, ship, ws)
         else:
-            propagate_log(z, delta[k - 1], delta[k], g[k - 1], g[k], dt, p, poly, hull_axis, hull_term, idx, ws)
+            propagate_log(z, rudder, dt, ship, idx, ws)
         for i in range(NZ):
             z[i] = zn[i]
         fpft(F, P, np.int64(NS), FP, P)
@@ -238,11 +247,21 @@ def run_log_filter(data, record, cfg: dict, q=None, duration: float | None = Non
         rudder known; use a tiny ``sigma_tau`` with it).
     Raises FilterDivergence.
     """
-    res = _run_once(data, record, cfg, q, duration, None, sigma_tau, uvr_std, rudder=rudder)
+    opts = _PassOptions(q, duration, sigma_tau, uvr_std, rudder)
+    res = _run_once(data, record, cfg, opts)
     for _ in range(passes - 1):
-        res = _run_once(data, record, cfg, q, duration, res.z[-1, ND:], sigma_tau, uvr_std,
-                        P_der=inflate * res.P[ND:, ND:], rudder=rudder)
+        res = _run_once(data, record, cfg, opts, (res.z[-1, ND:], inflate * res.P[ND:, ND:]))
     return res
+
+
+class _PassOptions(NamedTuple):
+    """:func:`run_log_filter`'s options of every pass (its parameters of the same names)."""
+
+    q: dict | None
+    duration: float | None
+    sigma_tau: float
+    uvr_std: object
+    rudder: str
 
 
 def _true_rudder(data, t: np.ndarray) -> np.ndarray:
@@ -251,12 +270,15 @@ def _true_rudder(data, t: np.ndarray) -> np.ndarray:
     return np.interp(t, np.asarray(data.truth.t, float), np.asarray(data.truth.delta, float))
 
 
-def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=None, P_der=None,
-              rudder: str = "rebuilt") -> LogFilterResult:
+def _run_once(data, record, cfg, opts: _PassOptions, start=None) -> LogFilterResult:
+    """One pass; start = (the derivatives' start values, their covariance), the config's and Table 7's
+    when None."""
     from mmg.rudder import movement_starts, reconstruct_rudder
 
     from .estimate import P0_for, initial_state
 
+    q, duration, sigma_tau, uvr_std, rudder = opts
+    start_derivs, P_der = (None, None) if start is None else start
     m = data.meas
     t = np.asarray(m.t, float)
     dt = float(t[1] - t[0])
@@ -293,9 +315,10 @@ def _run_once(data, record, cfg, q, duration, start_derivs, sigma_tau, uvr_std=N
     zs = np.full((N, NZ), np.nan)
     pd_ = np.full((N, NZ), np.nan)
     nis = np.full(len(mk), np.nan)
-    st, k, P = log_filter_kernel(carray(z0), carray(P0), obs, mk, delta, carray(g), reset_k, float(sigma_tau ** 2), dt,
-                                 carray(R), qv, *(carray(a, a.dtype) for a in data.packed.args()),
-                                 carray(data.slots, np.int64), zs, pd_, nis)
+    p, poly, hull_axis, hull_term, hull_coef = (carray(a, a.dtype) for a in data.packed.args())
+    st, k, P = log_filter_kernel((carray(z0), carray(P0)), (delta, carray(g), dt, obs, mk, reset_k),
+                                 (carray(R), qv, float(sigma_tau ** 2)), (p, poly, hull_axis, hull_term), hull_coef,
+                                 carray(data.slots, np.int64), (zs, pd_, nis))
     if st != OK:
         raise FilterDivergence(data.name, t[k], _REASON[st])
     return LogFilterResult(t, zs, pd_, P, nis, tuple(data.names))

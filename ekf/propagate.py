@@ -25,7 +25,7 @@ def workspace(nz, hull_coef):
 
 
 @njit(cache=True, inline="always")
-def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
+def propagate_step(z, d0, d1, dt, ship, idx, ws):
     """One RK4 step of the augmented state z (nz,) and its exact Jacobian into ``ws`` (z_next = ws[8], F = ws[9]).
 
     F by the tangent-linear RK4 of :func:`ekf.kernels.jacobian_step` (state columns by complex
@@ -33,10 +33,11 @@ def propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws):
     step, not 64 of the whole model).
 
     d0, d1 rudder angle [rad] at the start and end of the step (an input, linear over it), dt [s];
-    idx the derivatives' slots in ``hull_coef``; ws from :func:`workspace`."""
+    ship = (p, poly, hull_axis, hull_term) of the packed ship; idx the derivatives' slots in
+    ``hull_coef``; ws from :func:`workspace`."""
     # np.int64(): a literal constant would compile a specialisation of its own (Literal[int](4)),
     # beside the int64 one every other caller (the raw-log filter, Python) shares
-    jacobian_step(z, d0, d1, 0.0, 0.0, np.int64(-1), SLOTS, np.int64(NS), dt, p, poly, hull_axis, hull_term, idx, ws)
+    jacobian_step(z, (d0, d1, 0.0, 0.0), (SLOTS, np.int64(NS), idx, np.int64(-1)), dt, ship, ws)
 
 
 @njit(cache=True)
@@ -49,7 +50,7 @@ def propagate_jacobian(z, d0, d1, dt, p, poly, hull_axis, hull_term, hull_coef, 
     rounding (:func:`propagate_step`; no truncation error).
     """
     ws = workspace(z.shape[0], hull_coef)
-    propagate_step(z, d0, d1, dt, p, poly, hull_axis, hull_term, idx, ws)
+    propagate_step(z, d0, d1, dt, (p, poly, hull_axis, hull_term), idx, ws)
     zn, Fw = ws[8], ws[9]
     for i in range(zn.shape[0]):      # element-wise (a slice assignment compiles numba's shape-mismatch message)
         z_next[i] = zn[i]

@@ -442,8 +442,8 @@ def _poly(src: str, field: str, c: list[float], bound: float) -> tuple[float, ..
     return tuple(float(v) for v in c)
 
 
-def _build(f: _ShipFile, src: str) -> Ship:
-    """Units to SI and every value checked against the bounds above (InputError naming the field)."""
+def _particulars(f: _ShipFile, src: str) -> Particulars:
+    """particulars: SI, checked (the other sections' bounds scale with them)."""
     pa = f.particulars
     L = _qty(src, "particulars.L", pa.L, "length", *SHIP_LENGTH_RANGE)
     B = _qty(src, "particulars.B", pa.B, "length", L / 30, L, why=f"1 < L/B <= 30 with L = {L:g} m")
@@ -455,9 +455,13 @@ def _build(f: _ShipFile, src: str) -> Ship:
              why=f"0.3-1.5 x L (B + 2T) = {box:.6g} m^2")
     x_G = _qty(src, "particulars.x_G", pa.x_G, "length", -0.1 * L, 0.1 * L, why=f"|x_G| <= 0.1 L = {0.1 * L:g} m")
     rho = _qty(src, "particulars.rho", pa.rho, "density", *DENSITY_RANGE)
-    particulars = Particulars(L=L, B=B, T=T, C_b=C_b, S_wetted=S, x_G=x_G, rho=rho)
+    return Particulars(L=L, B=B, T=T, C_b=C_b, S_wetted=S, x_G=x_G, rho=rho)
 
+
+def _mass(f: _ShipFile, src: str, pa: Particulars) -> MassProperties:
+    """mass: checked against the particulars (m' near 2 C_b B / L)."""
     ms = f.mass
+    C_b, B, L = pa.C_b, pa.B, pa.L
     m0 = 2 * C_b * B / L
     m = _num(src, "mass.m_prime", ms.m_prime, 0.75 * m0, 1.25 * m0,
              why=f"within 25 % of 2 C_b B / L = {m0:.4g}, the primed mass of these particulars")
@@ -471,7 +475,11 @@ def _build(f: _ShipFile, src: str) -> Ship:
     )
     mass = replace(mass, J_z_prime=_num(src, "mass.J_z_prime", ms.J_z_prime, 0.0, 3 * mass.I_zG_prime,
                                         why=f"0 to 3 I_zG' = {3 * mass.I_zG_prime:.4g}"))
+    return mass
 
+
+def _hull(f: _ShipFile, src: str) -> HullModel:
+    """hull.coefficients: names on X_, Y_, N_ (each axis at least one), primed values."""
     names, axes, terms, values = [], [], [], []
     for name, c in f.hull.coefficients.items():
         field = f"hull.coefficients.{field_path([name])}"
@@ -487,9 +495,13 @@ def _build(f: _ShipFile, src: str) -> Ship:
         if axis not in axes:
             raise InputError(src, "hull.coefficients", f"no {axis}_ coefficient: the hull model needs at least one "
                                                        "force term on each of X, Y and N")
-    hull = HullModel(tuple(names), tuple(axes), tuple(terms), tuple(values))
+    return HullModel(tuple(names), tuple(axes), tuple(terms), tuple(values))
 
+
+def _propeller(f: _ShipFile, src: str, pa: Particulars) -> Propeller:
+    """propeller: SI, checked (D against the draught, the polynomials' constant terms)."""
     pr = f.propeller
+    T = pa.T
     D = _qty(src, "propeller.D", pr.D, "length", 0.0, 1.5 * T, lo_open=True,
              why=f"0 < D <= 1.5 T = {1.5 * T:g} m: the propeller works under water")
     if pr.P is not None:
@@ -505,7 +517,7 @@ def _build(f: _ShipFile, src: str) -> Ship:
     w_P0 = _poly(src, "propeller.w_P0", pr.w_P0, 10.0)
     _num(src, "propeller.w_P0.0", w_P0[0], 0.0, 1.0, hi_open=True, why="a wake fraction w_P0 is 0 to below 1")
     wk = pr.wake
-    propeller = Propeller(
+    return Propeller(
         D=D, K_T=K_T, K_Q=K_Q, t_P=t_P, w_P0=w_P0,
         x_P_prime=_num(src, "propeller.wake.x_P_prime", wk.x_P_prime, -1.0, 1.0, why="a position within +-1 L"),
         wake_model=wk.model,
@@ -515,9 +527,13 @@ def _build(f: _ShipFile, src: str) -> Ship:
         C_2_neg=_num(src, "propeller.wake.C_2_neg", wk.C_2_neg, 0.0, 10.0, lo_open=True),
     )
 
+
+def _rudder(f: _ShipFile, src: str, pa: Particulars) -> Rudder:
+    """rudder: SI, checked (area against L T)."""
     ru = f.rudder
+    L, T = pa.L, pa.T
     LT = L * T
-    rudder = Rudder(
+    return Rudder(
         A_R=_qty(src, "rudder.A_R", ru.A_R, "area", 0.002 * LT, 0.1 * LT,
                  why=f"0.002-0.1 L T = {0.002 * LT:.4g}-{0.1 * LT:.4g} m^2 (ships: 1/70-1/30 L T)"),
         H_R=_qty(src, "rudder.H_R", ru.H_R, "length", 0.0, 1.5 * T, lo_open=True, why=f"0 < H_R <= 1.5 T = {1.5 * T:g} m"),
@@ -534,44 +550,68 @@ def _build(f: _ShipFile, src: str) -> Ship:
         l_R_prime=_num(src, "rudder.l_R_prime", ru.l_R_prime, -3.0, 3.0),
     )
 
+
+def _steering(f: _ShipFile, src: str) -> SteeringGear:
+    """steering: SI, checked."""
     st = f.steering
-    steering = SteeringGear(
+    return SteeringGear(
         T_E=_qty(src, "steering.T_E", st.T_E, "time", 0.0, MAX_STEERING_TIME_CONSTANT, lo_open=True),
         rate_max=_qty(src, "steering.rate_max", st.rate_max, "angular_rate", 0.0, MAX_STEERING_RATE, lo_open=True),
         delta_max=_qty(src, "steering.delta_max", st.delta_max, "angle", 0.0, MAX_RUDDER, lo_open=True),
     )
 
+
+def _engine(f: _ShipFile, src: str) -> Engine:
+    """engine: checked (a constant-power engine needs its power curve)."""
     en = f.engine
     SHP_0 = tuple(float(v) for v in en.SHP_0)
     if en.mode == "constant_power" and not any(SHP_0):
         raise InputError(src, "engine.SHP_0", "a constant-power engine needs its power curve SHP_0(u) [hp], "
                                               "lowest power of u [m/s] first (all zero here)")
-    engine = Engine(
+    return Engine(
         mode=en.mode, SHP_0=SHP_0,
         watts_per_hp=_num(src, "engine.watts_per_hp", en.watts_per_hp, 700.0, 800.0, why="one horse power is 735.5-745.7 W"),
         shaft_inertia_coefficient=_num(src, "engine.shaft_inertia_coefficient", en.shaft_inertia_coefficient,
                                        0.0, 100.0, lo_open=True),
     )
-    wind = None
-    if f.wind is not None:
-        from .wind import WindParticulars
 
-        w = f.wind
-        area = (0.001 * L * L, 0.5 * L * L)           # a tenth of a per cent of L^2 to half of it
-        wind = Wind(
-            enabled=w.enabled, coefficients=w.coefficients,
-            geometry=WindParticulars(
-                A_T=_qty(src, "wind.A_T", w.A_T, "area", *area, lo_open=True),
-                A_L=_qty(src, "wind.A_L", w.A_L, "area", *area, lo_open=True),
-                L=_qty(src, "wind.L_oa", w.L_oa, "length", L, 1.3 * L) if w.L_oa is not None else L,
-                B=B,
-                A_OD=_qty(src, "wind.A_OD", w.A_OD, "area", 0.0, 0.5 * L * L, lo_open=True),
-                H_BR=_qty(src, "wind.H_BR", w.H_BR, "length", 0.0, L, lo_open=True),
-                x_AL=_qty(src, "wind.x_AL", w.x_AL, "length", -0.5 * L, 0.5 * L),
-                z_AL=_qty(src, "wind.z_AL", w.z_AL, "length", 0.0, L, lo_open=True),
-                x_AOD=_qty(src, "wind.x_AOD", w.x_AOD, "length", -0.5 * L, 0.5 * L)),
-            scale=_num(src, "wind.scale", w.scale, 0.0, 10.0),
-        )
+
+def _wind(f: _ShipFile, src: str, pa: Particulars) -> Wind | None:
+    """wind (None when the file has none): SI, areas and lengths checked against L."""
+    if f.wind is None:
+        return None
+    from .wind import WindParticulars
+
+    w = f.wind
+    L, B = pa.L, pa.B
+    area = (0.001 * L * L, 0.5 * L * L)           # a tenth of a per cent of L^2 to half of it
+    return Wind(
+        enabled=w.enabled, coefficients=w.coefficients,
+        geometry=WindParticulars(
+            A_T=_qty(src, "wind.A_T", w.A_T, "area", *area, lo_open=True),
+            A_L=_qty(src, "wind.A_L", w.A_L, "area", *area, lo_open=True),
+            L=_qty(src, "wind.L_oa", w.L_oa, "length", L, 1.3 * L) if w.L_oa is not None else L,
+            B=B,
+            A_OD=_qty(src, "wind.A_OD", w.A_OD, "area", 0.0, 0.5 * L * L, lo_open=True),
+            H_BR=_qty(src, "wind.H_BR", w.H_BR, "length", 0.0, L, lo_open=True),
+            x_AL=_qty(src, "wind.x_AL", w.x_AL, "length", -0.5 * L, 0.5 * L),
+            z_AL=_qty(src, "wind.z_AL", w.z_AL, "length", 0.0, L, lo_open=True),
+            x_AOD=_qty(src, "wind.x_AOD", w.x_AOD, "length", -0.5 * L, 0.5 * L)),
+        scale=_num(src, "wind.scale", w.scale, 0.0, 10.0),
+    )
+
+
+def _build(f: _ShipFile, src: str) -> Ship:
+    """Units to SI and every value checked against the bounds above (InputError naming the field), section
+    by section in the file's order."""
+    particulars = _particulars(f, src)
+    mass = _mass(f, src, particulars)
+    hull = _hull(f, src)
+    propeller = _propeller(f, src, particulars)
+    rudder = _rudder(f, src, particulars)
+    steering = _steering(f, src)
+    engine = _engine(f, src)
+    wind = _wind(f, src, particulars)
     effects, stated = _effects(f, wind, src)
     if effects is not None and effects.get("wind") is not None:
         wind = replace(wind, enabled=True, scale=effects.get("wind")["scale"])

@@ -81,7 +81,7 @@ def test_jacobian_equals_complex_step_reference(ship, layout):
         g0, g1 = rng.uniform(-0.05, 0.05, 2)
         ws, wr = make_workspace(nz, ns, pk.hull_coef), make_workspace(nz, ns, pk.hull_coef)
         for w, f in ((ws, jacobian_step), (wr, jacobian_step_reference)):
-            f(z, d0, d1, g0, g1, layout["itau"], layout["slots"], layout["c0"], 0.1, *pk.args()[:4], idx, w)
+            f(z, (d0, d1, g0, g1), (layout["slots"], layout["c0"], idx, layout["itau"]), 0.1, pk.args()[:4], w)
         np.testing.assert_allclose(ws[8], wr[8], rtol=1e-14, atol=1e-14 * np.abs(wr[8]).max())
         _assert_same_F(ws[9], wr[9], 1e-12)
         assert np.array_equal(ws[9][ns:], np.eye(nz)[ns:])

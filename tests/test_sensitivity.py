@@ -166,7 +166,7 @@ def test_rudder_timing_sensitivities_match_finite_differences(zigzag_tangent):
         for sgn in (+1, -1):
             d = np.ascontiguousarray(tan.delta + sgn * h * g * (seg == j))
             Y, S = np.empty((N, 4)), np.empty((N, 4, 16))
-            _tangent_kernel(z0, d, tr.dt, *pk.args(), idx, Y, S)
+            _tangent_kernel(z0, d, tr.dt, pk.args()[:4], pk.hull_coef, idx, Y, S)
             runs.append(Y)
         fd = (runs[0] - runs[1]) / (2 * h)
         ex = tan.S_tau[:, :, j]
@@ -197,7 +197,7 @@ def test_rudder_timing_sensitivities_are_the_raw_log_filters_tau(zigzag_tangent)
     s = np.zeros(LNS)
     got = np.zeros((len(tan.t), 4))
     for k in range(1, len(tan.t)):
-        propagate_log(z, tan.delta[k - 1], tan.delta[k], g[k - 1], g[k], tr.dt, *pk.args()[:4], idx, ws)
+        propagate_log(z, (tan.delta[k - 1], tan.delta[k], g[k - 1], g[k]), tr.dt, pk.args()[:4], idx, ws)
         F = ws[9]
         s = F[:LNS, :LNS] @ s + (F[:LNS, TAU] if seg[k - 1] == j else 0.0)
         z[:LNS] = ws[8][:LNS]

@@ -645,74 +645,24 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
         No length, no channel the metrics need, or a record that is not a turn / zigzag.
     """
     src = rec.source or rec.name or "record"
-    L = length if length is not None else rec.meta.get("length_m")
-    if L is None:
-        raise InputError(src, "--length", "the log does not give the ship length; pass --length")
-    try:
-        L = float(L)
-    except (TypeError, ValueError):
-        raise InputError(src, "length_m", f"ship length {L!r} is not a number") from None
-    if not (np.isfinite(L) and L > 0):
-        raise InputError(src, "length_m", f"ship length {L!r} is not a positive number of metres")
+    L = _record_length(rec, length, src)
     if rec.psi is None:
         raise InputError(src, "heading", "the record has no heading channel")
     notes = list(rec.meta.get("notes", []))
     psi = np.asarray(rec.psi, dtype=float)
     order = rec.meta.get("delta_order")
-    measured = order is None
     rudder = order if order is not None else rec.delta
     U = rec.speed()
     asked = kind
     kind = kind or rec.meta.get("kind")
     if kind not in ("turning", "zigzag", "stype"):
-        kind = _guess_kind(rec, psi, rudder, measured, src)
+        kind = _guess_kind(rec, psi, rudder, order is None, src)
     out = {"record": rec.name, "source": rec.source, "kind": kind, "length_m": L}
-    what = f"--kind {asked}" if asked else "kind"
+    ctx = (src, f"--kind {asked}" if asked else "kind", notes)
     if kind == "turning":
-        if rec.x is None or rec.y is None:
-            raise InputError(src, "lat_deg", "turning metrics need the track (positions)")
-        te = rec.meta.get("execute_s") if rudder is None else None
-        m = turning_metrics(rec.t, rec.x, rec.y, psi, U, L, t_execute=te,
-                            delta=None if order is not None else rec.delta, order=order, n=rec.n)
-        if m["advance_L"] is None:
-            held = "" if m["rudder_deg"] is None else (f" while the rudder is held at {m['rudder_deg']:.1f} deg "
-                                                       f"({m['execute_s']:g} to {m['turn_end_s']:g} s)")
-            raise InputError(src, what, f"not a turning test: the heading turns by at most {m['max_heading_change_deg']:.1f} deg "
-                                        f"from the execute at t = {m['execute_s']:g} s{held}; a turn needs 90 deg"
-                                        f"{_rad_hint(rec)}")
-        if m["steady_from_deg"] == 180.0:
-            notes.append(f"the turn ends at {m['heading_change_deg']:.0f} deg: steady diameter and speed loss are from "
-                         f"the part after 180 deg, which may not be steady yet")
-        out.update(m)
+        out.update(_record_turning(rec, psi, U, L, ctx))
     else:
-        if rudder is not None:
-            m = zigzag_metrics(rec.t, psi, order=rudder, U=U, L=L, measured=measured, r=rec.r)
-        else:
-            first = None
-            if rec.meta.get("first") in ("starboard", "port"):
-                first = 1 if rec.meta["first"] == "starboard" else -1
-            if kind == "stype":
-                a = _header_angle(rec, "switch_heading_deg") if angle is None else angle
-                if a is None:
-                    raise InputError(src, "switch_heading_deg", "an S-type log without rudder needs the switching heading "
-                                                                "in its header")
-                first = 1 if first is None else first
-                levels = (a, 0.0) if first > 0 else (0.0, -a)
-            else:
-                a = angle if angle is not None else _header_angle(rec, "heading_deg")
-                if a is None:
-                    raise InputError(src, "heading_deg", "a zigzag log without rudder needs --zigzag-angle")
-                levels = (a, -a)
-            m = zigzag_metrics(rec.t, psi, first=first, U=U, L=L, levels=levels, t_execute=rec.meta.get("execute_s"),
-                               r=rec.r)
-        why = zigzag_problem(m)
-        if why is not None:
-            name = "an S-type" if kind == "stype" else "a zigzag"
-            raise InputError(src, what, f"not {name}: {why}{_rad_hint(rec) if rudder is None else ''}")
-        for ts, st in m["heading_steps_removed"]:
-            notes.append(f"a step of {st:+.1f} deg of the heading sensor at t = {ts:g} s, which the yaw rate does not "
-                         f"show, is taken out of the overshoot it falls in")
-        out.update(m)
+        out.update(_record_zigzag(rec, psi, (U, L), kind, angle, ctx))
     out["execute_s"] = out.get("execute_s", out.get("execute_times_s", [None])[0])
     te, U0 = out["execute_s"], out.get("approach_speed_mps")
     if te is not None and U0 and te - 10.0 >= rec.t[0]:
@@ -722,6 +672,79 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
                          f"{U0:.3g} m/s in the 10 s before the execute at t = {te:g} s")
     out["notes"] = notes
     return out
+
+
+def _record_length(rec, length, src: str) -> float:
+    """Ship length L [m]: ``length``, else the record's; a positive finite number."""
+    L = length if length is not None else rec.meta.get("length_m")
+    if L is None:
+        raise InputError(src, "--length", "the log does not give the ship length; pass --length")
+    try:
+        L = float(L)
+    except (TypeError, ValueError):
+        raise InputError(src, "length_m", f"ship length {L!r} is not a number") from None
+    if not (np.isfinite(L) and L > 0):
+        raise InputError(src, "length_m", f"ship length {L!r} is not a positive number of metres")
+    return L
+
+
+def _record_turning(rec, psi, U, L: float, ctx) -> dict:
+    """:func:`turning_metrics` of a record, refused when it is no turn; ctx = (source, field, notes)."""
+    src, what, notes = ctx
+    order = rec.meta.get("delta_order")
+    rudder = order if order is not None else rec.delta
+    if rec.x is None or rec.y is None:
+        raise InputError(src, "lat_deg", "turning metrics need the track (positions)")
+    te = rec.meta.get("execute_s") if rudder is None else None
+    m = turning_metrics(rec.t, rec.x, rec.y, psi, U, L, t_execute=te,
+                        delta=None if order is not None else rec.delta, order=order, n=rec.n)
+    if m["advance_L"] is None:
+        held = "" if m["rudder_deg"] is None else (f" while the rudder is held at {m['rudder_deg']:.1f} deg "
+                                                   f"({m['execute_s']:g} to {m['turn_end_s']:g} s)")
+        raise InputError(src, what, f"not a turning test: the heading turns by at most {m['max_heading_change_deg']:.1f} deg "
+                                    f"from the execute at t = {m['execute_s']:g} s{held}; a turn needs 90 deg"
+                                    f"{_rad_hint(rec)}")
+    if m["steady_from_deg"] == 180.0:
+        notes.append(f"the turn ends at {m['heading_change_deg']:.0f} deg: steady diameter and speed loss are from "
+                     f"the part after 180 deg, which may not be steady yet")
+    return m
+
+
+def _record_zigzag(rec, psi, speed_length, kind: str, angle, ctx) -> dict:
+    """:func:`zigzag_metrics` of a record (zigzag or S-type), refused when it is neither; speed_length =
+    (U, L), ctx = (source, field, notes)."""
+    src, what, notes = ctx
+    U, L = speed_length
+    order = rec.meta.get("delta_order")
+    rudder = order if order is not None else rec.delta
+    if rudder is not None:
+        m = zigzag_metrics(rec.t, psi, order=rudder, U=U, L=L, measured=order is None, r=rec.r)
+    else:
+        first = None
+        if rec.meta.get("first") in ("starboard", "port"):
+            first = 1 if rec.meta["first"] == "starboard" else -1
+        if kind == "stype":
+            a = _header_angle(rec, "switch_heading_deg") if angle is None else angle
+            if a is None:
+                raise InputError(src, "switch_heading_deg", "an S-type log without rudder needs the switching heading "
+                                                            "in its header")
+            first = 1 if first is None else first
+            levels = (a, 0.0) if first > 0 else (0.0, -a)
+        else:
+            a = angle if angle is not None else _header_angle(rec, "heading_deg")
+            if a is None:
+                raise InputError(src, "heading_deg", "a zigzag log without rudder needs --zigzag-angle")
+            levels = (a, -a)
+        m = zigzag_metrics(rec.t, psi, first=first, U=U, L=L, levels=levels, t_execute=rec.meta.get("execute_s"),
+                           r=rec.r)
+    why = zigzag_problem(m)
+    if why is not None:
+        name = "an S-type" if kind == "stype" else "a zigzag"
+        raise InputError(src, what, f"not {name}: {why}{_rad_hint(rec) if rudder is None else ''}")
+    for ts, st in m["heading_steps_removed"]:
+        notes.append(f"a step of {st:+.1f} deg of the heading sensor at t = {ts:g} s, which the yaw rate does not "
+                     f"show, is taken out of the overshoot it falls in")
+    return m
 
 
 def _guess_kind(rec, psi, rudder, measured, src) -> str:

@@ -142,7 +142,7 @@ def warm_jacobian() -> None:
 
     pk, slots, t, meas, delta, z0, P0, R = _filter_args()
     ws = interpreted(propagate.workspace)(len(z0), pk.hull_coef)     # as ekf.filter.run_filter makes them
-    jacobian_step(z0, 0.0, 0.0, 0.0, 0.0, -1, propagate.SLOTS, propagate.NS, 1.0, *pk.args()[:4], slots, ws)
+    jacobian_step(z0, (0.0, 0.0, 0.0, 0.0), (propagate.SLOTS, propagate.NS, slots, -1), 1.0, pk.args()[:4], ws)
 
 
 def warm_jacobian_real_parts() -> None:

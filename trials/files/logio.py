@@ -679,70 +679,83 @@ def record_from_frame(df: pd.DataFrame, meta: dict, source: str = "simulation", 
                 raise
             raise InputError(e.source, e.field, f"{e.message}; the FRT-DS-ESSO layout's usual {FRT_LENGTH_M:g} m model "
                                                 f"was assumed: give the record's length (--length) or ship (--ship)") from None
+    head = {"name": name, "ship": ship, "source": src}
     if "u_mps" in cols or "psi_rad" in cols:
-        tab.require(TRUTH_COLUMNS)
-        a = {c: tab.numeric(c) for c in TRUTH_COLUMNS}
-        _check_time(tab, "time_s", a["time_s"], meta.get("dt_s"), "the header's dt_s", 1e-3)
-        _check_rudder(tab, "delta_rad", a["delta_rad"])
-        _check_rudder(tab, "delta_order_rad", a["delta_order_rad"])
-        _check_yaw_rate(tab, "r_radps", a["r_radps"])
-        _check_heading_rate(tab, "psi_rad", a["time_s"], a["psi_rad"])
-        _check_heading_vs_yaw_rate(tab, "psi_rad", "r_radps", a["time_s"], a["psi_rad"], a["r_radps"])
-        U = np.hypot(a["u_mps"], a["v_mps"])
-        _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L)
-        _check_velocities_vs_track(tab, {"u": "u_mps", "v": "v_mps", "psi": "psi_rad", "track": "x_m, y_m"},
-                                   a["time_s"], a["x_m"], a["y_m"], a["psi_rad"], a["u_mps"], a["v_mps"])
-        _check_speed(tab, "u_mps", U, L)
-        _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L, U, (0.2, 5.0), "u_mps")
-        _check_rps(tab, "n_rps", a["n_rps"])
-        wind = _apparent_wind(tab, cols, "wind_rel_mps", "wind_rel_rad", 1.0, 1.0)
-        return TrialRecord(t=a["time_s"], name=name, ship=ship, source=src, x=a["x_m"], y=a["y_m"],
-                           psi=a["psi_rad"], U=U, u=a["u_mps"],
-                           v=a["v_mps"], r=a["r_radps"], delta=a["delta_rad"], n=a["n_rps"],
-                           meta={**meta, "format": "truth", "delta_order": a["delta_order_rad"], "notes": notes,
-                                 **_holes(tab, {"wind_rel_mps": "wind_speed_rel", "wind_rel_rad": "wind_dir_rel"})},
-                           **wind)
+        return _truth_record(tab, cols, meta, head, notes, L)
     if "lat_deg" in cols or "heading_deg" in cols or "time_s" in cols:
-        tab.require(LOG_COLUMNS)
-        a = {c: tab.numeric(c) for c in LOG_COLUMNS}
-        t = a["time_s"]
-        _check_time(tab, "time_s", t, meta.get("interval_s"), "the header's interval_s", 1e-3)
-        _check_range(tab, "lat_deg", a["lat_deg"], -90.0, 90.0, "a latitude in degrees")
-        _check_range(tab, "lon_deg", a["lon_deg"], -180.0, 360.0, "a longitude in degrees")
-        # a gyro's 0-360, +-180, a cumulative count of turns: the same heading; its unit is told by the track
-        # in a log that says it is a project log (``interval_s``, as for the speed), else by the gyro's range
-        if "interval_s" not in meta:
-            _check_range(tab, "heading_deg", a["heading_deg"], -360.0, 360.0, "a heading in degrees (a gyro prints 0-360)")
-        psi = unwrap_heading(np.radians(a["heading_deg"]))
-        _check_heading_rate(tab, "heading_deg", t, psi, "degrees")
-        _check_rps(tab, "rpm", a["rpm"] / 60.0, "rpm", 60.0)
-        lat0 = float(meta.get("start_lat_deg", a["lat_deg"][0]))
-        lon0 = float(meta.get("start_lon_deg", a["lon_deg"][0]))
-        for col, key, v0 in (("lat_deg", "start_lat_deg", lat0), ("lon_deg", "start_lon_deg", lon0)):
-            if key in meta and abs(a[col][0] - v0) > 1.0:
-                raise InputError(src, col, f"the first position {a[col][0]:.6g} is {abs(a[col][0] - v0):.3g} deg from the "
-                                           f"header's {key} {v0:g}: not degrees?")
-        mlat = float(meta.get("m_per_deg_lat", M_PER_DEG_LAT))
-        mlon = float(meta.get("m_per_deg_lon", M_PER_DEG_LON))
-        x, y, U = (a["lat_deg"] - lat0) * mlat, (a["lon_deg"] - lon0) * mlon, a["speed_kn"] * KNOT
-        _check_speed(tab, "speed_kn", a["speed_kn"], L, "kn", KNOT)
-        # the track against the logged speed over ground, for a log that says it is a project log
-        _check_track(tab, "lat_deg, lon_deg", t, x, y, L, U, (0.7, 1.4) if "interval_s" in meta else None, "speed_kn")
-        if "interval_s" in meta:
-            _check_heading_vs_track(tab, "heading_deg", "lat_deg, lon_deg", t, x, y, psi, "degrees")
-        extra = {}
-        if "rudder_deg" in cols:
-            d = tab.numeric("rudder_deg", optional=True)
-            _check_rudder_deg(tab, "rudder_deg", d)
-            extra["delta"] = d * DEG
-        extra.update(_apparent_wind(tab, cols, "wind_rel_kn", "wind_rel_deg", KNOT, DEG))
-        return TrialRecord(t=t, name=name, ship=ship, source=src, x=x, y=y,
-                           psi=psi, U=U,
-                           n=a["rpm"] / 60.0, meta={**meta, "format": "log", "notes": notes, **_holes(
-                               tab, {"rudder_deg": "delta", "wind_rel_kn": "wind_speed_rel", "wind_rel_deg": "wind_dir_rel"})},
-                           **extra)
+        return _log_record(tab, cols, meta, head, notes, L)
     missing = sorted(set(LOG_COLUMNS) - cols)
     raise InputError(src, missing[0] if missing else "", "missing column (not a project log, truth file or FRT-DS-ESSO CSV)")
+
+
+def _truth_record(tab: _Table, cols, meta: dict, head: dict, notes: list, L) -> TrialRecord:
+    """A truth file's record, its channels checked; head = the record's name, ship and source."""
+    tab.require(TRUTH_COLUMNS)
+    a = {c: tab.numeric(c) for c in TRUTH_COLUMNS}
+    _check_time(tab, "time_s", a["time_s"], meta.get("dt_s"), "the header's dt_s", 1e-3)
+    _check_rudder(tab, "delta_rad", a["delta_rad"])
+    _check_rudder(tab, "delta_order_rad", a["delta_order_rad"])
+    _check_yaw_rate(tab, "r_radps", a["r_radps"])
+    _check_heading_rate(tab, "psi_rad", a["time_s"], a["psi_rad"])
+    _check_heading_vs_yaw_rate(tab, "psi_rad", "r_radps", a["time_s"], a["psi_rad"], a["r_radps"])
+    U = np.hypot(a["u_mps"], a["v_mps"])
+    _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L)
+    _check_velocities_vs_track(tab, {"u": "u_mps", "v": "v_mps", "psi": "psi_rad", "track": "x_m, y_m"},
+                               a["time_s"], a["x_m"], a["y_m"], a["psi_rad"], a["u_mps"], a["v_mps"])
+    _check_speed(tab, "u_mps", U, L)
+    _check_track(tab, "x_m, y_m", a["time_s"], a["x_m"], a["y_m"], L, U, (0.2, 5.0), "u_mps")
+    _check_rps(tab, "n_rps", a["n_rps"])
+    wind = _apparent_wind(tab, cols, "wind_rel_mps", "wind_rel_rad", 1.0, 1.0)
+    return TrialRecord(t=a["time_s"], **head, x=a["x_m"], y=a["y_m"],
+                       psi=a["psi_rad"], U=U, u=a["u_mps"],
+                       v=a["v_mps"], r=a["r_radps"], delta=a["delta_rad"], n=a["n_rps"],
+                       meta={**meta, "format": "truth", "delta_order": a["delta_order_rad"], "notes": notes,
+                             **_holes(tab, {"wind_rel_mps": "wind_speed_rel", "wind_rel_rad": "wind_dir_rel"})},
+                       **wind)
+
+
+def _log_record(tab: _Table, cols, meta: dict, head: dict, notes: list, L) -> TrialRecord:
+    """A project log's record (positions in degrees, heading, speed in knots, rpm), its channels checked;
+    head = the record's name, ship and source."""
+    tab.require(LOG_COLUMNS)
+    a = {c: tab.numeric(c) for c in LOG_COLUMNS}
+    t = a["time_s"]
+    _check_time(tab, "time_s", t, meta.get("interval_s"), "the header's interval_s", 1e-3)
+    _check_range(tab, "lat_deg", a["lat_deg"], -90.0, 90.0, "a latitude in degrees")
+    _check_range(tab, "lon_deg", a["lon_deg"], -180.0, 360.0, "a longitude in degrees")
+    # a gyro's 0-360, +-180, a cumulative count of turns: the same heading; its unit is told by the track
+    # in a log that says it is a project log (``interval_s``, as for the speed), else by the gyro's range
+    if "interval_s" not in meta:
+        _check_range(tab, "heading_deg", a["heading_deg"], -360.0, 360.0, "a heading in degrees (a gyro prints 0-360)")
+    psi = unwrap_heading(np.radians(a["heading_deg"]))
+    _check_heading_rate(tab, "heading_deg", t, psi, "degrees")
+    _check_rps(tab, "rpm", a["rpm"] / 60.0, "rpm", 60.0)
+    lat0 = float(meta.get("start_lat_deg", a["lat_deg"][0]))
+    lon0 = float(meta.get("start_lon_deg", a["lon_deg"][0]))
+    for col, key, v0 in (("lat_deg", "start_lat_deg", lat0), ("lon_deg", "start_lon_deg", lon0)):
+        if key in meta and abs(a[col][0] - v0) > 1.0:
+            raise InputError(head["source"], col, f"the first position {a[col][0]:.6g} is "
+                                                  f"{abs(a[col][0] - v0):.3g} deg from the header's {key} {v0:g}: "
+                                                  "not degrees?")
+    mlat = float(meta.get("m_per_deg_lat", M_PER_DEG_LAT))
+    mlon = float(meta.get("m_per_deg_lon", M_PER_DEG_LON))
+    x, y, U = (a["lat_deg"] - lat0) * mlat, (a["lon_deg"] - lon0) * mlon, a["speed_kn"] * KNOT
+    _check_speed(tab, "speed_kn", a["speed_kn"], L, "kn", KNOT)
+    # the track against the logged speed over ground, for a log that says it is a project log
+    _check_track(tab, "lat_deg, lon_deg", t, x, y, L, U, (0.7, 1.4) if "interval_s" in meta else None, "speed_kn")
+    if "interval_s" in meta:
+        _check_heading_vs_track(tab, "heading_deg", "lat_deg, lon_deg", t, x, y, psi, "degrees")
+    extra = {}
+    if "rudder_deg" in cols:
+        d = tab.numeric("rudder_deg", optional=True)
+        _check_rudder_deg(tab, "rudder_deg", d)
+        extra["delta"] = d * DEG
+    extra.update(_apparent_wind(tab, cols, "wind_rel_kn", "wind_rel_deg", KNOT, DEG))
+    return TrialRecord(t=t, **head, x=x, y=y,
+                       psi=psi, U=U,
+                       n=a["rpm"] / 60.0, meta={**meta, "format": "log", "notes": notes, **_holes(
+                           tab, {"rudder_deg": "delta", "wind_rel_kn": "wind_speed_rel", "wind_rel_deg": "wind_dir_rel"})},
+                       **extra)
 
 
 def _apparent_wind(tab: _Table, cols, speed_col: str, dir_col: str, speed_si: float, dir_si: float) -> dict:

@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -57,7 +57,8 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-__all__ = ["diagnose", "Diagnosis", "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
+__all__ = ["diagnose", "DiagnoseOptions", "Diagnosis",
+           "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
@@ -430,15 +431,12 @@ class Diagnosis:
         return out
 
 
-def diagnose(ship: Ship, items, wind: bool | None = False, candidates=None, segment_s: float | None = None,
-             stride: int | None = None, max_nfev: int = 12, per_run: bool = False, ship_free=None,
-             say=None, screen_nfev: int = SCREEN_NFEV) -> Diagnosis:
-    """Diagnose the records ``items`` against ``ship`` (module docstring).
+@dataclass(frozen=True)
+class DiagnoseOptions:
+    """How :func:`diagnose` searches (each field also a keyword argument of it).
 
-    Parameters
+    Attributes
     ----------
-    ship : Ship
-    items : list of paths, TrialRecord or Prepared
     wind : bool or None
         Wind loads in the model from the start: ``False`` (default: wind is then a candidate),
         ``True``, or ``None`` as the ship config says.
@@ -449,35 +447,40 @@ def diagnose(ship: Ship, items, wind: bool | None = False, candidates=None, segm
     stride : int, optional
         Use every ``stride``-th sample in the fits (default: samples 0.36 sqrt(L/g) apart, 0.2 s
         for the 3 m model, 2 s at 325 m; at least 1).
-    per_run : bool
-        With several records, also diagnose each alone (``runs``).
     max_nfev, screen_nfev : int
         Evaluation budgets of a fit: every candidate is first fitted (warm, from the current
         model) with ``screen_nfev``; one the budget stopped whose dBIC is positive or whose z
         clears the threshold is fitted on, up to ``max_nfev`` in all.
+    per_run : bool
+        With several records, also diagnose each alone (``runs``).
+    ship_free : sequence of str, optional
+        The ship's own parameters fitted with the effects (:func:`_ship_free`).
+    say : callable, optional
+        Where the progress lines go (nowhere when omitted).
     """
-    import time
 
-    from ekf.identify import Scales
+    wind: bool | None = False
+    candidates: object = None
+    segment_s: float | None = None
+    stride: int | None = None
+    max_nfev: int = 12
+    per_run: bool = False
+    ship_free: object = None
+    say: object = None
+    screen_nfev: int = SCREEN_NFEV
 
+
+def _default_stride(recs, L: float) -> int:
+    """Samples 0.36 sqrt(L/g) apart, at least every one."""
+    dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
+    return max(1, int(round(0.36 * math.sqrt(L / 9.80665) / dt)))
+
+
+def _candidates(recs, names, say):
+    """(the effect classes to try, the log entries of those skipped and why)."""
     import mmg.effects as E
 
-    t0 = time.perf_counter()
-    say = say or (lambda m: None)
-    recs = prepare(ship, items, wind=wind, segment_s=segment_s)
-    if not recs:
-        raise InputError("diagnose", "", "no record")
-    L = ship.particulars.L
-    packed = pack(ship)
-    if stride is None:
-        dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
-        stride = max(1, int(round(0.36 * math.sqrt(L / 9.80665) / dt)))
-    U = float(np.median(np.concatenate([np.hypot(r.seg.meas[:, 0], r.seg.meas[:, 1]) for r in recs])))
-    U = max(U, 0.05 * math.sqrt(9.80665 * L))
-    noise = np.median(np.vstack([_noise(r.seg.meas) for r in recs]), axis=0)
-    names = list(candidates) if candidates is not None else E.names()
-    cand = []
-    cand_log = []
+    cand, cand_log = [], []
     for nm in names:
         cls = E.get(nm, "--candidates")
         why = None
@@ -493,48 +496,62 @@ def diagnose(ship: Ship, items, wind: bool | None = False, candidates=None, segm
             say(f"candidate {nm} skipped: {why}")
         else:
             cand.append(cls)
+    return cand, cand_log
 
-    sfree = _ship_free(ship, packed, ship_free)
-    sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
-    fitter = _Fitter(ship, packed, recs, sc0, stride, max_nfev, sfree)
+
+def _baseline(fitter, noise, say):
+    """(the config's differences, the baseline fit): fitted, every channel rescaled by the first fit's
+    own residual (floored at the noise), fitted again."""
+    from ekf.identify import Scales
+
     d_config = fitter.diffs([], [], [])
     base = fitter.fit([])
-    # rescale every channel by the baseline's own residual (floored at the noise), refit
     D = _stack(base.diffs, 1)
     rm = np.sqrt(np.mean(D * D, axis=0))
     fl = np.maximum(rm, np.maximum(noise, 1e-9))
     fitter.scales = Scales(u=fl[0], v=fl[1], r=fl[2], psi=fl[5], pos=float(np.hypot(fl[3], fl[4])) / math.sqrt(2))
     base = fitter.fit([], start_ship=base.theta)
     say(f"baseline: {_rms(base.diffs)}")
-    current = base
-    named = []
-    rounds = []
-    remaining = list(cand)
+    return d_config, base
+
+
+def _taus(current, stride):
+    """(correlation times [samples] of each channel's residual, the standard-error inflation)."""
+    taus = np.array([np.median([_tau(d[::stride, j]) for d in current.diffs]) for j in range(6)])
+    return taus, math.sqrt(float(np.mean(taus)))
+
+
+def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
+    """(dBIC, clears the thresholds, cls, fit, values, standard errors, z) of ``current`` plus ``cls``:
+    screened with ``screen_nfev``, a promising one the budget stopped fitted on to ``max_nfev``."""
+    effs = current.effects + [cls]
+    m = fitter.fit(effs, start_ship=current.theta[:ns], start_eff=list(current.theta[ns:]), max_nfev=o.screen_nfev)
+    k = len(cls.fit_parameters())
+    dbic = _delta_bic(current, m, k, taus, o.stride)
+    vals, se, z = _effect_report(m, cls, inflate)
+    if m.fit.iterations >= o.screen_nfev and o.max_nfev > o.screen_nfev and (dbic > 0 or z > Z_THRESHOLD):
+        m = fitter.fit(effs, start=m.theta, max_nfev=o.max_nfev - o.screen_nfev)
+        dbic = _delta_bic(current, m, k, taus, o.stride)
+        vals, se, z = _effect_report(m, cls, inflate)
+    return dbic, dbic > BIC_THRESHOLD and z > Z_THRESHOLD, cls, m, vals, se, z
+
+
+def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
+    """Forward selection from the baseline: each round tries every remaining candidate and names the
+    best that clears the thresholds.  Returns (final fit, named effects, the rounds' log)."""
+    current, named, rounds, remaining = base, [], [], list(cand)
     while remaining:
-        taus = np.array([np.median([_tau(d[::stride, j]) for d in current.diffs]) for j in range(6)])
-        inflate = math.sqrt(float(np.mean(taus)))
+        taus, inflate = _taus(current, o.stride)
         results = []
-        ns = len(sfree)
         for cls in remaining:
-            eff_prev = current.theta[ns:]
-            effs = current.effects + [cls]
-            m = fitter.fit(effs, start_ship=current.theta[:ns], start_eff=list(eff_prev), max_nfev=screen_nfev)
-            k = len(cls.fit_parameters())
-            dbic = _delta_bic(current, m, k, taus, stride)
-            vals, se, z = _effect_report(m, cls, inflate)
-            if m.fit.iterations >= screen_nfev and max_nfev > screen_nfev and (dbic > 0 or z > Z_THRESHOLD):
-                # a promising candidate the screening budget stopped: fit it on to convergence
-                m = fitter.fit(effs, start=m.theta, max_nfev=max_nfev - screen_nfev)
-                dbic = _delta_bic(current, m, k, taus, stride)
-                vals, se, z = _effect_report(m, cls, inflate)
-            ok = dbic > BIC_THRESHOLD and z > Z_THRESHOLD
-            results.append((dbic, ok, cls, m, vals, se, z))
+            results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
+            dbic, _, _, _, vals, _, z = results[-1]
             say(f"  {cls.name}: dBIC {dbic:.1f}, z {z:.1f}, {vals}")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
                        "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
-                                       "clears_threshold": bool(o), "parameters": v, "standard_errors": s}
-                                      for d, o, c, m, v, s, z in results]})
+                                       "clears_threshold": bool(ok), "parameters": v, "standard_errors": s}
+                                      for d, ok, c, m, v, s, z in results]})
         ok = [r for r in results if r[1]]
         if not ok:
             break
@@ -542,30 +559,79 @@ def diagnose(ship: Ship, items, wind: bool | None = False, candidates=None, segm
         named.append(best[2].name)
         current = best[3]
         remaining.remove(best[2])
-    taus = np.array([np.median([_tau(d[::stride, j]) for d in current.diffs]) for j in range(6)])
-    inflate = math.sqrt(float(np.mean(taus)))
+    return current, named, rounds
+
+
+def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs) -> Diagnosis:
+    """Diagnose the records ``items`` against ``ship`` (module docstring).
+
+    Parameters
+    ----------
+    ship : Ship
+    items : list of paths, TrialRecord or Prepared
+    options : DiagnoseOptions, optional
+        How to search; defaults when omitted.
+    **kwargs
+        Any :class:`DiagnoseOptions` field by name (``wind``, ``candidates``, ``segment_s``,
+        ``stride``, ``max_nfev``, ``per_run``, ``ship_free``, ``say``, ``screen_nfev``), over
+        ``options``.
+    """
+    import time
+
+    from ekf.identify import Scales
+
+    import mmg.effects as E
+
+    t0 = time.perf_counter()
+    o = DiagnoseOptions(**kwargs) if options is None else replace(options, **kwargs)
+    say = o.say or (lambda m: None)
+    recs = prepare(ship, items, wind=o.wind, segment_s=o.segment_s)
+    if not recs:
+        raise InputError("diagnose", "", "no record")
+    L = ship.particulars.L
+    packed = pack(ship)
+    if o.stride is None:
+        o = replace(o, stride=_default_stride(recs, L))
+    U = float(np.median(np.concatenate([np.hypot(r.seg.meas[:, 0], r.seg.meas[:, 1]) for r in recs])))
+    U = max(U, 0.05 * math.sqrt(9.80665 * L))
+    noise = np.median(np.vstack([_noise(r.seg.meas) for r in recs]), axis=0)
+    cand, cand_log = _candidates(recs, list(o.candidates) if o.candidates is not None else E.names(), say)
+    sfree = _ship_free(ship, packed, o.ship_free)
+    sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
+    fitter = _Fitter(ship, packed, recs, sc0, o.stride, o.max_nfev, sfree)
+    d_config, base = _baseline(fitter, noise, say)
+    current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
+    res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
+                     o.stride)
+    res.seconds = time.perf_counter() - t0
+    if o.per_run and len(recs) > 1:
+        res.runs = [diagnose(ship, [r], replace(o, per_run=False, say=None)) for r in recs]
+        res.seconds = time.perf_counter() - t0
+    return res
+
+
+def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int) -> Diagnosis:
+    """The :class:`Diagnosis`: baseline = (the config's differences, the baseline fit), search = (final
+    fit, named effects, rounds) of :func:`_search`, cands = (candidates, log) of :func:`_candidates`;
+    the named effects' values with standard errors inflated by the residuals' correlation, what is left."""
+    d_config, base = baseline
+    current, named, rounds = search
+    cand, cand_log = cands
+    _, inflate = _taus(current, stride)
     params, ses = {}, {}
     for cls in current.effects:
         v, s, _ = _effect_report(current, cls, inflate)
         params[cls.name] = v
         ses[cls.name] = s
-    for c in cand:
-        entry = {"effect": c.name, "named": c.name in named}
-        cand_log.append(entry)
+    cand_log = cand_log + [{"effect": c.name, "named": c.name in named} for c in cand]
     unexpl, desc, _ = _describe(recs, current.diffs, noise, None)
-    ns = len(sfree)
     ship_vals = _ship_values(ship, current.free[:ns], current.theta[:ns])
-    res = Diagnosis(named=named, parameters=params, standard_errors=ses, rms_config=_rms(d_config),
-                    rms_before=_rms(base.diffs), rms_after=_rms(current.diffs), unexplained=unexpl,
-                    unexplained_description=desc, candidates=cand_log, rounds=rounds, ship_values=ship_vals,
-                    records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
-                    pred_after=[r.seg.meas + d for r, d in zip(recs, current.diffs)],
-                    seconds=time.perf_counter() - t0, effects=current.effects)
-    if per_run and len(recs) > 1:
-        res.runs = [diagnose(ship, [r], wind=wind, candidates=candidates, segment_s=segment_s, stride=stride,
-                             max_nfev=max_nfev, ship_free=ship_free, screen_nfev=screen_nfev) for r in recs]
-        res.seconds = time.perf_counter() - t0
-    return res
+    return Diagnosis(named=named, parameters=params, standard_errors=ses, rms_config=_rms(d_config),
+                     rms_before=_rms(base.diffs), rms_after=_rms(current.diffs), unexplained=unexpl,
+                     unexplained_description=desc, candidates=cand_log, rounds=rounds, ship_values=ship_vals,
+                     records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
+                     pred_after=[r.seg.meas + d for r, d in zip(recs, current.diffs)],
+                     seconds=0.0, effects=current.effects)
 
 
 # --------------------------------------------------------------------------- synthetic records

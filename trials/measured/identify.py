@@ -36,7 +36,7 @@ fit against another model (the Kijima ship the cross-flow prior was converted fr
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -47,7 +47,8 @@ from mmg.ship import Ship
 
 from .predict import MeasuredRun, measured_run, replay_record
 
-__all__ = ["identify", "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
+__all__ = ["identify", "IdentifyOptions",
+           "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description"]
 
@@ -242,20 +243,12 @@ def stage_description(segment_s: float) -> str:
     return f"segment-wise fit: {segment_s:.3g} s segments, each restarted from the measured state"
 
 
-def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | None = None, wind: bool | None = None,
-             max_nfev: int = DEFAULT_MAX_NFEV, progress=None, say=_log, prior_rel_std: float = 0.5,
-             initial: Ship | None = None, record_weighting: str = DEFAULT_WEIGHTING, loss: str = "linear",
-             f_scale: float = 1.0, record_nuisance=(), velocity_weight: float = 1.0) -> Identification:
-    """Identify ``free`` jointly over the training records (module docstring).
+@dataclass(frozen=True)
+class IdentifyOptions:
+    """How :func:`identify` fits (each field also a keyword argument of it).
 
-    Parameters
+    Attributes
     ----------
-    ship : Ship
-        The initial model (the prior).
-    paths_or_runs : list of paths or of MeasuredRun
-    free : sequence of str
-        Hull coefficient names, ``"hull-except-constants"``, ``"hull"`` (every hull coefficient),
-        ``"w_P0"``, ``"epsilon"``, ``"kappa"``, ``"wind_scale"``.
     segment_s : float or sequence of float, optional
         Segment length(s) [s] of successive fits; :data:`DEFAULT_SEGMENTS_L` when omitted.
     wind : bool, optional
@@ -267,6 +260,8 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     progress : callable, optional
         ``progress(iteration, cost, stage)`` after each Jacobian; ``stage`` names the stage:
         ``"stage 1/2: segment-wise fit: ..."`` (:func:`stage_description`).
+    say : callable
+        Where a skipped record's one line goes.
     prior_rel_std : float
         Prior std of each freed coefficient relative to its config value (:func:`ekf.identify.free_parameters`).
     initial : Ship, optional
@@ -291,57 +286,115 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
         fit follows the heading, the score a replay is judged by).  docs/identify_cv.md: 0.1
         predicts the kept-out records better without wind and worse with it.
     """
-    from ekf.identify import Segmented, free_parameters, identify_segments, record_residual_rms, record_weights, \
-        segment_resets
 
+    segment_s: object = None
+    wind: bool | None = None
+    max_nfev: int = DEFAULT_MAX_NFEV
+    progress: object = None
+    say: object = _log
+    prior_rel_std: float = 0.5
+    initial: Ship | None = None
+    record_weighting: str = DEFAULT_WEIGHTING
+    loss: str = "linear"
+    f_scale: float = 1.0
+    record_nuisance: tuple = ()
+    velocity_weight: float = 1.0
+
+
+def _check_velocity_weight(velocity_weight) -> None:
     try:
-        vw_ok = bool(np.isfinite(float(velocity_weight)) and float(velocity_weight) > 0)
+        ok = bool(np.isfinite(float(velocity_weight)) and float(velocity_weight) > 0)
     except (TypeError, ValueError):
-        vw_ok = False
-    if not vw_ok:                                           # before any record is read
+        ok = False
+    if not ok:
         raise ValueError(f"velocity_weight: a positive finite number, got {velocity_weight!r}")
+
+
+def _training_runs(ship: Ship, paths_or_runs, o: IdentifyOptions) -> list[MeasuredRun]:
+    """The given runs, then the records read from the given paths (unusable ones skipped with one line)."""
     items = list(paths_or_runs)
     runs = [r for r in items if isinstance(r, MeasuredRun)]
     paths = [r for r in items if not isinstance(r, MeasuredRun)]
-    runs += load_runs(ship, paths, wind=wind, say=say) if paths else []
+    runs += load_runs(ship, paths, wind=o.wind, say=o.say) if paths else []
     if not runs:
         raise InputError("--train", "", "no usable training record")
-    L = ship.particulars.L
-    stages = DEFAULT_SEGMENTS_L if segment_s is None else np.atleast_1d(segment_s) / np.sqrt(L / 9.80665)
-    packed = pack(ship)
+    return runs
+
+
+def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
+    """(free parameters, the per-record nuisance effects or None)."""
+    from ekf.identify import free_parameters
+
     names = _free_names(ship, free)
     if not any(r.inputs.ext is not None for r in runs):
         names = [n for n in names if n != "wind_scale"]       # no wind loads to scale
-    fp = free_parameters(packed, ship.hull.names, names, prior_rel_std)
-    nuisance = None
-    if record_nuisance:
-        import mmg.effects as E
-        from ekf.identify import record_effect_parameters
+    fp = free_parameters(packed, ship.hull.names, names, o.prior_rel_std)
+    if not o.record_nuisance:
+        return fp, None
+    import mmg.effects as E
+    from ekf.identify import record_effect_parameters
 
-        nuisance = [E.get(n, "record_nuisance") for n in record_nuisance]
-        fp = fp + record_effect_parameters(nuisance, len(runs), names=[r.name for r in runs])
+    nuisance = [E.get(n, "record_nuisance") for n in o.record_nuisance]
+    return fp + record_effect_parameters(nuisance, len(runs), names=[r.name for r in runs]), nuisance
+
+
+def _fit_stage(problem: tuple, seg: float, label: str, last: bool, fit, o: IdentifyOptions):
+    """One stage of :func:`identify`: every record cut into ``seg`` [s] segments, fitted from ``fit``'s values
+    (the priors when None); problem = (ship, packed ship, runs, free parameters, nuisance effects or None)."""
+    from ekf.identify import Segmented, identify_segments, record_residual_rms, record_weights, segment_resets
+
+    ship, packed, runs, fp, nuisance = problem
+    stage_progress = None if o.progress is None else (lambda i, c, _l=label: o.progress(i, c, _l))
+    segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects) for r in runs]
+    sc = _scales(runs, ship.particulars.L, o.velocity_weight)
+    theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
+    rms = (record_residual_rms(packed, segs, fp, theta, sc, effects=nuisance, ship=ship)
+           if o.record_weighting == "relative" else None)
+    return identify_segments(packed, segs, fp, sc, max_nfev=o.max_nfev, progress=stage_progress, effects=nuisance,
+                             ship=ship, start=None if fit is None else fit.theta,
+                             weights=record_weights(segs, o.record_weighting, rms=rms),
+                             loss=o.loss if last else "linear", f_scale=o.f_scale)
+
+
+def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, options: IdentifyOptions | None = None,
+             **kwargs) -> Identification:
+    """Identify ``free`` jointly over the training records (module docstring).
+
+    Parameters
+    ----------
+    ship : Ship
+        The initial model (the prior).
+    paths_or_runs : list of paths or of MeasuredRun
+    free : sequence of str
+        Hull coefficient names, ``"hull-except-constants"``, ``"hull"`` (every hull coefficient),
+        ``"w_P0"``, ``"epsilon"``, ``"kappa"``, ``"wind_scale"``.
+    options : IdentifyOptions, optional
+        How to fit; defaults when omitted.
+    **kwargs
+        Any :class:`IdentifyOptions` field by name (``segment_s``, ``wind``, ``max_nfev``,
+        ``progress``, ``say``, ``prior_rel_std``, ``initial``, ``record_weighting``, ``loss``,
+        ``f_scale``, ``record_nuisance``, ``velocity_weight``), over ``options``.
+    """
+    o = IdentifyOptions(**kwargs) if options is None else replace(options, **kwargs)
+    _check_velocity_weight(o.velocity_weight)                # before any record is read
+    runs = _training_runs(ship, paths_or_runs, o)
+    L = ship.particulars.L
+    stages = DEFAULT_SEGMENTS_L if o.segment_s is None else np.atleast_1d(o.segment_s) / np.sqrt(L / 9.80665)
+    packed = pack(ship)
+    fp, nuisance = _free_of(ship, packed, runs, free, o)
     fit = None
     done = []
     for k, st in enumerate(stages):
         seg = float(st) * float(np.sqrt(L / 9.80665))
         label = f"stage {k + 1}/{len(stages)}: {stage_description(seg)}"
-        stage_progress = None if progress is None else (lambda i, c, _l=label: progress(i, c, _l))
-        segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects) for r in runs]
-        sc = _scales(runs, L, velocity_weight)
-        theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
-        rms = (record_residual_rms(packed, segs, fp, theta, sc, effects=nuisance, ship=ship)
-               if record_weighting == "relative" else None)
-        last = k == len(stages) - 1
-        fit = identify_segments(packed, segs, fp, sc, max_nfev=max_nfev, progress=stage_progress, effects=nuisance,
-                                ship=ship, start=None if fit is None else fit.theta,
-                                weights=record_weights(segs, record_weighting, rms=rms),
-                                loss=loss if last else "linear", f_scale=f_scale)
+        fit = _fit_stage((ship, packed, runs, fp, nuisance), seg, label, k == len(stages) - 1, fit, o)
         done.append({"segment_s": seg, "description": stage_description(seg), "evaluations": fit.iterations,
-                     "max_nfev": int(max_nfev), "cost_initial": fit.cost_initial, "cost_final": fit.cost_final,
+                     "max_nfev": int(o.max_nfev), "cost_initial": fit.cost_initial, "cost_final": fit.cost_final,
                      "status": fit.status, "message": fit.message})
-    return Identification(ship=_ship_with(ship, fit.values()), initial=ship if initial is None else initial, fit=fit,
-                          runs=runs, segment_s=seg, prior=None if initial is None else ship,
-                          record_weighting=record_weighting, velocity_weight=float(velocity_weight), stages=tuple(done))
+    return Identification(ship=_ship_with(ship, fit.values()), initial=ship if o.initial is None else o.initial,
+                          fit=fit, runs=runs, segment_s=seg, prior=None if o.initial is None else ship,
+                          record_weighting=o.record_weighting, velocity_weight=float(o.velocity_weight),
+                          stages=tuple(done))
 
 
 FOLD_ASSIGNMENTS = ("order", "revolutions")
@@ -483,19 +536,9 @@ def _stage_lines(ident: Identification) -> list[str]:
     return out
 
 
-def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
-    """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
-
-    ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
-    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given;
-    ``test_runs`` (records never trained on) are predicted with both models and reported."""
-    out_dir = Path(out_dir)
+def _report_fit(ident: Identification) -> list:
+    """The report's title, stages, values with standard errors, warnings and strong correlations."""
     fit = ident.fit
-    note = (f"segment-wise output error over {len(ident.runs)} records "
-            f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
-    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note))
-    a = ident.scores(model="initial")
-    b = ident.scores()
     lines = [f"# Identification of {ident.initial.name}", ""]
     if ident.prior is not None:
         lines += [f"Fitted in the form of {ident.prior.name} (the prior, 'config' below); 'initial' scores are "
@@ -520,6 +563,14 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     strong = [(names[i], names[j], fit.corr[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
               if np.isfinite(fit.corr[i, j]) and abs(fit.corr[i, j]) >= 0.8]
     lines += [f"- {x} / {y}: {c:+.2f}" for x, y, c in strong] or ["- none"]
+    return lines
+
+
+def _report_training(ident: Identification) -> list:
+    """The report's training fits (heading and speed RMS) and manoeuvre metrics, measured and replayed."""
+    a = ident.scores(model="initial")
+    b = ident.scores()
+    lines = []
     lines += ["", "## Training fits (open-loop replay from each record's first state)", "",
               "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] |",
               "|---|---|---|---|---|"]
@@ -538,35 +589,64 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
         _, mf = manoeuvre_metrics(ident.replay(r))
         lines.append(f"| {r.name} | " + " | ".join(f"{_fmt_metric(m0, k)} / {_fmt_metric(mi, k)} / {_fmt_metric(mf, k)}"
                                                     for k, _ in METRIC_COLUMNS) + " |")
+    return lines
+
+
+def _report_test(ident: Identification, test_runs) -> list:
+    """The report's predictions of the records never trained on."""
+    lines = []
+    lines += ["", "## Predictions of records never trained on", "",
+              "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
+              "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
+    gone = []
+    for r in test_runs:
+        ri, rf = ident.replay(r, "initial"), ident.replay(r)
+        x, y = ri.scores(), rf.scores()
+        gone += [f"{r.name} ({who}, at t = {g.diverged_at:.1f} s)" for who, g in (("initial", ri), ("identified", rf))
+                 if g.diverged_at is not None]
+        lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
+                     f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
+    if gone:
+        lines += ["", f"'nan': the replay diverged (its state stopped being finite): {', '.join(gone)}."]
+    return lines
+
+
+def _report_cv(cv: list) -> list:
+    """The report's cross-validation table and summary."""
+    lines = []
+    lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
+              "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]
+    for c in cv:
+        x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
+        lines.append(f"| {c['name']} | {c['fold']} | {x:.2f} | {y:.2f} | {x / y:.2f} |")
+    ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
+    xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
+    xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
+    better = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
+    lines.append(f"| **mean** | | {xa:.2f} | {xb:.2f} | {xa / xb:.2f} |")
+    lines += ["", f"Identified better on {better} of {len(cv)} kept-out records; mean ratio {xa / xb:.2f}."]
+    diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
+    if diverged:
+        lines += ["", f"The identified model's replay diverged on {len(diverged)} kept-out record(s) "
+                      f"({', '.join(diverged)}): counted as not better, left out of both means."]
+    return lines
+
+
+def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
+    """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
+
+    ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
+    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given;
+    ``test_runs`` (records never trained on) are predicted with both models and reported."""
+    out_dir = Path(out_dir)
+    fit = ident.fit
+    note = (f"segment-wise output error over {len(ident.runs)} records "
+            f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
+    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note))
+    lines = _report_fit(ident) + _report_training(ident)
     if test_runs:
-        lines += ["", "## Predictions of records never trained on", "",
-                  "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
-                  "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
-        gone = []
-        for r in test_runs:
-            ri, rf = ident.replay(r, "initial"), ident.replay(r)
-            x, y = ri.scores(), rf.scores()
-            gone += [f"{r.name} ({who}, at t = {g.diverged_at:.1f} s)" for who, g in (("initial", ri), ("identified", rf))
-                     if g.diverged_at is not None]
-            lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
-                         f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
-        if gone:
-            lines += ["", f"'nan': the replay diverged (its state stopped being finite): {', '.join(gone)}."]
+        lines += _report_test(ident, test_runs)
     if cv:
-        lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
-                  "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]
-        for c in cv:
-            x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
-            lines.append(f"| {c['name']} | {c['fold']} | {x:.2f} | {y:.2f} | {x / y:.2f} |")
-        ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
-        xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
-        xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
-        better = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
-        lines.append(f"| **mean** | | {xa:.2f} | {xb:.2f} | {xa / xb:.2f} |")
-        lines += ["", f"Identified better on {better} of {len(cv)} kept-out records; mean ratio {xa / xb:.2f}."]
-        diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
-        if diverged:
-            lines += ["", f"The identified model's replay diverged on {len(diverged)} kept-out record(s) "
-                          f"({', '.join(diverged)}): counted as not better, left out of both means."]
+        lines += _report_cv(cv)
     (out_dir / "report.md").write_text("\n".join(lines) + "\n")
     return {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}

@@ -78,8 +78,9 @@ NOISE_MODELS = ("log", "filter", "thinned")
 
 
 @njit(cache=True)
-def _tangent_kernel(z0, delta, dt, p, poly, hull_axis, hull_term, hull_coef, idx, Y, S):
-    """Fill Y (N, 4) with the model's u, v, r, n and S (N, 4, 16) with their sensitivities to z0."""
+def _tangent_kernel(z0, delta, dt, ship, hull_coef, idx, Y, S):
+    """Fill Y (N, 4) with the model's u, v, r, n and S (N, 4, 16) with their sensitivities to z0; ship =
+    (p, poly, hull_axis, hull_term), hull_coef and idx the packed ship's coefficients and the derivatives' slots."""
     nz = z0.shape[0]
     N = delta.shape[0]
     z = z0.copy()
@@ -90,7 +91,7 @@ def _tangent_kernel(z0, delta, dt, p, poly, hull_axis, hull_term, hull_coef, idx
         for j in range(nz):
             S[0, i, j] = 1.0 if i == j else 0.0
     for k in range(1, N):
-        propagate_step(z, delta[k - 1], delta[k], dt, p, poly, hull_axis, hull_term, idx, ws)
+        propagate_step(z, delta[k - 1], delta[k], dt, ship, idx, ws)
         for i in range(nz):
             z[i] = zn[i]
         for i in range(NS):
@@ -104,16 +105,20 @@ def _tangent_kernel(z0, delta, dt, p, poly, hull_axis, hull_term, hull_coef, idx
 
 
 @njit(cache=True)
-def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, hull_coef, idx, out):
+def _timing_kernel(z0, rudder, dt, ship, hull_coef, idx, out):
     """out (N, 4, n_seg): d(u, v, r, n)(t_k) / d tau_j, the rudder being delta + tau_j g over the
     steps with seg == j (seg non-decreasing); one complex-step run of the raw-log EKF's RK4 step
     per movement, started where the movement starts from a stored unperturbed run.
 
-    z0 (20,) the raw-log filter's state layout (x, y, psi, n, u, v, r, tau, derivatives)."""
+    z0 (20,) the raw-log filter's state layout (x, y, psi, n, u, v, r, tau, derivatives); rudder =
+    (delta, g, seg, n_seg); ship = (p, poly, hull_axis, hull_term), hull_coef and idx the packed
+    ship's coefficients and the derivatives' slots."""
+    delta, g, seg, n_seg = rudder
     N = delta.shape[0]
     h = CSTEP
     ws = make_workspace(np.int64(LOG_NZ), np.int64(LOG_NS), hull_coef)
-    coef, xs, k1, k2, k3, k4, nxt = ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
+    nxt = ws[7]
+    layout = (LOG_SLOTS, np.int64(LOG_ND), idx, np.int64(-1))
     z = np.empty(z0.shape[0], dtype=np.complex128)
     for i in range(z0.shape[0]):
         z[i] = z0[i]
@@ -122,8 +127,7 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
     for i in range(LOG_NS):           # element-wise (a slice assignment compiles numba's shape-mismatch message)
         zh[0, i] = z[i]
     for k in range(1, N):
-        rk4_step(z, LOG_SLOTS, np.int64(LOG_ND), delta[k - 1] + 0.0j, delta[k] + 0.0j, dt, p, poly, hull_axis, hull_term,
-                 coef, idx, xs, k1, k2, k3, k4, nxt)
+        rk4_step(z, delta[k - 1] + 0.0j, delta[k] + 0.0j, dt, layout, ship, ws)
         for i in range(LOG_NS):
             z[i] = nxt[i]
             zh[k, i] = nxt[i]
@@ -139,8 +143,7 @@ def _timing_kernel(z0, delta, g, seg, n_seg, dt, p, poly, hull_axis, hull_term, 
         for k in range(k0 + 1, N):
             a0 = 1j * h * g[k - 1] if seg[k - 1] == j else 0.0j
             a1 = 1j * h * g[k] if seg[k - 1] == j else 0.0j
-            rk4_step(z, LOG_SLOTS, np.int64(LOG_ND), delta[k - 1] + a0, delta[k] + a1, dt, p, poly, hull_axis, hull_term,
-                     coef, idx, xs, k1, k2, k3, k4, nxt)
+            rk4_step(z, delta[k - 1] + a0, delta[k] + a1, dt, layout, ship, ws)
             for i in range(LOG_NS):
                 z[i] = nxt[i]
             out[k, 0, j] = z[4].imag / h
@@ -214,7 +217,7 @@ def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tang
     N = len(delta)
     Y = np.empty((N, NS))
     S = np.empty((N, NS, NZ))
-    _tangent_kernel(z0, delta, step, *pk.args(), idx, Y, S)
+    _tangent_kernel(z0, delta, step, pk.args()[:4], pk.hull_coef, idx, Y, S)
     S_tau = None
     if rudder_timing and trial.kind not in REBUILT_KINDS:
         S_tau = np.empty((N, NS, 0))          # a time schedule: the rudder's timing is known
@@ -224,7 +227,7 @@ def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tang
         g = -np.gradient(delta, step)
         zl = np.r_[0.0, 0.0, x0[PSI_], x0[N_], x0[U_], x0[V_], x0[R_], 0.0, values]
         S_tau = np.empty((N, NS, n_seg))
-        _timing_kernel(zl, delta, g, seg, n_seg, step, *pk.args(), idx, S_tau)
+        _timing_kernel(zl, (delta, g, seg, n_seg), step, pk.args()[:4], pk.hull_coef, idx, S_tau)
     lg = trial.log
     from ..files.logio import M_PER_DEG_LAT, M_PER_DEG_LON
 

@@ -510,6 +510,148 @@ def _polyval(c, x: float) -> float:
     return float(np.polyval(np.asarray(c, float)[::-1], x))
 
 
+def _si(src: str, field: str, value, dimension: str, lo=None, hi=None, **kw) -> float:
+    """:func:`mmg.units.to_si`, its refusal an InputError naming ``src`` and ``field``."""
+    try:
+        return to_si(value, dimension, lo, hi, **kw)
+    except ValueError as e:
+        raise InputError(src, field, str(e)) from None
+
+
+def _trial_file(data, src: str, ship: Ship | None) -> _TrialFile:
+    """The mapping validated (types, keys); with ``ship`` given, ``ship:`` may be omitted."""
+    if not isinstance(data, Mapping):
+        raise InputError(src, "", f"expected a mapping of trial fields, got {type(data).__name__}")
+    data = dict(data)
+    if ship is not None:
+        if not isinstance(ship, Ship):
+            raise InputError(src, "ship", f"expected a Ship, got {type(ship).__name__}")
+        data["ship"] = data.get("ship") or ship.name
+    try:
+        return _TrialFile.model_validate(data)
+    except ValidationError as e:
+        err = e.errors()[0]
+        raise InputError(src, _loc(err), _message(err)) from None
+
+
+def _run_size(f: _TrialFile, src: str) -> tuple[float, float]:
+    """(duration, dt) [s], refused before the ship is read or anything allocated."""
+    duration = _si(src, "duration", f.duration, "time", 0.0, None, lo_open=True)
+    dt = _si(src, "dt", f.dt, "time", MIN_DT, None)
+    if dt > duration:
+        raise InputError(src, "dt", f"{f.dt} is longer than the duration ({f.duration})")
+    check_steps(duration, dt, src, "duration")
+    return duration, dt
+
+
+def _trial_ship(f: _TrialFile, ship: Ship | None, base: Path, src: str, dt: float) -> tuple[Ship, str, str]:
+    """(the ship, its file or "", its label in messages); dt checked against its steering gear."""
+    if ship is None:
+        ship_path = _resolve_ship(f.ship, base, src)
+        ship = load_ship(ship_path)
+        ship_path = str(ship_path)
+    else:
+        ship_path = ""
+    label = f"{ship.name} ({ship_path})" if ship_path else ship.name
+    T_E = ship.steering.T_E
+    if dt > T_E * (1 + 1e-9):
+        raise InputError(src, "dt", f"{f.dt} is longer than the steering gear's time constant T_E = {T_E:g} s of "
+                                    f"{label}: the step must resolve it (RK4 is unstable beyond 2.8 T_E)")
+    return ship, ship_path, label
+
+
+def _approach(f: _TrialFile, ship: Ship, label: str, src: str) -> tuple[float, float | None]:
+    """(u0 [m/s], n0 [rps] or None to solve), checked against the ship's propeller and engine data."""
+    u0 = _si(src, "approach.speed", f.approach.speed, "speed", 0.0, MAX_SHIP_SPEED, lo_open=True)
+    L = ship.particulars.L
+    fn = u0 / np.sqrt(9.81 * L)
+    if fn > MAX_FROUDE:
+        raise InputError(src, "approach.speed", f"{f.approach.speed} is a Froude number of {fn:.3g} for the {L:g} m "
+                                                f"{label}; above {MAX_FROUDE:g} no displacement ship sails "
+                                                "(probably the wrong unit)")
+    pr = ship.propeller
+    for name, poly in (("t_P", pr.t_P), ("w_P0", pr.w_P0)):
+        v = _polyval(poly, u0)
+        if not 0.0 <= v < 1.0:
+            raise InputError(src, "approach.speed", f"at {f.approach.speed} the ship's {name}(u) polynomial gives "
+                                                    f"{v:.4g}, outside [0, 1): the speed is outside the range of "
+                                                    f"the propeller data of {label}")
+    if ship.engine.mode == "constant_power":
+        shp = _polyval(ship.engine.SHP_0, u0)
+        if not shp > 0.0:
+            raise InputError(src, "approach.speed", f"at {f.approach.speed} the constant-power engine's SHP_0(u) "
+                                                    f"gives {shp:.4g} hp; it needs positive power (the speed is "
+                                                    f"outside the engine data of {label})")
+    n0 = None if f.approach.rpm == "solve" else _si(src, "approach.rpm", f.approach.rpm, "revolutions", 0.0, MAX_RPM,
+                                                    lo_open=True)
+    return u0, n0
+
+
+def _manoeuvre(f: _TrialFile, ship: Ship, label: str, src: str, run: tuple[float, float], base: Path):
+    """(kind, its fields in SI); rudder angles within the steering gear's limit; run = (duration, dt)."""
+    duration, dt = run
+    dmax = ship.steering.delta_max
+    man = f.manoeuvre.model_dump()
+    kind = man.pop("kind")
+    conv: dict = {}
+    for k, v in man.items():
+        field = f"manoeuvre.{k}"
+        if k in ("rudder", "amplitude"):
+            x = _si(src, field, v, "angle", -MAX_RUDDER, MAX_RUDDER)
+            if abs(x) > dmax + 1e-12:
+                raise InputError(src, field, f"{v} exceeds the steering gear limit of {dmax / DEG:g} deg of {label}")
+            if k == "rudder" and kind in ("zigzag", "stype") and not x > 0:
+                raise InputError(src, field, f"must be positive, got {v!r} (the first side is set by 'first')")
+            conv[k] = x
+        elif k in ("heading", "switch_heading"):
+            conv[k] = _si(src, field, v, "angle", 0.0, MAX_HEADING_CHANGE, lo_open=True)
+        elif k == "period":
+            conv[k] = _si(src, field, v, "time", MIN_STEPS_PER_PERIOD * dt, None,
+                          why=f"at least {MIN_STEPS_PER_PERIOD} steps of dt = {dt:g} s, so the order is resolved")
+        elif k == "execute":
+            conv[k] = _si(src, field, v, "time", 0.0, duration, hi_open=True,
+                          why=f"the execute time must lie in [0, {duration:g} s), within the run")
+        else:
+            conv[k] = v
+    if kind == "schedule":
+        conv = {"table": _schedule(conv, ship, label, duration, base, src)}
+    return kind, conv
+
+
+def _log_spec(f: _TrialFile, src: str, run: tuple[float, float]) -> LogSpec:
+    """log: SI, interval a multiple of dt at most the duration; run = (duration, dt)."""
+    duration, dt = run
+    lg = f.log
+    interval = _si(src, "log.interval", lg.interval, "time", 0.0, duration, lo_open=True,
+                   why=f"a positive interval at most the duration {f.duration}")
+    ratio = interval / dt
+    if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-6:
+        raise InputError(src, "log.interval", f"must be a positive multiple of dt ({f.dt}), got {lg.interval!r}")
+    start_lat = _si(src, "log.start_lat", lg.start_lat, "angle", -MAX_LATITUDE, MAX_LATITUDE,
+                    why="a latitude is within +-90 deg")
+    start_lon = _si(src, "log.start_lon", lg.start_lon, "angle", *LONGITUDE_RANGE, why="a longitude is -180 to 360 deg")
+    noise = {c: _si(src, f"log.noise.{c}", getattr(lg.noise, c), _DIM[c], 0.0, NOISE_MAX[c]) for c in _DIM}
+    bias = {c: _si(src, f"log.bias.{c}", getattr(lg.bias, c), _DIM[c], -NOISE_MAX[c], NOISE_MAX[c])
+            for c in ("heading", "speed", "rpm")}
+    return LogSpec(interval, lg.seed, start_lat, start_lon, noise["lat"], noise["lon"], noise["heading"],
+                   noise["speed"], noise["rpm"], SensorBias(bias["heading"], bias["speed"], bias["rpm"]))
+
+
+def _disturbances(f: _TrialFile, src: str) -> list:
+    """disturbances: the uniform current and the rudder offset, SI."""
+    dist = []
+    d = f.disturbances
+    if d.current is not None:
+        dist.append(UniformCurrent(
+            _si(src, "disturbances.current.speed", d.current.speed, "speed", 0.0, MAX_CURRENT,
+                why="a current runs at 0-20 kn (its sense is the direction)"),
+            _si(src, "disturbances.current.direction", d.current.direction, "angle", -2 * np.pi, 2 * np.pi)))
+    off = _si(src, "disturbances.rudder_offset", d.rudder_offset, "angle", -MAX_RUDDER_OFFSET, MAX_RUDDER_OFFSET)
+    if off != 0.0:
+        dist.append(RudderOffset(off))
+    return dist
+
+
 def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | None = None,
                     ship: Ship | None = None) -> Trial:
     """Validate a trial mapping (a trial YAML's content) and build the :class:`Trial`.
@@ -560,125 +702,15 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
     """
     src = str(source)
     base = Path.cwd() if base is None else Path(base)
-    if not isinstance(data, Mapping):
-        raise InputError(src, "", f"expected a mapping of trial fields, got {type(data).__name__}")
-    data = dict(data)
-    if ship is not None:
-        if not isinstance(ship, Ship):
-            raise InputError(src, "ship", f"expected a Ship, got {type(ship).__name__}")
-        data["ship"] = data.get("ship") or ship.name
-    try:
-        f = _TrialFile.model_validate(data)
-    except ValidationError as e:
-        err = e.errors()[0]
-        raise InputError(src, _loc(err), _message(err)) from None
-
-    def q(field, value, dimension, lo=None, hi=None, **kw) -> float:
-        try:
-            return to_si(value, dimension, lo, hi, **kw)
-        except ValueError as e:
-            raise InputError(src, field, str(e)) from None
-
-    # the size of the run first: refused before the ship is read or anything allocated
-    duration = q("duration", f.duration, "time", 0.0, None, lo_open=True)
-    dt = q("dt", f.dt, "time", MIN_DT, None)
-    if dt > duration:
-        raise InputError(src, "dt", f"{f.dt} is longer than the duration ({f.duration})")
-    check_steps(duration, dt, src, "duration")
-
-    if ship is None:
-        ship_path = _resolve_ship(f.ship, base, src)
-        ship = load_ship(ship_path)
-        ship_path = str(ship_path)
-    else:
-        ship_path = ""
-    label = f"{ship.name} ({ship_path})" if ship_path else ship.name
-    T_E = ship.steering.T_E
-    if dt > T_E * (1 + 1e-9):
-        raise InputError(src, "dt", f"{f.dt} is longer than the steering gear's time constant T_E = {T_E:g} s of "
-                                    f"{label}: the step must resolve it (RK4 is unstable beyond 2.8 T_E)")
-
-    # approach, against the ship
-    u0 = q("approach.speed", f.approach.speed, "speed", 0.0, MAX_SHIP_SPEED, lo_open=True)
-    L = ship.particulars.L
-    fn = u0 / np.sqrt(9.81 * L)
-    if fn > MAX_FROUDE:
-        raise InputError(src, "approach.speed", f"{f.approach.speed} is a Froude number of {fn:.3g} for the {L:g} m "
-                                                f"{label}; above {MAX_FROUDE:g} no displacement ship sails "
-                                                "(probably the wrong unit)")
-    pr = ship.propeller
-    for name, poly in (("t_P", pr.t_P), ("w_P0", pr.w_P0)):
-        v = _polyval(poly, u0)
-        if not 0.0 <= v < 1.0:
-            raise InputError(src, "approach.speed", f"at {f.approach.speed} the ship's {name}(u) polynomial gives "
-                                                    f"{v:.4g}, outside [0, 1): the speed is outside the range of "
-                                                    f"the propeller data of {label}")
-    if ship.engine.mode == "constant_power":
-        shp = _polyval(ship.engine.SHP_0, u0)
-        if not shp > 0.0:
-            raise InputError(src, "approach.speed", f"at {f.approach.speed} the constant-power engine's SHP_0(u) "
-                                                    f"gives {shp:.4g} hp; it needs positive power (the speed is "
-                                                    f"outside the engine data of {label})")
-    n0 = None if f.approach.rpm == "solve" else q("approach.rpm", f.approach.rpm, "revolutions", 0.0, MAX_RPM,
-                                                  lo_open=True)
-
-    # the manoeuvre
-    dmax = ship.steering.delta_max
-    man = f.manoeuvre.model_dump()
-    kind = man.pop("kind")
-    conv: dict = {}
-    for k, v in man.items():
-        field = f"manoeuvre.{k}"
-        if k in ("rudder", "amplitude"):
-            x = q(field, v, "angle", -MAX_RUDDER, MAX_RUDDER)
-            if abs(x) > dmax + 1e-12:
-                raise InputError(src, field, f"{v} exceeds the steering gear limit of {dmax / DEG:g} deg of {label}")
-            if k == "rudder" and kind in ("zigzag", "stype") and not x > 0:
-                raise InputError(src, field, f"must be positive, got {v!r} (the first side is set by 'first')")
-            conv[k] = x
-        elif k in ("heading", "switch_heading"):
-            conv[k] = q(field, v, "angle", 0.0, MAX_HEADING_CHANGE, lo_open=True)
-        elif k == "period":
-            conv[k] = q(field, v, "time", MIN_STEPS_PER_PERIOD * dt, None,
-                        why=f"at least {MIN_STEPS_PER_PERIOD} steps of dt = {dt:g} s, so the order is resolved")
-        elif k == "execute":
-            conv[k] = q(field, v, "time", 0.0, duration, hi_open=True,
-                        why=f"the execute time must lie in [0, {duration:g} s), within the run")
-        else:
-            conv[k] = v
-    if kind == "schedule":
-        conv = {"table": _schedule(conv, ship, label, duration, base, src)}
-
-    # the log
-    lg = f.log
-    interval = q("log.interval", lg.interval, "time", 0.0, duration, lo_open=True,
-                 why=f"a positive interval at most the duration {f.duration}")
-    ratio = interval / dt
-    if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-6:
-        raise InputError(src, "log.interval", f"must be a positive multiple of dt ({f.dt}), got {lg.interval!r}")
-    start_lat = q("log.start_lat", lg.start_lat, "angle", -MAX_LATITUDE, MAX_LATITUDE,
-                  why="a latitude is within +-90 deg")
-    start_lon = q("log.start_lon", lg.start_lon, "angle", *LONGITUDE_RANGE, why="a longitude is -180 to 360 deg")
-    noise = {c: q(f"log.noise.{c}", getattr(lg.noise, c), _DIM[c], 0.0, NOISE_MAX[c]) for c in _DIM}
-    bias = {c: q(f"log.bias.{c}", getattr(lg.bias, c), _DIM[c], -NOISE_MAX[c], NOISE_MAX[c])
-            for c in ("heading", "speed", "rpm")}
-    log = LogSpec(interval, lg.seed, start_lat, start_lon, noise["lat"], noise["lon"], noise["heading"],
-                  noise["speed"], noise["rpm"], SensorBias(bias["heading"], bias["speed"], bias["rpm"]))
-
-    # disturbances
-    dist = []
-    d = f.disturbances
-    if d.current is not None:
-        dist.append(UniformCurrent(
-            q("disturbances.current.speed", d.current.speed, "speed", 0.0, MAX_CURRENT,
-              why="a current runs at 0-20 kn (its sense is the direction)"),
-            q("disturbances.current.direction", d.current.direction, "angle", -2 * np.pi, 2 * np.pi)))
-    off = q("disturbances.rudder_offset", d.rudder_offset, "angle", -MAX_RUDDER_OFFSET, MAX_RUDDER_OFFSET)
-    if off != 0.0:
-        dist.append(RudderOffset(off))
-
+    f = _trial_file(data, src, ship)
+    run = duration, dt = _run_size(f, src)
+    ship, ship_path, label = _trial_ship(f, ship, base, src, dt)
+    u0, n0 = _approach(f, ship, label, src)
+    kind, conv = _manoeuvre(f, ship, label, src, run, base)
+    log = _log_spec(f, src, run)
+    dist = _disturbances(f, src)
     # effects (mmg.effects), besides the ship's; each value given in one place only
-    effects = _trial_effects(f, ship, src, label, legacy=_legacy_statements(f, dist, bias["heading"], src))
+    effects = _trial_effects(f, ship, src, label, legacy=_legacy_statements(f, dist, log.bias.heading, src))
     if n0 is not None:
         _check_approach_rpm(src, f.approach, ship, label, u0, n0, dist, effects)
     hb = ship.effect_set().merged(effects).get("heading_bias")

@@ -85,6 +85,58 @@ class FitResult:
         return pd.DataFrame([self.to_dict()])
 
 
+def _regression_eq15(z: ZigzagData, fit_bias: bool):
+    """(regressors, dependent variable, theta -> K, T1, T2, T3 (, delta_bias)) of eq. (15) as it stands."""
+    one = np.ones_like(z.s)
+    cols = [z.eps, z.omega, z.Delta, z.delta, one] + ([z.s] if fit_bias else [])
+    b = -z.psi
+
+    def to_params(th):  # th = x1..x4, c0 (, K delta_bias)
+        K, T1, T2, T3, _ = _params_from_x(th[:4])
+        return np.array([K, T1, T2, T3] + ([th[5] / K] if fit_bias else []), float)
+    return cols, b, to_params
+
+
+def _regression_integrated(z: ZigzagData, fit_bias: bool):
+    """The same for eq. (15) integrated once more from the execute."""
+    one = np.ones_like(z.s)
+    psi = z.psi if z.psi_raw is None else z.psi_raw
+    Psi = cumulative_trapezoid(psi, z.s, initial=0.0)
+    DD = cumulative_trapezoid(z.Delta, z.s, initial=0.0)
+    # x1 omega' + x2 psi + Psi + x3 DD + x4 Delta + c0 + c1 s' + c2 s'^2 = 0, solved for the
+    # measured heading so that its noise is in the dependent variable, not in a regressor
+    cols = [Psi, z.omega, DD, z.Delta, one, z.s] + ([z.s ** 2] if fit_bias else [])
+
+    def to_params(th):
+        x2 = -1.0 / th[0]
+        x = np.array([-th[1] * x2, x2, -th[2] * x2, -th[3] * x2])
+        K, T1, T2, T3, _ = _params_from_x(x)
+        return np.array([K, T1, T2, T3] + ([2.0 * (-th[6] * x2) / K] if fit_bias else []), float)
+    return cols, psi, to_params
+
+
+def _regression_integrated2(z: ZigzagData, fit_bias: bool):
+    """The same for eq. (15) integrated twice more (only the recorded heading and rudder enter)."""
+    one = np.ones_like(z.s)
+    psi = z.psi if z.psi_raw is None else z.psi_raw
+    Psi = cumulative_trapezoid(psi, z.s, initial=0.0)
+    PP = cumulative_trapezoid(Psi, z.s, initial=0.0)
+    DD = cumulative_trapezoid(z.Delta, z.s, initial=0.0)
+    DDD = cumulative_trapezoid(DD, z.s, initial=0.0)
+    # x1 psi + x2 Psi + PP + x3 DDD + x4 DD + c0 + c1 s' + c2 s'^2 (+ c3 s'^3) = 0, solved for psi
+    cols = [PP, Psi, DDD, DD, one, z.s, z.s ** 2] + ([z.s ** 3] if fit_bias else [])
+
+    def to_params(th):
+        x1 = -1.0 / th[0]
+        x = np.array([x1, -th[1] * x1, -th[2] * x1, -th[3] * x1])
+        K, T1, T2, T3, _ = _params_from_x(x)
+        return np.array([K, T1, T2, T3] + ([6.0 * (-th[7] * x1) / K] if fit_bias else []), float)
+    return cols, psi, to_params
+
+
+_REGRESSIONS = {"eq15": _regression_eq15, "integrated": _regression_integrated, "integrated2": _regression_integrated2}
+
+
 def fit_least_squares(z: ZigzagData, form: str = "integrated2", fit_bias: bool = True) -> FitResult:
     """Least-squares fit of eq. (15) over every sample of the zigzag, with 95 % intervals.
 
@@ -138,45 +190,10 @@ def fit_least_squares(z: ZigzagData, form: str = "integrated2", fit_bias: bool =
     ValueError
         Unknown ``form``.
     """
-    one = np.ones_like(z.s)
-    if form == "eq15":
-        cols = [z.eps, z.omega, z.Delta, z.delta, one] + ([z.s] if fit_bias else [])
-        b = -z.psi
-
-        def to_params(th):  # th = x1..x4, c0 (, K delta_bias)
-            K, T1, T2, T3, _ = _params_from_x(th[:4])
-            return np.array([K, T1, T2, T3] + ([th[5] / K] if fit_bias else []), float)
-    elif form == "integrated":
-        psi = z.psi if z.psi_raw is None else z.psi_raw
-        Psi = cumulative_trapezoid(psi, z.s, initial=0.0)
-        DD = cumulative_trapezoid(z.Delta, z.s, initial=0.0)
-        # x1 omega' + x2 psi + Psi + x3 DD + x4 Delta + c0 + c1 s' + c2 s'^2 = 0, solved for the
-        # measured heading so that its noise is in the dependent variable, not in a regressor
-        cols = [Psi, z.omega, DD, z.Delta, one, z.s] + ([z.s ** 2] if fit_bias else [])
-        b = psi
-
-        def to_params(th):
-            x2 = -1.0 / th[0]
-            x = np.array([-th[1] * x2, x2, -th[2] * x2, -th[3] * x2])
-            K, T1, T2, T3, _ = _params_from_x(x)
-            return np.array([K, T1, T2, T3] + ([2.0 * (-th[6] * x2) / K] if fit_bias else []), float)
-    elif form == "integrated2":
-        psi = z.psi if z.psi_raw is None else z.psi_raw
-        Psi = cumulative_trapezoid(psi, z.s, initial=0.0)
-        PP = cumulative_trapezoid(Psi, z.s, initial=0.0)
-        DD = cumulative_trapezoid(z.Delta, z.s, initial=0.0)
-        DDD = cumulative_trapezoid(DD, z.s, initial=0.0)
-        # x1 psi + x2 Psi + PP + x3 DDD + x4 DD + c0 + c1 s' + c2 s'^2 (+ c3 s'^3) = 0, solved for psi
-        cols = [PP, Psi, DDD, DD, one, z.s, z.s ** 2] + ([z.s ** 3] if fit_bias else [])
-        b = psi
-
-        def to_params(th):
-            x1 = -1.0 / th[0]
-            x = np.array([x1, -th[1] * x1, -th[2] * x1, -th[3] * x1])
-            K, T1, T2, T3, _ = _params_from_x(x)
-            return np.array([K, T1, T2, T3] + ([6.0 * (-th[7] * x1) / K] if fit_bias else []), float)
-    else:
+    regression = _REGRESSIONS.get(form)
+    if regression is None:
         raise ValueError(f"unknown form {form!r}")
+    cols, b, to_params = regression(z, fit_bias)
     A = np.column_stack(cols)
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0

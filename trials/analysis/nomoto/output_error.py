@@ -22,6 +22,39 @@ from trials.analysis.nomoto.zigzag import ZigzagData
 __all__ = ["fit_output_error"]
 
 
+def _starts(z: ZigzagData, fit_bias: bool) -> list:
+    """Starting models: the least-squares fit, the four-point result and the classical first-order
+    K, T with T2 = T3 = 0.1 |T| (those that could be had)."""
+    starts = [fit_least_squares(z, fit_bias=fit_bias).model]
+    try:
+        starts.append(four_point(z.points(2)).model)
+    except InputError:
+        pass
+    try:  # the robust first-order estimate, with a small T2 and T3 = T2
+        cl = classical_first_order(z)
+        starts.append(NomotoModel(cl.K, cl.T, 0.1 * abs(cl.T), 0.1 * abs(cl.T)))
+    except InputError:
+        pass
+    return starts
+
+
+def _best_of(resid, q0s, name: str):
+    """The lowest-cost optimum of ``resid`` from the starting points q0s (several: the heading misfit is
+    not convex in these parameters); InputError when every start fails."""
+    sol = None
+    for q0 in q0s:
+        try:
+            with np.errstate(all="ignore"):
+                cand = optimize.least_squares(resid, q0, x_scale="jac", max_nfev=300)
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+        if np.isfinite(cand.cost) and (sol is None or cand.cost < sol.cost):
+            sol = cand
+    if sol is None:
+        raise InputError(name, "heading", "output-error fit failed from every starting point")
+    return sol
+
+
 def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bias: bool = True) -> FitResult:
     """Output-error fit: the 2nd-order ODE driven by the recorded rudder, fitted to the heading.
 
@@ -65,22 +98,7 @@ def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bia
     step = max(1, len(s) // 2000)
     idx = np.arange(0, len(s), step)
     ss, dd, pp = s[idx], (z.delta + z.delta_e)[idx], (z.psi if z.psi_raw is None else z.psi_raw)[idx]
-    if start is None:
-        starts = []
-        ls = fit_least_squares(z, fit_bias=fit_bias)
-        starts.append(ls.model)
-        try:
-            fp = four_point(z.points(2))
-            starts.append(fp.model)
-        except InputError:
-            pass
-        try:  # the robust first-order estimate, with a small T2 and T3 = T2
-            cl = classical_first_order(z)
-            starts.append(NomotoModel(cl.K, cl.T, 0.1 * abs(cl.T), 0.1 * abs(cl.T)))
-        except InputError:
-            pass
-    else:
-        starts = [start]
+    starts = _starts(z, fit_bias) if start is None else [start]
     starts = [m for m in starts if np.isfinite([m.K, m.T1, m.T2, m.T3]).all() and abs(m.T1 * m.T2) > 1e-6] \
         or [NomotoModel(2.0, 3.0, 0.3, 1.0)]
     nb = 1 if fit_bias else 0
@@ -91,19 +109,8 @@ def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bia
         return simulate_response((q[0], q[1], q[2], q[3]), ss, dd, q[4 + nb], q[5 + nb], q[6 + nb],
                                  q[4] if fit_bias else 0.0) - pp
 
-    sol = None
-    for st in starts:  # several starts: the heading misfit is not convex in these parameters
-        q0 = np.array([st.K, st.T1 * st.T2, st.T1 + st.T2, st.T3] + ([0.0] if fit_bias else [])
-                      + [0.0, z.omega_e, z.eps_e])
-        try:
-            with np.errstate(all="ignore"):
-                cand = optimize.least_squares(resid, q0, x_scale="jac", max_nfev=300)
-        except (ValueError, np.linalg.LinAlgError):
-            continue
-        if np.isfinite(cand.cost) and (sol is None or cand.cost < sol.cost):
-            sol = cand
-    if sol is None:
-        raise InputError(z.name, "heading", "output-error fit failed from every starting point")
+    sol = _best_of(resid, [np.array([st.K, st.T1 * st.T2, st.T1 + st.T2, st.T3] + ([0.0] if fit_bias else [])
+                                    + [0.0, z.omega_e, z.eps_e]) for st in starts], z.name)
     q = sol.x
     J = _jac(resid, q)
     r = sol.fun

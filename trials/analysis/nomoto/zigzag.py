@@ -225,6 +225,58 @@ def _plateaus(delta):
     return [tuple(r) for r in best], float(d0)
 
 
+def _counter_rudders(plats, delta, dl, s, ie: int, sign: float) -> tuple:
+    """s' of each counter-rudder: where the ramp leaving plateau k, extended back, meets the plateau
+    level (delta the whole record's rudder, dl and s from the execute at sample ie)."""
+    s_cr = []
+    for (a, b, sg) in plats[:-1]:
+        level = float(np.median(delta[a:b + 1]))
+        sc = s[b - ie]
+        if b + 2 - ie < len(s):
+            i1, i2 = b + 1 - ie, b + 2 - ie
+            slope = (dl[i2] - dl[i1]) / (s[i2] - s[i1])
+            if slope * sg * sign < 0:
+                sc = float(np.clip(s[i1] - (dl[i1] - level) / slope, s[a - ie], s[i1]))
+        s_cr.append(float(sc))
+    return tuple(s_cr)
+
+
+def _overshoots(s, psi, omega, s_cr) -> tuple:
+    """s' of each overshoot: the extreme of the heading between counter-rudder k and the next one,
+    refined to omega' = 0; stops at the first window still turning at its end."""
+    s_os = []
+    bounds = list(s_cr) + [s[-1]]
+    side = 1.0
+    for k, a in enumerate(s_cr):
+        m = np.where((s >= a) & (s <= bounds[k + 1]))[0]
+        if len(m) < 3:
+            break
+        i = m[np.argmax(side * psi[m])]
+        if i == m[-1]:  # still turning at the end of the window: no overshoot yet
+            break
+        # refine: omega' sign change next to the extreme
+        lo, hi = max(i - 1, m[0]), min(i + 1, m[-1])
+        so = s[i]
+        for q in range(lo, hi):
+            if omega[q] * side > 0 >= omega[q + 1] * side:
+                so = s[q] + (s[q + 1] - s[q]) * omega[q] / (omega[q] - omega[q + 1])
+        s_os.append(float(so))
+        side = -side
+    return tuple(s_os)
+
+
+def _zero_crossings(s, psi, s_os) -> tuple:
+    """s' of the heading's first zero crossing after each overshoot (those there are)."""
+    s_z = []
+    for so in s_os:
+        m = np.where((s > so))[0]
+        for q in m[:-1]:
+            if psi[q] * psi[q + 1] <= 0 and psi[q] != psi[q + 1] and abs(psi[q]) > 0:
+                s_z.append(float(s[q] + (s[q + 1] - s[q]) * psi[q] / (psi[q] - psi[q + 1])))
+                break
+    return tuple(s_z)
+
+
 def zigzag_data(record: TrialRecord, L: float, U: Optional[float] = None, per_knot: Optional[int] = None) -> ZigzagData:
     """Find the zigzag in a record and convert it to dimensionless variables.
 
@@ -280,10 +332,9 @@ def zigzag_data(record: TrialRecord, L: float, U: Optional[float] = None, per_kn
     sign = plats[0][2]
     delta = sign * delta_raw
     # execute: walk back from the first plateau while the rudder was still moving towards it
-    j = plats[0][0]
-    while j > 0 and delta[j] - delta[j - 1] > 1e-4 * d0:
-        j -= 1
-    ie = j
+    ie = plats[0][0]
+    while ie > 0 and delta[ie] - delta[ie - 1] > 1e-4 * d0:
+        ie -= 1
     t_e = t[ie]
     if U is None:
         try:
@@ -309,49 +360,13 @@ def zigzag_data(record: TrialRecord, L: float, U: Optional[float] = None, per_kn
     dl = delta[sl]
     Delta = cumulative_trapezoid(dl, s, initial=0.0)
     psi = psi_s - psi_s[0]
-    # counter-rudder: where the ramp leaving plateau k, extended back, meets the plateau level
-    s_cr = []
-    for (a, b, sg) in plats[:-1]:
-        level = float(np.median(delta[a:b + 1]))
-        sc = s[b - ie]
-        if b + 2 - ie < len(s):
-            i1, i2 = b + 1 - ie, b + 2 - ie
-            slope = (dl[i2] - dl[i1]) / (s[i2] - s[i1])
-            if slope * sg * sign < 0:
-                sc = float(np.clip(s[i1] - (dl[i1] - level) / slope, s[a - ie], s[i1]))
-        s_cr.append(float(sc))
-    s_cr = tuple(s_cr)
-    # overshoots: extreme of heading between counter-rudder k and the next one
-    s_os = []
-    bounds = list(s_cr) + [s[-1]]
-    side = 1.0
-    for k, a in enumerate(s_cr):
-        m = np.where((s >= a) & (s <= bounds[k + 1]))[0]
-        if len(m) < 3:
-            break
-        i = m[np.argmax(side * psi[m])]
-        if i == m[-1]:  # still turning at the end of the window: no overshoot yet
-            break
-        # refine: omega' sign change next to the extreme
-        lo, hi = max(i - 1, m[0]), min(i + 1, m[-1])
-        so = s[i]
-        for q in range(lo, hi):
-            if omega[q] * side > 0 >= omega[q + 1] * side:
-                so = s[q] + (s[q + 1] - s[q]) * omega[q] / (omega[q] - omega[q + 1])
-        s_os.append(float(so))
-        side = -side
-    # heading zero crossings after each overshoot
-    s_z = []
-    for so in s_os:
-        m = np.where((s > so))[0]
-        for q in m[:-1]:
-            if psi[q] * psi[q + 1] <= 0 and psi[q] != psi[q + 1] and abs(psi[q]) > 0:
-                s_z.append(float(s[q] + (s[q + 1] - s[q]) * psi[q] / (psi[q] - psi[q + 1])))
-                break
+    s_cr = _counter_rudders(plats, delta, dl, s, ie, sign)
+    s_os = _overshoots(s, psi, omega, s_cr)
+    s_z = _zero_crossings(s, psi, s_os)
     return ZigzagData(s=s, psi=psi, omega=omega, eps=eps, delta=dl - dl[0], Delta=Delta,
                       psi_e=float(sign * psi_s[0]), omega_e=float(omega[0]), eps_e=float(eps[0]),
                       delta_e=float(dl[0]), sign=float(sign), L=float(L), U=float(U), t_execute=float(t_e),
-                      s_cr=s_cr, s_os=tuple(s_os), s_z=tuple(s_z), delta0=d0, yaw_rate_source=src_r,
+                      s_cr=s_cr, s_os=s_os, s_z=s_z, delta0=d0, yaw_rate_source=src_r,
                       name=record.name or src, psi_raw=psi_abs - psi_s[0])
 
 
