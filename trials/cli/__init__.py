@@ -281,6 +281,9 @@ def _run(argv) -> int:
     from ..files.output import collect_commits, others_note
 
     try:
+        from .common import check_outputs_apart
+
+        check_outputs_apart(args)          # no output over an input or another output: before any work
         with collect_commits() as committed:
             code = int(args.func(args) or 0)
         for stage in committed:            # the folders written into: what they hold that this run did not write
