@@ -40,6 +40,7 @@ import numpy as np
 
 from mmg.errors import InputError
 from mmg.units import DEG
+from ..files.logio import DENSE_STEP_S, _step_within
 
 HEADING_JUMP = 1.5 * DEG
 """A heading step this much larger than the yaw rate explains, on a dense record, is a sensor step."""
@@ -101,7 +102,7 @@ def corrected_heading(t, psi, r=None):
     (psi_corrected, steps) where steps is a list of (t [s], step [deg]).
     """
     t, psi = np.asarray(t, dtype=float), np.asarray(psi, dtype=float)
-    if r is None or len(t) < 3 or _median_dt(t) > 1.0:
+    if r is None or len(t) < 3 or not _step_within(_median_dt(t), hi=DENSE_STEP_S):
         return psi, []
     r = np.asarray(r, dtype=float)
     res = np.diff(psi) - 0.5 * (r[1:] + r[:-1]) * np.diff(t)

@@ -140,6 +140,16 @@ MAX_FILE_BYTES = 256 * MAX_SAMPLES
 FRT_INTERVAL_S = 0.1
 """FRT-DS-ESSO sampling step [s] (10 Hz)."""
 FRT_STEP_RANGE = (0.02, 1.0, FRT_INTERVAL_S)
+STEP_RTOL = 1e-6
+"""Relative tolerance of every comparison of a sampling step with a bound: a step read from a
+file's times (0.02 s resampled: a median of 0.0199999999999996 s) is that step, not beyond it."""
+DENSE_STEP_S = 1.0
+"""Largest sampling step [s] of a dense record (the sample-to-sample heading checks)."""
+
+
+def _step_within(step: float, lo: float | None = None, hi: float | None = None) -> bool:
+    """``lo <= step <= hi`` (either bound optional) within the relative tolerance :data:`STEP_RTOL`."""
+    return ((lo is None or step >= lo * (1 - STEP_RTOL)) and (hi is None or step <= hi * (1 + STEP_RTOL)))
 """Sampling steps [s] accepted in the FRT-DS-ESSO layout (copies resampled between 50 Hz and 1 Hz)."""
 FRT_LENGTH_M = 3.0
 MAX_RUDDER = 45.0 * DEG
@@ -491,7 +501,7 @@ def _check_time(tab: _Table, col: str, t: np.ndarray, nominal: float | None, wha
             raise InputError(src, col, f"sampling step {med:g} s, but {what} is {nominal:g} s{_time_hint(ratio, med, nominal)}")
     if step_range is not None:
         lo, hi, fmt = step_range
-        if not lo <= med <= hi:
+        if not _step_within(med, lo, hi):
             raise InputError(src, col, f"sampling step {med:g} s, but {what} is {fmt:g} s (resampled copies "
                                        f"{lo:g} to {hi:g} s){_time_hint(med / fmt, med, fmt)}")
     span = float(t[-1] - t[0])
@@ -549,7 +559,7 @@ def _check_heading_rate(tab: _Table, col: str, t: np.ndarray, psi: np.ndarray, u
     """On a dense record (step <= 1 s) the heading [rad, from a column in ``unit``] cannot change faster
     than MAX_YAW_RATE sample after sample."""
     dt = np.diff(t)
-    if len(dt) < 10 or np.median(dt) > 1.0:
+    if len(dt) < 10 or not _step_within(float(np.median(dt)), hi=DENSE_STEP_S):
         return
     rate = np.abs(np.diff(psi)) / dt
     p99 = float(np.percentile(rate, 99))
@@ -586,7 +596,7 @@ def _check_heading_vs_yaw_rate(tab: _Table, psi_col: str, r_col: str, t: np.ndar
     if len(dt) < 10:
         return
     med = float(np.median(dt))
-    if med > 1.0:
+    if not _step_within(med, hi=DENSE_STEP_S):
         return
     k = max(1, int(round(1.0 / med)))
     idx = np.arange(0, len(t), k)
