@@ -1,0 +1,80 @@
+"""The hostile-input review's findings, each as a class (V1-V3, V5, V6, M1, M2; V4 in
+test_output_apart.py): valid records never refused, wrong units or ships refused in one line."""
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from mmg.errors import InputError
+from mmg.ship import load_ship
+from trials.files import shipcheck as sc
+from trials.files.logio import read_record
+
+from .conftest import CONFIGS, FRT, REPO, needs_frt
+
+DEV = REPO.parent / "shared" / "data" / "diagnose-dev" / "data"
+needs_dev = pytest.mark.skipif(not DEV.is_dir(), reason="diagnose-dev data absent")
+
+
+def _scaled(src: Path, dst: Path, col: str, factor: float) -> Path:
+    df = pd.read_csv(src)
+    df[col] = df[col] * factor
+    df.to_csv(dst, index=False)
+    return dst
+
+
+# --------------------------------------------------------------------------- V3: propeller tip speed
+
+
+@needs_dev
+@pytest.mark.parametrize("factor, unit", [(60.0, "rpm"), (2 * np.pi, "rad/s")])
+def test_full_scale_propeller_speed_in_another_unit_refused(tmp_path, factor, unit):
+    """A full-scale record with n in rpm (52 "rps": under the reader's 100 rps cap) or rad/s is refused
+    by the tip speed pi n D of the ship's propeller, naming the likely unit; every command checks so."""
+    esso = load_ship(CONFIGS / "ships" / "esso_osaka.yaml")
+    for src in sorted(DEV.glob("*.csv"))[:3]:
+        p = _scaled(src, tmp_path / src.name, "n_prop [rps]", factor)
+        with pytest.raises(sc.ShipMismatch, match=f"tip speed.*{unit}") as e:
+            sc.read_for_ship(p, esso)
+        assert e.value.field == "n_prop"
+        with pytest.raises(sc.ShipMismatch, match=unit):       # a length only (mmg metrics --length 325)
+            sc.read_for_ship(p, 325.0)
+
+
+@needs_dev
+@needs_frt()
+def test_valid_propeller_speeds_accepted():
+    """Every real record with its own ship: tip speed inside the bound (margins: bench/ship_check_margins.py)."""
+    esso, m3 = load_ship(CONFIGS / "ships" / "esso_osaka.yaml"), load_ship(CONFIGS / "ships" / "esso_osaka_3m.yaml")
+    for files, ship in ((sorted(DEV.glob("*.csv")), esso), (sorted(FRT.glob("*/*.csv")), m3)):
+        for p in files:
+            s = sc.read_for_ship(p, ship)
+            assert sc.tip_speed(s.n[np.isfinite(s.n)].max() if s.n is not None else 0, ship.propeller.D) < sc.TIP_SPEED_MAX
+
+
+def test_tip_speed_message_names_unit():
+    with pytest.raises(sc.ShipMismatch, match=r"rpm\? \(600 rpm = 10 rps"):
+        sc.check_tip_speed(600.0, 3.0 / 35, "r.csv", "the 3 m model")
+    sc.check_tip_speed(17.95, 0.1427, "r.csv", "KVLCC2 L7")        # the MMG-2015 model: 8 m/s
+
+
+# --------------------------------------------------------------------------- V1: steps with a tolerance
+
+
+@needs_frt()
+@pytest.mark.parametrize("step", [0.02, 0.05, 1.0])
+def test_frt_record_resampled_to_the_range_ends_accepted(tmp_path, step):
+    """A valid record resampled to 50 Hz (its median step 0.0199999999999996 s) or to the other ends of
+    the accepted range is read, not refused as beyond the range."""
+    src = sorted((FRT / "zigzag").glob("*.csv"))[0]
+    df = pd.read_csv(src).dropna(how="all")
+    t0 = df["t [s]"].to_numpy()
+    t = t0[0] + np.arange(int((t0[-1] - t0[0]) / step)) * step
+    t = np.round(t0[0] + np.cumsum(np.r_[0, np.full(len(t) - 1, step)]), 12) if step == 1.0 else t
+    out = pd.DataFrame({c: np.interp(t, t0, df[c].to_numpy()) for c in df.columns})
+    out["t [s]"] = t
+    p = tmp_path / "resampled.csv"
+    out.to_csv(p, index=False)
+    rec = read_record(p)
+    assert abs(np.median(np.diff(rec.t)) - step) < 1e-9
