@@ -78,3 +78,30 @@ def test_frt_record_resampled_to_the_range_ends_accepted(tmp_path, step):
     out.to_csv(p, index=False)
     rec = read_record(p)
     assert abs(np.median(np.diff(rec.t)) - step) < 1e-9
+
+
+# --------------------------------------------------------------------------- V2: a second ship option
+
+
+@needs_frt()
+@pytest.mark.parametrize("ship, initial", [("esso_osaka_3m", "esso_osaka"), ("esso_osaka", "esso_osaka_3m"),
+                                           ("esso_osaka_3m_crossflow", "kvlcc2_l7")])
+def test_identify_initial_of_another_ship_refused(tmp_path, capsys, ship, initial):
+    """--initial with other particulars than --ship: one line naming both, before any record is read."""
+    from trials.cli import main
+
+    rec = sorted((FRT / "zigzag").glob("*.csv"))[0]
+    assert main(["identify", "--ship", ship, "--initial", initial, "--train", str(rec),
+                 "--out", str(tmp_path / "o"), "--max-nfev", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: --initial: particulars."), err
+    assert load_ship(ship).name in err[0] and load_ship(initial).name in err[0]
+    assert not (tmp_path / "o").exists()
+
+
+def test_identify_library_refuses_initial_of_another_ship():
+    from trials.measured.identify import identify
+
+    with pytest.raises(sc.ShipMismatch, match="particulars.L"):
+        identify(load_ship("esso_osaka_3m"), [], initial=load_ship("esso_osaka"))
+    sc.check_same_ship(load_ship("esso_osaka_3m_crossflow"), load_ship("esso_osaka_3m"))   # one ship, two forms

@@ -38,6 +38,11 @@ def cmd_identify(args) -> int:
     ship = load_ship(src)
     if args.free:
         _check_free(ship, args.free)
+    initial = load_ship(ship_path(args.initial)) if args.initial else None
+    if initial is not None:                # the same ship's particulars, before any record is read
+        from ..files.shipcheck import check_same_ship
+
+        check_same_ship(ship, initial)
     wind = None if args.wind is None else args.wind == "on"
     t0 = time.perf_counter()
     names = record_labels(args.train + (args.test or []))   # training and test records told apart together
@@ -67,7 +72,6 @@ def cmd_identify(args) -> int:
         print(f"  {stage.split(':')[0]}, iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)",
               file=sys.stderr, flush=True)
 
-    initial = load_ship(ship_path(args.initial)) if args.initial else None
     kw = {"record_weighting": args.weighting} if args.weighting else {}
     kw["max_nfev"] = args.max_nfev or DEFAULT_MAX_NFEV
     if args.velocity_weight is not None:

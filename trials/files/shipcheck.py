@@ -171,6 +171,20 @@ def check_record_ship(rec, ship_or_length, src: str | None = None, name: str | N
     return s
 
 
+def check_same_ship(ship, other, option: str = "--initial", ship_option: str = "--ship") -> None:
+    """Refuse a second ship (``--initial``, any other ship option) whose particulars are not ``ship``'s:
+    length, beam and draught within :data:`LENGTH_TOLERANCE` (a model and its full-scale ship, or two
+    hulls, are not two forms of one ship's model).  One :class:`ShipMismatch` naming both."""
+    a, b = ship.particulars, other.particulars
+    for key, words in (("L", "length"), ("B", "beam"), ("T", "draught")):
+        x, y = float(getattr(a, key)), float(getattr(b, key))
+        if not (x > 0 and y > 0) or abs(y / x - 1) > LENGTH_TOLERANCE:
+            raise ShipMismatch(option, f"particulars.{key}",
+                               f"{other.name or 'the ship'} has {words} {key} = {y:g} m, {ship_option} "
+                               f"{ship.name or 'ship'} {x:g} m: not a model of the same ship; give one of "
+                               f"{ship.name or ship_option}'s particulars")
+
+
 def propeller_diameter(ship_or_length) -> float:
     """The ship's propeller diameter [m]; :data:`DIAMETER_PER_LENGTH` times a length given instead of a ship."""
     prop = getattr(ship_or_length, "propeller", None)

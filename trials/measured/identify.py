@@ -294,6 +294,11 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, segment_s: float | No
     from ekf.identify import Segmented, free_parameters, identify_segments, record_residual_rms, record_weights, \
         segment_resets
 
+    from ..files.shipcheck import check_same_ship
+
+    if initial is not None:                                 # the same ship's, before any record is read
+        check_same_ship(ship, initial)
+
     try:
         vw_ok = bool(np.isfinite(float(velocity_weight)) and float(velocity_weight) > 0)
     except (TypeError, ValueError):
@@ -407,6 +412,10 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     how records are dealt into folds (:func:`fold_of`).  Each record's dict also holds ``"ship"``,
     the model identified without it (for further replays of the kept-out record)."""
     ref = ship if initial is None else initial
+    if initial is not None:
+        from ..files.shipcheck import check_same_ship
+
+        check_same_ship(ship, initial)
     out = []
     idx = np.arange(len(runs))
     folds = cv_folds(runs, folds)
