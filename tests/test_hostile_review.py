@@ -105,3 +105,25 @@ def test_identify_library_refuses_initial_of_another_ship():
     with pytest.raises(sc.ShipMismatch, match="particulars.L"):
         identify(load_ship("esso_osaka_3m"), [], initial=load_ship("esso_osaka"))
     sc.check_same_ship(load_ship("esso_osaka_3m_crossflow"), load_ship("esso_osaka_3m"))   # one ship, two forms
+
+
+# --------------------------------------------------------------------------- V5: turning circles below 1 L
+
+
+@needs_frt()
+def test_turn_with_a_wrong_length_refused(capsys):
+    """A real 3 m model turn read with L = 7 m or more turns on circles under 1 L: refused, one line, the figure;
+    with its own length (3 m) every FRT-DS-ESSO turn is accepted (bench/turn_diameter_margins.py: margins >= 1.87)."""
+    from trials.analysis.metrics import MIN_TURN_DIAMETER_L, record_metrics
+    from trials.cli import main
+
+    turns = sorted((FRT / "turning").glob("*.csv"))
+    for p in turns:
+        m = record_metrics(read_record(p, length_m=3.0), kind="turning", length=3.0)
+        assert min(m["tactical_diameter_L"], m["steady_diameter_L"]) >= MIN_TURN_DIAMETER_L
+    for L in ("20", "12"):
+        assert main(["metrics", "--length", L, str(turns[0])]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "not this ship's length?" in err[0] and " L (" in err[0], err
+    with pytest.raises(InputError, match="diameter"):
+        record_metrics(read_record(turns[0], length_m=20.0), kind="turning", length=20.0)
