@@ -127,3 +127,24 @@ def test_turn_with_a_wrong_length_refused(capsys):
         assert len(err) == 1 and "not this ship's length?" in err[0] and " L (" in err[0], err
     with pytest.raises(InputError, match="diameter"):
         record_metrics(read_record(turns[0], length_m=20.0), kind="turning", length=20.0)
+
+
+# --------------------------------------------------------------------------- V6: constant-rpm approach rpm
+
+
+@pytest.mark.parametrize("rpm, ok", [("3000 rpm", False), ("1500 rpm", False), ("300 rpm", False),
+                                     ("17.95 rps", True), ("711 rpm", True), ("solve", True)])
+def test_constant_rpm_approach_within_a_factor_2(rpm, ok):
+    """The KVLCC2 model (constant rpm) at 1.179 m/s: its straight run needs 711 rpm (11.85 rps); the published
+    MMG-2015 17.95 rps (factor 1.51) is accepted, 3000 rpm (which runs the ship up to 3.58 m/s) refused."""
+    import yaml
+
+    from trials.runs.trial import trial_from_dict
+
+    data = yaml.safe_load((CONFIGS / "trials" / "kvlcc2_zz20.yaml").read_text())
+    data["approach"]["rpm"] = rpm
+    if ok:
+        trial_from_dict(data, "t.yaml", base=CONFIGS / "trials")
+    else:
+        with pytest.raises(InputError, match=r"approach.rpm: .* times the rpm of the straight run.*711"):
+            trial_from_dict(data, "t.yaml", base=CONFIGS / "trials")
