@@ -148,3 +148,50 @@ def test_constant_rpm_approach_within_a_factor_2(rpm, ok):
     else:
         with pytest.raises(InputError, match=r"approach.rpm: .* times the rpm of the straight run.*711"):
             trial_from_dict(data, "t.yaml", base=CONFIGS / "trials")
+
+
+# --------------------------------------------------------------------------- M1, M2: a refusal is one line
+
+
+def _wind_nan(src: Path, dst: Path, rows=None) -> Path:
+    df = pd.read_csv(src)
+    cols = ["wind_velo_relative_mid [m/s]", "wind_dir_relative_mid [rad]"]
+    df[cols] = df[cols].astype(float)
+    df.loc[df.index if rows is None else rows, cols] = np.nan
+    df.to_csv(dst, index=False)
+    return dst
+
+
+@needs_frt()
+def test_wind_nan_throughout_is_no_wind(tmp_path, capsys):
+    """Relative-wind columns NaN in every row: as if absent (the same one 'wind skipped' note, accepted);
+    partly NaN with the wind used: refused, and stderr holds only the error line (no reader notes first)."""
+    from trials.cli import main
+
+    src = sorted((FRT / "zigzag").glob("*.csv"))[0]
+    p = _wind_nan(src, tmp_path / "nan.csv")
+    rec = read_record(p)
+    assert rec.wind_speed_rel is None and rec.wind_dir_rel is None
+    assert main(["predict", "--ship", "esso_osaka_3m", "--json", str(tmp_path / "a.json"), str(p)]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert [ln for ln in err if "wind" in ln] == [f"{p}: wind skipped: the record has no wind_speed_rel / "
+                                                  "wind_dir_rel channels"], err
+    q = _wind_nan(src, tmp_path / "part.csv", rows=slice(100, 200))
+    assert main(["predict", "--ship", "esso_osaka_3m", "--json", str(tmp_path / "b.json"), str(q)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: ") and "wind_velo_relative_mid" in err[0], err
+    assert not (tmp_path / "b.json").exists()
+
+
+@needs_frt()
+@needs_dev
+def test_identify_refuses_a_test_record_before_any_progress(tmp_path, capsys):
+    """--test of another ship: exit 2 with the one error line, not 'training on 1 record' first."""
+    from trials.cli import main
+
+    train = sorted((FRT / "zigzag").glob("*.csv"))[0]
+    test = sorted(DEV.glob("*.csv"))[0]
+    assert main(["identify", "--ship", "esso_osaka_3m", "--train", str(train), "--test", str(test),
+                 "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: {test}"), err

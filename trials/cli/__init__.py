@@ -280,12 +280,28 @@ def _run(argv) -> int:
         os.environ.setdefault("MPLBACKEND", "Agg")   # files only; no display needed (cheap: nothing imported)
     from ..files.output import collect_commits, others_note
 
-    try:
-        from .common import check_outputs_apart
+    import logging
 
+    from .common import HeldNotes, _held
+
+    held = HeldNotes()                     # the library's notes: printed once the command proceeds
+    logging.root.addHandler(held)
+    _held.append(held)
+    try:
+        return _run_command(args, collect_commits, others_note)
+    finally:
+        logging.root.removeHandler(held)
+        _held.remove(held)
+
+
+def _run_command(args, collect_commits, others_note) -> int:
+    from .common import check_outputs_apart, release_notes
+
+    try:
         check_outputs_apart(args)          # no output over an input or another output: before any work
         with collect_commits() as committed:
             code = int(args.func(args) or 0)
+        release_notes()                    # done: the notes of the inputs it accepted
         for stage in committed:            # the folders written into: what they hold that this run did not write
             note = others_note(stage)
             if note:

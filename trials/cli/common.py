@@ -161,3 +161,42 @@ def check_outputs_apart(args) -> None:
         for oopt2, out2 in outs[i + 1:]:
             if _same(out, out2) and not (oopt == oopt2 and os.path.normpath(out) == os.path.normpath(out2)):
                 raise InputError(oopt, out, f"is also the output of {oopt2} ({out2}): give each output its own path")
+
+
+# --------------------------------------------------------------------------- notes held until the run proceeds
+
+import logging  # noqa: E402
+
+
+class HeldNotes(logging.Handler):
+    """The library's logged notes (WARNING and above: a reader's "note: ... kept as NaN", a skipped
+    effect) held while a command reads and checks its inputs, so that a refusal stays one line; printed
+    on stderr, in order, by :func:`release_notes` once the command proceeds (its first progress line,
+    or its end), and from then on as they come.  Dropped when the command is refused."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.held: list[str] = []
+        self.passing = False
+
+    def emit(self, record) -> None:
+        msg = record.getMessage()
+        if self.passing:
+            print(msg, file=sys.stderr, flush=True)
+        else:
+            self.held.append(msg)
+
+    def print_held(self) -> None:          # (not ``release``: the Handler's lock method)
+        self.passing = True
+        held, self.held = self.held, []
+        for msg in held:
+            print(msg, file=sys.stderr, flush=True)
+
+
+_held: list[HeldNotes] = []
+
+
+def release_notes() -> None:
+    """Print the notes held so far (the command proceeds: its inputs are read and accepted)."""
+    for h in _held:
+        h.print_held()

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _finite_positive, _output_path, _positive_int, _whole
+from .common import _finite_positive, _output_path, _positive_int, _whole, release_notes
 
 
 def _check_free(ship, names) -> None:
@@ -46,9 +46,17 @@ def cmd_identify(args) -> int:
     wind = None if args.wind is None else args.wind == "on"
     t0 = time.perf_counter()
     names = record_labels(args.train + (args.test or []))   # training and test records told apart together
-    runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)])   # an unusable one: one line, skipped
+    import logging
+
+    note = logging.getLogger("trials.cli.identify").warning     # held until every record is read
+    runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)], say=note)   # an unusable one: one line, skipped
     if not runs:
         raise InputError("--train", "", "no usable training record")
+    tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):], say=note)   # a bad one: one line, before any progress line
+             if args.test else None)
+    if args.test and not tests:
+        raise InputError("--test", "", "no usable record")
+    release_notes()
     print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
     if args.cv:                                          # refused or narrowed before any fit
         try:
@@ -58,10 +66,6 @@ def cmd_identify(args) -> int:
         if folds < args.cv:
             print(f"note: --cv {args.cv}: {folds} independent records, so {folds} folds (each kept out once)",
                   file=sys.stderr, flush=True)
-    tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):])   # a bad one: one line, before the fit
-             if args.test else None)
-    if args.test and not tests:
-        raise InputError("--test", "", "no usable record")
 
     shown = [None]
 

@@ -429,6 +429,7 @@ class _Table:
     def __init__(self, df: pd.DataFrame, src: str, lines=None):
         self.df, self.src, self.lines = df, src, lines
         self.holes: dict[str, str] = {}     # optional column -> where its first missing value is
+        self.empty: set[str] = set()        # optional columns with no value at all: no data, as if absent
 
     def where(self, i: int) -> str:
         return f"line {int(self.lines[i])}" if self.lines is not None else f"data row {i + 1}"
@@ -455,7 +456,11 @@ class _Table:
             what = "empty cell" if raw == "" else (f"value {raw[:20]!r} is not a finite number")
             where = f"{what} at {self.where(i)}" + (f" ({bad.size} such cells)" if bad.size > 1 else "")
             if optional and all(str(col.iloc[j]).strip().lower() in _MISSING for j in bad):
-                self.holes[c] = where
+                if bad.size == len(vals):      # missing throughout: no data, the channel is absent
+                    self.empty.add(c)
+                    _log.info("note: %s: %s: no value in any row: treated as absent", self.src, c)
+                else:
+                    self.holes[c] = where
                 return vals
             raise InputError(self.src, c, where)
         huge = np.flatnonzero(np.abs(vals) > MAX_MAGNITUDE)
@@ -766,8 +771,12 @@ def _apparent_wind(tab: _Table, cols, speed_col: str, dir_col: str, speed_si: fl
     if len(have) == 1:
         other = dir_col if have[0] == speed_col else speed_col
         raise InputError(tab.src, other, f"missing: {have[0]} needs {other} (the apparent wind is a speed and a direction)")
-    V = tab.numeric(speed_col, optional=True) * speed_si
-    d = tab.numeric(dir_col, optional=True)
+    V, d = tab.numeric(speed_col, optional=True), tab.numeric(dir_col, optional=True)
+    if speed_col in tab.empty or dir_col in tab.empty:       # a wind with no values: no wind channels
+        for c in (speed_col, dir_col):
+            tab.holes.pop(c, None)
+        return {}
+    V = V * speed_si
     Vf, df_ = V[np.isfinite(V)], d[np.isfinite(d)]          # missing values: refused by a command that uses them
     if Vf.size and (Vf.min() < 0 or Vf.max() > MAX_WIND_MPS):
         bad = np.max(np.abs(Vf)) / speed_si
@@ -853,6 +862,7 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
     tab.require(FRT_REQUIRED)
     present = [c for c in FRT_COLUMNS if c in df.columns]
     a = {FRT_COLUMNS[c]: tab.numeric(c, optional=c not in FRT_REQUIRED) for c in present}
+    a = {k: v for k, v in a.items() if _frt_column(k) not in tab.empty}     # no values at all: absent
     t = a["t"]
     _check_time(tab, "t [s]", t, None, "the FRT-DS-ESSO sampling step (10 Hz)", 0.0, FRT_STEP_RANGE)
     # wrapped, cumulative (a gyro's count of turns) or offset by whole turns: all the same heading; degrees
@@ -870,6 +880,10 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
         meta["nan_channels"] = {**_holes(tab, FRT_COLUMNS)["nan_channels"], **holes}
     return TrialRecord(t=a.pop("t"), name=path.stem, ship=meta["ship"], source=src,
                        psi=psi, U=U, meta=meta, **a)
+
+
+def _frt_column(channel: str) -> str:
+    return next(c for c, k in FRT_COLUMNS.items() if k == channel)
 
 
 def _check_frt_channels(tab: _Table, a: dict, t: np.ndarray, psi: np.ndarray, L: float) -> None:
