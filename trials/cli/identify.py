@@ -48,14 +48,21 @@ def cmd_identify(args) -> int:
     names = record_labels(args.train + (args.test or []))   # training and test records told apart together
     import logging
 
-    note = logging.getLogger("trials.cli.identify").warning     # held until every record is read
+    skipped: list = []
+
+    def note(msg):                          # held until every record is read (a refusal: one line)
+        skipped.append(msg)
+        logging.getLogger("trials.cli.identify").warning(msg)
+
+    def why() -> str:                       # the refusal of an option none of whose records is usable says why
+        return f"no usable record ({'; '.join(skipped)})" if skipped else "no usable record"
     runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)], say=note)   # an unusable one: one line, skipped
     if not runs:
-        raise InputError("--train", "", "no usable training record")
+        raise InputError("--train", "", why().replace("record", "training record", 1))
     tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):], say=note)   # a bad one: one line, before any progress line
              if args.test else None)
     if args.test and not tests:
-        raise InputError("--test", "", "no usable record")
+        raise InputError("--test", "", why())
     release_notes()
     print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
     if args.cv:                                          # refused or narrowed before any fit
