@@ -54,15 +54,17 @@ def cmd_identify(args) -> int:
         skipped.append(msg)
         logging.getLogger("trials.cli.identify").warning(msg)
 
-    def why() -> str:                       # the refusal of an option none of whose records is usable says why
-        return f"no usable record ({'; '.join(skipped)})" if skipped else "no usable record"
+    def why(first: int = 0) -> str:         # the refusal of an option none of whose records is usable says why
+        return f"no usable record ({'; '.join(skipped[first:])})" if skipped[first:] else "no usable record"
+
     runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)], say=note)   # an unusable one: one line, skipped
     if not runs:
         raise InputError("--train", "", why().replace("record", "training record", 1))
+    first_test = len(skipped)
     tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):], say=note)   # a bad one: one line, before any progress line
              if args.test else None)
     if args.test and not tests:
-        raise InputError("--test", "", why())
+        raise InputError("--test", "", why(first_test))
     release_notes()
     print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
     if args.cv:                                          # refused or narrowed before any fit
