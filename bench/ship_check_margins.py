@@ -4,7 +4,7 @@ Valid: the real FRT-DS-ESSO 3 m model records (turning, zigzag, random, berthing
 ships, the full-scale diagnose-dev logs (another simulator) with ``esso_osaka``, the project's
 own simulated logs and truth files (``configs/trials/*.yaml``) with their ship.  Crossed: each
 of them with a ship of another size.  Per class it prints the range of the statistics the check
-judges (Froude number, r L / U; the lower r L / U bound only over records whose heading changes
+judges (Froude number, r L / U, the propeller tip speed pi n D; the lower r L / U bound only over records whose heading changes
 by more than ``TURNING_DEG``), the verdict counts and the margin to the threshold (the factor
 by which the nearest record of the class stays on its side: > 1 is inside for a valid class,
 outside for a crossed one; "-" where the statistic does not decide).
@@ -78,8 +78,9 @@ def _range(vals):
     return f"{min(v):.3g}-{max(v):.3g}" if v else "-"
 
 
-def summarise(name: str, valid: bool, rows: list) -> str:
+def summarise(name: str, valid: bool, rows: list, D: float) -> str:
     st = [s for s, _ in rows if s is not None]
+    tip = [sc.tip_speed(s["rps"], D) for s in st]
     fn = [s["froude"] for s in st]
     tr = [s["turn_rate"] for s in st]
     tl = [s["turn_rate"] for s in st if s["heading_range_deg"] > sc.TURNING_DEG]
@@ -90,14 +91,16 @@ def summarise(name: str, valid: bool, rows: list) -> str:
     if valid:       # how far the worst record stays inside each bound
         m = [sc.FROUDE_MAX / max(fin(fn)) if fin(fn) else np.nan,
              sc.TURN_RATE_MAX / max(fin(tr)) if fin(tr) else np.nan,
-             min(fin(tl)) / sc.TURN_RATE_MIN if fin(tl) else np.nan]
+             min(fin(tl)) / sc.TURN_RATE_MIN if fin(tl) else np.nan,
+             sc.TIP_SPEED_MAX / max(fin(tip)) if fin(tip) else np.nan]
     else:           # how far the nearest record stays outside the bound that refuses the class
         m = [min(fin(fn)) / sc.FROUDE_MAX if fin(fn) else np.nan,
              min(fin(tr)) / sc.TURN_RATE_MAX if fin(tr) else np.nan,
-             sc.TURN_RATE_MIN / max(fin(tl)) if fin(tl) else np.nan]
+             sc.TURN_RATE_MIN / max(fin(tl)) if fin(tl) else np.nan,
+             min(fin(tip)) / sc.TIP_SPEED_MAX if fin(tip) else np.nan]
     ms = " ".join(f"{x:6.3g}" if np.isfinite(x) else "     -" for x in m)
     vs = ", ".join(f"{k} {n}" for k, n in sorted(verdicts.items()))
-    return f"{name:44s} {len(rows):3d} {_range(fn):>15s} {_range(tr):>15s} {_range(tl):>15s}  {ms}   {vs}"
+    return f"{name:44s} {len(rows):3d} {_range(fn):>15s} {_range(tr):>15s} {_range(tl):>15s} {_range(tip):>11s}  {ms}   {vs}"
 
 
 def main() -> int:
@@ -122,15 +125,24 @@ def main() -> int:
                     ("project KVLCC2 log+truth / esso_osaka", False, kv, "esso_osaka"),
                     ("project KVLCC2 log+truth / esso_osaka_3m", False, kv, "esso_osaka_3m")]
         print(f"thresholds: Froude <= {sc.FROUDE_MAX:g}; r L/U (p99, moving) <= {sc.TURN_RATE_MAX:g}; "
-              f">= {sc.TURN_RATE_MIN:g} when the heading changes > {sc.TURNING_DEG:g} deg")
-        print(f"{'class (records / ship)':44s} {'n':>3s} {'Fn p99':>15s} {'rL/U p99':>15s} {'rL/U turning':>15s}  "
-              f"margins: Fn, r'max, r'min   verdicts")
-        bad = 0
+              f">= {sc.TURN_RATE_MIN:g} when the heading changes > {sc.TURNING_DEG:g} deg; "
+              f"tip speed pi n D (p99) <= {sc.TIP_SPEED_MAX:g} m/s")
+        print(f"{'class (records / ship)':44s} {'n':>3s} {'Fn p99':>15s} {'rL/U p99':>15s} {'rL/U turning':>15s} {'tip m/s':>11s}  "
+              f"margins: Fn, r'max, r'min, tip   verdicts")
+        bad, units = 0, []
         for name, valid, files, ship in classes:
             rows = [judge(p, ships[ship]) for p in files]
-            print(summarise(name, valid, rows))
+            print(summarise(name, valid, rows, ships[ship].propeller.D))
+            if valid:            # the same records with n in rpm or rad/s: how far outside the tip-speed bound
+                tips = [sc.tip_speed(st["rps"], ships[ship].propeller.D) for st, _ in rows if st is not None]
+                tips = [x for x in tips if np.isfinite(x) and x > 0]
+                if tips:
+                    units.append(f"{name:44s} n in rpm: margin {60 * min(tips) / sc.TIP_SPEED_MAX:6.3g}; "
+                                 f"in rad/s: margin {2 * np.pi * min(tips) / sc.TIP_SPEED_MAX:6.3g}")
             ok = [v == "accepted" for _, v in rows]
             bad += sum(not o for o in ok) if valid else sum(ok)
+        print("valid records with the propeller speed in another unit (margin > 1: refused by the tip speed):")
+        print("\n".join(units))
     print(f"wrong verdicts: {bad}")
     return 1 if bad else 0
 

@@ -375,7 +375,7 @@ RPM_CASES = {
     "constant power, too high": ("70 rpm", None, "cannot hold"),
     "beyond any engine": ("1e5 rpm", None, "wrong unit"),
     "a model below its zero-thrust rpm": ("100 rpm", THREE_M, "zero-thrust"),
-    "a model's motor beyond its propeller data": ("6000 rpm", THREE_M, "outside [0, 1)"),
+    "a model's motor far above the straight run's rpm": ("6000 rpm", THREE_M, "times the rpm of the straight run"),
 }
 
 

@@ -40,6 +40,7 @@ import numpy as np
 
 from mmg.errors import InputError
 from mmg.units import DEG
+from ..files.logio import DENSE_STEP_S, _step_within
 
 HEADING_JUMP = 1.5 * DEG
 """A heading step this much larger than the yaw rate explains, on a dense record, is a sensor step."""
@@ -101,7 +102,7 @@ def corrected_heading(t, psi, r=None):
     (psi_corrected, steps) where steps is a list of (t [s], step [deg]).
     """
     t, psi = np.asarray(t, dtype=float), np.asarray(psi, dtype=float)
-    if r is None or len(t) < 3 or _median_dt(t) > 1.0:
+    if r is None or len(t) < 3 or not _step_within(_median_dt(t), hi=DENSE_STEP_S):
         return psi, []
     r = np.asarray(r, dtype=float)
     res = np.diff(psi) - 0.5 * (r[1:] + r[:-1]) * np.diff(t)
@@ -618,6 +619,25 @@ def _rad_hint(rec) -> str:
     return " (heading in radians where degrees are expected?)" if rec.meta.get("format") == "log" and span < 2 * np.pi * DEG else ""
 
 
+MIN_TURN_DIAMETER_L = 1.0
+"""Smallest tactical or steady turning diameter [ship lengths] of any ship.  The handiest ships
+(twin-screw ferries, high-lift rudders) turn on tactical diameters of about 1.5-2 L, a single-screw
+tanker on 2.5-3.5 L (the Esso Osaka's 3 m model: 2.6 L; the full-scale 325 m logs: 2.9-3.2 L): below
+1 L the length given is not the ship's (a 3 m model's turn read with L = 20 m is 0.39 L).
+``bench/turn_diameter_margins.py`` prints the margins on the real and simulated turns."""
+
+
+def check_turning_diameters(m: dict, L: float, src: str) -> None:
+    """Refuse turning metrics ``m`` whose tactical or steady diameter is below :data:`MIN_TURN_DIAMETER_L`
+    (the record is not of a ship of length ``L`` [m]); the message gives the figure and the length it implies."""
+    for key, words in (("tactical_diameter_L", "tactical diameter"), ("steady_diameter_L", "steady turning diameter")):
+        d = m.get(key)
+        if d is not None and np.isfinite(d) and d < MIN_TURN_DIAMETER_L:
+            raise InputError(src, "length_m", f"{words} {d:.3g} L ({d * L:.3g} m for L = {L:g} m): no ship turns on a "
+                                              f"circle smaller than {MIN_TURN_DIAMETER_L:g} L; not this ship's length? "
+                                              f"(this turn is of a ship of at most {d * L / MIN_TURN_DIAMETER_L:.3g} m)")
+
+
 def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
     """Metrics of a read record, refusing one that is not the manoeuvre asked for.
 
@@ -642,7 +662,8 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
     Raises
     ------
     InputError
-        No length, no channel the metrics need, or a record that is not a turn / zigzag.
+        No length, no channel the metrics need, a record that is not a turn / zigzag, or a turn
+        on circles smaller than any ship's for this length (:func:`check_turning_diameters`).
     """
     src = rec.source or rec.name or "record"
     L = _record_length(rec, length, src)
@@ -704,6 +725,7 @@ def _record_turning(rec, psi, U, L: float, ctx) -> dict:
         raise InputError(src, what, f"not a turning test: the heading turns by at most {m['max_heading_change_deg']:.1f} deg "
                                     f"from the execute at t = {m['execute_s']:g} s{held}; a turn needs 90 deg"
                                     f"{_rad_hint(rec)}")
+    check_turning_diameters(m, L, src)
     if m["steady_from_deg"] == 180.0:
         notes.append(f"the turn ends at {m['heading_change_deg']:.0f} deg: steady diameter and speed loss are from "
                      f"the part after 180 deg, which may not be steady yet")

@@ -28,6 +28,16 @@ another command's) one ``note:`` line on stderr names them after the run
 (:func:`trials.files.output.others_note`).  Inputs are named after their files in printed lines and
 outputs (:func:`trials.files.output.record_labels`).
 
+Outputs apart from inputs: before any work, an output path (``--json``, ``--out-ship``, the files a
+``--out`` or ``--plots`` folder is known to receive) that is the same file as an input (records,
+``--train``/``--test``, ``--ship``/``--initial``/``--config``, ``--truth``, trial YAMLs; symlinks, relative
+paths and hard links resolved) or as another output is refused in one line
+(:func:`trials.cli.common.check_outputs_apart`, from the parser's option names).
+
+Notes: the library's logged notes (a reader's "kept as NaN", a skipped effect) are held while the
+command reads its inputs (:class:`trials.cli.common.HeldNotes`) and printed once it proceeds (its first
+progress line, or its end): a refused run prints its one error line only.
+
 Console output: a reader that leaves early (``mmg ... | head``) costs only the lines it did not
 read: stdout and stderr are wrapped (:class:`_ReaderGone`) so that a closed pipe sends the rest
 of the console output to ``os.devnull``; the run goes on, writes every file and exits with its
@@ -280,9 +290,28 @@ def _run(argv) -> int:
         os.environ.setdefault("MPLBACKEND", "Agg")   # files only; no display needed (cheap: nothing imported)
     from ..files.output import collect_commits, others_note
 
+    import logging
+
+    from .common import HeldNotes, _held
+
+    held = HeldNotes()                     # the library's notes: printed once the command proceeds
+    logging.root.addHandler(held)
+    _held.append(held)
     try:
+        return _run_command(args, collect_commits, others_note)
+    finally:
+        logging.root.removeHandler(held)
+        _held.remove(held)
+
+
+def _run_command(args, collect_commits, others_note) -> int:
+    from .common import check_outputs_apart, release_notes
+
+    try:
+        check_outputs_apart(args)          # no output over an input or another output: before any work
         with collect_commits() as committed:
             code = int(args.func(args) or 0)
+        release_notes()                    # done: the notes of the inputs it accepted
         for stage in committed:            # the folders written into: what they hold that this run did not write
             note = others_note(stage)
             if note:

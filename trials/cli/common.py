@@ -81,3 +81,122 @@ def _listing(names) -> str:
     for (pat, suffix), ns in groups.items():
         out += [f"{pat}{suffix} ({len(ns)})"] if len(ns) >= 3 else ns
     return ", ".join(out) or "nothing"
+
+
+# --------------------------------------------------------------------------- outputs apart from inputs
+
+INPUT_OPTIONS = {"log": "LOG", "logs": "LOG", "train": "--train", "test": "--test", "ship": "--ship",
+                 "initial": "--initial", "config": "--config", "truth": "--truth", "trials": "TRIAL",
+                 "inputs": "LOG_OR_TRIAL", "ekf_comparison": "--ekf-comparison", "ekf_summary": "--ekf-summary"}
+"""The argument names (argparse ``dest``) of every input file of every command, with the option shown."""
+
+OUTPUT_OPTIONS = {"json": "--json", "out_ship": "--out-ship", "out": "--out", "plots": "--plots"}
+"""The argument names of every output (a file or a folder) of every command, with the option shown."""
+
+FOLDER_FILES = {"simulate": {"out": ("log.csv", "truth.csv", "metrics.json", "track.png", "histories.png")},
+                "identify": {"out": ("ship.yaml", "report.md")}}
+"""The files a command's output folder is known to receive (replaced there when the run succeeds)."""
+
+
+def _paths(value) -> list[str]:
+    if value is None:
+        return []
+    return [str(v) for v in (value if isinstance(value, (list, tuple)) else [value])]
+
+
+def _same(a: str, b: str) -> bool:
+    """The two paths name one file (symlinks, relative paths and hard links resolved)."""
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def _outputs(args) -> list[tuple[str, str]]:
+    """(option, path) of every file or folder ``args``' command writes, the files inside a folder where known."""
+    outs = []
+    for dest, opt in OUTPUT_OPTIONS.items():
+        for p in _paths(getattr(args, dest, None)):
+            outs.append((opt, p))
+            for name in FOLDER_FILES.get(getattr(args, "command", None), {}).get(dest, ()):
+                outs.append((opt, os.path.join(p, name)))
+            if dest == "plots":        # <record stem>.png per record (mmg predict, mmg diagnose)
+                outs += [(opt, os.path.join(p, os.path.splitext(os.path.basename(r))[0] + ".png"))
+                         for r in _paths(getattr(args, "logs", None))]
+    if getattr(args, "command", None) == "nomoto" and getattr(args, "json", None):
+        outs.append(("--json", os.path.splitext(args.json)[0] + ".png"))      # its plot, beside it
+    return outs
+
+
+def check_outputs_apart(args) -> None:
+    """Refuse, before any work, an output that is the same file as an input or as another output.
+
+    Every output path (``--json``, ``--out-ship``, ``--plots``, ``--out`` and the files known to be
+    written in such a folder, :data:`FOLDER_FILES`) against every input file that exists (records,
+    ``--train``/``--test``, ``--ship``/``--initial``/``--config``, ``--truth``, trial YAMLs) and against
+    each other; symlinks, relative paths and hard links resolved.  One :class:`~mmg.errors.InputError`
+    naming both; nothing read or written yet.
+    """
+    from mmg.errors import InputError
+
+    ins = [(opt, p) for dest, opt in INPUT_OPTIONS.items() for p in _paths(getattr(args, dest, None))
+           if os.path.isfile(p)]
+    for dest in ("ship", "initial"):          # a bundled ship name resolves to its YAML
+        name = getattr(args, dest, None)
+        if isinstance(name, str) and not os.path.isfile(name):
+            try:
+                from mmg.resources import ship_path
+
+                ins.append((INPUT_OPTIONS[dest], str(ship_path(name))))
+            except Exception:                  # noqa: BLE001 - the command itself says what is wrong with it
+                pass
+    outs = _outputs(args)
+    for i, (oopt, out) in enumerate(outs):
+        for iopt, inp in ins:
+            if _same(out, inp):
+                raise InputError(oopt, out, f"is the input {inp} ({iopt}): writing it would destroy the input; "
+                                            "give another output path")
+        for oopt2, out2 in outs[i + 1:]:
+            if _same(out, out2) and not (oopt == oopt2 and os.path.normpath(out) == os.path.normpath(out2)):
+                raise InputError(oopt, out, f"is also the output of {oopt2} ({out2}): give each output its own path")
+
+
+# --------------------------------------------------------------------------- notes held until the run proceeds
+
+import logging  # noqa: E402
+
+
+class HeldNotes(logging.Handler):
+    """The library's logged notes (WARNING and above: a reader's "note: ... kept as NaN", a skipped
+    effect) held while a command reads and checks its inputs, so that a refusal stays one line; printed
+    on stderr, in order, by :func:`release_notes` once the command proceeds (its first progress line,
+    or its end), and from then on as they come.  Dropped when the command is refused."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.held: list[str] = []
+        self.passing = False
+
+    def emit(self, record) -> None:
+        msg = record.getMessage()
+        if self.passing:
+            print(msg, file=sys.stderr, flush=True)
+        else:
+            self.held.append(msg)
+
+    def print_held(self) -> None:          # (not ``release``: the Handler's lock method)
+        self.passing = True
+        held, self.held = self.held, []
+        for msg in held:
+            print(msg, file=sys.stderr, flush=True)
+
+
+_held: list[HeldNotes] = []
+
+
+def release_notes() -> None:
+    """Print the notes held so far (the command proceeds: its inputs are read and accepted)."""
+    for h in _held:
+        h.print_held()

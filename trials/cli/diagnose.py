@@ -7,7 +7,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _output_path
+from .common import _output_path, release_notes
 
 
 def cmd_diagnose(args) -> int:
@@ -31,6 +31,7 @@ def cmd_diagnose(args) -> int:
     ship = load_ship(src)
     wind = False if args.wind is None else args.wind == "on"
     recs = prepare(ship, args.logs, wind=wind)           # every record read (a bad one: one line) first
+    release_notes()                                      # accepted: their notes, then the progress
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
     d = diagnose(ship, recs, wind=wind, per_run=len(recs) > 1, say=say)
     text = dumps_json(d.to_json())

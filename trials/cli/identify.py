@@ -7,7 +7,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _finite_positive, _output_path, _positive_int, _whole
+from .common import _finite_positive, _output_path, _positive_int, _whole, release_notes
 
 
 def _check_free(ship, names) -> None:
@@ -38,12 +38,34 @@ def cmd_identify(args) -> int:
     ship = load_ship(src)
     if args.free:
         _check_free(ship, args.free)
+    initial = load_ship(ship_path(args.initial)) if args.initial else None
+    if initial is not None:                # the same ship's particulars, before any record is read
+        from ..files.shipcheck import check_same_ship
+
+        check_same_ship(ship, initial)
     wind = None if args.wind is None else args.wind == "on"
     t0 = time.perf_counter()
     names = record_labels(args.train + (args.test or []))   # training and test records told apart together
-    runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)])   # an unusable one: one line, skipped
+    import logging
+
+    skipped: list = []
+
+    def note(msg):                          # held until every record is read (a refusal: one line)
+        skipped.append(msg)
+        logging.getLogger("trials.cli.identify").warning(msg)
+
+    def why(first: int = 0) -> str:         # the refusal of an option none of whose records is usable says why
+        return f"no usable record ({'; '.join(skipped[first:])})" if skipped[first:] else "no usable record"
+
+    runs = load_runs(ship, args.train, wind=wind, names=names[:len(args.train)], say=note)   # an unusable one: one line, skipped
     if not runs:
-        raise InputError("--train", "", "no usable training record")
+        raise InputError("--train", "", why().replace("record", "training record", 1))
+    first_test = len(skipped)
+    tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):], say=note)   # a bad one: one line, before any progress line
+             if args.test else None)
+    if args.test and not tests:
+        raise InputError("--test", "", why(first_test))
+    release_notes()
     print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
     if args.cv:                                          # refused or narrowed before any fit
         try:
@@ -53,10 +75,6 @@ def cmd_identify(args) -> int:
         if folds < args.cv:
             print(f"note: --cv {args.cv}: {folds} independent records, so {folds} folds (each kept out once)",
                   file=sys.stderr, flush=True)
-    tests = (load_runs(ship, args.test, wind=wind, names=names[len(args.train):])   # a bad one: one line, before the fit
-             if args.test else None)
-    if args.test and not tests:
-        raise InputError("--test", "", "no usable record")
 
     shown = [None]
 
@@ -67,7 +85,6 @@ def cmd_identify(args) -> int:
         print(f"  {stage.split(':')[0]}, iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)",
               file=sys.stderr, flush=True)
 
-    initial = load_ship(ship_path(args.initial)) if args.initial else None
     kw = {"record_weighting": args.weighting} if args.weighting else {}
     kw["max_nfev"] = args.max_nfev or DEFAULT_MAX_NFEV
     if args.velocity_weight is not None:

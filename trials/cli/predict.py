@@ -6,7 +6,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _output_path
+from .common import _output_path, release_notes
 
 
 def cmd_predict(args) -> int:
@@ -27,6 +27,7 @@ def cmd_predict(args) -> int:
     wind = None if args.wind is None else args.wind == "on"
 
     def progress(i, n, name):
+        release_notes()                    # every record read and accepted: their notes, then progress
         print(f"replayed {i}/{n}: {name}", file=sys.stderr, flush=True)
 
     pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)   # runs named after their files

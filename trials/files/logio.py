@@ -140,6 +140,16 @@ MAX_FILE_BYTES = 256 * MAX_SAMPLES
 FRT_INTERVAL_S = 0.1
 """FRT-DS-ESSO sampling step [s] (10 Hz)."""
 FRT_STEP_RANGE = (0.02, 1.0, FRT_INTERVAL_S)
+STEP_RTOL = 1e-6
+"""Relative tolerance of every comparison of a sampling step with a bound: a step read from a
+file's times (0.02 s resampled: a median of 0.0199999999999996 s) is that step, not beyond it."""
+DENSE_STEP_S = 1.0
+"""Largest sampling step [s] of a dense record (the sample-to-sample heading checks)."""
+
+
+def _step_within(step: float, lo: float | None = None, hi: float | None = None) -> bool:
+    """``lo <= step <= hi`` (either bound optional) within the relative tolerance :data:`STEP_RTOL`."""
+    return ((lo is None or step >= lo * (1 - STEP_RTOL)) and (hi is None or step <= hi * (1 + STEP_RTOL)))
 """Sampling steps [s] accepted in the FRT-DS-ESSO layout (copies resampled between 50 Hz and 1 Hz)."""
 FRT_LENGTH_M = 3.0
 MAX_RUDDER = 45.0 * DEG
@@ -419,6 +429,7 @@ class _Table:
     def __init__(self, df: pd.DataFrame, src: str, lines=None):
         self.df, self.src, self.lines = df, src, lines
         self.holes: dict[str, str] = {}     # optional column -> where its first missing value is
+        self.empty: set[str] = set()        # optional columns with no value at all: no data, as if absent
 
     def where(self, i: int) -> str:
         return f"line {int(self.lines[i])}" if self.lines is not None else f"data row {i + 1}"
@@ -445,7 +456,11 @@ class _Table:
             what = "empty cell" if raw == "" else (f"value {raw[:20]!r} is not a finite number")
             where = f"{what} at {self.where(i)}" + (f" ({bad.size} such cells)" if bad.size > 1 else "")
             if optional and all(str(col.iloc[j]).strip().lower() in _MISSING for j in bad):
-                self.holes[c] = where
+                if bad.size == len(vals):      # missing throughout: no data, the channel is absent
+                    self.empty.add(c)
+                    _log.info("note: %s: %s: no value in any row: treated as absent", self.src, c)
+                else:
+                    self.holes[c] = where
                 return vals
             raise InputError(self.src, c, where)
         huge = np.flatnonzero(np.abs(vals) > MAX_MAGNITUDE)
@@ -491,7 +506,7 @@ def _check_time(tab: _Table, col: str, t: np.ndarray, nominal: float | None, wha
             raise InputError(src, col, f"sampling step {med:g} s, but {what} is {nominal:g} s{_time_hint(ratio, med, nominal)}")
     if step_range is not None:
         lo, hi, fmt = step_range
-        if not lo <= med <= hi:
+        if not _step_within(med, lo, hi):
             raise InputError(src, col, f"sampling step {med:g} s, but {what} is {fmt:g} s (resampled copies "
                                        f"{lo:g} to {hi:g} s){_time_hint(med / fmt, med, fmt)}")
     span = float(t[-1] - t[0])
@@ -549,7 +564,7 @@ def _check_heading_rate(tab: _Table, col: str, t: np.ndarray, psi: np.ndarray, u
     """On a dense record (step <= 1 s) the heading [rad, from a column in ``unit``] cannot change faster
     than MAX_YAW_RATE sample after sample."""
     dt = np.diff(t)
-    if len(dt) < 10 or np.median(dt) > 1.0:
+    if len(dt) < 10 or not _step_within(float(np.median(dt)), hi=DENSE_STEP_S):
         return
     rate = np.abs(np.diff(psi)) / dt
     p99 = float(np.percentile(rate, 99))
@@ -586,7 +601,7 @@ def _check_heading_vs_yaw_rate(tab: _Table, psi_col: str, r_col: str, t: np.ndar
     if len(dt) < 10:
         return
     med = float(np.median(dt))
-    if med > 1.0:
+    if not _step_within(med, hi=DENSE_STEP_S):
         return
     k = max(1, int(round(1.0 / med)))
     idx = np.arange(0, len(t), k)
@@ -769,8 +784,12 @@ def _apparent_wind(tab: _Table, cols, speed_col: str, dir_col: str, speed_si: fl
     if len(have) == 1:
         other = dir_col if have[0] == speed_col else speed_col
         raise InputError(tab.src, other, f"missing: {have[0]} needs {other} (the apparent wind is a speed and a direction)")
-    V = tab.numeric(speed_col, optional=True) * speed_si
-    d = tab.numeric(dir_col, optional=True)
+    V, d = tab.numeric(speed_col, optional=True), tab.numeric(dir_col, optional=True)
+    if speed_col in tab.empty or dir_col in tab.empty:       # a wind with no values: no wind channels
+        for c in (speed_col, dir_col):
+            tab.holes.pop(c, None)
+        return {}
+    V = V * speed_si
     Vf, df_ = V[np.isfinite(V)], d[np.isfinite(d)]          # missing values: refused by a command that uses them
     if Vf.size and (Vf.min() < 0 or Vf.max() > MAX_WIND_MPS):
         bad = np.max(np.abs(Vf)) / speed_si
@@ -856,6 +875,7 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
     tab.require(FRT_REQUIRED)
     present = [c for c in FRT_COLUMNS if c in df.columns]
     a = {FRT_COLUMNS[c]: tab.numeric(c, optional=c not in FRT_REQUIRED) for c in present}
+    a = {k: v for k, v in a.items() if _frt_column(k) not in tab.empty}     # no values at all: absent
     t = a["t"]
     _check_time(tab, "t [s]", t, None, "the FRT-DS-ESSO sampling step (10 Hz)", 0.0, FRT_STEP_RANGE)
     # wrapped, cumulative (a gyro's count of turns) or offset by whole turns: all the same heading; degrees
@@ -873,6 +893,10 @@ def _read_frt(tab: _Table, src: str, path: Path, notes: list, L: float) -> Trial
         meta["nan_channels"] = {**_holes(tab, FRT_COLUMNS)["nan_channels"], **holes}
     return TrialRecord(t=a.pop("t"), name=path.stem, ship=meta["ship"], source=src,
                        psi=psi, U=U, meta=meta, **a)
+
+
+def _frt_column(channel: str) -> str:
+    return next(c for c, k in FRT_COLUMNS.items() if k == channel)
 
 
 def _check_frt_channels(tab: _Table, a: dict, t: np.ndarray, psi: np.ndarray, L: float) -> None:

@@ -13,6 +13,11 @@ The checks are dimensionless, so one threshold serves every ship:
 * the Froude number ``U / sqrt(g L)`` of the record's speeds (99th percentile) at most
   :data:`FROUDE_MAX`: displacement ships and their models run below Fn 0.35; a full-scale
   record read as a 3 m model runs at Fn 0.5 to 1;
+* the propeller's tip speed ``pi |n| D`` (99th percentile; ``D`` the ship's propeller diameter, or
+  :data:`DIAMETER_PER_LENGTH` ``L`` for a ship given by its length) at most :data:`TIP_SPEED_MAX`:
+  real propellers turn with tips below about 45 m/s (the 325 m Esso Osaka about 26 m/s, its
+  3 m model about 2.6 m/s), so a full-scale record in rpm (52 "rps" for the 325 m ship: 1.5 km/s)
+  or in rad/s, or a model record in rpm, is refused with the likely unit;
 * the non-dimensional turning rate ``r' = |r| L / U`` (99th percentile over the samples at a
   meaningful speed: at least :data:`MOVING_FRACTION` of the record's 95th-percentile speed):
   at most :data:`TURN_RATE_MAX` (L / R: a ship turns on a circle of at least a fraction of its
@@ -46,6 +51,13 @@ MOVING_FRACTION = 0.25
 """Samples at a meaningful speed: at least this fraction of the record's 95th-percentile speed."""
 LENGTH_TOLERANCE = 0.05
 """Largest relative difference between a header's ``length_m`` and the ship's length."""
+TIP_SPEED_MAX = 80.0
+"""Largest propeller tip speed pi |n| D [m/s] (99th percentile) of a record of the ship: real ones stay below ~45."""
+TIP_SPEED_PLAUSIBLE = 45.0
+"""Tip speed [m/s] up to which a propeller speed read in another unit is named as the likely one."""
+DIAMETER_PER_LENGTH = 0.02
+"""Propeller diameter per ship length assumed for a ship given by its length only (real ships 0.025-0.035:
+the smaller figure, so that a valid record is never refused for it)."""
 HINT = "a record of another ship? give the record's own ship or length"
 
 
@@ -70,11 +82,18 @@ def record_statistics(rec, L: float) -> dict:
     Returns
     -------
     dict
+        ``rps`` (99th percentile of the propeller speed |n| [rps]; NaN without it),
         ``froude`` (99th percentile of U / sqrt(g L)), ``speed`` (that speed [m/s]),
         ``turn_rate`` (99th percentile of |r| L / U over the moving samples; NaN without
         speed or yaw rate), ``heading_range_deg`` (NaN without heading).  NaN samples are left out.
     """
-    out = {"froude": math.nan, "speed": math.nan, "turn_rate": math.nan, "heading_range_deg": math.nan}
+    out = {"froude": math.nan, "speed": math.nan, "turn_rate": math.nan, "heading_range_deg": math.nan,
+           "rps": math.nan}
+    n = getattr(rec, "n", None)
+    if n is not None:
+        n = np.abs(np.asarray(n, dtype=float))
+        if np.isfinite(n).any():
+            out["rps"] = float(np.nanpercentile(n, 99))
     try:
         U = np.abs(np.asarray(rec.speed(), dtype=float))
     except ValueError:
@@ -110,7 +129,7 @@ def check_header(rec, ship_or_length, src: str | None = None, name: str | None =
 
 
 def check_record_ship(rec, ship_or_length, src: str | None = None, name: str | None = None) -> dict:
-    """Refuse a record that cannot be of the ship: header length, Froude number, turning rate.
+    """Refuse a record that cannot be of the ship: header length, propeller tip speed, Froude number, turning rate.
 
     Parameters
     ----------
@@ -137,6 +156,7 @@ def check_record_ship(rec, ship_or_length, src: str | None = None, name: str | N
     L, who = _ship_label(ship_or_length, name)
     check_header(rec, ship_or_length, src, name)
     s = record_statistics(rec, L)
+    check_tip_speed(s["rps"], propeller_diameter(ship_or_length), src, who)
     if s["froude"] > FROUDE_MAX:
         raise ShipMismatch(src, "speed", f"speeds up to {s['speed']:.3g} m/s (99th percentile) are Froude number "
                                          f"{s['froude']:.3g} for {who} (at most {FROUDE_MAX:g}): {HINT}")
@@ -149,6 +169,48 @@ def check_record_ship(rec, ship_or_length, src: str | None = None, name: str | N
                                             f"{s['turn_rate']:.3g} (99th percentile) for {who}, on circles of "
                                             f"{1 / s['turn_rate']:.3g} ship lengths (at least {TURN_RATE_MIN:g}): {HINT}")
     return s
+
+
+def check_same_ship(ship, other, option: str = "--initial", ship_option: str = "--ship") -> None:
+    """Refuse a second ship (``--initial``, any other ship option) whose particulars are not ``ship``'s:
+    length, beam and draught within :data:`LENGTH_TOLERANCE` (a model and its full-scale ship, or two
+    hulls, are not two forms of one ship's model).  One :class:`ShipMismatch` naming both."""
+    a, b = ship.particulars, other.particulars
+    for key, words in (("L", "length"), ("B", "beam"), ("T", "draught")):
+        x, y = float(getattr(a, key)), float(getattr(b, key))
+        if not (x > 0 and y > 0) or abs(y / x - 1) > LENGTH_TOLERANCE:
+            raise ShipMismatch(option, f"particulars.{key}",
+                               f"{other.name or 'the ship'} has {words} {key} = {y:g} m, {ship_option} "
+                               f"{ship.name or 'ship'} {x:g} m: not a model of the same ship; give one of "
+                               f"{ship.name or ship_option}'s particulars")
+
+
+def propeller_diameter(ship_or_length) -> float:
+    """The ship's propeller diameter [m]; :data:`DIAMETER_PER_LENGTH` times a length given instead of a ship."""
+    prop = getattr(ship_or_length, "propeller", None)
+    if prop is not None and getattr(prop, "D", None):
+        return float(prop.D)
+    return DIAMETER_PER_LENGTH * _ship_label(ship_or_length)[0]
+
+
+def tip_speed(rps: float, D: float) -> float:
+    """The propeller's tip speed pi |n| D [m/s] at ``rps`` [rev/s] for a diameter ``D`` [m]."""
+    return math.pi * abs(rps) * D
+
+
+def check_tip_speed(rps: float, D: float, src: str, who: str, field: str = "n_prop") -> None:
+    """Refuse a propeller speed ``rps`` [rev/s] whose tip speed with diameter ``D`` exceeds
+    :data:`TIP_SPEED_MAX`, naming the unit it is likely in (rpm, rad/s)."""
+    if not (math.isfinite(rps) and D > 0):
+        return
+    v = tip_speed(rps, D)
+    if v <= TIP_SPEED_MAX:
+        return
+    likely = [f"{u}? ({rps:.3g} {u} = {rps / f:.3g} rps, tip speed {v / f:.3g} m/s)"
+              for u, f in (("rpm", 60.0), ("rad/s", 2 * math.pi)) if v / f <= TIP_SPEED_PLAUSIBLE]
+    raise ShipMismatch(src, field, f"{rps:.3g} rps (99th percentile) is a propeller tip speed pi n D = {v:.3g} m/s "
+                                   f"with D = {D:.3g} m of {who}, beyond any real propeller (at most "
+                                   f"{TIP_SPEED_MAX:g} m/s): " + ("; ".join(likely) or HINT))
 
 
 def check_speed_option(rec, speed: float, L: float, src: str | None = None, option: str = "--speed") -> None:

@@ -377,6 +377,10 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, options: IdentifyOpti
     """
     o = IdentifyOptions(**kwargs) if options is None else replace(options, **kwargs)
     _check_velocity_weight(o.velocity_weight)                # before any record is read
+    if o.initial is not None:                                 # the same ship's, before any record is read
+        from ..files.shipcheck import check_same_ship
+
+        check_same_ship(ship, o.initial)
     runs = _training_runs(ship, paths_or_runs, o)
     L = ship.particulars.L
     stages = DEFAULT_SEGMENTS_L if o.segment_s is None else np.atleast_1d(o.segment_s) / np.sqrt(L / 9.80665)
@@ -460,6 +464,10 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     how records are dealt into folds (:func:`fold_of`).  Each record's dict also holds ``"ship"``,
     the model identified without it (for further replays of the kept-out record)."""
     ref = ship if initial is None else initial
+    if initial is not None:
+        from ..files.shipcheck import check_same_ship
+
+        check_same_ship(ship, initial)
     out = []
     idx = np.arange(len(runs))
     folds = cv_folds(runs, folds)

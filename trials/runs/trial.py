@@ -663,7 +663,8 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
       w_P0(u) within [0, 1) and (constant power) SHP_0(u) > 0 at that speed; rpm 0-6000 rpm, and
       one that can drive that approach (:func:`_check_approach_rpm`: the propeller pushing ahead;
       a constant-power engine's rpm within 5 % of the one the straight run needs; a constant-rpm
-      motor's rpm driving the ship to a speed within its propeller data);
+      motor's rpm within a factor 2 of it, either way, and driving the ship to a speed within its
+      propeller data);
     * dt 0.1 ms to the ship's steering-gear time constant T_E (RK4 on the gear's first-order
       lag is unstable beyond 2.8 T_E); dt <= duration; at most :data:`mmg.limits.MAX_STEPS`
       steps (refused before anything is allocated, saying how much it would need);
@@ -728,6 +729,14 @@ APPROACH_RPM_TOLERANCE = 0.05
 at ``approach.speed`` needs (the engine's power is SHP_0 at that speed: the rpm follows from it)."""
 
 
+CONSTANT_RPM_FACTOR_MAX = 2.0
+"""How far (a factor, either way) a constant-rpm motor's ``approach.rpm`` may be from the rpm the straight
+run at ``approach.speed`` needs: the MMG-2015 KVLCC2 convention (the model-scale self-propulsion point,
+17.95 rps where the model's own straight run at 1.179 m/s needs 11.85 rps) is a factor 1.51; beyond 2 the
+ship runs away from its approach during the trial (3000 rpm at 1.179 m/s: 3.58 m/s), so the trial's
+approach speed and its metrics would describe another run."""
+
+
 def zero_thrust_advance_ratio(ship: Ship) -> float:
     """The advance ratio J where the open-water K_T(J) first falls to zero (inf if it never does):
     beyond it the propeller no longer pushes ahead and the K_T, K_Q polynomials are extrapolations."""
@@ -756,7 +765,8 @@ def _check_approach_rpm(src: str, ap, ship: Ship, label: str, u0: float, n0: flo
       propeller's torque at it, and a far one would rescale K_Q by the cube of the ratio);
     * a constant-rpm motor holds the rpm: the ship starts at the approach speed and runs up or
       down to the speed that rpm gives (the MMG 2015 convention of a model-scale self-propulsion
-      rpm), which must lie within the ship's data (Froude number, t_P(u), w_P0(u) in [0, 1))."""
+      rpm), which must be within :data:`CONSTANT_RPM_FACTOR_MAX` (either way) of the rpm the straight
+      run needs and drive it to a speed within the ship's data (Froude number, t_P(u), w_P0(u) in [0, 1))."""
     from mmg.disturbances import combine
     from mmg.effects import EffectSet
     from mmg.equilibrium import straight_run
@@ -782,6 +792,12 @@ def _check_approach_rpm(src: str, ap, ship: Ship, label: str, u0: float, n0: flo
                                                   f"{label} (its power is SHP_0 at that speed): {needs} (within "
                                                   f"{APPROACH_RPM_TOLERANCE:.0%}; or write 'solve')")
         return
+    if not 1 / CONSTANT_RPM_FACTOR_MAX <= n0 / need <= CONSTANT_RPM_FACTOR_MAX:
+        raise InputError(src, "approach.rpm", f"{rpm} is {n0 / need:.3g} times the rpm of the straight run at "
+                                              f"{ap.speed} with the constant-rpm motor of {label}: {needs}; the ship "
+                                              f"would run {'up' if n0 > need else 'down'} from its approach speed "
+                                              f"during the trial (at most a factor {CONSTANT_RPM_FACTOR_MAX:g} either "
+                                              f"way; or write 'solve')")
     surge = _surge(ship, n0, es, slots)
     top = MAX_FROUDE * np.sqrt(9.81 * ship.particulars.L)
     if surge(top) > 0:
