@@ -40,7 +40,6 @@ import numpy as np
 
 from mmg.errors import InputError
 from mmg.units import DEG
-from ..files.logio import DENSE_STEP_S, _step_within
 
 HEADING_JUMP = 1.5 * DEG
 """A heading step this much larger than the yaw rate explains, on a dense record, is a sensor step."""
@@ -101,6 +100,8 @@ def corrected_heading(t, psi, r=None):
     -------
     (psi_corrected, steps) where steps is a list of (t [s], step [deg]).
     """
+    from ..files.logio import DENSE_STEP_S, _step_within     # here: a simulation's metrics import no pandas
+
     t, psi = np.asarray(t, dtype=float), np.asarray(psi, dtype=float)
     if r is None or len(t) < 3 or not _step_within(_median_dt(t), hi=DENSE_STEP_S):
         return psi, []

@@ -140,6 +140,7 @@ MAX_FILE_BYTES = 256 * MAX_SAMPLES
 FRT_INTERVAL_S = 0.1
 """FRT-DS-ESSO sampling step [s] (10 Hz)."""
 FRT_STEP_RANGE = (0.02, 1.0, FRT_INTERVAL_S)
+"""Sampling steps [s] accepted in the FRT-DS-ESSO layout (copies resampled between 50 Hz and 1 Hz)."""
 STEP_RTOL = 1e-6
 """Relative tolerance of every comparison of a sampling step with a bound: a step read from a
 file's times (0.02 s resampled: a median of 0.0199999999999996 s) is that step, not beyond it."""
@@ -150,7 +151,8 @@ DENSE_STEP_S = 1.0
 def _step_within(step: float, lo: float | None = None, hi: float | None = None) -> bool:
     """``lo <= step <= hi`` (either bound optional) within the relative tolerance :data:`STEP_RTOL`."""
     return ((lo is None or step >= lo * (1 - STEP_RTOL)) and (hi is None or step <= hi * (1 + STEP_RTOL)))
-"""Sampling steps [s] accepted in the FRT-DS-ESSO layout (copies resampled between 50 Hz and 1 Hz)."""
+
+
 FRT_LENGTH_M = 3.0
 MAX_RUDDER = 45.0 * DEG
 """Largest plausible rudder angle [rad]; a larger value in a radian column is a unit error."""
