@@ -16,6 +16,8 @@ __all__ = ["simulate_kernel", "rk4_step", "SCHEDULE", "HEADING_SWITCH"]
 
 SCHEDULE, HEADING_SWITCH = 0, 1
 
+ZERO8 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
 # HEADING_SWITCH parameters
 HS_AMP, HS_HI, HS_LO, HS_FIRST, HS_PSI0, HS_TSTART, HS_TRIM = range(7)
 
@@ -42,22 +44,24 @@ def _axpy(a, c, b):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def rk4_step(f, xs, dt, args):
-    """One classical RK4 step of length ``dt`` from the state ``xs`` (an 8-tuple): the one
-    integrator step of the simulator (:func:`simulate_kernel`) and the replay (:mod:`mmg.replay`).
+def rk4_step(f, axpy, zero, xs, dt, args):
+    """One classical RK4 step of length ``dt`` from the state ``xs`` (a tuple of floats): the one
+    integrator step of the simulator (:func:`simulate_kernel`, 8 states) and the replay
+    (:mod:`mmg.replay`, 6).
 
     ``f(y, tau, args)`` is the right-hand side at the stage state ``y`` and the stage's fraction
-    ``tau`` of the step (0, 1/2, 1/2, 1: where inputs that vary within the step are taken), as an
-    8-tuple; ``args`` its other arguments (a tuple).  The state and the stage derivatives stay in
-    scalars (registers), summed with the RK4 weights as they come."""
-    k = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    ``tau`` of the step (0, 1/2, 1/2, 1: where inputs that vary within the step are taken), as a
+    tuple like ``xs``; ``args`` its other arguments (a tuple); ``axpy(a, c, b)`` = a + c b of two
+    such tuples and ``zero`` the zero one (the state's length: each caller keeps only its own states
+    in scalars, i.e. registers).  The stage derivatives are summed with the RK4 weights as they come."""
+    k = zero
     acc = k
     for s in range(4):
         tau = 0.0 if s == 0 else (0.5 if s < 3 else 1.0)
-        y = _axpy(xs, tau * dt, k)
+        y = axpy(xs, tau * dt, k)
         k = f(y, tau, args)
-        acc = _axpy(acc, 1.0 if (s == 0 or s == 3) else 2.0, k)
-    return _axpy(xs, dt / 6.0, acc)
+        acc = axpy(acc, 1.0 if (s == 0 or s == 3) else 2.0, k)
+    return axpy(xs, dt / 6.0, acc)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -109,7 +113,7 @@ def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
         if i == nsteps:
             break
         # the four RK4 stages through one inlined copy of the right-hand side (rk4_step)
-        xs = rk4_step(_simulator_rhs, xs, dt, (dcmd, p, poly, hull_axis, hull_term, hull_coef))
+        xs = rk4_step(_simulator_rhs, _axpy, ZERO8, xs, dt, (dcmd, p, poly, hull_axis, hull_term, hull_coef))
     return nsteps + 1
 
 

@@ -82,10 +82,19 @@ def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _axpy(a, c, b):
+    """a + c b of two 6-tuples (the state and a stage derivative), as a tuple."""
+    return (a[0] + c * b[0], a[1] + c * b[1], a[2] + c * b[2], a[3] + c * b[3], a[4] + c * b[4],
+            a[5] + c * b[5])
+
+
+ZERO6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _replay_rhs(y, tau, args):
     """The replay's right-hand side for :func:`mmg.kernel.rk4_step`: :func:`_deriv` with the inputs
-    linear in the sample interval, at the fraction (k + tau) / m of it (sub-step k of m); the state
-    is the simulator's 8-tuple, its rudder and revolutions slots unused (zero)."""
+    linear in the sample interval, at the fraction (k + tau) / m of it (sub-step k of m)."""
     k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef = args
     a = (k + tau) / m
     d = delta[i] + a * (delta[i + 1] - delta[i])
@@ -93,30 +102,30 @@ def _replay_rhs(y, tau, args):
     fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
     fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
     fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
-    du, dv, dr, dx, dy, dpsi = _deriv(y, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef)
-    return du, dv, dr, dx, dy, dpsi, 0.0, 0.0
+    return _deriv(y, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef)
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis, hull_term, hull_coef, out):
     """RK4 of the dynamics along a record: sub-steps of at most ``dt_max`` between samples, inputs linear
     within a sample interval, the state reset to ``meas`` where ``reset``; fills ``out`` (N, 6), returns the
     number of valid rows."""
     N = t.shape[0]
-    # the state as the simulator's 8-tuple of scalars (kept in registers across the stages)
-    s = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5], 0.0, 0.0)
+    # the state as a 6-tuple of scalars (kept in registers across the stages)
+    s = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5])
     for j in range(6):
         out[0, j] = s[j]
     for i in range(N - 1):
         if reset[i]:
-            s = (meas[i, 0], meas[i, 1], meas[i, 2], meas[i, 3], meas[i, 4], meas[i, 5], 0.0, 0.0)
+            s = (meas[i, 0], meas[i, 1], meas[i, 2], meas[i, 3], meas[i, 4], meas[i, 5])
         h = t[i + 1] - t[i]
         m = int(np.ceil(h / dt_max - 1e-9))
         if m < 1:
             m = 1
         dt = h / m
         for k in range(m):                       # the simulator's RK4 step (one inlined copy of the model)
-            s = rk4_step(_replay_rhs, s, dt, (k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef))
+            s = rk4_step(_replay_rhs, _axpy, ZERO6, s, dt,
+                         (k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef))
         ok = True
         for j in range(6):
             if not np.isfinite(s[j]):
