@@ -76,12 +76,12 @@ def test_disturbances_build_the_same_effects(ship):
     from mmg.simulation import simulate
 
     dist = [UniformCurrent(0.05, math.radians(40.0)), RudderOffset(math.radians(1.5))]
-    es, slots = as_effects(dist)
-    assert es.names() == ["current", "rudder_offset"] and slots == {}
+    built, slots = as_effects(dist)
+    assert built.names() == ["current", "rudder_offset"] and slots == {}
     law = CommandLaw.schedule([0.0, 5.0, 5.01, 60.0], [0.0, 0.0, math.radians(20.0), math.radians(20.0)])
     a = simulate(ship, law, 60.0, 0.05, 0.5, disturbances=dist)
-    b = simulate(ship, law, 60.0, 0.05, 0.5, effects=E.effect_set({"current": {"speed_mps": 0.05, "direction_deg": 40.0},
-                                                                   "rudder_offset": {"offset_deg": 1.5}}))
+    es = E.effect_set({"current": {"speed_mps": 0.05, "direction_deg": 40.0}, "rudder_offset": {"offset_deg": 1.5}})
+    b = simulate(ship, law, 60.0, 0.05, 0.5, effects=es)
     np.testing.assert_allclose(a.states, b.states, rtol=1e-9, atol=1e-9)
 
 

@@ -620,8 +620,9 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
         states = replay_states(pk, ReplayInputs(t, delta, n), s0)
     sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(9.80665 / L), 0.002 * L,
                                                     0.002 * L, math.radians(0.05)])
+    label = name or f"synthetic_{kind}"
     return logged_record(t, states, delta, n, es, sd, np.random.default_rng(seed), wind_rel,
-                         name=name or f"synthetic_{kind}", source=name or f"synthetic_{kind}", meta={"format": "synthetic"})
+                         name=label, source=label, meta={"format": "synthetic"})
 
 
 def write_frt_csv(rec, path) -> None:
