@@ -40,8 +40,8 @@ from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
            "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
-           "record_residual_rms",
-           "RECORD_WEIGHTINGS", "effect_parameters", "record_effect_parameters", "effect_set_of",
+           "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled",
+           "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "record_effect_parameters", "effect_set_of",
            "predict_logged"]
 
 RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
@@ -49,14 +49,26 @@ RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0
 """Rudder constants (:class:`mmg.ship.Rudder` fields) :func:`free_parameters` can free: their index in
 the packed parameters and bounds (the flow-straightening coefficients gamma_R of the rudder's
 inflow angle, positive and negative beta_R, and the effective lever l_R' of the yaw rate in it)."""
-RUDDER_OFFSET_LIMIT = float(np.radians(10.0))
-"""Bound [rad] of a freed ``rudder_offset`` (:data:`mmg.units.MAX_RUDDER_OFFSET`)."""
 MASS_CONSTANTS = {"m_x": P_MX, "m_y": P_MY, "J_z": P_JZ}
 """Added masses [kg] and added moment of inertia [kg m^2] :func:`free_parameters` can free (the
 config's primed ``m_x_prime``, ``m_y_prime``, ``J_z_prime`` times the mass / inertia scale)."""
 SHIP_CONSTANTS = (("w_P0", "epsilon", "kappa", "wind_scale", "rudder_offset") + tuple(RUDDER_CONSTANTS)
                   + tuple(MASS_CONSTANTS))
-"""Ship constants besides the hull coefficients that :func:`free_parameters` can free."""
+"""Ship constants besides the hull coefficients that :func:`free_parameters` can free (``"wind_scale"``
+and ``"rudder_offset"`` are the ``wind`` and ``rudder_offset`` effects' parameters under their
+``mmg identify --free`` names: their priors and bounds are the effects' own, :func:`effect_prior`)."""
+
+PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
+"""Prior std of a freed ship coefficient relative to its config value, per family: the one table of
+the ship coefficients' prior widths (identification's: the value is known to a factor of about 2
+either way).  Floors: 0.01 for a hull coefficient, 0.05 for a rudder constant; ``w_P0``: 0.15
+absolute.  Effect parameters carry their own prior (:class:`mmg.effects.Parameter`)."""
+
+DIAGNOSIS_PRIOR_REL_STD = {**PRIOR_REL_STD, "mass": 0.2}
+"""The diagnosis's policy (:func:`trials.measured.diagnose.diagnose`): :data:`PRIOR_REL_STD` with the added
+masses at 20 %: it frees them with every candidate effect, and an added mass a few % off leaves a
+residual (surge speed loss in the turn, sway and yaw lag) an effect would otherwise take; a wider
+prior would let the added masses take an effect's residual instead."""
 
 
 @dataclass(frozen=True)
@@ -113,42 +125,66 @@ class FreeParameter:
     record: int | None = None
     """For a record's own nuisance parameter (:func:`record_effect_parameters`): the record's index
     in the fit; None: shared by every record."""
+    start: float | None = None
+    """Where a fit starts (:func:`identify_segments` without ``start``); the prior when None."""
 
 
-def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float = 0.5) -> list[FreeParameter]:
+def effect_prior(effect, name: str, nm: str | None = None, kind: str = "effect", index: int = 0,
+                 factor: float = 1.0, centre: float | None = None) -> "FreeParameter":
+    """The :class:`FreeParameter` of fit parameter ``name`` of ``effect`` (:meth:`mmg.effects.Effect.fit_parameters`)
+    with the effect's own prior, bounds and start, the values times ``factor`` (e.g. degrees to
+    radians) and the prior centred on ``centre`` (default the parameter's own): the one place an
+    estimator reads an effect parameter's prior."""
+    fp = effect.fit_parameters()
+    j = [q.name for q in fp].index(name)
+    q = fp[j]
+    start = None if q.start is None else factor * q.start
+    return FreeParameter(nm or f"{effect.name}.{q.name}", kind, index,
+                         factor * q.default if centre is None else float(centre), factor * q.sigma,
+                         factor * q.lower, factor * q.upper, sub=j, start=start)
+
+
+def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float | None = None,
+                    priors: dict | None = None) -> list[FreeParameter]:
     """The :class:`FreeParameter` list for ``names`` (hull coefficient names or :data:`SHIP_CONSTANTS`).
 
-    The prior std is ``prior_rel_std`` times the config value (0.5: the value is known to a factor of
-    about 2 either way), at least 0.01 for hull coefficients."""
+    The prior std of a ship coefficient is its family's relative std (``priors``, default
+    :data:`PRIOR_REL_STD`) times its config value, with the table's floors; ``prior_rel_std``, when
+    given, is one relative std for every family instead.  ``"rudder_offset"`` and ``"wind_scale"``
+    take the effects' priors (:func:`effect_prior`)."""
+    import mmg.effects as E
+
+    rel = dict(priors or PRIOR_REL_STD)
+    if prior_rel_std is not None:
+        rel = {k: float(prior_rel_std) for k in rel}
     out = []
     for nm in names:
         if nm in hull_names:
             i = list(hull_names).index(nm)
             v = float(packed.hull_coef[i])
             lo, hi = (-np.inf, 0.0) if nm == "X_uu" else (-np.inf, np.inf)      # resistance stays a resistance
-            out.append(FreeParameter(nm, "hull", i, v, max(prior_rel_std * abs(v), 0.01), lo, hi))
+            out.append(FreeParameter(nm, "hull", i, v, max(rel["hull"] * abs(v), 0.01), lo, hi))
         elif nm == "w_P0":
             v = float(packed.poly[POLY_WP0][0])
             out.append(FreeParameter(nm, "w_P0", 0, v, 0.15, 0.0, 0.8))           # a wake fraction
         elif nm == "epsilon":
             v = float(packed.p[P_EPS])
-            out.append(FreeParameter(nm, "epsilon", P_EPS, v, prior_rel_std * v, 0.3, 3.0))
+            out.append(FreeParameter(nm, "epsilon", P_EPS, v, rel["epsilon"] * v, 0.3, 3.0))
         elif nm == "kappa":                              # a share of the slipstream's speed-up: [0, 1]
             v = float(packed.p[P_KAPPA])
-            out.append(FreeParameter(nm, "kappa", P_KAPPA, v, prior_rel_std * v, 0.0, 1.0))
+            out.append(FreeParameter(nm, "kappa", P_KAPPA, v, rel["kappa"] * v, 0.0, 1.0))
         elif nm in RUDDER_CONSTANTS:
             i, lo, hi = RUDDER_CONSTANTS[nm]
             v = float(packed.p[i])
-            out.append(FreeParameter(nm, "rudder", i, v, max(prior_rel_std * abs(v), 0.05), lo, hi))
-        elif nm == "rudder_offset":                      # the rudder effect's blade offset [rad], prior 0
-            v = float(packed.p[P_RUDDER_OFFSET])
-            out.append(FreeParameter(nm, "rudder", P_RUDDER_OFFSET, v, 0.05, -RUDDER_OFFSET_LIMIT,
-                                     RUDDER_OFFSET_LIMIT))
+            out.append(FreeParameter(nm, "rudder", i, v, max(rel["rudder"] * abs(v), 0.05), lo, hi))
+        elif nm == "rudder_offset":      # the rudder_offset effect's offset [rad], prior at the config's
+            out.append(effect_prior(E.RudderOffset, "offset_deg", nm, "rudder", P_RUDDER_OFFSET, np.pi / 180.0,
+                                    float(packed.p[P_RUDDER_OFFSET])))
         elif nm in MASS_CONSTANTS:
             v = float(packed.p[MASS_CONSTANTS[nm]])
-            out.append(FreeParameter(nm, "mass", MASS_CONSTANTS[nm], v, prior_rel_std * v, 0.0, 3.0 * v))
-        elif nm == "wind_scale":                         # factor on the records' external (wind) loads
-            out.append(FreeParameter(nm, "wind_scale", 0, 1.0, 0.5, 0.0, 3.0))
+            out.append(FreeParameter(nm, "mass", MASS_CONSTANTS[nm], v, rel["mass"] * v, 0.0, 3.0 * v))
+        elif nm == "wind_scale":         # the wind effect's scale on the records' external (wind) loads
+            out.append(replace(effect_prior(E.Wind, "scale", nm, "wind_scale"), sub=0))
         else:
             raise KeyError(f"unknown parameter {nm!r}: not a hull coefficient of the ship nor one of {SHIP_CONSTANTS}")
     return out
@@ -175,8 +211,7 @@ def effect_parameters(effects) -> list[FreeParameter]:
     out = []
     for i, e in enumerate(effects):
         for j, q in enumerate(e.fit_parameters()):
-            out.append(FreeParameter(f"{e.name}.{q.name}", "effect", i, float(q.default), float(q.sigma),
-                                     float(q.lower), float(q.upper), sub=j))
+            out.append(effect_prior(e, q.name, index=i))
     return out
 
 
@@ -190,8 +225,8 @@ def record_effect_parameters(effects, n_records: int, first_index: int = 0, name
         tag = names[k] if names is not None else k
         for i, e in enumerate(effects):
             for j, q in enumerate(e.fit_parameters()):
-                out.append(FreeParameter(f"{e.name}.{q.name}[{tag}]", "effect", first_index + i, float(q.default),
-                                         float(q.sigma), float(q.lower), float(q.upper), sub=j, record=k))
+                out.append(replace(effect_prior(e, q.name, f"{e.name}.{q.name}[{tag}]", index=first_index + i),
+                                   record=k))
     return out
 
 
@@ -242,10 +277,17 @@ def segment_resets(t: np.ndarray, segment_s: float) -> np.ndarray:
     return reset
 
 
+def wind_scaled(inputs: ReplayInputs, scale: float) -> ReplayInputs:
+    """``inputs`` with their external (measured-wind) loads times a fitted ``wind_scale`` (the wind
+    effect's loads are linear in its scale, :meth:`mmg.effects.Wind.external`): the one place the
+    fitted scale is applied, in the fit and in the identified model's replays."""
+    return inputs if inputs.ext is None else replace(inputs, ext=inputs.ext * scale)
+
+
 def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
     for f, v in zip(free, theta):
         if f.kind == "wind_scale" and rec.inputs.ext is not None:
-            return replace(rec, inputs=replace(rec.inputs, ext=rec.inputs.ext * v))
+            return replace(rec, inputs=wind_scaled(rec.inputs, v))
     return rec
 
 
@@ -506,7 +548,8 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
         r_init = fit.resid(fit.theta0)
         lo = np.array([f.lower for f in free])
         hi = np.array([f.upper for f in free])
-        x0 = fit.theta0 if o.start is None else np.asarray(o.start, float)
+        x0 = np.array([f.prior if f.start is None else f.start for f in free]) if o.start is None \
+            else np.asarray(o.start, float)
         sol = least_squares(fit.resid, np.clip(x0, lo, hi), jac=fit.jac, method="trf", x_scale=fit.sig0,
                             max_nfev=o.max_nfev, bounds=(lo, hi), loss=o.loss, f_scale=o.f_scale)
     finally:

@@ -1,5 +1,8 @@
 """The trial-config disturbances (``disturbances.current``, ``disturbances.rudder_offset``,
-``log.bias``) as thin SI adapters over the effects of :mod:`mmg.effects`.
+``log.bias``) as thin SI adapters over the effects of :mod:`mmg.effects`: a documented alias.
+
+``simulate(..., disturbances=[...])`` builds the same :class:`mmg.effects.EffectSet` as
+``effects=`` (:func:`as_effects`); new code states effects as effects.
 
 The physics of each is defined once, in its effect (:class:`mmg.effects.Current`,
 :class:`mmg.effects.RudderOffset`); the classes here keep the simulator's SI interface (speed in
@@ -123,6 +126,21 @@ class SensorBias:
     def effect(self):
         """The heading part as the ``heading_bias`` effect (speed and rpm biases have no effect module)."""
         return E.HeadingBias, {"bias_deg": math.degrees(self.heading)}
+
+
+def as_effects(disturbances) -> tuple:
+    """(:class:`mmg.effects.EffectSet` of the components' effects, slots of those that are no named
+    effect (:class:`ConstantForce`)): how ``simulate(disturbances=...)`` builds the same effects as
+    ``effects=`` (the documented alias; the physics is the effects')."""
+    items, slots = [], {}
+    for d in disturbances or ():
+        if isinstance(d, E.EffectSet):
+            items += list(d.items)
+        elif isinstance(d, ConstantForce):
+            slots.update(d.slots())
+        else:
+            items.append(d.effect())
+    return E.EffectSet(tuple(items)), slots
 
 
 def combine(disturbances) -> dict[int, float]:

@@ -12,9 +12,11 @@ from ._jit import njit
 from .model import DELTA_, ENGINE_CONSTANT_RPM, N_, P_ENGINE, PSI_, R_, U_, V_, rhs_of
 from .rudder import switch_side
 
-__all__ = ["simulate_kernel", "SCHEDULE", "HEADING_SWITCH"]
+__all__ = ["simulate_kernel", "rk4_step", "SCHEDULE", "HEADING_SWITCH"]
 
 SCHEDULE, HEADING_SWITCH = 0, 1
+
+ZERO8 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 # HEADING_SWITCH parameters
 HS_AMP, HS_HI, HS_LO, HS_FIRST, HS_PSI0, HS_TSTART, HS_TRIM = range(7)
@@ -41,6 +43,35 @@ def _axpy(a, c, b):
             a[4] + c * b[4], a[5] + c * b[5], a[6] + c * b[6], a[7] + c * b[7])
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def rk4_step(f, axpy, zero, xs, dt, args):
+    """One classical RK4 step of length ``dt`` from the state ``xs`` (a tuple of floats): the one
+    integrator step of the simulator (:func:`simulate_kernel`, 8 states) and the replay
+    (:mod:`mmg.replay`, 6).
+
+    ``f(y, tau, args)`` is the right-hand side at the stage state ``y`` and the stage's fraction
+    ``tau`` of the step (0, 1/2, 1/2, 1: where inputs that vary within the step are taken), as a
+    tuple like ``xs``; ``args`` its other arguments (a tuple); ``axpy(a, c, b)`` = a + c b of two
+    such tuples and ``zero`` the zero one (the state's length: each caller keeps only its own states
+    in scalars, i.e. registers).  The stage derivatives are summed with the RK4 weights as they come."""
+    k = zero
+    acc = k
+    for s in range(4):
+        tau = 0.0 if s == 0 else (0.5 if s < 3 else 1.0)
+        y = axpy(xs, tau * dt, k)
+        k = f(y, tau, args)
+        acc = axpy(acc, 1.0 if (s == 0 or s == 3) else 2.0, k)
+    return axpy(xs, dt / 6.0, acc)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _simulator_rhs(y, tau, args):
+    """The simulator's right-hand side for :func:`rk4_step`: :func:`mmg.model.rhs_of` with the
+    rudder order held over the step (``args`` = (order, p, poly, hull_axis, hull_term, hull_coef))."""
+    dcmd, p, poly, hull_axis, hull_term, hull_coef = args
+    return rhs_of(y[U_], y[V_], y[R_], y[PSI_], y[DELTA_], y[N_], dcmd, p, poly, hull_axis, hull_term, hull_coef)
+
+
 @njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
                     kind, cpar, st, sd, sn, states, orders):
@@ -61,7 +92,6 @@ def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
     ptrn = 0
     u_min = 0.01 * abs(x0[U_])
     constant_rpm = p[P_ENGINE] == ENGINE_CONSTANT_RPM
-    half_dt, dt6 = 0.5 * dt, dt / 6.0
     for i in range(nsteps + 1):
         t = i * dt
         if kind == SCHEDULE:
@@ -82,17 +112,8 @@ def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
             return i
         if i == nsteps:
             break
-        # the four RK4 stages through one inlined copy of the right-hand side, the state and
-        # the stage derivatives in scalars (registers), summed with the RK4 weights as they come
-        k = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        acc = k
-        for s in range(4):
-            c = 0.0 if s == 0 else (half_dt if s < 3 else dt)
-            y = _axpy(xs, c, k)
-            k = rhs_of(y[U_], y[V_], y[R_], y[PSI_], y[DELTA_], y[N_], dcmd, p, poly, hull_axis, hull_term,
-                       hull_coef)
-            acc = _axpy(acc, 1.0 if (s == 0 or s == 3) else 2.0, k)
-        xs = _axpy(xs, dt6, acc)
+        # the four RK4 stages through one inlined copy of the right-hand side (rk4_step)
+        xs = rk4_step(_simulator_rhs, _axpy, ZERO8, xs, dt, (dcmd, p, poly, hull_axis, hull_term, hull_coef))
     return nsteps + 1
 
 

@@ -364,6 +364,17 @@ def wind_loads(u, v, psi, p):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def with_steady_wind(fx, fy, fn, u, v, psi, p):
+    """External loads fx, fy [N], fn [N m] plus those of a steady true wind (:func:`wind_loads`) when
+    the ``wind`` effect gives one (``p[P_WIND_V]`` != 0; else unchanged): the one steady-wind branch
+    of the simulator's right-hand side (:func:`rhs_of`) and the replay's (:mod:`mmg.replay`)."""
+    if p[P_WIND_V] != 0.0:
+        wx, wy, wn = wind_loads(u, v, psi, p)
+        return fx + wx, fy + wy, fn + wn
+    return fx, fy, fn
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def force_accelerations(X, Y, N, p):
     """du/dt, dv/dt, dr/dt [m/s^2, m/s^2, rad/s^2] an added load X, Y [N], N [N m] about midship
     gives: the affine part of :func:`accelerations` (the inverse mass matrix times the load)."""
@@ -417,14 +428,9 @@ def rhs_of(u, v, r, psi, delta, n, delta_cmd, p, poly, hull_axis, hull_term, hul
     state order (du/dt, dv/dt, dr/dt, dx0/dt, dy0/dt, dpsi/dt, ddelta/dt, dn/dt): a loop that
     holds its state in scalars (the simulator's RK4 loop) keeps it in registers."""
     X, Y, N, J = forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef)
+    X, Y, N = with_steady_wind(X, Y, N, u, v, psi, p)     # a steady true wind: loads depend on the heading
     du, dv, dr = accelerations_of(X, Y, N, u, v, r, p)
     dn = shaft_acceleration(u, n, J, p, poly)
-    if p[P_WIND_V] != 0.0:        # a steady true wind (the ``wind`` effect): loads depend on the heading
-        wx, wy, wn = wind_loads(u, v, psi, p)
-        wu, wv, wr = force_accelerations(wx, wy, wn, p)
-        du += wu
-        dv += wv
-        dr += wr
     dx, dy, dpsi = track_of(u, v, r, psi, p)
     return du, dv, dr, dx, dy, dpsi, steering_rate(delta_cmd, delta, p), dn
 

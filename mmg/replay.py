@@ -9,7 +9,9 @@ midship at the samples.  The state is the rigid-body part of :data:`mmg.model.ST
 
 and the right-hand side is :func:`mmg.model.forces_of`, :func:`mmg.model.accelerations_of` and
 :func:`mmg.model.track_of` (the one physics of the simulator, the estimators and the workflow).  Between two samples the step is
-split into equal RK4 sub-steps no longer than ``dt_max``.
+split into equal RK4 sub-steps no longer than ``dt_max``, each the simulator's own step
+(:func:`mmg.kernel.rk4_step`: one integrator for both), and a steady true wind acts through the
+simulator's branch (:func:`mmg.model.with_steady_wind`).
 
 With ``reset`` the state is set back to the measured one at the flagged samples: the prediction
 of each segment then starts from the record (segment-wise output error, multiple shooting).
@@ -20,8 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from ._jit import carray, njit
+from .kernel import rk4_step
 
-from .model import P_L, P_WIND_V, PackedShip, accelerations_of, forces_of, inverse_mass, track_of, wind_loads
+from .model import P_L, PackedShip, accelerations_of, forces_of, inverse_mass, track_of, with_steady_wind
 
 __all__ = ["ReplayInputs", "replay", "replay_states", "default_dt_max", "STATE"]
 
@@ -72,11 +75,7 @@ def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef):
     X, Y, N, _ = forces_of(u, v, r, d, n, p, poly, hull_axis, hull_term, hull_coef)
     du, dv, dr = accelerations_of(X, Y, N, u, v, r, p)
     dx, dy, dpsi = track_of(u, v, r, psi, p)
-    if p[P_WIND_V] != 0.0:          # a steady true wind, from the state (as the simulator's rhs)
-        wx, wy, wn = wind_loads(u, v, psi, p)
-        fx += wx
-        fy += wy
-        fn += wn
+    fx, fy, fn = with_steady_wind(fx, fy, fn, u, v, psi, p)     # the simulator's steady-wind branch
     return (du + minv[0] * fx + minv[1] * fy + minv[2] * fn,
             dv + minv[3] * fx + minv[4] * fy + minv[5] * fn,
             dr + minv[6] * fx + minv[7] * fy + minv[8] * fn, dx, dy, dpsi)
@@ -89,13 +88,30 @@ def _axpy(a, c, b):
             a[5] + c * b[5])
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+ZERO6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _replay_rhs(y, tau, args):
+    """The replay's right-hand side for :func:`mmg.kernel.rk4_step`: :func:`_deriv` with the inputs
+    linear in the sample interval, at the fraction (k + tau) / m of it (sub-step k of m)."""
+    k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef = args
+    a = (k + tau) / m
+    d = delta[i] + a * (delta[i + 1] - delta[i])
+    nn = n[i] + a * (n[i + 1] - n[i])
+    fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
+    fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
+    fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
+    return _deriv(y, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef)
+
+
+@njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis, hull_term, hull_coef, out):
     """RK4 of the dynamics along a record: sub-steps of at most ``dt_max`` between samples, inputs linear
     within a sample interval, the state reset to ``meas`` where ``reset``; fills ``out`` (N, 6), returns the
     number of valid rows."""
     N = t.shape[0]
-    # the state and the RK4 stages as 6-tuples of scalars: kept in registers across the stages
+    # the state as a 6-tuple of scalars (kept in registers across the stages)
     s = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5])
     for j in range(6):
         out[0, j] = s[j]
@@ -107,24 +123,9 @@ def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis,
         if m < 1:
             m = 1
         dt = h / m
-        for k in range(m):
-            a0 = k / m
-            a5 = (k + 0.5) / m
-            a1 = (k + 1.0) / m
-            kst = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-            acc = kst
-            for st in range(4):                  # the RK4 stages: one inlined copy of the model
-                a = a0 if st == 0 else (a5 if st < 3 else a1)
-                c = 0.0 if st == 0 else (0.5 * dt if st < 3 else dt)
-                d = delta[i] + a * (delta[i + 1] - delta[i])
-                nn = n[i] + a * (n[i + 1] - n[i])
-                fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
-                fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
-                fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
-                kst = _deriv(_axpy(s, c, kst), d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term,
-                             hull_coef)
-                acc = _axpy(acc, 1.0 if (st == 0 or st == 3) else 2.0, kst)
-            s = _axpy(s, dt / 6.0, acc)
+        for k in range(m):                       # the simulator's RK4 step (one inlined copy of the model)
+            s = rk4_step(_replay_rhs, _axpy, ZERO6, s, dt,
+                         (k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef))
         ok = True
         for j in range(6):
             if not np.isfinite(s[j]):

@@ -5,7 +5,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .disturbances import combine
+from .disturbances import as_effects
 from .equilibrium import Equilibrium, straight_run, with_kq_scale
 from .integrate import CommandLaw, integrate
 from .model import STATE_NAMES, pack
@@ -51,12 +51,13 @@ class SimulationResult:
 def prepare(ship: Ship, u0: float, n0: float | None = None, trim: bool = True, disturbances=(), effects=None):
     """Solve the straight run and pack the (K_Q-calibrated) ship; returns (packed, equilibrium).
 
-    ``disturbances``: :mod:`mmg.disturbances` components (slots); ``effects``: an
-    :class:`mmg.effects.EffectSet` added to the ship's own (:attr:`mmg.ship.Ship.effects`; a trial's
-    ``effects:`` section).  Measurement effects (a heading bias) act on logs, not here."""
-    es = ship.effect_set().merged(effects)
+    ``effects``: an :class:`mmg.effects.EffectSet` added to the ship's own (:attr:`mmg.ship.Ship.effects`;
+    a trial's ``effects:`` section); ``disturbances``: the alias, :mod:`mmg.disturbances` components
+    turned into the same effects (:func:`mmg.disturbances.as_effects`).  Measurement effects (a
+    heading bias) act on logs, not here."""
+    extra, slots = as_effects(disturbances)
+    es = ship.effect_set().merged(extra).merged(effects)
     es = es if es.items else None
-    slots = combine(disturbances)
     eq = straight_run(ship, u0, n=n0, trim=trim, disturbance_slots=slots, effects=es)
     sh = with_kq_scale(ship, eq.K_Q_scale)
     pk = pack(sh, eq.power_W, slots)
@@ -83,6 +84,8 @@ def simulate(ship: Ship, law: CommandLaw, duration: float, dt: float, u0: float,
     trim : bool
         Start from the trimmed straight run (rudder and drift that cancel Y_0, N_0).
     disturbances : sequence of :class:`mmg.disturbances.Disturbance`
+        Alias of ``effects`` (the same effects, :func:`prepare`), kept for the trial files'
+        ``disturbances:`` section and older scripts.
     effects : mmg.effects.EffectSet, optional
         Effects besides the ship's own (:func:`prepare`).
     """

@@ -51,7 +51,9 @@ class Parameter:
 
     default: the value that switches the effect off (or its neutral value); lower, upper: the
     physically allowed range; sigma: the prior standard deviation a fit uses (wide: a prior
-    that keeps a fit regular, not information); start: where a fit starts."""
+    that keeps a fit regular, not information); start: where a fit starts.  The one prior of the
+    parameter: every estimator reads it through :func:`ekf.identify.effect_prior` (``mmg identify``,
+    ``mmg diagnose`` alike)."""
 
     name: str
     unit: str

@@ -24,6 +24,7 @@ Not fitted: the fit frees ``scale`` only.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -35,11 +36,15 @@ MAX_TRUE_WIND = 60.0
 """Largest steady true wind [m/s] a config may give (a hurricane; beyond it the value is in another unit)."""
 
 
+_SCALE = Parameter("scale", "1", 1.0, 0.0, 10.0, 2.0, "factor on the published wind loads")
+"""The wind scale: 1 (the published loads) when a config names the effect; range and prior width."""
+
+
 class Wind(Effect):
     name = "wind"
     kind = "force"
     description = "wind loads from the measured relative wind"
-    parameters = (Parameter("scale", "1", 1.0, 0.0, 10.0, 2.0, "factor on the published wind loads"),
+    parameters = (_SCALE,
                   Parameter("true_speed_mps", "m/s", 0.0, 0.0, MAX_TRUE_WIND, 5.0,
                             "steady true wind speed (0: the record's measured wind)"),
                   Parameter("true_from_deg", "deg", 0.0, -360.0, 360.0, 180.0,
@@ -49,8 +54,9 @@ class Wind(Effect):
 
     @classmethod
     def fit_parameters(cls):
-        # prior centred on no wind (0), wide; the fit starts from the published loads (1)
-        return (Parameter("scale", "1", 0.0, 0.0, 10.0, 2.0, "factor on the published wind loads", 1.0),)
+        # the same parameter, its prior centred on no wind (0, as every effect's on its neutral value),
+        # wide; the fit starts from the published loads (1).  mmg identify's --free wind_scale is this one
+        return (replace(_SCALE, default=0.0, start=1.0),)
 
     @classmethod
     def from_fit(cls, theta):
@@ -84,7 +90,6 @@ class Wind(Effect):
             return packed
         if ship is None or getattr(ship, "wind", None) is None:
             raise InputError("wind", "true_speed_mps", "a steady wind needs the ship's wind section (its geometry)")
-        from dataclasses import replace
 
         from ..wind import RHO_AIR, amplitude_vector
 

@@ -122,3 +122,29 @@ class TrialRecord:
             if a.shape != b.shape or not np.allclose(a, b, rtol=rtol, atol=atol):
                 return False
         return True
+
+
+def logged_record(t, states, delta, n, effects, noise=None, rng=None, wind_rel=None, **fields) -> TrialRecord:
+    """The one record generator: model states as an on-board system logs them, with hidden effects.
+
+    ``states`` (N, 6) model u, v, r, x, y, psi (:data:`mmg.replay.STATE`) become the logged ones through
+    ``effects`` (:meth:`mmg.effects.EffectSet.to_logged`: u, v over ground resolved in the logged
+    heading, the heading with its bias), plus white noise of std ``noise`` (6 values; none when None)
+    drawn from ``rng``; with ``wind_rel`` (relative speed [m/s], direction [rad], dataset convention)
+    the relative and true wind channels (the true wind from the relative one and the motion over
+    ground).  Used by :meth:`trials.runs.run.TrialRun.record` and :func:`trials.measured.diagnose.synthetic_record`;
+    ``fields`` (name, source, meta, ...) go to the :class:`TrialRecord`."""
+    s = np.asarray(states, float)
+    lg = effects.to_logged(s)
+    if noise is not None:
+        lg = lg + (rng or np.random.default_rng(0)).standard_normal(lg.shape) * np.asarray(noise, float)
+    ch = {}
+    if wind_rel is not None:
+        from mmg.wind import true_wind_from_relative
+
+        og = effects.without(*[e.name for e, _ in effects.items if e.kind == "measurement"]).to_logged(s)
+        ch["wind_speed_rel"], ch["wind_dir_rel"] = wind_rel
+        ch["wind_speed_true"], ch["wind_dir_true"] = true_wind_from_relative(ch["wind_speed_rel"], ch["wind_dir_rel"],
+                                                                             og[:, 0], og[:, 1], og[:, 5])
+    return TrialRecord(t=t, u=lg[:, 0], v=lg[:, 1], r=lg[:, 2], x=lg[:, 3], y=lg[:, 4], psi=lg[:, 5],
+                       U=np.hypot(lg[:, 0], lg[:, 1]), delta=delta, n=n, **fields, **ch)

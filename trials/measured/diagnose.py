@@ -223,22 +223,10 @@ class _Model:
 
 
 MASS_FREE = ("m_x", "m_y", "J_z")
-"""Added masses and the added moment of inertia the diagnosis fits with every model (prior:
-the config value, relative std :data:`MASS_PRIOR_REL`): an added mass a few % off leaves a
-residual (surge speed loss in the turn, sway and yaw lag) that an effect would otherwise take."""
-MASS_PRIOR_REL = 0.2
-
-
-def _mass_free(packed, names):
-    from ekf.identify import FreeParameter
-    from mmg import model as M
-
-    slot = {"m_x": M.P_MX, "m_y": M.P_MY, "J_z": M.P_JZ}
-    out = []
-    for nm in names:
-        v = float(packed.p[slot[nm]])
-        out.append(FreeParameter(nm, "p", slot[nm], v, MASS_PRIOR_REL * v, 0.0, 3.0 * v))
-    return out
+"""Added masses and the added moment of inertia the diagnosis fits with every model (prior: the
+config value, relative std from :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`, the diagnosis's policy
+in the one table of prior widths): an added mass a few % off leaves a residual (surge speed loss in
+the turn, sway and yaw lag) that an effect would otherwise take."""
 
 
 def _ship_values(ship: Ship, free, theta) -> dict:
@@ -258,7 +246,7 @@ def _ship_values(ship: Ship, free, theta) -> dict:
 
 
 def _ship_free(ship: Ship, packed, names=None):
-    from ekf.identify import free_parameters
+    from ekf.identify import DIAGNOSIS_PRIOR_REL_STD, free_parameters
 
     if names is None:
         names = [n for n, t in zip(ship.hull.names, ship.hull.terms) if t in SHIP_FREE_TERMS] + ["w_P0"]
@@ -266,7 +254,7 @@ def _ship_free(ship: Ship, packed, names=None):
     else:
         mass = [n for n in names if n in MASS_FREE]
         names = [n for n in names if n not in MASS_FREE]
-    return free_parameters(packed, ship.hull.names, names) + _mass_free(packed, mass)
+    return free_parameters(packed, ship.hull.names, names + mass, priors=DIAGNOSIS_PRIOR_REL_STD)
 
 
 class _Fitter:
@@ -288,10 +276,7 @@ class _Fitter:
         free = list(self.ship_free) + effect_parameters(effects)
         if start is None:
             x_ship = [f.prior for f in self.ship_free] if start_ship is None else list(start_ship)
-            eff_start = []
-            for e in effects:
-                for q in e.fit_parameters():
-                    eff_start.append(q.default if q.start is None else q.start)
+            eff_start = [f.prior if f.start is None else f.start for f in free[len(self.ship_free):]]
             if start_eff is not None:
                 eff_start[:len(start_eff)] = list(start_eff)
             start = x_ship + eff_start
@@ -653,9 +638,9 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     from mmg.integrate import CommandLaw
     from mmg.replay import ReplayInputs, replay_states
     from mmg.simulation import simulate
-    from mmg.wind import relative_wind_from_true, true_wind_from_relative
+    from mmg.wind import relative_wind_from_true
 
-    from ..files.records import TrialRecord
+    from ..files.records import logged_record
 
     es = effects if isinstance(effects, E.EffectSet) else E.effect_set(effects or {})
     truth = truth_ship or ship
@@ -671,10 +656,10 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
         law = CommandLaw.heading_switch(a, a, -a, 1.0, psi0=0.0)
     else:
         raise ValueError(kind)
-    slots = {}
-    for cls, v in es.items:
-        slots.update(cls.slots(v))
-    sim = simulate(truth, law, T, min(dt, 0.05 * s), U0, trim=False, disturbances=[_Slots(slots)])
+    # the closed-loop run that makes the rudder history has the effects that act on the dynamics
+    # through the parameter vector (current, rudder offset); the record's states are the replay's below
+    sim = simulate(truth, law, T, min(dt, 0.05 * s), U0, trim=False,
+                   effects=E.EffectSet(tuple(it for it in es.items if it[0].slots(it[1]))))
     t = np.arange(0.0, T + 1e-9, dt)
     idx = np.searchsorted(sim.t, t - 1e-9)
     idx = np.minimum(idx, len(sim.t) - 1)
@@ -683,42 +668,27 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     pk = es.pack(pack(truth, sim.equilibrium.power_W), truth)
     wind_on = any(c.name == "wind" for c, _ in es.items)
     Vt, dt_ = true_wind
-    ch = {}
+    wind_rel = None
     if wind_on:
         wind_eff = [(c, v) for c, v in es.items if c.name == "wind"]
         rest = E.EffectSet(tuple(it for it in es.items if it[0].name != "wind"))
         states = replay_states(pk, ReplayInputs(t, delta, n), s0)
         for _ in range(4):
-            lg = rest.to_logged(states)
             # the anemometer is aboard: the relative wind from the true one and the true motion over ground
             og = E.EffectSet(tuple(it for it in rest.items if it[0].kind != "measurement")).to_logged(states)
             Vr, ang = relative_wind_from_true(Vt, dt_, og[:, 0], og[:, 1], states[:, 5])
-            ch = {"wind_speed_rel": Vr, "wind_dir_rel": np.mod(ang, 2 * np.pi)}
-            ctx = E.Context(t=t, delta=delta, n=n, channels=ch, ship=truth)
+            wind_rel = (Vr, np.mod(ang, 2 * np.pi))
+            ctx = E.Context(t=t, delta=delta, n=n, channels=dict(zip(("wind_speed_rel", "wind_dir_rel"), wind_rel)),
+                            ship=truth)
             ext = wind_eff[0][0].external(wind_eff[0][1], ctx)
             states = replay_states(pk, ReplayInputs(t, delta, n, ext), s0)
-        ch["wind_speed_true"], ch["wind_dir_true"] = true_wind_from_relative(ch["wind_speed_rel"], ch["wind_dir_rel"],
-                                                                             og[:, 0], og[:, 1], states[:, 5])
     else:
         states = replay_states(pk, ReplayInputs(t, delta, n), s0)
-    lg = es.to_logged(states)
-    rng = np.random.default_rng(seed)
     sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(9.80665 / L), 0.002 * L,
                                                     0.002 * L, math.radians(0.05)])
-    lg = lg + rng.standard_normal(lg.shape) * sd
-    return TrialRecord(t=t, name=name or f"synthetic_{kind}", source=name or f"synthetic_{kind}",
-                       u=lg[:, 0], v=lg[:, 1], r=lg[:, 2], x=lg[:, 3], y=lg[:, 4], psi=lg[:, 5],
-                       U=np.hypot(lg[:, 0], lg[:, 1]), delta=delta, n=n, meta={"format": "synthetic"}, **ch)
-
-
-@dataclass(frozen=True)
-class _Slots:
-    """Parameter-vector slots as a disturbance for :func:`mmg.simulation.simulate`."""
-
-    values: dict
-
-    def slots(self):
-        return dict(self.values)
+    label = name or f"synthetic_{kind}"
+    return logged_record(t, states, delta, n, es, sd, np.random.default_rng(seed), wind_rel,
+                         name=label, source=label, meta={"format": "synthetic"})
 
 
 def write_frt_csv(rec, path) -> None:

@@ -194,9 +194,11 @@ def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
     """``run`` with its wind loads scaled by a fitted ``wind_scale`` (as the identified ship computes them)."""
     from dataclasses import replace
 
+    from ekf.identify import wind_scaled
+
     if "wind_scale" not in values or run.inputs.ext is None:
         return run
-    return replace(run, inputs=replace(run.inputs, ext=run.inputs.ext * values["wind_scale"]))
+    return replace(run, inputs=wind_scaled(run.inputs, values["wind_scale"]))
 
 
 def _ship_with(ship: Ship, values: dict) -> Ship:

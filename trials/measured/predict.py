@@ -106,11 +106,11 @@ def _wind_loads(ship: Ship, rec: TrialRecord, es) -> tuple[np.ndarray | None, st
     from ..files.logio import require_finite
 
     require_finite(rec, ("wind_speed_rel", "wind_dir_rel"), "the replay with the measured wind")
-    from mmg.wind import angle_from_dataset, wind_forces
+    from mmg.effects import Context
 
-    X, Y, N = wind_forces(rec.wind_speed_rel, angle_from_dataset(rec.wind_dir_rel), ship.wind.particulars(),
-                          scale=float(w["scale"]))
-    return np.column_stack([X, Y, N]), "on"
+    ctx = Context(t=np.asarray(rec.t, float), delta=rec.delta, n=rec.n, ship=ship,
+                  channels={c: getattr(rec, c) for c in ("wind_speed_rel", "wind_dir_rel")})
+    return Wind.external(w, ctx), "on"                 # the wind effect's loads, defined once
 
 
 def measured_run(ship: Ship, rec: TrialRecord, start: float | None = None, wind: bool | None = None) -> MeasuredRun:

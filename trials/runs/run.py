@@ -257,29 +257,16 @@ class TrialRun:
         -------
         trials.files.records.TrialRecord
         """
-        from ..files.records import TrialRecord
+        from ..files.records import logged_record
 
         r, tr = self.result, self.trial
         step = max(1, int(round((interval or tr.log.interval) / tr.dt)))
         sel = slice(0, len(r.t), step)
-        es = tr.logged_effects()
-        lg = es.to_logged(r.states[sel, :6])
-        if noise is not None:
-            rng = np.random.default_rng(tr.log.seed if seed is None else seed)
-            lg = lg + rng.standard_normal(lg.shape) * np.asarray(noise, float)
-        ch = {}
         w = self.apparent_wind()
-        if w is not None:
-            from mmg.wind import true_wind_from_relative
-
-            og = es.without("heading_bias").to_logged(r.states[sel, :6])
-            ch["wind_speed_rel"], ch["wind_dir_rel"] = w[0][sel], w[1][sel]
-            ch["wind_speed_true"], ch["wind_dir_true"] = true_wind_from_relative(ch["wind_speed_rel"], ch["wind_dir_rel"],
-                                                                                 og[:, 0], og[:, 1], og[:, 5])
-        return TrialRecord(t=r.t[sel], name=tr.name, ship=tr.ship.name, source=f"simulation of {tr.name}",
-                           u=lg[:, 0], v=lg[:, 1], r=lg[:, 2], x=lg[:, 3], y=lg[:, 4], psi=lg[:, 5],
-                           U=np.hypot(lg[:, 0], lg[:, 1]), delta=r.delta[sel], n=r.n[sel],
-                           meta={"format": "simulation", "trial": tr.name}, **ch)
+        rng = None if noise is None else np.random.default_rng(tr.log.seed if seed is None else seed)
+        return logged_record(r.t[sel], r.states[sel, :6], r.delta[sel], r.n[sel], tr.logged_effects(), noise, rng,
+                             None if w is None else (w[0][sel], w[1][sel]), name=tr.name, ship=tr.ship.name,
+                             source=f"simulation of {tr.name}", meta={"format": "simulation", "trial": tr.name})
 
     def log_meta(self) -> dict:
         """Header of the log and truth files."""

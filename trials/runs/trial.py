@@ -304,10 +304,7 @@ class Trial:
 
     def current(self):
         """(speed [m/s], direction it sets towards [rad]) of the run's current, (0, 0) without one."""
-        for d in self.disturbances:
-            if isinstance(d, UniformCurrent):
-                return d.speed, d.direction
-        c = self.effect_set().get("current")
+        c = self.logged_effects().get("current")          # the disturbances: alias builds the same effect
         if c is not None:
             return c["speed_mps"], float(np.radians(c["direction_deg"]))
         return 0.0, 0.0
@@ -767,13 +764,12 @@ def _check_approach_rpm(src: str, ap, ship: Ship, label: str, u0: float, n0: flo
       down to the speed that rpm gives (the MMG 2015 convention of a model-scale self-propulsion
       rpm), which must be within :data:`CONSTANT_RPM_FACTOR_MAX` (either way) of the rpm the straight
       run needs and drive it to a speed within the ship's data (Froude number, t_P(u), w_P0(u) in [0, 1))."""
-    from mmg.disturbances import combine
-    from mmg.effects import EffectSet
+    from mmg.disturbances import as_effects
     from mmg.equilibrium import straight_run
 
-    es = ship.effect_set().merged(effects)
+    extra, slots = as_effects(dist)                         # as mmg.simulation.prepare builds them
+    es = ship.effect_set().merged(extra).merged(effects)
     es = es if es.items else None
-    slots = combine(dist)
     pr = ship.propeller
     rpm = f"{ap.rpm} ({n0 * 60:.4g} rpm)" if not ap.rpm.strip().endswith("rpm") else ap.rpm
     try:

@@ -1,0 +1,105 @@
+"""One definition of each effect (issue 25): the estimators take an effect parameter's prior from its
+:class:`mmg.effects.Parameter`, the ship coefficients' prior widths come from one table, the replay's
+measured-wind loads are the ``wind`` effect's, ``disturbances=`` builds the same effects as
+``effects=``, and one function turns model states into a logged record (trial runs and the
+diagnosis's synthetic records alike)."""
+import math
+
+import numpy as np
+import pytest
+
+import mmg
+import mmg.effects as E
+from mmg.model import pack
+
+
+@pytest.fixture(scope="module")
+def ship():
+    return mmg.load_ship("esso_osaka_3m")
+
+
+def test_freed_rudder_offset_and_wind_scale_take_the_effects_priors(ship):
+    """``mmg identify --free rudder_offset wind_scale``: prior width, bounds and start are the effects'
+    own (before: 0.05 rad within +-10 deg, and 1 +- 0.5 within [0, 3], numbers of their own)."""
+    from ekf.identify import free_parameters
+
+    off, wind = free_parameters(pack(ship), ship.hull.names, ["rudder_offset", "wind_scale"])
+    q = E.RudderOffset.parameters[0]
+    assert off.sigma == pytest.approx(math.radians(q.sigma))
+    assert (off.lower, off.upper) == pytest.approx((math.radians(q.lower), math.radians(q.upper)))
+    w = E.Wind.fit_parameters()[0]
+    assert (wind.prior, wind.sigma, wind.lower, wind.upper, wind.start) == (w.default, w.sigma, w.lower, w.upper,
+                                                                           w.start)
+    # the wind effect's named scale and its fit parameter are one Parameter (range and width)
+    named = E.Wind.parameters[0]
+    assert (named.lower, named.upper, named.sigma) == (w.lower, w.upper, w.sigma)
+
+
+def test_coefficient_prior_widths_are_one_table(ship):
+    """Identification and diagnosis read the ship coefficients' prior widths from one table per family
+    (ekf.identify.PRIOR_REL_STD) and the diagnosis's named policy beside it (added masses narrower)."""
+    from ekf.identify import DIAGNOSIS_PRIOR_REL_STD, PRIOR_REL_STD, free_parameters
+    from trials.measured.diagnose import MASS_FREE, _ship_free
+
+    pk = pack(ship)
+    ident = {f.name: f for f in free_parameters(pk, ship.hull.names, ["N_r", *MASS_FREE])}
+    diag = {f.name: f for f in _ship_free(ship, pk)}
+    for nm in MASS_FREE:
+        assert ident[nm].sigma == pytest.approx(PRIOR_REL_STD["mass"] * ident[nm].prior)
+        assert diag[nm].sigma == pytest.approx(DIAGNOSIS_PRIOR_REL_STD["mass"] * diag[nm].prior)
+    assert ident["N_r"].sigma == pytest.approx(max(PRIOR_REL_STD["hull"] * abs(ident["N_r"].prior), 0.01))
+    assert diag["N_r"].sigma == pytest.approx(max(DIAGNOSIS_PRIOR_REL_STD["hull"] * abs(diag["N_r"].prior), 0.01))
+
+
+def test_replay_wind_loads_are_the_wind_effects(ship, monkeypatch):
+    """trials.measured.predict's measured-wind loads are mmg.effects.Wind.external (no second copy): a
+    changed effect changes the replay's loads."""
+    from trials.measured.predict import measured_run
+    from trials.files.records import TrialRecord
+
+    t = np.arange(0.0, 20.0, 0.1)
+    one = np.ones_like(t)
+    rec = TrialRecord(t=t, name="r", source="r", u=0.5 * one, v=0 * one, r=0 * one, x=0.5 * t, y=0 * one,
+                      psi=0 * one, U=0.5 * one, delta=0 * one, n=10 * one, wind_speed_rel=1.5 + 0.1 * np.sin(t),
+                      wind_dir_rel=np.mod(0.3 * t, 2 * np.pi))
+    base = measured_run(ship, rec, wind=True).inputs.ext
+    assert base is not None and np.abs(base).max() > 0
+    orig = E.Wind.external.__func__
+    monkeypatch.setattr(E.Wind, "external", classmethod(lambda cls, v, ctx: 3.0 * orig(cls, v, ctx)))
+    np.testing.assert_allclose(measured_run(ship, rec, wind=True).inputs.ext, 3.0 * base, rtol=1e-12)
+
+
+def test_disturbances_build_the_same_effects(ship):
+    """``simulate(disturbances=...)`` is an alias: the same effects as ``effects=`` (to round-off)."""
+    from mmg.disturbances import RudderOffset, UniformCurrent, as_effects
+    from mmg.integrate import CommandLaw
+    from mmg.simulation import simulate
+
+    dist = [UniformCurrent(0.05, math.radians(40.0)), RudderOffset(math.radians(1.5))]
+    built, slots = as_effects(dist)
+    assert built.names() == ["current", "rudder_offset"] and slots == {}
+    law = CommandLaw.schedule([0.0, 5.0, 5.01, 60.0], [0.0, 0.0, math.radians(20.0), math.radians(20.0)])
+    a = simulate(ship, law, 60.0, 0.05, 0.5, disturbances=dist)
+    es = E.effect_set({"current": {"speed_mps": 0.05, "direction_deg": 40.0}, "rudder_offset": {"offset_deg": 1.5}})
+    b = simulate(ship, law, 60.0, 0.05, 0.5, effects=es)
+    np.testing.assert_allclose(a.states, b.states, rtol=1e-9, atol=1e-9)
+
+
+def test_one_record_generator(ship, monkeypatch):
+    """TrialRun.record and trials.measured.diagnose.synthetic_record both log through trials.files.records.logged_record."""
+    import trials.files.records as R
+    from trials.measured.diagnose import synthetic_record
+
+    calls = []
+    real = R.logged_record
+
+    def spy(*a, **k):
+        calls.append(k.get("name"))
+        return real(*a, **k)
+
+    monkeypatch.setattr(R, "logged_record", spy)
+    rec = synthetic_record(ship, "turning", {"rudder_offset": {"offset_deg": 1.0}}, duration=20.0, name="syn")
+    run = mmg.simulate(mmg.load_trial("zz20"))
+    log = run.record()
+    assert calls == ["syn", run.trial.name]
+    assert len(rec.t) > 10 and len(log.t) > 10
