@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ._jit import interpreted
+from .numdiff import central_jacobian
 from .model import POLY_KQ, N_, PackedShip, forces, pack, polyval, rhs
 from .ship import Ship
 
@@ -78,13 +79,7 @@ def _newton(fun, z0, tol: float = 1e-13, max_iter: int = 50) -> np.ndarray:
     for _ in range(max_iter):
         if not np.all(np.isfinite(f)):
             break
-        J = np.empty((len(f), len(z)))
-        for j in range(len(z)):
-            h = 1e-6 * max(abs(z[j]), 1e-3)
-            zp, zm = z.copy(), z.copy()
-            zp[j] += h
-            zm[j] -= h
-            J[:, j] = (np.asarray(fun(zp)) - np.asarray(fun(zm))) / (2 * h)
+        J = central_jacobian(fun, z, 1e-3, f)
         try:
             step = np.linalg.solve(J, -f)
         except np.linalg.LinAlgError:

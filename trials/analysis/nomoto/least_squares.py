@@ -216,14 +216,10 @@ def fit_least_squares(z: ZigzagData, form: str = "integrated2", fit_bias: bool =
 
 def _delta_method(th, cov, g, names):
     """95 % intervals of g(th) from the covariance of th (numerical Jacobian of g)."""
+    from mmg.numdiff import central_jacobian
+
     g0 = g(th)
-    J = np.empty((len(g0), len(th)))
-    for j in range(len(th)):
-        h = 1e-6 * max(abs(th[j]), 1e-8)
-        xp, xm = th.copy(), th.copy()
-        xp[j] += h
-        xm[j] -= h
-        J[:, j] = (g(xp) - g(xm)) / (2 * h)
+    J = central_jacobian(g, th, 1e-8, g0)
     sd = np.sqrt(np.abs(np.diag(J @ cov @ J.T)))
     return {nm: (float(v - Z95 * e), float(v + Z95 * e)) for nm, v, e in zip(names, g0, sd)}
 

@@ -138,14 +138,8 @@ def fit_output_error(z: ZigzagData, start: Optional[NomotoModel] = None, fit_bia
 
 def _jac(fun, q):
     """Central-difference Jacobian of a vector function."""
-    f0 = fun(q)
-    J = np.empty((len(f0), len(q)))
-    for j in range(len(q)):
-        h = 1e-6 * max(abs(q[j]), 1e-4)
-        a, b = q.copy(), q.copy()
-        a[j] += h
-        b[j] -= h
-        J[:, j] = (fun(a) - fun(b)) / (2 * h)
-    return J
+    from mmg.numdiff import central_jacobian
+
+    return central_jacobian(fun, q, 1e-4)
 
 
