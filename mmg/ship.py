@@ -180,19 +180,26 @@ class Wind:
 
     enabled: whether the replay, the estimators and ``mmg predict`` apply them; coefficients: the
     regression (``"fujiwara1998"``: Fujiwara, Ueno & Nimura 1998, J. SNAJ 183); scale: a factor on
-    all three loads (1 = as published); geometry: the above-water particulars the regression
-    needs (:class:`mmg.wind.WindParticulars`: areas [m^2], lengths and heights [m], L the length
-    over all, the moment arm).
+    all three loads (1 = as published); sway_factor, yaw_factor: further factors on the sway force
+    and the yaw moment (the :class:`mmg.effects.Wind` effect's shape factors, 1 = as published);
+    geometry: the above-water particulars the regression needs (:class:`mmg.wind.WindParticulars`:
+    areas [m^2], lengths and heights [m], L the length over all, the moment arm).
     """
 
     enabled: bool
     coefficients: str
     geometry: "WindParticulars"
     scale: float = 1.0
+    sway_factor: float = 1.0
+    yaw_factor: float = 1.0
 
     def particulars(self):
         """The :class:`mmg.wind.WindParticulars` of this ship."""
         return self.geometry
+
+    def values(self) -> dict:
+        """The wind effect's values this section gives: ``scale``, ``sway_factor``, ``yaw_factor``."""
+        return {"scale": self.scale, "sway_factor": self.sway_factor, "yaw_factor": self.yaw_factor}
 
 
 @dataclass(frozen=True)
@@ -254,7 +261,8 @@ class Ship:
 #                0 < shaft_inertia_coefficient <= 100
 #   effects      {name: {parameter: value}} of mmg.effects (current, wind, rudder_offset,
 #                heading_bias, shallow_water), each parameter within its effect's bounds;
-#                wind needs the wind section; wind.enabled: true is effects: {wind: {scale}};
+#                wind needs the wind section; wind.enabled: true is effects: {wind: {scale,
+#                sway_factor, yaw_factor}} (wind.sway_factor, wind.yaw_factor: 0.2-3, default 1);
 #                a value given twice (wind.scale and effects.wind.scale, even equal) is refused,
 #                and so is effects.wind with wind.enabled: false
 #
@@ -363,6 +371,8 @@ class _Wind(_Strict):
     z_AL: Quantity
     x_AOD: Quantity
     scale: float = 1.0
+    sway_factor: float = 1.0
+    yaw_factor: float = 1.0
 
 
 class _ShipFile(_Strict):
@@ -598,7 +608,16 @@ def _wind(f: _ShipFile, src: str, pa: Particulars) -> Wind | None:
             z_AL=_qty(src, "wind.z_AL", w.z_AL, "length", 0.0, L, lo_open=True),
             x_AOD=_qty(src, "wind.x_AOD", w.x_AOD, "length", -0.5 * L, 0.5 * L)),
         scale=_num(src, "wind.scale", w.scale, 0.0, 10.0),
+        **{k: _num(src, f"wind.{k}", getattr(w, k), q.lower, q.upper) for k, q in _shape_parameters().items()},
     )
+
+
+def _shape_parameters() -> dict:
+    """The wind effect's shape factors (name -> :class:`mmg.effects.Parameter`): their bounds are the effect's."""
+    from .effects import Wind as WindEffect
+    from .effects.wind import SHAPE_FACTORS
+
+    return {q.name: q for q in WindEffect.parameters if q.name in SHAPE_FACTORS}
 
 
 def _build(f: _ShipFile, src: str) -> Ship:
@@ -614,7 +633,7 @@ def _build(f: _ShipFile, src: str) -> Ship:
     wind = _wind(f, src, particulars)
     effects, stated = _effects(f, wind, src)
     if effects is not None and effects.get("wind") is not None:
-        wind = replace(wind, enabled=True, scale=effects.get("wind")["scale"])
+        wind = replace(wind, enabled=True, **{k: effects.get("wind")[k] for k in wind.values()})
     return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
                 steering=steering, engine=engine, source=f.source, wind=wind, effects=effects, stated=stated)
 
@@ -628,8 +647,9 @@ def _effects(f: _ShipFile, wind: Wind | None, src: str):
     from .effects import effect_set, refuse_twice, statements
 
     stated = []
-    if wind is not None and "scale" in f.wind.model_fields_set:
-        stated.append(("wind", "scale", src, "wind.scale", wind.scale))
+    for k, v in (wind.values() if wind is not None else {}).items():     # scale and the shape factors
+        if k in f.wind.model_fields_set:
+            stated.append(("wind", k, src, f"wind.{k}", v))
     if f.effects is None and not (wind is not None and wind.enabled):
         return None, tuple(stated)
     effects = effect_set(f.effects, "effects", src)
@@ -642,10 +662,11 @@ def _effects(f: _ShipFile, wind: Wind | None, src: str):
         if not wind.enabled:
             raise InputError(src, "effects.wind", "switches the wind on and wind.enabled: false switches it off: "
                                                   "give one (wind.enabled: true, or drop effects.wind)")
-        if "scale" not in dict(f.effects["wind"] or {}):            # the wind section's scale (stated or 1)
-            effects = effects.merged(effect_set({"wind": {**effects.get("wind"), "scale": wind.scale}}))
+        given = dict(f.effects["wind"] or {})                       # the wind section's values (stated or 1)
+        effects = effects.merged(effect_set({"wind": {**effects.get("wind"),
+                                                      **{k: v for k, v in wind.values().items() if k not in given}}}))
     elif wind is not None and wind.enabled:                           # wind.enabled: the shorthand
-        effects = effects.merged(effect_set({"wind": {"scale": wind.scale}}))
+        effects = effects.merged(effect_set({"wind": wind.values()}))
     return (effects if effects.items else None), tuple(stated)
 
 

@@ -202,10 +202,31 @@ AMPLITUDES = ("X0", "X1", "X3", "X5", "Y1", "Y3", "Y5", "N1", "N2", "N3")
 """Order of the amplitudes in :func:`amplitude_vector` and :func:`fujiwara_series`."""
 
 
-def amplitude_vector(particulars: WindParticulars = ESSO_OSAKA_MODEL) -> np.ndarray:
-    """The ten Fujiwara amplitudes as an array in the order of :data:`AMPLITUDES`."""
+def amplitude_vector(particulars: WindParticulars = ESSO_OSAKA_MODEL, sway_factor: float = 1.0,
+                     yaw_factor: float = 1.0) -> np.ndarray:
+    """The ten Fujiwara amplitudes as an array in the order of :data:`AMPLITUDES`, with the shape factors.
+
+    The one place the wind effect's shape factors act (:class:`mmg.effects.Wind`): the sway amplitudes
+    Y1, Y3, Y5 times ``sway_factor`` and the yaw amplitudes N1, N2, N3 times ``yaw_factor`` (the series
+    is linear in them, so C_Y and C_N are the published ones times the factors at every angle; C_X
+    unchanged).  Used by :func:`wind_forces` (the replay's loads from the measured wind) and by the
+    simulator's steady wind (the ``P_WIND_AMP`` slots of :mod:`mmg.model`, written by
+    :meth:`mmg.effects.Wind.pack`).
+
+    Parameters
+    ----------
+    particulars : WindParticulars
+        Above-water geometry of the ship.
+    sway_factor, yaw_factor : float
+        Factors on the sway force and the yaw moment (1: as published).
+
+    Returns
+    -------
+    ndarray, shape (10,)
+    """
     A = fujiwara_amplitudes(particulars)
-    return np.array([A[k] for k in AMPLITUDES])
+    f = {"Y": float(sway_factor), "N": float(yaw_factor)}
+    return np.array([A[k] * f.get(k[0], 1.0) for k in AMPLITUDES])
 
 
 def fujiwara_series(c, s, A):
@@ -240,7 +261,8 @@ def fujiwara_series(c, s, A):
 
 
 def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODEL,
-                rho_air: float = RHO_AIR, scale: float = 1.0):
+                rho_air: float = RHO_AIR, scale: float = 1.0, sway_factor: float = 1.0,
+                yaw_factor: float = 1.0):
     """Wind surge force, sway force and yaw moment about midship from the relative wind.
 
     Parameters
@@ -257,6 +279,8 @@ def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODE
         Air density [kg/m^3].
     scale : float
         Overall factor on all three loads (1 = as published).
+    sway_factor, yaw_factor : float
+        Further factors on the sway force and the yaw moment alone (:func:`amplitude_vector`).
 
     Returns
     -------
@@ -277,7 +301,8 @@ def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODE
     if np.any(V < 0):
         raise ValueError("V_rel must be >= 0")
     p = particulars
-    cx, cy, cn = fujiwara_coefficients(angle_rel, p)
+    a = np.asarray(angle_rel, dtype=float)
+    cx, cy, cn = fujiwara_series(np.cos(a), np.sin(a), amplitude_vector(p, sway_factor, yaw_factor))
     q = 0.5 * rho_air * V**2 * scale
     return q * p.A_T * cx, q * p.A_L * cy, q * p.A_L * p.L * cn
 

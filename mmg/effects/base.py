@@ -129,6 +129,13 @@ class Effect(abc.ABC):
         return cls.parameters
 
     @classmethod
+    def presence_parameters(cls) -> tuple:
+        """Names of the fit parameters whose departure from their neutral value means the effect is
+        there (default: every fit parameter; the wind: its scale alone, its shape factors only shape
+        a wind that is there).  :mod:`trials.measured.diagnose` judges an effect present on these."""
+        return tuple(p.name for p in cls.fit_parameters())
+
+    @classmethod
     def from_fit(cls, theta) -> dict:
         """Named values from fitted ones (identity by default)."""
         return {p.name: float(v) for p, v in zip(cls.fit_parameters(), theta)}

@@ -8,10 +8,29 @@ samples, interpolated by the replay.  It needs the relative-wind channels and a 
 section; a record without them skips the effect with that reason.  Records whose wind columns
 are all zero (:meth:`Wind.unavailable`) are skipped too: the scale is then not identifiable.
 
-Only ``scale`` is fitted.  The published set is a regression over many hulls; a second
-parameter (e.g. a separate scale on the yaw moment, the arm of the lateral load) would be
-justified by a record with the wind from many directions and a strong wind; the pond records
-have 1.5-2 m/s apparent wind and cannot separate it from the hull's own yaw moment.
+Fitted: ``scale`` and two shape factors, ``sway_factor`` and ``yaw_factor``: the loads are
+X = scale X_F, Y = scale sway_factor Y_F, N = scale yaw_factor N_F with X_F, Y_F, N_F the published
+regression's (:func:`mmg.wind.amplitude_vector`, the one place the factors act, for the replay's
+measured-wind loads and the simulator's steady wind alike).  The effect stands for *a* wind load,
+not for one regression's numbers: a real ship's side force and, above all, its yaw moment (the arm
+of the lateral load, a small difference of large terms) stray from any regression, so one scale
+cannot stand for them and the misfit would be named as other effects.  Only ``scale`` says whether
+the wind is there (:meth:`Wind.presence_parameters`): with it at 0 the factors do nothing.
+
+The factors' prior (:data:`SHAPE_SIGMA` = 0.35 about 1, bounds 0.2-3): how far a real ship's
+coefficients stray from a regression's.  Owens & Palo (1982), *Wind-induced steady loads on ships*,
+NAVFAC technical report, DTIC ADA119984 (abstract read; the report itself not), fitting 31 ships from
+six independent wind-tunnel series, give the head-wind drag coefficient to 12 % and the peak
+lateral-force coefficient to 10 % within their own data, and the yaw moment only "by inspection"
+of the data (no regression of useful accuracy): the moment, a lateral load times an arm that is a
+small difference of large terms, is the least predictable part.  A factor here also takes up the
+curve's shape over the angles a record sees and the geometry a config guesses (no full-scale
+geometry is published for the bundled ships), so its prior is wider than a regression's fit
+accuracy: 0.35 puts 0.3 and 1.7 at 2 sigma.  The project's own evidence agrees: on the independent
+simulator's logs (issue 26) one scale fitted 0.36-0.82 for one and the same wind.  Further reading
+(not checked here): Haddara & Guedes Soares (1999), Marine Structures 12:199-209, four methods
+compared on one tanker; Ueno, Kitamura, Sogihara & Fujiwara (2012), ACEM'12, the 76 ships behind
+Fujiwara's regression; Blendermann (1994), J. Wind Eng. Ind. Aerodyn. 51:339-351.
 
 A steady true wind (``true_speed_mps`` > 0, coming FROM ``true_from_deg``, clockwise from
 north, the meteorological convention and that of the data set's ``wind_dir_true``) is the
@@ -19,7 +38,7 @@ further parameter pair: a simulation has no anemometer record, so the simulator 
 of a record without wind channels) computes the apparent wind from the true one and the ship's
 own motion at every step (:func:`mmg.model.wind_loads`, the same Fujiwara series).  With a true
 wind given, the logged wind channels are not used (the wind is then what the config says).
-Not fitted: the fit frees ``scale`` only.
+Not fitted: the fit frees ``scale`` and the shape factors only.
 """
 from __future__ import annotations
 
@@ -39,12 +58,21 @@ MAX_TRUE_WIND = 60.0
 _SCALE = Parameter("scale", "1", 1.0, 0.0, 10.0, 2.0, "factor on the published wind loads")
 """The wind scale: 1 (the published loads) when a config names the effect; range and prior width."""
 
+SHAPE_SIGMA = 0.35
+"""Prior standard deviation of the shape factors about 1 (module docstring: how far real ships stray)."""
+
+SHAPE_FACTORS = ("sway_factor", "yaw_factor")
+"""The shape factors' names: optional in a ship's ``wind:`` section and an ``effects: wind`` section."""
+
+_SWAY = Parameter("sway_factor", "1", 1.0, 0.2, 3.0, SHAPE_SIGMA, "further factor on the published sway force")
+_YAW = Parameter("yaw_factor", "1", 1.0, 0.2, 3.0, SHAPE_SIGMA, "further factor on the published yaw moment")
+
 
 class Wind(Effect):
     name = "wind"
     kind = "force"
     description = "wind loads from the measured relative wind"
-    parameters = (_SCALE,
+    parameters = (_SCALE, _SWAY, _YAW,
                   Parameter("true_speed_mps", "m/s", 0.0, 0.0, MAX_TRUE_WIND, 5.0,
                             "steady true wind speed (0: the record's measured wind)"),
                   Parameter("true_from_deg", "deg", 0.0, -360.0, 360.0, 180.0,
@@ -56,11 +84,25 @@ class Wind(Effect):
     def fit_parameters(cls):
         # the same parameter, its prior centred on no wind (0, as every effect's on its neutral value),
         # wide; the fit starts from the published loads (1).  mmg identify's --free wind_scale is this one
-        return (replace(_SCALE, default=0.0, start=1.0),)
+        # the shape factors: prior and start on the published curves (1)
+        return (replace(_SCALE, default=0.0, start=1.0), _SWAY, _YAW)
 
     @classmethod
     def from_fit(cls, theta):
-        return {"scale": float(theta[0])}
+        return {"scale": float(theta[0]), "sway_factor": float(theta[1]), "yaw_factor": float(theta[2])}
+
+    @classmethod
+    def presence_parameters(cls):
+        """Only the scale: at 0 there is no wind whatever the shape factors say."""
+        return ("scale",)
+
+    @classmethod
+    def amplitudes(cls, values, particulars):
+        """The Fujiwara amplitudes with the values' shape factors (:func:`mmg.wind.amplitude_vector`)."""
+        from ..wind import amplitude_vector
+
+        return amplitude_vector(particulars, float(values.get("sway_factor", 1.0)),
+                                float(values.get("yaw_factor", 1.0)))
 
     @classmethod
     def unavailable(cls, ctx: Context):
@@ -91,7 +133,7 @@ class Wind(Effect):
         if ship is None or getattr(ship, "wind", None) is None:
             raise InputError("wind", "true_speed_mps", "a steady wind needs the ship's wind section (its geometry)")
 
-        from ..wind import RHO_AIR, amplitude_vector
+        from ..wind import RHO_AIR
 
         g = ship.wind.particulars()
         p = packed.p.copy()
@@ -99,7 +141,7 @@ class Wind(Effect):
         p[M.P_WIND_FROM] = math.radians(float(values["true_from_deg"]))
         p[M.P_WIND_Q] = 0.5 * RHO_AIR * float(values["scale"])
         p[M.P_WIND_AT], p[M.P_WIND_AL], p[M.P_WIND_ALL] = g.A_T, g.A_L, g.A_L * g.L
-        p[M.P_WIND_AMP:M.P_WIND_AMP + M.N_WIND_AMP] = amplitude_vector(g)
+        p[M.P_WIND_AMP:M.P_WIND_AMP + M.N_WIND_AMP] = cls.amplitudes(values, g)
         return replace(packed, p=p)
 
     @classmethod
@@ -110,5 +152,6 @@ class Wind(Effect):
 
         X, Y, N = wind_forces(np.asarray(ctx.channels["wind_speed_rel"], float),
                               angle_from_dataset(ctx.channels["wind_dir_rel"]), ctx.ship.wind.particulars(),
-                              scale=float(values["scale"]))
+                              scale=float(values["scale"]), sway_factor=float(values.get("sway_factor", 1.0)),
+                              yaw_factor=float(values.get("yaw_factor", 1.0)))
         return np.column_stack([X, Y, N])

@@ -59,7 +59,8 @@ def cmd_diagnose(args) -> int:
             for e, p in d.parameters.items():
                 eff[e] = {k: float(f"{v:.6g}") for k, v in p.items() if math.isfinite(v)}
             if "wind" in eff and data.get("wind") is not None:
-                data["wind"].pop("scale", None)            # the scale is the effect's now
+                for k in ("scale", "sway_factor", "yaw_factor"):  # the scale and shape are the effect's now
+                    data["wind"].pop(k, None)
                 data["wind"]["enabled"] = True             # (effects.wind with enabled: false is refused)
             data["effects"] = eff
         ship_text = "".join(head) + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)

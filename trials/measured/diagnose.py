@@ -316,8 +316,9 @@ def _effect_report(model: _Model, effect, inflate: float):
     cov = corr * np.outer(std, std)
     vals, se = effect.report(th, cov)
     neutral = np.array([q.default for q in effect.fit_parameters()])
+    on = np.array([q.name in effect.presence_parameters() for q in effect.fit_parameters()])  # z: presence only
     with np.errstate(divide="ignore", invalid="ignore"):
-        z = float(np.sqrt(np.sum(((th - neutral) / np.where(std > 0, std, np.inf)) ** 2)))
+        z = float(np.sqrt(np.sum(((th - neutral)[on] / np.where(std > 0, std, np.inf)[on]) ** 2)))
     return vals, se, z
 
 

@@ -90,7 +90,7 @@ def run_effects(ship: Ship, wind: bool | None = None):
     if ship.wind is None:
         raise InputError(ship.source or ship.name, "wind", "wind was asked for but the ship config has no wind section")
     if es.get("wind") is None:
-        es = es.merged(E.effect_set({"wind": {"scale": ship.wind.scale}}))
+        es = es.merged(E.effect_set({"wind": ship.wind.values()}))
     return es
 
 

@@ -860,7 +860,7 @@ def _trial_effects(f: _TrialFile, ship: Ship, src: str, label: str, legacy: list
         if effects.get(eff) is not None:
             raise InputError(src, f"effects.{eff}", f"also given as {_LEGACY[eff]}: give it in one place")
     mine = statements(f.effects, effects, "effects", src)
-    shipped = [st for st in ship.stated if own.get(st[0]) is not None or st[:2] == ("wind", "scale")]
+    shipped = [st for st in ship.stated if own.get(st[0]) is not None or st[0] == "wind"]   # scale, shape factors
     refuse_twice(shipped + mine, src)
     if effects.get("wind") is not None and ship.wind is None:
         raise InputError(src, "effects.wind", f"the wind effect needs a ship with a wind section; {label} has none")
