@@ -116,14 +116,18 @@ def test_factors_in_the_ship_wind_section_reach_the_replay(tmp_path, ship):
 
 @pytest.mark.parametrize("key", ["sway_factor", "yaw_factor"])
 def test_a_shape_factor_given_twice_is_refused(tmp_path, key):
-    def twice(d):
+    def once(d):
+        d["wind"][key] = 1.2
+    assert getattr(mmg.load_ship(_ship_yaml(tmp_path, "once.yaml", once)).wind, key) == 1.2
+
+    def both(d):
         d["wind"][key] = 1.2
         d["effects"] = {"wind": {key: 1.2}}
-    p = _ship_yaml(tmp_path, "twice.yaml", twice)
+    p = _ship_yaml(tmp_path, "both.yaml", both)
     with pytest.raises(InputError) as e:
         mmg.load_ship(p)
     msg = str(e.value)
-    assert "\n" not in msg and str(p) in msg and "twice" in msg and f"wind.{key}" in msg
+    assert "\n" not in msg and str(p) in msg and "given twice" in msg and f"wind.{key}" in msg
 
     def out_of_range(d):
         d["wind"][key] = 30.0
