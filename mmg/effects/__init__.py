@@ -7,7 +7,7 @@ module with an :class:`~mmg.effects.base.Effect` subclass plus one :func:`regist
 name                      kind           parameters
 ========================  =============  =================================================
 ``current``               kinematic      ``speed_mps``, ``direction_deg`` (sets towards)
-``wind``                  force          ``scale``
+``wind``                  force          ``scale``, ``sway_factor``, ``yaw_factor``
 ``rudder_offset``         force          ``offset_deg``
 ``heading_bias``          measurement    ``bias_deg``
 ``shallow_water``         coefficients   ``depth_to_draft``
