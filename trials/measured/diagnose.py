@@ -57,7 +57,7 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-from .diagnose_report import format_rms, format_values
+from .diagnose_report import fmt3, format_rms, format_values
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis",
            "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
@@ -551,7 +551,7 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
         for cls in remaining:
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
             dbic, _, _, _, vals, _, z = results[-1]
-            say(f"  {cls.name}: dBIC {dbic:.1f}, z {z:.1f}, {format_values(cls.name, vals)}")
+            say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
                        "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),

@@ -35,11 +35,11 @@ def along_cross(north, east, ref_north, ref_east):
 
 
 def _nice_factor(x: float) -> float:
-    """The largest of 1, 2, 5, 10, 20, ... not above ``x`` (at least 1)."""
+    """The largest round factor (1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6, 8 times a power of ten) not above ``x``; at least 1."""
     if x <= 1.0:
         return 1.0
     e = 10.0 ** math.floor(math.log10(x))
-    return max(f * e for f in (1.0, 2.0, 5.0) if f * e <= x)
+    return max(f * e for f in (1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0) if f * e <= x)
 
 
 def _along_track_panel(ax, tracks, box_ratio: float):
@@ -59,7 +59,7 @@ def _along_track_panel(ax, tracks, box_ratio: float):
     ax.set_aspect(k, adjustable="datalim")
     if not ax.yaxis_inverted():
         ax.invert_yaxis()                                       # starboard down: the chart turned to the course
-    ax.set_xlabel(f"along-track distance [m], along the mean course {course:03.0f} deg")
+    ax.set_xlabel(f"along-track distance [m], along the mean course {round(course) % 360:03d} deg")
     ax.set_ylabel("cross-track [m], to starboard \u2193")
     ax.grid(True, alpha=0.3)
     return k, course
@@ -103,7 +103,7 @@ def diagnose_figure(diag, i: int):
     tracks = [(m, "logged", dict(color="k", lw=2.4, alpha=0.35)), (b, "before", dict(lw=0.9)),
               (a, "after", dict(lw=0.9, ls="--"))]
     if wide:
-        k, _ = _along_track_panel(ax, tracks, box_ratio=10.0 / (track_h * 0.8))
+        k, _ = _along_track_panel(ax, tracks, box_ratio=3.2)        # the track axes' width / height in this layout
         ax.tick_params(labelsize=7)
         ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
         ax.set_title(f"track against the mean course (segment-wise replay); cross-track scale x{k:g} "
