@@ -279,3 +279,12 @@ def test_zigzag_track_not_a_strip():
     lg = ax.get_legend().get_window_extent()
     assert not ((xy[:, 0] > lg.x0) & (xy[:, 0] < lg.x1) & (xy[:, 1] > lg.y0) & (xy[:, 1] < lg.y1)).any()
     assert "m" in ax.get_xlabel() and "m" in ax.get_ylabel()
+
+
+def test_negative_interval_reads_as_a_range():
+    from trials.measured.diagnose_report import effect_line
+
+    ln = effect_line("heading_bias", {"bias_deg": -1.5234}, {"bias_deg": [-1.6234, -1.4234]},
+                     {"delta_bic": 61.04, "z": 30.2, "false_alarm_probability": 0.0031})
+    assert "bias -1.52 deg" in ln and "-1.62 to -1.42 deg" in ln and "false-alarm p 0.00310" in ln
+    _check_plain([ln])

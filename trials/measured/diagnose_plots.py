@@ -246,7 +246,7 @@ def diagnose_summary_figure(diag):
         ax.tick_params(labelsize=7)
         _mark_records(ax, diag, times, label=k == 0)
         if k == 0:
-            ax.set_title("manoeuvre as logged", fontsize=9, loc="left")
+            ax.set_title("manoeuvre as logged", fontsize=9, loc="right")
     for k, (lab, ch, f) in enumerate(_RESIDUALS):
         ax = fig.add_subplot(gs[k + 2, 0], sharex=ax0)
         unit = lab[lab.index("[") + 1:-1]

@@ -238,7 +238,8 @@ def _range(iv, unit: str) -> str:
         return "any direction"
     if iv is None or iv[0] is None or iv[1] is None:
         return "n/a"
-    return f"{fmt3(iv[0])}-{fmt3(iv[1])}{_unit(unit)}"
+    sep = " to " if iv[0] < 0 or iv[1] < 0 else "-"          # -1.62 to -1.43 deg, not -1.62--1.43
+    return f"{fmt3(iv[0])}{sep}{fmt3(iv[1])}{_unit(unit)}"
 
 
 def effect_line(effect: str, values: dict, intervals: dict, evidence: dict) -> str:
