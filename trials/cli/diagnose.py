@@ -68,22 +68,18 @@ def cmd_diagnose(args) -> int:
         with StagedFile(args.out_ship) if args.out_ship is not None else nullcontext() as tship:
             with StagedOutput(args.plots) if args.plots is not None else nullcontext() as stage:
                 if args.plots is not None:
-                    from ..measured.diagnose_plots import diagnose_figure
+                    from ..measured.diagnose_plots import diagnose_figure, diagnose_summary_figure
 
                     for i, r in enumerate(d.records):       # named after their files (unique: prepare)
                         diagnose_figure(d, i).savefig(stage.path(f"{r.name}.png"))
+                    diagnose_summary_figure(d).savefig(stage.path("diagnosis_summary.png"))
             if tship is not None:
                 tship.write_text(ship_text)
         tmp.write_text(text)
-    b, a = d.rms_before, d.rms_after
-    print(f"named: {', '.join(d.named) or 'nothing'}" + "".join(
-        f"; {e} " + ", ".join(f"{k} {v:.4g} +- {d.standard_errors[e][k]:.2g}" for k, v in p.items())
-        for e, p in d.parameters.items()))
-    print("residual RMS before -> after: " + ", ".join(f"{c} {b[c]:.3g} -> {a[c]:.3g}" for c in b))
-    if d.unexplained:
-        print(f"unexplained: {d.unexplained_description}")
+    for line in d.summary_lines():
+        print(line)
     print(f"wrote {args.json}" + (f", {args.out_ship}" if args.out_ship is not None else "") +
-          (f" and {len(d.records)} plot(s) to {args.plots}" if args.plots is not None else ""))
+          (f" and {len(d.records)} plot(s) and diagnosis_summary.png to {args.plots}" if args.plots is not None else ""))
     return 0
 
 
@@ -95,7 +91,8 @@ def add_parser(sub) -> None:
     p.add_argument("--ship", required=True, help="ship YAML or bundled name (esso_osaka_3m, esso_osaka, ...)")
     p.add_argument("--json", required=True, type=_output_path, help="write the diagnosis to this JSON file")
     p.add_argument("--plots", default=None, metavar="DIR", type=_output_path,
-                   help="also one figure per record, DIR/<name>.png (<name>: the record's file name, as for predict)")
+                   help="also one figure per record, DIR/<name>.png (<name>: the record's file name, as for predict), "
+                        "and DIR/diagnosis_summary.png (manoeuvre, residuals, fitted values with 95 %% intervals)")
     p.add_argument("--out-ship", default=None, metavar="NEW.yaml", type=_output_path,
                    help="write the ship config with the fitted coefficients (and a named wind scale)")
     p.add_argument("--wind", choices=("on", "off"), default=None,

@@ -57,6 +57,8 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
+from .diagnose_report import fmt3, format_rms, format_values
+
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis",
            "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
@@ -340,18 +342,20 @@ def _describe(recs, diffs, noise, rms_after) -> tuple[bool, str, dict]:
     big = [c for c in ("u", "v", "r", "heading") if ratio[c] > UNEXPLAINED_FACTOR]
     if not big:
         return False, "", ratio
+    from .diagnose_report import channel_text
+
     parts = []
     psi = M[:, 5]
     for c in big:
         j = names.index(c)
         e = D[:, j] - D[:, j].mean()
-        desc = [f"{c} residual {ratio[c]:.1f} x its noise level"]
+        desc = [channel_text(c, float(np.sqrt(np.mean(D[:, j] ** 2))), float(noise[j]), float(D[:, j].mean()))]
         # earth-fixed: explained by cos/sin of heading; rudder: by delta
         A = np.column_stack([np.cos(psi), np.sin(psi), np.ones_like(psi)])
         r2_h = _r2(A, D[:, j])
         r2_d = _r2(np.column_stack([delta, np.abs(delta), np.ones_like(delta)]), D[:, j])
         r2_c = 1.0 - float(np.var(e)) / max(float(np.mean(D[:, j] ** 2)), 1e-300)
-        desc.append(f"body-fixed constant {r2_c:.0%}")
+        desc.append(f"its constant part {r2_c:.0%} of the mean square")
         desc.append(f"correlated with heading (earth-fixed) R2 {r2_h:.2f}")
         desc.append(f"with rudder R2 {r2_d:.2f}")
         ws = [r.seg.context.channels.get("wind_speed_rel") if r.seg.context else None for r in recs]
@@ -400,10 +404,26 @@ class Diagnosis:
     seconds: float
     runs: list = field(default_factory=list)
     effects: list = field(default_factory=list)
+    intervals_95: dict = field(default_factory=dict)
+    """{effect: {parameter: [lo, hi] or "any"}} (:func:`trials.measured.diagnose_report.effect_intervals`)."""
+    evidence: dict = field(default_factory=dict)
+    """{effect: {"delta_bic", "z", "false_alarm_probability"}} (:func:`~trials.measured.diagnose_report.effect_evidence`)."""
+    not_identifiable: list = field(default_factory=list)
+    """[{"effect", "confused_with", "correlation", "what_would_separate"}]: effects these records cannot separate."""
+    model_form_mismatch: dict = field(default_factory=dict)
+    """Ship coefficients the fit took far outside their priors (which, how far)."""
+
+    def summary_lines(self) -> list:
+        """The console text (:func:`trials.measured.diagnose_report.summary_lines`)."""
+        from .diagnose_report import summary_lines
+
+        return summary_lines(self)
 
     def to_json(self) -> dict:
         out = {"named_effects": list(self.named), "parameters": self.parameters,
-               "standard_errors": self.standard_errors,
+               "standard_errors": self.standard_errors, "intervals_95": self.intervals_95,
+               "evidence": self.evidence, "not_identifiable": list(self.not_identifiable),
+               "model_form_mismatch": self.model_form_mismatch,
                "rms_before": self.rms_before, "rms_after": self.rms_after, "rms_config": self.rms_config,
                "rms_units": {"u": "m/s", "v": "m/s", "r": "deg/s", "heading": "deg", "position": "m"},
                "unexplained": bool(self.unexplained), "unexplained_description": self.unexplained_description,
@@ -497,7 +517,7 @@ def _baseline(fitter, noise, say):
     fl = np.maximum(rm, np.maximum(noise, 1e-9))
     fitter.scales = Scales(u=fl[0], v=fl[1], r=fl[2], psi=fl[5], pos=float(np.hypot(fl[3], fl[4])) / math.sqrt(2))
     base = fitter.fit([], start_ship=base.theta)
-    say(f"baseline: {_rms(base.diffs)}")
+    say(f"baseline (ship fitted, no effect): residual RMS {format_rms(_rms(base.diffs))}")
     return d_config, base
 
 
@@ -532,7 +552,7 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
         for cls in remaining:
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
             dbic, _, _, _, vals, _, z = results[-1]
-            say(f"  {cls.name}: dBIC {dbic:.1f}, z {z:.1f}, {vals}")
+            say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
                        "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
@@ -604,11 +624,14 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
     current, named, rounds = search
     cand, cand_log = cands
     _, inflate = _taus(current, stride)
-    params, ses = {}, {}
+    from .diagnose_report import effect_estimate, effect_evidence, effect_intervals
+
+    params, ses, ivs = {}, {}, {}
     for cls in current.effects:
         v, s, _ = _effect_report(current, cls, inflate)
         params[cls.name] = v
         ses[cls.name] = s
+        ivs[cls.name] = effect_intervals(cls, *effect_estimate(current, cls, inflate))
     cand_log = cand_log + [{"effect": c.name, "named": c.name in named} for c in cand]
     unexpl, desc, _ = _describe(recs, current.diffs, noise, None)
     ship_vals = _ship_values(ship, current.free[:ns], current.theta[:ns])
@@ -617,7 +640,7 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
                      unexplained_description=desc, candidates=cand_log, rounds=rounds, ship_values=ship_vals,
                      records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
                      pred_after=[r.seg.meas + d for r, d in zip(recs, current.diffs)],
-                     seconds=0.0, effects=current.effects)
+                     seconds=0.0, effects=current.effects, intervals_95=ivs, evidence=effect_evidence(named, rounds))
 
 
 # --------------------------------------------------------------------------- synthetic records
