@@ -1,0 +1,321 @@
+"""What the records cannot tell apart (``mmg diagnose``'s ``not_identifiable``, issue 26).
+
+A candidate effect the forward selection of :func:`trials.measured.diagnose.diagnose` does not
+name is either absent or one the records cannot separate from the ship's own coefficients (or
+another effect): a rudder offset on a single turning circle moves the turn the way a slightly
+different N_delta or N_r would, and the hull terms absorb it.  Such an effect is reported, not
+dropped silently.
+
+For each candidate (and each named effect, as a check) the Fisher information of the records is
+formed at the final model with the candidate added at its start value: the fit's own residual
+(:class:`ekf.identify._SegmentFit`, the same scaled residuals and prior rows the fit minimises)
+differentiated by forward differences, ``I = J^T J / s2``, s2 the residual variance per degree of
+freedom, and the covariance ``C = I^-1`` inflated by the residuals' correlation time as the
+diagnosis's standard errors are.  For the effect's parameter block b:
+
+* the marginal std (others free) is sqrt of the largest eigenvalue of ``C_bb``;
+* the conditional std (others fixed) is that of ``(I_bb)^-1``;
+* the multiple correlation of the block with the rest (its first canonical correlation) is
+  ``R^2 = 1 - 1/lambda``, lambda the largest eigenvalue of ``C_bb I_bb``; for one parameter
+  ``R^2 = 1 - 1/(C_ii (C^-1)_ii)`` and marginal / conditional std = sqrt(lambda) = 1/sqrt(1 - R^2).
+
+**Rule.**  An effect is reported ``not_identifiable`` when it is not named, its marginal 2-sigma
+exceeds its :data:`DETECTION_SIZE` (the records could not have shown it at a size that matters),
+and confounding is the reason: R >= :data:`R_CONFOUNDED` or marginal / conditional std >=
+:data:`STD_RATIO_CONFOUNDED`.  An effect skipped for lack of channels is not assessed.
+
+``what_would_separate``: the information of candidate additional trials (the mirror of a turn,
+a 20/20 zigzag where the records have none, a 35 deg turn where they have none), simulated with the
+config ship (:func:`trials.measured.diagnose.synthetic_record`) and differentiated the same way at
+the same parameters, added to the records'; the trial that brings the effect's marginal std down
+most is named with the std before and after.  Several records diagnosed together share the effect's
+parameters (:func:`ekf.identify.effect_parameters`: ``record`` None), so a second record adds its
+information to the same parameters exactly as here.
+"""
+from __future__ import annotations
+
+import math
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+__all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "block_confounding",
+           "assess", "not_identifiable_lines"]
+
+DETECTION_SIZE = {"rudder_offset": (1.0, "deg"), "heading_bias": (1.0, "deg"), "current": (0.0027, "sqrt(gL)"),
+                  "wind": (0.5, "1"), "shallow_water": (0.3, "1")}
+"""The smallest size of each effect that matters physically, in its fit parameters' unit: the
+size a diagnosis should be able to show (issue 26's acceptance sizes).  rudder_offset: 1 deg of
+blade against indicated angle; heading_bias: 1 deg of logged against true heading; current: 0.0027
+sqrt(g L) in its worst-determined direction (3 % of a trial speed of Froude number 0.09: 0.15 m/s at
+325 m, 0.015 m/s for the 3 m model), a drift of 0.27 L per 100 s at full scale; wind: 0.5 on the scale
+of the published loads; shallow_water: T/H 0.3 (H/T 3.3, where the hull forces start to change
+by several per cent).  An effect whose marginal 2-sigma on the records exceeds this size could
+have been present at a size that matters without being named."""
+R_CONFOUNDED = 0.9
+"""Multiple correlation of the effect's parameters with the rest above which confounding, not
+noise, is why the effect cannot be shown."""
+STD_RATIO_CONFOUNDED = 3.0
+"""Marginal / conditional std above which the same holds (equivalent to R >= 0.943)."""
+_CONFUSED_MIN = 0.5
+"""|correlation| of another parameter with the effect's worst direction to be named as confused with it."""
+
+
+def detection_size(effect: str, L: float) -> float:
+    """The :data:`DETECTION_SIZE` of ``effect`` in its fit unit for a ship of length ``L`` [m]
+    (inf for an effect not in the table)."""
+    v, unit = DETECTION_SIZE.get(effect, (math.inf, "1"))
+    return v * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else v
+
+
+def block_confounding(cov: np.ndarray, idx) -> dict:
+    """Confounding of the parameters ``idx`` with the rest, from the posterior covariance ``cov``.
+
+    Returns
+    -------
+    dict
+        ``R``: the multiple (first canonical) correlation of the block with the other parameters;
+        ``ratio``: marginal / conditional std along the worst direction (sqrt(1 / (1 - R^2)));
+        ``sd``: the largest marginal std of the block; ``sd_conditional``: the conditional std
+        along the worst direction; ``direction``: that direction (unit vector in the block);
+        ``corr``: the correlation of each parameter with the block's worst linear combination.
+    """
+    from scipy.linalg import eigh
+
+    cov = np.asarray(cov, float)
+    idx = list(idx)
+    info = sym_inv(cov)
+    Cb = cov[np.ix_(idx, idx)]
+    Ib = info[np.ix_(idx, idx)]
+    lam, vec = eigh(Cb, np.linalg.inv(Ib))          # C_bb a = lambda I_bb^-1 a
+    a = vec[:, -1] / np.linalg.norm(vec[:, -1])
+    lam_max = float(max(lam[-1], 1.0))
+    sd_dir = math.sqrt(float(a @ Cb @ a))
+    cross = cov[:, idx] @ a
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cross / (sd_dir * np.sqrt(np.diag(cov)))
+    return {"R": math.sqrt(max(0.0, 1.0 - 1.0 / lam_max)), "ratio": math.sqrt(lam_max),
+            "sd": math.sqrt(float(np.linalg.eigvalsh(Cb)[-1])), "sd_conditional": sd_dir / math.sqrt(lam_max),
+            "direction": a, "corr": np.nan_to_num(corr)}
+
+
+def sym_inv(A: np.ndarray) -> np.ndarray:
+    """Inverse of a symmetric positive definite ``A`` whose parameters differ by many orders of
+    magnitude (added masses in kg beside primed derivatives): inverted in the scaled form
+    D A D, D = diag(A)^-1/2, so that the scale does not cost the precision."""
+    A = np.asarray(A, float)
+    d = 1.0 / np.sqrt(np.abs(np.diag(A)))
+    return d[:, None] * np.linalg.inv(A * np.outer(d, d)) * d[None, :]
+
+
+# --------------------------------------------------------------------------- information
+
+
+class _Info:
+    """Fisher information of the fit's residuals of some records at one parameter vector."""
+
+    def __init__(self, fitter, stride):
+        self.fitter, self.stride = fitter, stride
+
+    def jacobian(self, segs, effects, free, theta):
+        """(J of the scaled residuals without the prior rows, the residuals, the prior rows' count)."""
+        from ekf.identify import FitOptions, _SegmentFit
+
+        f = self.fitter
+        opts = FitOptions(stride=self.stride, effects=list(effects) or None, ship=f.ship)
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            sf = _SegmentFit(f.packed, segs, free, f.scales, opts, pool)
+            J = sf.jac(np.asarray(theta, float))
+            r = sf.resid(np.asarray(theta, float))
+        n = len(free)
+        return J[:-n], r[:-n], sf.sig0
+
+    def records(self, effects, free, theta):
+        """(information of the records with the prior, s2)."""
+        J, r, sig0 = self.jacobian([p.seg for p in self.fitter.recs], effects, free, theta)
+        prior = (np.asarray(theta) - np.array([q.prior for q in free])) / sig0
+        dof = max(len(r), 1)                      # residual rows + prior rows - parameters, as the fit's
+        s2 = float(r @ r + prior @ prior) / dof
+        return (J.T @ J + np.diag(1.0 / sig0 ** 2)) / s2, s2
+
+
+def _setup(current, cls, ns):
+    """(effects, free, theta) of the final model with ``cls`` added at its start value (as is when named)."""
+    from ekf.identify import effect_parameters
+
+    effects = list(current.effects)
+    theta = list(current.theta)
+    if cls not in effects:
+        effects.append(cls)
+        theta += [f.prior if f.start is None else f.start for f in effect_parameters([cls])]
+    free = list(current.free[:ns]) + effect_parameters(effects)
+    return effects, free, np.array(theta, float)
+
+
+# --------------------------------------------------------------------------- trials that would separate
+
+
+def _kinds(recs):
+    """Each record's manoeuvre: ("turn", +1 starboard / -1 port) or ("zigzag", 0) or ("other", 0)."""
+    out = []
+    for p in recs:
+        d = np.asarray(p.seg.inputs.delta, float)
+        big = d[np.abs(d) > math.radians(5.0)]
+        if len(big) < 0.2 * len(d):
+            out.append(("other", 0))
+            continue
+        pos = float(np.mean(big > 0))
+        out.append(("turn", 1 if pos > 0.5 else -1) if min(pos, 1.0 - pos) < 0.05 else ("zigzag", 0))
+    return out
+
+
+def _trial_specs(recs, L):
+    """(label, synthetic_record kwargs) of the trials that could add what the records lack."""
+    s = math.sqrt(L / 9.80665)
+    kinds = _kinds(recs)
+    turns = {sg for k, sg in kinds if k == "turn"}
+    specs = []
+    for sg in (1, -1):
+        if sg in turns and -sg not in turns:
+            rec = recs[[k for k in kinds].index(("turn", sg))]
+            amp = round(math.degrees(float(np.max(np.abs(rec.seg.inputs.delta)))))
+            side = "port" if sg > 0 else "starboard"
+            T = float(rec.seg.inputs.t[-1] - rec.seg.inputs.t[0])
+            specs.append((f"a {amp} deg {side} turn", dict(kind="turning", rudder_deg=-sg * amp, duration=T)))
+    if not any(k == "zigzag" for k, _ in kinds):
+        specs.append(("a 20/20 zigzag", dict(kind="zigzag", rudder_deg=20.0, duration=330.0 * s)))
+    if not turns:
+        specs.append(("a 35 deg starboard turn", dict(kind="turning", rudder_deg=35.0, duration=250.0 * s)))
+    return specs
+
+
+def _trial_segments(fitter, specs, segment_s):
+    """The candidate trials simulated with the config ship at the records' approach speed, prepared."""
+    from .diagnose import prepare, synthetic_record
+
+    recs = fitter.recs
+    U = float(np.median([math.hypot(p.seg.meas[0, 0], p.seg.meas[0, 1]) for p in recs]))
+    dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
+    out = []
+    for label, kw in specs:
+        rec = synthetic_record(fitter.ship, effects=None, speed=U, dt=dt, seed=0, name=f"trial{len(out)}", **kw)
+        out.append((label, prepare(fitter.ship, [rec], segment_s=segment_s)[0].seg))
+    return out
+
+
+def _separation(info_fn, trials, effects, free, theta, info_rec, s2, idx, inflate, cls):
+    """(text, [(label, sd)]): the trial that brings the effect's marginal std down most."""
+    sd0 = block_confounding(sym_inv(info_rec) * inflate ** 2, idx)["sd"]
+    res = []
+    for label, seg in trials:
+        if seg.context is not None and cls.unavailable(seg.context):
+            continue
+        J, _, _ = info_fn.jacobian([seg], effects, free, theta)
+        cov = sym_inv(info_rec + J.T @ J / s2) * inflate ** 2
+        res.append((label, block_confounding(cov, idx)["sd"]))
+    unit = _unit(cls)
+    if not res:
+        return "no trial of those tried (mirrored turn, zigzag, turn) informs it: a record with its channels", res
+    label, sd = min(res, key=lambda t: t[1])
+    text = f"{label} with {'these' if len(info_fn.fitter.recs) > 1 else 'this one'}: sd {_fmt(sd0)} -> {_fmt(sd)} {unit}"
+    if sd > 0.7 * sd0:
+        text = f"none of the trials tried separates it well (best: {text})"
+    return text, res
+
+
+def _unit(cls) -> str:
+    u = cls.fit_parameters()[0].unit
+    return "" if u == "1" else u
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.2g}" if abs(x) < 1 else f"{x:.3g}"
+
+
+# --------------------------------------------------------------------------- the assessment
+
+
+def assess(fitter, current, named, cand, ns: int, stride: int, inflate: float, segment_s=None, say=None):
+    """The identifiability of every candidate effect on the records of ``fitter``.
+
+    Parameters
+    ----------
+    fitter : trials.measured.diagnose._Fitter
+        The diagnosis's fitter (ship, packed ship, records, residual scales).
+    current : trials.measured.diagnose._Model
+        The final model of the search.
+    named : list of str
+        The named effects.
+    cand : list
+        The candidate effect classes (those skipped for lack of channels are not among them).
+    ns : int
+        Number of ship parameters at the head of ``current.free``.
+    stride : int
+        The fits' sample stride.
+    inflate : float
+        The standard-error inflation of the residuals' correlation (the diagnosis's).
+    segment_s : float, optional
+        The diagnosis's segment length (the candidate trials are cut alike).
+    say : callable, optional
+        Progress lines.
+
+    Returns
+    -------
+    (list of dict, list of dict)
+        The ``not_identifiable`` entries (module docstring) and, for every candidate, its figures
+        (effect, named, correlation, std, std_conditional, detection_size, confused_with).
+    """
+    say = say or (lambda m: None)
+    L = fitter.ship.particulars.L
+    info_fn = _Info(fitter, stride)
+    entries, table, trials = [], [], None
+    for cls in cand:
+        effects, free, theta = _setup(current, cls, ns)
+        try:
+            info_rec, s2 = info_fn.records(effects, free, theta)
+            idx = [i for i, f in enumerate(free) if f.kind == "effect" and f.index == effects.index(cls)]
+            b = block_confounding(sym_inv(info_rec) * inflate ** 2, idx)
+        except (np.linalg.LinAlgError, ValueError) as e:
+            say(f"identifiability of {cls.name}: not assessed ({e})")
+            continue
+        others = [(abs(c), _name(free[j])) for j, c in enumerate(b["corr"]) if j not in idx]
+        confused = []
+        for c, nm in sorted(others, reverse=True):
+            if c >= _CONFUSED_MIN and nm not in confused and len(confused) < 3:
+                confused.append(nm)
+        det = detection_size(cls.name, L)
+        row = {"effect": cls.name, "named": cls.name in named, "correlation": round(b["R"], 3),
+               "std": float(f"{b['sd']:.3g}"), "std_conditional": float(f"{b['sd_conditional']:.3g}"),
+               "detection_size": float(f"{det:.3g}"), "unit": _unit(cls), "confused_with": confused}
+        table.append(row)
+        say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
+            f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
+        confounded = b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED
+        if cls.name in named or not (2.0 * b["sd"] > det and confounded):
+            continue
+        if trials is None:
+            trials = _trial_segments(fitter, _trial_specs(fitter.recs, L), segment_s)
+        text, res = _separation(info_fn, trials, effects, free, theta, info_rec, s2, idx, inflate, cls)
+        entries.append({"effect": cls.name, "confused_with": confused or [_name(free[j]) for j in
+                                                                           np.argsort(-np.abs(b["corr"]))[:1]],
+                        "correlation": round(b["R"], 3), "what_would_separate": text,
+                        "std": row["std"], "std_conditional": row["std_conditional"], "detection_size": row["detection_size"],
+                        "unit": row["unit"], "trials": [{"trial": lb, "std": float(f"{sd:.3g}")} for lb, sd in res]})
+    return entries, table
+
+
+def _name(f) -> str:
+    """A free parameter's name as a reader knows it: a hull or ship constant by name, an effect by the effect's."""
+    return f.name.split(".")[0] if f.kind == "effect" else f.name
+
+
+def not_identifiable_lines(entries) -> list[str]:
+    """One console line per ``not_identifiable`` entry."""
+    out = []
+    for e in entries:
+        unit = f" {e['unit']}" if e.get("unit") else ""
+        sd = f"sd {_fmt(e['std'])}{unit} (2 sd above the {_fmt(e['detection_size'])}{unit} it should show), " \
+            if "std" in e else ""
+        out.append(f"not identifiable: {e['effect']} ({sd}correlation {e['correlation']:.2f} with "
+                   f"{', '.join(e['confused_with'])}); would separate: {e['what_would_separate']}")
+    return out
