@@ -78,6 +78,10 @@ def cmd_diagnose(args) -> int:
     print(f"named: {', '.join(d.named) or 'nothing'}" + "".join(
         f"; {e} " + ", ".join(f"{k} {v:.4g} +- {d.standard_errors[e][k]:.2g}" for k, v in p.items())
         for e, p in d.parameters.items()))
+    from ..measured.identifiability import not_identifiable_lines
+
+    for line in not_identifiable_lines(d.not_identifiable):
+        print(line)
     print("residual RMS before -> after: " + ", ".join(f"{c} {b[c]:.3g} -> {a[c]:.3g}" for c in b))
     if d.unexplained:
         print(f"unexplained: {d.unexplained_description}")

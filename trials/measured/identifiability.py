@@ -19,10 +19,12 @@ diagnosis's standard errors are.  For the effect's parameter block b:
   ``R^2 = 1 - 1/lambda``, lambda the largest eigenvalue of ``C_bb I_bb``; for one parameter
   ``R^2 = 1 - 1/(C_ii (C^-1)_ii)`` and marginal / conditional std = sqrt(lambda) = 1/sqrt(1 - R^2).
 
-**Rule.**  An effect is reported ``not_identifiable`` when it is not named, its marginal 2-sigma
-exceeds its :data:`DETECTION_SIZE` (the records could not have shown it at a size that matters),
-and confounding is the reason: R >= :data:`R_CONFOUNDED` or marginal / conditional std >=
-:data:`STD_RATIO_CONFOUNDED`.  An effect skipped for lack of channels is not assessed.
+**Rule.**  An effect is reported ``not_identifiable`` when it is not named, its marginal std times
+the naming z threshold (:data:`trials.measured.diagnose.Z_THRESHOLD`, 3; never less than 2)
+exceeds its :data:`DETECTION_SIZE` (the records could not have named it at a size that matters:
+an effect of that size would have been within the threshold's z of nothing), and confounding is the
+reason: R >= :data:`R_CONFOUNDED` or marginal / conditional std >= :data:`STD_RATIO_CONFOUNDED`.
+An effect skipped for lack of channels is not assessed.
 
 ``what_would_separate``: the information of candidate additional trials (the mirror of a turn,
 a 20/20 zigzag where the records have none, a 35 deg turn where they have none), simulated with the
@@ -43,14 +45,14 @@ __all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_
            "assess", "not_identifiable_lines"]
 
 DETECTION_SIZE = {"rudder_offset": (1.0, "deg"), "heading_bias": (1.0, "deg"), "current": (0.0027, "sqrt(gL)"),
-                  "wind": (0.5, "1"), "shallow_water": (0.3, "1")}
+                  "wind": (0.5, "1"), "shallow_water": (0.5, "1")}
 """The smallest size of each effect that matters physically, in its fit parameters' unit: the
 size a diagnosis should be able to show (issue 26's acceptance sizes).  rudder_offset: 1 deg of
 blade against indicated angle; heading_bias: 1 deg of logged against true heading; current: 0.0027
 sqrt(g L) in its worst-determined direction (3 % of a trial speed of Froude number 0.09: 0.15 m/s at
 325 m, 0.015 m/s for the 3 m model), a drift of 0.27 L per 100 s at full scale; wind: 0.5 on the scale
-of the published loads; shallow_water: T/H 0.3 (H/T 3.3, where the hull forces start to change
-by several per cent).  An effect whose marginal 2-sigma on the records exceeds this size could
+of the published loads; shallow_water: T/H 0.5 (H/T 2, where the hull derivatives have changed by
+tens of per cent).  An effect whose marginal 2-sigma on the records exceeds this size could
 have been present at a size that matters without being named."""
 R_CONFOUNDED = 0.9
 """Multiple correlation of the effect's parameters with the rest above which confounding, not
@@ -118,7 +120,7 @@ class _Info:
         self.fitter, self.stride = fitter, stride
 
     def jacobian(self, segs, effects, free, theta):
-        """(J of the scaled residuals without the prior rows, the residuals, the prior rows' count)."""
+        """(J of the fit's scaled residuals of ``segs`` without the prior rows, the prior stds)."""
         from ekf.identify import FitOptions, _SegmentFit
 
         f = self.fitter
@@ -126,30 +128,34 @@ class _Info:
         with ThreadPoolExecutor(max_workers=2) as pool:
             sf = _SegmentFit(f.packed, segs, free, f.scales, opts, pool)
             J = sf.jac(np.asarray(theta, float))
-            r = sf.resid(np.asarray(theta, float))
-        n = len(free)
-        return J[:-n], r[:-n], sf.sig0
+        return J[:-len(free)], sf.sig0
 
-    def records(self, effects, free, theta):
-        """(information of the records with the prior, s2)."""
-        J, r, sig0 = self.jacobian([p.seg for p in self.fitter.recs], effects, free, theta)
-        prior = (np.asarray(theta) - np.array([q.prior for q in free])) / sig0
-        dof = max(len(r), 1)                      # residual rows + prior rows - parameters, as the fit's
-        s2 = float(r @ r + prior @ prior) / dof
-        return (J.T @ J + np.diag(1.0 / sig0 ** 2)) / s2, s2
+    def records(self, effects, free, theta, s2):
+        """The information of the records with the prior (the fit's residual variance ``s2``)."""
+        J, sig0 = self.jacobian([p.seg for p in self.fitter.recs], effects, free, theta)
+        return (J.T @ J + np.diag(1.0 / sig0 ** 2)) / s2
 
 
-def _setup(current, cls, ns):
-    """(effects, free, theta) of the final model with ``cls`` added at its start value (as is when named)."""
+def _setup(current, cls, ns, L):
+    """(effects, free, theta, s2) of the final model with ``cls`` added (as is when named): its
+    parameters at their fit start values, a one-parameter effect at least its detection size from
+    its neutral value (the size the question is about: shallow water's forces are not linear in
+    T/H); s2 the final fit's residual variance per degree of freedom (the one its standard errors use)."""
     from ekf.identify import effect_parameters
 
     effects = list(current.effects)
     theta = list(current.theta)
     if cls not in effects:
         effects.append(cls)
-        theta += [f.prior if f.start is None else f.start for f in effect_parameters([cls])]
+        new = effect_parameters([cls])
+        x = [f.prior if f.start is None else f.start for f in new]
+        if len(new) == 1 and abs(x[0] - new[0].prior) < detection_size(cls.name, L):
+            x[0] = min(new[0].prior + detection_size(cls.name, L), new[0].upper)
+        theta += x
     free = list(current.free[:ns]) + effect_parameters(effects)
-    return effects, free, np.array(theta, float)
+    fit = current.fit
+    s2 = 2.0 * float(fit.cost_final) / max(fit.n_residuals - len(fit.free), 1)
+    return effects, free, np.array(theta, float), s2
 
 
 # --------------------------------------------------------------------------- trials that would separate
@@ -210,7 +216,7 @@ def _separation(info_fn, trials, effects, free, theta, info_rec, s2, idx, inflat
     for label, seg in trials:
         if seg.context is not None and cls.unavailable(seg.context):
             continue
-        J, _, _ = info_fn.jacobian([seg], effects, free, theta)
+        J, _ = info_fn.jacobian([seg], effects, free, theta)
         cov = sym_inv(info_rec + J.T @ J / s2) * inflate ** 2
         res.append((label, block_confounding(cov, idx)["sd"]))
     unit = _unit(cls)
@@ -265,14 +271,16 @@ def assess(fitter, current, named, cand, ns: int, stride: int, inflate: float, s
         The ``not_identifiable`` entries (module docstring) and, for every candidate, its figures
         (effect, named, correlation, std, std_conditional, detection_size, confused_with).
     """
+    from .diagnose import Z_THRESHOLD as z_name
+
     say = say or (lambda m: None)
     L = fitter.ship.particulars.L
     info_fn = _Info(fitter, stride)
     entries, table, trials = [], [], None
     for cls in cand:
-        effects, free, theta = _setup(current, cls, ns)
+        effects, free, theta, s2 = _setup(current, cls, ns, L)
         try:
-            info_rec, s2 = info_fn.records(effects, free, theta)
+            info_rec = info_fn.records(effects, free, theta, s2)
             idx = [i for i, f in enumerate(free) if f.kind == "effect" and f.index == effects.index(cls)]
             b = block_confounding(sym_inv(info_rec) * inflate ** 2, idx)
         except (np.linalg.LinAlgError, ValueError) as e:
@@ -291,7 +299,7 @@ def assess(fitter, current, named, cand, ns: int, stride: int, inflate: float, s
         say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
             f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
         confounded = b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED
-        if cls.name in named or not (2.0 * b["sd"] > det and confounded):
+        if cls.name in named or not (max(2.0, z_name) * b["sd"] > det and confounded):
             continue
         if trials is None:
             trials = _trial_segments(fitter, _trial_specs(fitter.recs, L), segment_s)
@@ -314,8 +322,7 @@ def not_identifiable_lines(entries) -> list[str]:
     out = []
     for e in entries:
         unit = f" {e['unit']}" if e.get("unit") else ""
-        sd = f"sd {_fmt(e['std'])}{unit} (2 sd above the {_fmt(e['detection_size'])}{unit} it should show), " \
-            if "std" in e else ""
+        sd = f"sd {_fmt(e['std'])}{unit}: could not have shown {_fmt(e['detection_size'])}{unit}; " if "std" in e else ""
         out.append(f"not identifiable: {e['effect']} ({sd}correlation {e['correlation']:.2f} with "
                    f"{', '.join(e['confused_with'])}); would separate: {e['what_would_separate']}")
     return out
