@@ -221,7 +221,9 @@ def _separation(info_fn, trials, effects, free, theta, info_rec, s2, idx, inflat
         res.append((label, block_confounding(cov, idx)["sd"]))
     unit = _unit(cls)
     if not res:
-        return "no trial of those tried (mirrored turn, zigzag, turn) informs it: a record with its channels", res
+        why = ("no candidate trial informs it without its channels" if trials else
+               "the records already hold turns both ways and a zigzag")
+        return f"{why}: a longer record, or one where the effect is larger", res
     label, sd = min(res, key=lambda t: t[1])
     text = f"{label} with {'these' if len(info_fn.fitter.recs) > 1 else 'this one'}: sd {_fmt(sd0)} -> {_fmt(sd)} {unit}"
     if sd > 0.7 * sd0:
