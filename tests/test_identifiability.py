@@ -151,3 +151,22 @@ def test_dev_single_turn_offset_reported(stem):
         ent = {e["effect"]: e for e in d.to_json()["not_identifiable"]}
         assert "rudder_offset" in ent
         assert set(ent["rudder_offset"]["confused_with"]) <= set(ship.hull.names) | {"w_P0", "m_x", "m_y", "J_z"}
+
+
+def test_trial_advice_with_a_named_wind_in_the_model(monkeypatch):
+    """A wind named in the model (the 3 m model's turn with a wind and a rudder offset): the candidate
+    trials, simulated without wind channels, are replayed in calm air, and the advice is still formed
+    (detection size lowered so that the heading bias is reported and the trial path runs)."""
+    import trials.measured.identifiability as I
+    from mmg.ship import load_ship
+    from trials.measured.diagnose import diagnose, synthetic_record
+
+    ship = load_ship("esso_osaka_3m")
+    rec = synthetic_record(ship, "turning", {"wind": {"scale": 1.0}, "rudder_offset": {"offset_deg": 1.0}},
+                           true_wind=(3.0, math.radians(40.0)), seed=1, name="t", rudder_deg=35.0)
+    monkeypatch.setitem(I.DETECTION_SIZE, "heading_bias", (1e-3, "deg"))
+    d = diagnose(ship, [rec])
+    assert "wind" in d.named
+    ent = {e["effect"]: e for e in d.not_identifiable}["heading_bias"]
+    assert {t["trial"] for t in ent["trials"]} == {"a 35 deg port turn", "a 20/20 zigzag"}
+    assert all(t["std"] < ent["std"] for t in ent["trials"])

@@ -197,6 +197,8 @@ def _trial_specs(recs, L):
 
 def _trial_segments(fitter, specs, segment_s):
     """The candidate trials simulated with the config ship at the records' approach speed, prepared."""
+    from dataclasses import replace
+
     from .diagnose import prepare, synthetic_record
 
     recs = fitter.recs
@@ -205,6 +207,8 @@ def _trial_segments(fitter, specs, segment_s):
     out = []
     for label, kw in specs:
         rec = synthetic_record(fitter.ship, effects=None, speed=U, dt=dt, seed=0, name=f"trial{len(out)}", **kw)
+        calm = np.zeros_like(rec.t)              # a trial in calm air: a named wind effect's loads are zero in it
+        rec = replace(rec, wind_speed_rel=calm, wind_dir_rel=calm)
         out.append((label, prepare(fitter.ship, [rec], segment_s=segment_s)[0].seg))
     return out
 
