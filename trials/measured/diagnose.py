@@ -593,7 +593,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
     res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
                      o.stride)
-    res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, len(sfree), o)
+    res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o)
     res.seconds = time.perf_counter() - t0
     if o.per_run and len(recs) > 1:
         res.runs = [diagnose(ship, [r], replace(o, per_run=False, say=None)) for r in recs]
@@ -601,12 +601,12 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     return res
 
 
-def _identifiability(fitter, current, named, cand, ns, o: DiagnoseOptions):
+def _identifiability(fitter, current, named, cand, o: DiagnoseOptions):
     """(not_identifiable entries, every candidate's figures): :func:`trials.measured.identifiability.assess`."""
     from .identifiability import assess
 
     _, inflate = _taus(current, o.stride)
-    return assess(fitter, current, named, cand, ns, o.stride, inflate, o.segment_s, o.say)
+    return assess(fitter, current, named, cand, inflate, o.segment_s, o.say)
 
 
 def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int) -> Diagnosis:

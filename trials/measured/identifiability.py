@@ -213,8 +213,10 @@ def _trial_segments(fitter, specs, segment_s):
     return out
 
 
-def _separation(info_fn, trials, effects, free, theta, info_rec, s2, idx, inflate, cls):
-    """(text, [(label, sd)]): the trial that brings the effect's marginal std down most."""
+def _separation(info_fn, trials, setup, info_rec, idx, inflate, cls):
+    """(text, [(label, sd)]): the trial that brings the effect's marginal std down most; ``setup`` the
+    (effects, free, theta, s2) of :func:`_setup`."""
+    effects, free, theta, s2 = setup
     sd0 = block_confounding(sym_inv(info_rec) * inflate ** 2, idx)["sd"]
     res = []
     for label, seg in trials:
@@ -247,23 +249,20 @@ def _fmt(x: float) -> str:
 # --------------------------------------------------------------------------- the assessment
 
 
-def assess(fitter, current, named, cand, ns: int, stride: int, inflate: float, segment_s=None, say=None):
+def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=None):
     """The identifiability of every candidate effect on the records of ``fitter``.
 
     Parameters
     ----------
     fitter : trials.measured.diagnose._Fitter
-        The diagnosis's fitter (ship, packed ship, records, residual scales).
+        The diagnosis's fitter (ship, packed ship, records, residual scales, the ship's free
+        parameters at the head of every fit's, the sample stride).
     current : trials.measured.diagnose._Model
         The final model of the search.
     named : list of str
         The named effects.
     cand : list
         The candidate effect classes (those skipped for lack of channels are not among them).
-    ns : int
-        Number of ship parameters at the head of ``current.free``.
-    stride : int
-        The fits' sample stride.
     inflate : float
         The standard-error inflation of the residuals' correlation (the diagnosis's).
     segment_s : float, optional
@@ -275,16 +274,20 @@ def assess(fitter, current, named, cand, ns: int, stride: int, inflate: float, s
     -------
     (list of dict, list of dict)
         The ``not_identifiable`` entries (module docstring) and, for every candidate, its figures
-        (effect, named, correlation, std, std_conditional, detection_size, confused_with).
+        (effect, named, correlation, std, std_conditional, detection_size, confused_with, and
+        ``confounded``: the rule's test without "not named", i.e. for a named effect that its value
+        leans on the ship's coefficients or another effect, a check on it).
     """
     from .diagnose import Z_THRESHOLD as z_name
 
     say = say or (lambda m: None)
     L = fitter.ship.particulars.L
-    info_fn = _Info(fitter, stride)
+    ns = len(fitter.ship_free)
+    info_fn = _Info(fitter, fitter.stride)
     entries, table, trials = [], [], None
     for cls in cand:
-        effects, free, theta, s2 = _setup(current, cls, ns, L)
+        setup = _setup(current, cls, ns, L)
+        effects, free, theta, s2 = setup
         try:
             info_rec = info_fn.records(effects, free, theta, s2)
             idx = [i for i, f in enumerate(free) if f.kind == "effect" and f.index == effects.index(cls)]
@@ -304,12 +307,13 @@ def assess(fitter, current, named, cand, ns: int, stride: int, inflate: float, s
         table.append(row)
         say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
             f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
-        confounded = b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED
-        if cls.name in named or not (max(2.0, z_name) * b["sd"] > det and confounded):
+        row["confounded"] = bool(max(2.0, z_name) * b["sd"] > det
+                                 and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED))
+        if cls.name in named or not row["confounded"]:
             continue
         if trials is None:
             trials = _trial_segments(fitter, _trial_specs(fitter.recs, L), segment_s)
-        text, res = _separation(info_fn, trials, effects, free, theta, info_rec, s2, idx, inflate, cls)
+        text, res = _separation(info_fn, trials, setup, info_rec, idx, inflate, cls)
         entries.append({"effect": cls.name, "confused_with": confused or [_name(free[j]) for j in
                                                                            np.argsort(-np.abs(b["corr"]))[:1]],
                         "correlation": round(b["R"], 3), "what_would_separate": text,
