@@ -410,6 +410,8 @@ class Diagnosis:
     """{effect: {"delta_bic", "z", "false_alarm_probability"}} (:func:`~trials.measured.diagnose_report.effect_evidence`)."""
     not_identifiable: list = field(default_factory=list)
     """[{"effect", "confused_with", "correlation", "what_would_separate"}]: effects these records cannot separate."""
+    identifiability: list = field(default_factory=list)
+    """Every candidate's correlation with the rest, std and detection size (:mod:`trials.measured.identifiability`)."""
     model_form_mismatch: dict = field(default_factory=dict)
     """Ship coefficients the fit took far outside their priors (which, how far)."""
 
@@ -431,7 +433,8 @@ class Diagnosis:
                "threshold": {"delta_bic": BIC_THRESHOLD, "z": Z_THRESHOLD},
                "ship_coefficients": self.ship_values,
                "files": [r.source for r in self.records], "names": [r.name for r in self.records],
-               "seconds": round(self.seconds, 2)}
+               "seconds": round(self.seconds, 2),
+               "not_identifiable": self.not_identifiable, "identifiability": self.identifiability}
         if self.runs:
             out["runs"] = [dict(r.to_json(), name=r.records[0].name, file=r.records[0].source) for r in self.runs]
         return out
@@ -609,11 +612,20 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
     res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
                      o.stride)
+    res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o)
     res.seconds = time.perf_counter() - t0
     if o.per_run and len(recs) > 1:
         res.runs = [diagnose(ship, [r], replace(o, per_run=False, say=None)) for r in recs]
         res.seconds = time.perf_counter() - t0
     return res
+
+
+def _identifiability(fitter, current, named, cand, o: DiagnoseOptions):
+    """(not_identifiable entries, every candidate's figures): :func:`trials.measured.identifiability.assess`."""
+    from .identifiability import assess
+
+    _, inflate = _taus(current, o.stride)
+    return assess(fitter, current, named, cand, inflate, o.segment_s, o.say)
 
 
 def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int) -> Diagnosis:

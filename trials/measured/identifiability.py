@@ -1,0 +1,338 @@
+"""What the records cannot tell apart (``mmg diagnose``'s ``not_identifiable``, issue 26).
+
+A candidate effect the forward selection of :func:`trials.measured.diagnose.diagnose` does not
+name is either absent or one the records cannot separate from the ship's own coefficients (or
+another effect): a rudder offset on a single turning circle moves the turn the way a slightly
+different N_delta or N_r would, and the hull terms absorb it.  Such an effect is reported, not
+dropped silently.
+
+For each candidate (and each named effect, as a check) the Fisher information of the records is
+formed at the final model with the candidate added at its start value: the fit's own residual
+(:class:`ekf.identify._SegmentFit`, the same scaled residuals and prior rows the fit minimises)
+differentiated by forward differences, ``I = J^T J / s2``, s2 the residual variance per degree of
+freedom, and the covariance ``C = I^-1`` inflated by the residuals' correlation time as the
+diagnosis's standard errors are.  For the effect's parameter block b:
+
+* the marginal std (others free) is sqrt of the largest eigenvalue of ``C_bb``;
+* the conditional std (others fixed) is that of ``(I_bb)^-1``;
+* the multiple correlation of the block with the rest (its first canonical correlation) is
+  ``R^2 = 1 - 1/lambda``, lambda the largest eigenvalue of ``C_bb I_bb``; for one parameter
+  ``R^2 = 1 - 1/(C_ii (C^-1)_ii)`` and marginal / conditional std = sqrt(lambda) = 1/sqrt(1 - R^2).
+
+**Rule.**  An effect is reported ``not_identifiable`` when it is not named, its marginal std times
+the naming z threshold (:data:`trials.measured.diagnose.Z_THRESHOLD`, 3; never less than 2)
+exceeds its :data:`DETECTION_SIZE` (the records could not have named it at a size that matters:
+an effect of that size would have been within the threshold's z of nothing), and confounding is the
+reason: R >= :data:`R_CONFOUNDED` or marginal / conditional std >= :data:`STD_RATIO_CONFOUNDED`.
+An effect skipped for lack of channels is not assessed.
+
+``what_would_separate``: the information of candidate additional trials (the mirror of a turn,
+a 20/20 zigzag where the records have none, a 35 deg turn where they have none), simulated with the
+config ship (:func:`trials.measured.diagnose.synthetic_record`) and differentiated the same way at
+the same parameters, added to the records'; the trial that brings the effect's marginal std down
+most is named with the std before and after.  Several records diagnosed together share the effect's
+parameters (:func:`ekf.identify.effect_parameters`: ``record`` None), so a second record adds its
+information to the same parameters exactly as here.
+"""
+from __future__ import annotations
+
+import math
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+__all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "block_confounding",
+           "assess", "not_identifiable_lines"]
+
+DETECTION_SIZE = {"rudder_offset": (1.0, "deg"), "heading_bias": (1.0, "deg"), "current": (0.0027, "sqrt(gL)"),
+                  "wind": (0.5, "1"), "shallow_water": (0.5, "1")}
+"""The smallest size of each effect that matters physically, in its fit parameters' unit: the
+size a diagnosis should be able to show (issue 26's acceptance sizes).  rudder_offset: 1 deg of
+blade against indicated angle; heading_bias: 1 deg of logged against true heading; current: 0.0027
+sqrt(g L) in its worst-determined direction (3 % of a trial speed of Froude number 0.09: 0.15 m/s at
+325 m, 0.015 m/s for the 3 m model), a drift of 0.27 L per 100 s at full scale; wind: 0.5 on the scale
+of the published loads; shallow_water: T/H 0.5 (H/T 2, where the hull derivatives have changed by
+tens of per cent).  An effect whose marginal 2-sigma on the records exceeds this size could
+have been present at a size that matters without being named."""
+R_CONFOUNDED = 0.9
+"""Multiple correlation of the effect's parameters with the rest above which confounding, not
+noise, is why the effect cannot be shown."""
+STD_RATIO_CONFOUNDED = 3.0
+"""Marginal / conditional std above which the same holds (equivalent to R >= 0.943)."""
+_CONFUSED_MIN = 0.5
+"""|correlation| of another parameter with the effect's worst direction to be named as confused with it."""
+
+
+def detection_size(effect: str, L: float) -> float:
+    """The :data:`DETECTION_SIZE` of ``effect`` in its fit unit for a ship of length ``L`` [m]
+    (inf for an effect not in the table)."""
+    v, unit = DETECTION_SIZE.get(effect, (math.inf, "1"))
+    return v * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else v
+
+
+def block_confounding(cov: np.ndarray, idx) -> dict:
+    """Confounding of the parameters ``idx`` with the rest, from the posterior covariance ``cov``.
+
+    Returns
+    -------
+    dict
+        ``R``: the multiple (first canonical) correlation of the block with the other parameters;
+        ``ratio``: marginal / conditional std along the worst direction (sqrt(1 / (1 - R^2)));
+        ``sd``: the largest marginal std of the block; ``sd_conditional``: the conditional std
+        along the worst direction; ``direction``: that direction (unit vector in the block);
+        ``corr``: the correlation of each parameter with the block's worst linear combination.
+    """
+    from scipy.linalg import eigh
+
+    cov = np.asarray(cov, float)
+    idx = list(idx)
+    info = sym_inv(cov)
+    Cb = cov[np.ix_(idx, idx)]
+    Ib = info[np.ix_(idx, idx)]
+    lam, vec = eigh(Cb, np.linalg.inv(Ib))          # C_bb a = lambda I_bb^-1 a
+    a = vec[:, -1] / np.linalg.norm(vec[:, -1])
+    lam_max = float(max(lam[-1], 1.0))
+    sd_dir = math.sqrt(float(a @ Cb @ a))
+    cross = cov[:, idx] @ a
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cross / (sd_dir * np.sqrt(np.diag(cov)))
+    return {"R": math.sqrt(max(0.0, 1.0 - 1.0 / lam_max)), "ratio": math.sqrt(lam_max),
+            "sd": math.sqrt(float(np.linalg.eigvalsh(Cb)[-1])), "sd_conditional": sd_dir / math.sqrt(lam_max),
+            "direction": a, "corr": np.nan_to_num(corr)}
+
+
+def sym_inv(A: np.ndarray) -> np.ndarray:
+    """Inverse of a symmetric positive definite ``A`` whose parameters differ by many orders of
+    magnitude (added masses in kg beside primed derivatives): inverted in the scaled form
+    D A D, D = diag(A)^-1/2, so that the scale does not cost the precision."""
+    A = np.asarray(A, float)
+    d = 1.0 / np.sqrt(np.abs(np.diag(A)))
+    return d[:, None] * np.linalg.inv(A * np.outer(d, d)) * d[None, :]
+
+
+# --------------------------------------------------------------------------- information
+
+
+class _Info:
+    """Fisher information of the fit's residuals of some records at one parameter vector."""
+
+    def __init__(self, fitter, stride):
+        self.fitter, self.stride = fitter, stride
+
+    def jacobian(self, segs, effects, free, theta):
+        """(J of the fit's scaled residuals of ``segs`` without the prior rows, the prior stds)."""
+        from ekf.identify import FitOptions, _SegmentFit
+
+        f = self.fitter
+        opts = FitOptions(stride=self.stride, effects=list(effects) or None, ship=f.ship)
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            sf = _SegmentFit(f.packed, segs, free, f.scales, opts, pool)
+            J = sf.jac(np.asarray(theta, float))
+        return J[:-len(free)], sf.sig0
+
+    def records(self, effects, free, theta, s2):
+        """The information of the records with the prior (the fit's residual variance ``s2``)."""
+        J, sig0 = self.jacobian([p.seg for p in self.fitter.recs], effects, free, theta)
+        return (J.T @ J + np.diag(1.0 / sig0 ** 2)) / s2
+
+
+def _setup(current, cls, ns, L):
+    """(effects, free, theta, s2) of the final model with ``cls`` added (as is when named): its
+    parameters at their fit start values, a one-parameter effect at least its detection size from
+    its neutral value (the size the question is about: shallow water's forces are not linear in
+    T/H); s2 the final fit's residual variance per degree of freedom (the one its standard errors use)."""
+    from ekf.identify import effect_parameters
+
+    effects = list(current.effects)
+    theta = list(current.theta)
+    if cls not in effects:
+        effects.append(cls)
+        new = effect_parameters([cls])
+        x = [f.prior if f.start is None else f.start for f in new]
+        if len(new) == 1 and abs(x[0] - new[0].prior) < detection_size(cls.name, L):
+            x[0] = min(new[0].prior + detection_size(cls.name, L), new[0].upper)
+        theta += x
+    free = list(current.free[:ns]) + effect_parameters(effects)
+    fit = current.fit
+    s2 = 2.0 * float(fit.cost_final) / max(fit.n_residuals - len(fit.free), 1)
+    return effects, free, np.array(theta, float), s2
+
+
+# --------------------------------------------------------------------------- trials that would separate
+
+
+def _kinds(recs):
+    """Each record's manoeuvre: ("turn", +1 starboard / -1 port) or ("zigzag", 0) or ("other", 0)."""
+    out = []
+    for p in recs:
+        d = np.asarray(p.seg.inputs.delta, float)
+        big = d[np.abs(d) > math.radians(5.0)]
+        if len(big) < 0.2 * len(d):
+            out.append(("other", 0))
+            continue
+        pos = float(np.mean(big > 0))
+        out.append(("turn", 1 if pos > 0.5 else -1) if min(pos, 1.0 - pos) < 0.05 else ("zigzag", 0))
+    return out
+
+
+def _trial_specs(recs, L):
+    """(label, synthetic_record kwargs) of the trials that could add what the records lack."""
+    s = math.sqrt(L / 9.80665)
+    kinds = _kinds(recs)
+    turns = {sg for k, sg in kinds if k == "turn"}
+    specs = []
+    for sg in (1, -1):
+        if sg in turns and -sg not in turns:
+            rec = recs[[k for k in kinds].index(("turn", sg))]
+            amp = round(math.degrees(float(np.max(np.abs(rec.seg.inputs.delta)))))
+            side = "port" if sg > 0 else "starboard"
+            T = float(rec.seg.inputs.t[-1] - rec.seg.inputs.t[0])
+            specs.append((f"a {amp} deg {side} turn", dict(kind="turning", rudder_deg=-sg * amp, duration=T)))
+    if not any(k == "zigzag" for k, _ in kinds):
+        specs.append(("a 20/20 zigzag", dict(kind="zigzag", rudder_deg=20.0, duration=330.0 * s)))
+    if not turns:
+        specs.append(("a 35 deg starboard turn", dict(kind="turning", rudder_deg=35.0, duration=250.0 * s)))
+    return specs
+
+
+def _trial_segments(fitter, specs, segment_s):
+    """The candidate trials simulated with the config ship at the records' approach speed, prepared."""
+    from dataclasses import replace
+
+    from .diagnose import prepare, synthetic_record
+
+    recs = fitter.recs
+    U = float(np.median([math.hypot(p.seg.meas[0, 0], p.seg.meas[0, 1]) for p in recs]))
+    dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
+    out = []
+    for label, kw in specs:
+        rec = synthetic_record(fitter.ship, effects=None, speed=U, dt=dt, seed=0, name=f"trial{len(out)}", **kw)
+        calm = np.zeros_like(rec.t)              # a trial in calm air: a named wind effect's loads are zero in it
+        rec = replace(rec, wind_speed_rel=calm, wind_dir_rel=calm)
+        out.append((label, prepare(fitter.ship, [rec], segment_s=segment_s)[0].seg))
+    return out
+
+
+def _separation(info_fn, trials, setup, info_rec, idx, inflate, cls):
+    """(text, [(label, sd)]): the trial that brings the effect's marginal std down most; ``setup`` the
+    (effects, free, theta, s2) of :func:`_setup`."""
+    effects, free, theta, s2 = setup
+    sd0 = block_confounding(sym_inv(info_rec) * inflate ** 2, idx)["sd"]
+    res = []
+    for label, seg in trials:
+        if seg.context is not None and cls.unavailable(seg.context):
+            continue
+        J, _ = info_fn.jacobian([seg], effects, free, theta)
+        cov = sym_inv(info_rec + J.T @ J / s2) * inflate ** 2
+        res.append((label, block_confounding(cov, idx)["sd"]))
+    unit = _unit(cls)
+    if not res:
+        why = ("no candidate trial informs it without its channels" if trials else
+               "the records already hold turns both ways and a zigzag")
+        return f"{why}: a longer record, or one where the effect is larger", res
+    label, sd = min(res, key=lambda t: t[1])
+    text = f"{label} with {'these' if len(info_fn.fitter.recs) > 1 else 'this one'}: sd {_fmt(sd0)} -> {_fmt(sd)} {unit}"
+    if sd > 0.7 * sd0:
+        text = f"none of the trials tried separates it well (best: {text})"
+    return text, res
+
+
+def _unit(cls) -> str:
+    u = cls.fit_parameters()[0].unit
+    return "" if u == "1" else u
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.2g}" if abs(x) < 1 else f"{x:.3g}"
+
+
+# --------------------------------------------------------------------------- the assessment
+
+
+def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=None):
+    """The identifiability of every candidate effect on the records of ``fitter``.
+
+    Parameters
+    ----------
+    fitter : trials.measured.diagnose._Fitter
+        The diagnosis's fitter (ship, packed ship, records, residual scales, the ship's free
+        parameters at the head of every fit's, the sample stride).
+    current : trials.measured.diagnose._Model
+        The final model of the search.
+    named : list of str
+        The named effects.
+    cand : list
+        The candidate effect classes (those skipped for lack of channels are not among them).
+    inflate : float
+        The standard-error inflation of the residuals' correlation (the diagnosis's).
+    segment_s : float, optional
+        The diagnosis's segment length (the candidate trials are cut alike).
+    say : callable, optional
+        Progress lines.
+
+    Returns
+    -------
+    (list of dict, list of dict)
+        The ``not_identifiable`` entries (module docstring) and, for every candidate, its figures
+        (effect, named, correlation, std, std_conditional, detection_size, confused_with, and
+        ``confounded``: the rule's test without "not named", i.e. for a named effect that its value
+        leans on the ship's coefficients or another effect, a check on it).
+    """
+    from .diagnose import Z_THRESHOLD as z_name
+
+    say = say or (lambda m: None)
+    L = fitter.ship.particulars.L
+    ns = len(fitter.ship_free)
+    info_fn = _Info(fitter, fitter.stride)
+    entries, table, trials = [], [], None
+    for cls in cand:
+        setup = _setup(current, cls, ns, L)
+        effects, free, theta, s2 = setup
+        try:
+            info_rec = info_fn.records(effects, free, theta, s2)
+            idx = [i for i, f in enumerate(free) if f.kind == "effect" and f.index == effects.index(cls)]
+            b = block_confounding(sym_inv(info_rec) * inflate ** 2, idx)
+        except (np.linalg.LinAlgError, ValueError) as e:
+            say(f"identifiability of {cls.name}: not assessed ({e})")
+            continue
+        others = [(abs(c), _name(free[j])) for j, c in enumerate(b["corr"]) if j not in idx]
+        confused = []
+        for c, nm in sorted(others, reverse=True):
+            if c >= _CONFUSED_MIN and nm not in confused and len(confused) < 3:
+                confused.append(nm)
+        det = detection_size(cls.name, L)
+        row = {"effect": cls.name, "named": cls.name in named, "correlation": round(b["R"], 3),
+               "std": float(f"{b['sd']:.3g}"), "std_conditional": float(f"{b['sd_conditional']:.3g}"),
+               "detection_size": float(f"{det:.3g}"), "unit": _unit(cls), "confused_with": confused}
+        table.append(row)
+        say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
+            f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
+        row["confounded"] = bool(max(2.0, z_name) * b["sd"] > det
+                                 and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED))
+        if cls.name in named or not row["confounded"]:
+            continue
+        if trials is None:
+            trials = _trial_segments(fitter, _trial_specs(fitter.recs, L), segment_s)
+        text, res = _separation(info_fn, trials, setup, info_rec, idx, inflate, cls)
+        entries.append({"effect": cls.name, "confused_with": confused or [_name(free[j]) for j in
+                                                                           np.argsort(-np.abs(b["corr"]))[:1]],
+                        "correlation": round(b["R"], 3), "what_would_separate": text,
+                        "std": row["std"], "std_conditional": row["std_conditional"], "detection_size": row["detection_size"],
+                        "unit": row["unit"], "trials": [{"trial": lb, "std": float(f"{sd:.3g}")} for lb, sd in res]})
+    return entries, table
+
+
+def _name(f) -> str:
+    """A free parameter's name as a reader knows it: a hull or ship constant by name, an effect by the effect's."""
+    return f.name.split(".")[0] if f.kind == "effect" else f.name
+
+
+def not_identifiable_lines(entries) -> list[str]:
+    """One console line per ``not_identifiable`` entry."""
+    out = []
+    for e in entries:
+        unit = f" {e['unit']}" if e.get("unit") else ""
+        sd = f"sd {_fmt(e['std'])}{unit}: could not have shown {_fmt(e['detection_size'])}{unit}; " if "std" in e else ""
+        out.append(f"not identifiable: {e['effect']} ({sd}correlation {e['correlation']:.2f} with "
+                   f"{', '.join(e['confused_with'])}); would separate: {e['what_would_separate']}")
+    return out
