@@ -277,7 +277,6 @@ def _dev(name):
     return DEV / entry["file"], entry
 
 
-@pytest.mark.slow
 def test_dev_current_on_a_port_turn():
     """dev_06: a port 35 deg turn with a current: the current alone, within 0.05 m/s and 15 deg."""
     from mmg.resources import ship_path
@@ -293,7 +292,6 @@ def test_dev_current_on_a_port_turn():
     assert abs(_angdiff(p["direction_deg"], truth["set_towards_deg"])) <= 15.0, p
 
 
-@pytest.mark.slow
 def test_dev_heading_bias_on_a_zigzag():
     """dev_14: a 20/20 zigzag with a heading bias: the bias alone, within 0.3 deg."""
     from mmg.resources import ship_path
