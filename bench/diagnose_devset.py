@@ -71,7 +71,12 @@ def score(entry: dict, res: dict) -> dict:
             err = _angle_err(fv, tv) if key == "direction_deg" else abs(fv - tv)
             errs[f"{eff}.{key}"] = err
             ok_vals &= err <= tol
-    return {"exact": named == true, "false_alarm": not true and bool(named), "values_ok": ok_vals, "errors": errs}
+    ni = {x.get("effect") for x in res.get("not_identifiable", [])}
+    # a true effect left unnamed but reported not_identifiable (with its correlation) counts as right,
+    # listed apart: exact_or_not_identifiable; a named wrong effect never does
+    honest = named <= true and (true - named) <= ni
+    return {"exact": named == true, "exact_or_not_identifiable": named == true or honest,
+            "false_alarm": not true and bool(named), "values_ok": ok_vals, "errors": errs}
 
 
 def main(argv=None) -> int:
@@ -104,13 +109,14 @@ def main(argv=None) -> int:
     clean = [r for r in results if r["true"] == ["none"]]
     exact = sum(r["exact"] for r in results)
     exact_vals = sum(r["exact"] and r["values_ok"] for r in results)
+    honest = sum(r["exact_or_not_identifiable"] for r in results)
     fa = sum(r["false_alarm"] for r in clean)
     print(f"exact naming {exact} of {len(results)} (with values in tolerance {exact_vals}); false alarms {fa} of "
-          f"{len(clean)} clean logs; {time.perf_counter() - t0:.0f} s wall, median "
+          f"{len(clean)} clean logs; exact or the missing effect reported not_identifiable {honest} of {len(results)}; {time.perf_counter() - t0:.0f} s wall, median "
           f"{sorted(r['seconds'] for r in results)[len(results) // 2]:.1f} s per log")
     out = Path(a.json)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"ship": a.ship, "exact": exact, "exact_with_values": exact_vals, "false_alarms": fa,
+    out.write_text(json.dumps({"ship": a.ship, "exact": exact, "exact_with_values": exact_vals, "false_alarms": fa, "exact_or_not_identifiable": honest,
                                "clean": len(clean), "logs": results}, indent=1, default=float))
     return 0
 
