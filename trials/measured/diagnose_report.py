@@ -276,7 +276,7 @@ def summary_lines(diag) -> list[str]:
     """The console text of a :class:`trials.measured.diagnose.Diagnosis`: a line per named effect
     (:func:`effect_line`), the statistics' legend, a line per effect that cannot be told apart, the
     residual RMS per channel (config, ship fitted, with the named effects), ``unexplained`` when set."""
-    from .diagnose import BIC_THRESHOLD, Z_THRESHOLD
+    from .decision import BIC_THRESHOLD, Z_THRESHOLD
 
     lines = []
     for e in diag.named:

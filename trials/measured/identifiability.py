@@ -199,7 +199,7 @@ def _trial_segments(fitter, specs, segment_s):
     """The candidate trials simulated with the config ship at the records' approach speed, prepared."""
     from dataclasses import replace
 
-    from .diagnose import prepare, synthetic_record
+    from .diagnose_records import prepare, synthetic_record
 
     recs = fitter.recs
     U = float(np.median([math.hypot(p.seg.meas[0, 0], p.seg.meas[0, 1]) for p in recs]))
@@ -278,7 +278,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         ``confounded``: the rule's test without "not named", i.e. for a named effect that its value
         leans on the ship's coefficients or another effect, a check on it).
     """
-    from .diagnose import Z_THRESHOLD as z_name
+    from .decision import Z_THRESHOLD as z_name
 
     say = say or (lambda m: None)
     L = fitter.ship.particulars.L

@@ -1,0 +1,178 @@
+"""Records for ``mmg diagnose``: read and segmented (:func:`prepare`), and made with hidden effects
+(:func:`synthetic_record`, :func:`write_frt_csv`) for the trial-design advice, the tests and the
+benches."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mmg.errors import InputError
+from mmg.model import pack
+from mmg.ship import Ship
+
+__all__ = ["Prepared", "prepare", "synthetic_record", "write_frt_csv", "RESTART_SMOOTH"]
+
+RESTART_SMOOTH = 6.0
+"""Every segment restarts from the logged state smoothed over this many sqrt(L/g) (quadratic
+Savitzky-Golay: 3.3 s for the 3 m model, 35 s at 325 m): a restart from one noisy sample leaves a
+transient through the segment that a current or heading bias (which shift the restart states)
+would partly fit (clean records: 3/20 named an effect with single-sample restarts)."""
+
+# --------------------------------------------------------------------------- records
+
+
+@dataclass
+class Prepared:
+    """One record made ready: the segmented record (with its effect context) and notes."""
+
+    name: str
+    source: str
+    seg: object
+    notes: list = field(default_factory=list)
+
+
+def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | None = None) -> list[Prepared]:
+    """Read and prepare the records (paths, :class:`trials.files.records.TrialRecord` or ready
+    :class:`Prepared`); a malformed one raises :class:`~mmg.errors.InputError` naming it.  Each is
+    named after its file (:func:`trials.files.output.record_labels`), in the JSON and the plots."""
+    from dataclasses import replace
+
+    from ekf.identify import Segmented, segment_resets
+    from mmg.effects import Context
+
+    from ..files.logio import require_finite
+    from .predict import measured_run
+    from ..files.records import TrialRecord
+    from ..files.output import record_labels
+    from ..files.shipcheck import read_for_ship
+
+    L = ship.particulars.L
+    seg_s = segment_s or 52.0 * math.sqrt(L / 9.80665)
+    items = list(items)
+    labels = record_labels([it.source if isinstance(it, Prepared) else
+                            (it.source or it.name) if isinstance(it, TrialRecord) else it for it in items])
+    out = []
+    for it, label in zip(items, labels):
+        if isinstance(it, Prepared):
+            out.append(it)
+            continue
+        # a record of another ship is refused, not diagnosed
+        rec = it if isinstance(it, TrialRecord) else read_for_ship(it, ship)
+        require_finite(rec, ("wind_speed_rel", "wind_dir_rel"), "mmg diagnose")     # the wind it diagnoses
+        run = replace(measured_run(ship, rec, wind=wind), name=label)     # named after its file, unique
+        bad = ~np.isfinite(run.meas).all(axis=1)
+        if bad.any():
+            raise InputError(run.source or run.name, "", f"{int(bad.sum())} rows with NaN: not usable")
+        ch = {c: getattr(rec, c) for c in ("wind_speed_rel", "wind_dir_rel")}
+        if run.inputs.delta is not None and len(run.inputs.t) != len(rec.t):     # rebuilt rudder: resampled
+            ch = {c: None for c in ch}
+        ctx = Context(t=run.t, delta=run.inputs.delta, n=run.inputs.n, channels=ch, ship=ship)
+        seg = Segmented(run.name, run.meas, run.inputs, segment_resets(run.t, seg_s), context=ctx,
+                        start=_smoothed(run.t, run.meas, RESTART_SMOOTH * math.sqrt(L / 9.80665)),
+                        fixed=run.effects)
+        out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes)))
+    return out
+
+
+def _smoothed(t: np.ndarray, meas: np.ndarray, window_s: float) -> np.ndarray:
+    """The logged states smoothed by a quadratic Savitzky-Golay filter over ``window_s`` (heading
+    unwrapped, on its logged branch): the states the segments restart from."""
+    from scipy.signal import savgol_filter
+
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
+    w = int(round(window_s / dt)) | 1
+    w = min(w, (len(t) - 1) | 1 if len(t) % 2 == 0 else len(t))
+    if w < 5:
+        return meas
+    out = savgol_filter(meas, w, 2, axis=0, mode="interp")
+    psi = np.unwrap(meas[:, 5])
+    out[:, 5] = meas[:, 5] + savgol_filter(psi, w, 2, mode="interp") - psi
+    return out
+
+
+
+# --------------------------------------------------------------------------- synthetic records
+
+
+def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | None = None, speed: float | None = None,
+                     duration: float | None = None, dt: float = 0.5, rudder_deg: float = 20.0,
+                     true_wind=(0.0, 0.0), noise=None, seed: int = 0, name: str | None = None):
+    """A record as a trial would log it, with hidden effects: a turning or zigzag of ``truth_ship``
+    (default ``ship``) simulated closed loop (the rudder orders from its own heading), then
+    replayed with its rudder and revolutions and the ``effects`` (an :class:`mmg.effects.EffectSet`
+    or a ``{name: {parameter: value}}`` mapping; wind from the constant ``true_wind`` (speed
+    [m/s], direction it comes from [rad]) by a fixed-point iteration on the relative wind) and
+    logged (u, v over ground resolved in the logged heading, heading with its bias) with white
+    noise (``noise``: std per column u, v, r, x, y, psi; default small).  Returns a
+    :class:`trials.files.records.TrialRecord` with rudder, revolutions and, when wind is on, the relative
+    and true wind channels."""
+    import mmg.effects as E
+    from mmg.integrate import CommandLaw
+    from mmg.replay import ReplayInputs, replay_states
+    from mmg.simulation import simulate
+    from mmg.wind import relative_wind_from_true
+
+    from ..files.records import logged_record
+
+    es = effects if isinstance(effects, E.EffectSet) else E.effect_set(effects or {})
+    truth = truth_ship or ship
+    L = truth.particulars.L
+    s = math.sqrt(L / 9.80665)
+    U0 = speed or 0.09 * math.sqrt(9.80665 * L)
+    a = math.radians(rudder_deg)
+    if kind == "turning":
+        T = duration or 120.0 * s
+        law = CommandLaw.schedule([0.0, 5.0 * s, 5.0 * s + 1e-6, T], [0.0, 0.0, a, a])
+    elif kind == "zigzag":
+        T = duration or 160.0 * s
+        law = CommandLaw.heading_switch(a, a, -a, 1.0, psi0=0.0)
+    else:
+        raise ValueError(kind)
+    # the closed-loop run that makes the rudder history has the effects that act on the dynamics
+    # through the parameter vector (current, rudder offset); the record's states are the replay's below
+    sim = simulate(truth, law, T, min(dt, 0.05 * s), U0, trim=False,
+                   effects=E.EffectSet(tuple(it for it in es.items if it[0].slots(it[1]))))
+    t = np.arange(0.0, T + 1e-9, dt)
+    idx = np.searchsorted(sim.t, t - 1e-9)
+    idx = np.minimum(idx, len(sim.t) - 1)
+    delta, n = sim.states[idx, 6], sim.states[idx, 7]
+    s0 = sim.states[0, :6].copy()
+    pk = es.pack(pack(truth, sim.equilibrium.power_W), truth)
+    wind_on = any(c.name == "wind" for c, _ in es.items)
+    Vt, dt_ = true_wind
+    wind_rel = None
+    if wind_on:
+        wind_eff = [(c, v) for c, v in es.items if c.name == "wind"]
+        rest = E.EffectSet(tuple(it for it in es.items if it[0].name != "wind"))
+        states = replay_states(pk, ReplayInputs(t, delta, n), s0)
+        for _ in range(4):
+            # the anemometer is aboard: the relative wind from the true one and the true motion over ground
+            og = E.EffectSet(tuple(it for it in rest.items if it[0].kind != "measurement")).to_logged(states)
+            Vr, ang = relative_wind_from_true(Vt, dt_, og[:, 0], og[:, 1], states[:, 5])
+            wind_rel = (Vr, np.mod(ang, 2 * np.pi))
+            ctx = E.Context(t=t, delta=delta, n=n, channels=dict(zip(("wind_speed_rel", "wind_dir_rel"), wind_rel)),
+                            ship=truth)
+            ext = wind_eff[0][0].external(wind_eff[0][1], ctx)
+            states = replay_states(pk, ReplayInputs(t, delta, n, ext), s0)
+    else:
+        states = replay_states(pk, ReplayInputs(t, delta, n), s0)
+    sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(9.80665 / L), 0.002 * L,
+                                                    0.002 * L, math.radians(0.05)])
+    label = name or f"synthetic_{kind}"
+    return logged_record(t, states, delta, n, es, sd, np.random.default_rng(seed), wind_rel,
+                         name=label, source=label, meta={"format": "synthetic"})
+
+
+def write_frt_csv(rec, path) -> None:
+    """Write a record in the FRT-DS-ESSO column layout (what :func:`trials.files.logio.read_record` reads)."""
+    import pandas as pd
+
+    cols = {"t [s]": rec.t, "x_position_mid [m]": rec.x, "u_velo [m/s]": rec.u, "y_position_mid [m]": rec.y,
+            "vm_velo [m/s]": rec.v, "psi_hat [rad]": np.mod(rec.psi, 2 * np.pi), "r_angvelo [rad/s]": rec.r,
+            "n_prop [rps]": rec.n, "delta_rudder [rad]": rec.delta}
+    if rec.wind_speed_rel is not None:
+        cols.update({"wind_velo_relative_mid [m/s]": rec.wind_speed_rel, "wind_dir_relative_mid [rad]": rec.wind_dir_rel,
+                     "wind_velo_true [m/s]": rec.wind_speed_true, "wind_dir_true [rad]": rec.wind_dir_true})
+    pd.DataFrame(cols).to_csv(path, index=False)
