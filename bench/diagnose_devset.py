@@ -51,7 +51,10 @@ def _one(path: str, ship: str) -> dict:
     d = diagnose(load_ship(ship_path(ship)), [path], wind=False)
     j = d.to_json()
     return {"named": list(d.named), "parameters": d.parameters, "unexplained": bool(d.unexplained),
-            "not_identifiable": j.get("not_identifiable", []), "seconds": time.perf_counter() - t0}
+            "not_identifiable": j.get("not_identifiable", []), "rounds": j["rounds"],
+            "ship_coefficients": j["ship_coefficients"], "model_form_mismatch": j.get("model_form_mismatch", {}),
+            "rms_config": j["rms_config"], "rms_before": j["rms_before"], "rms_after": j["rms_after"],
+            "seconds": time.perf_counter() - t0}
 
 
 def _angle_err(a: float, b: float) -> float:

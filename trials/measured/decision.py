@@ -1,9 +1,38 @@
-"""The naming decision of ``mmg diagnose``: the thresholds an effect's fit must clear to be named
+"""The naming decision of ``mmg diagnose``: what an effect's fit must clear to be named
 (:func:`trials.measured.diagnose.diagnose`); a module of its own so that the report and the
-identifiability check read them without importing the workflow."""
+identifiability check read it without importing the workflow.
+
+An effect is named when three tests hold:
+
+1. **evidence**: its dBIC exceeds :data:`BIC_THRESHOLD` (the model with it replays the records
+   better by more than the parameters it costs);
+2. **precision**: its presence parameters differ from their neutral values by more than
+   :data:`Z_THRESHOLD` standard errors;
+3. **size beyond the ship's own mismatch**: its magnitude (:func:`magnitude`: a current's speed over
+   sqrt(g L), a rudder offset's or heading bias's |angle| in deg, a wind's load scale, shallow water's
+   T/H) exceeds the *calibrated floor* for the effect and the kind of record (:func:`record_kind`:
+   turn or zigzag).  A ship is never its config: on records with no effect at all the fit of a
+   candidate still finds a small current, offset or bias that soaks up the hull's, rudder's and
+   propeller's own errors, and with 3500 samples its dBIC and z are large.  The floors are the
+   largest magnitudes the candidates took on clean records of a family of ships that differ from the
+   config as real ships do (:mod:`trials.measured.mismatch`; hull linear terms +-10 %, nonlinear
+   +-25 %, rudder and propeller constants +-15 %, other wind-load factors, another hull form),
+   made by ``python bench/bench_diagnose.py --mismatch --calibrate`` and kept in the packaged
+   ``configs/calibration/diagnose.yaml`` with their seeds and sample counts.
+
+:func:`false_alarm_probability` reads the same clean magnitudes: the share of clean records on
+which the candidate's magnitude reached the value (with one added record for the value itself,
+so never 0 from a finite sample).
+"""
 from __future__ import annotations
 
-__all__ = ["BIC_THRESHOLD", "Z_THRESHOLD"]
+import math
+from functools import lru_cache
+
+import numpy as np
+
+__all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "KINDS", "magnitude", "record_kind", "floor",
+           "false_alarm_probability", "calibration"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -12,3 +41,97 @@ perturbed record pairs (bench/bench_diagnose.py, seeds 0-19) was 15.4, 10.9, 9.5
 above 10), so the threshold is set at 20 and the false-alarm rate checked on fresh seeds."""
 Z_THRESHOLD = 3.0
 """|parameter - neutral| / standard error an effect's fit must exceed to be named."""
+KINDS = ("turn", "zigzag")
+"""Kinds of record the floors are calibrated for (:func:`record_kind`)."""
+MAGNITUDE_UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1",
+                   "shallow_water": "T/H"}
+"""The unit of each effect's :func:`magnitude`."""
+
+
+def magnitude(effect: str, values: dict, L: float) -> float:
+    """How large an effect is, in a measure that does not depend on the ship's size.
+
+    Parameters
+    ----------
+    effect : str
+        The effect's name.
+    values : dict
+        Its reported values (:meth:`mmg.effects.Effect.from_fit`: ``speed_mps``, ``offset_deg``,
+        ``bias_deg``, ``scale``, ``depth_to_draft``).
+    L : float
+        Ship length [m].
+
+    Returns
+    -------
+    float
+        current: speed / sqrt(g L); rudder offset, heading bias: |angle| [deg]; wind: the load
+        scale; shallow water: T/H (0 in deep water); NaN for an effect it does not know.
+    """
+    if effect == "current":
+        return float(values["speed_mps"]) / math.sqrt(9.80665 * L)
+    if effect == "rudder_offset":
+        return abs(float(values["offset_deg"]))
+    if effect == "heading_bias":
+        return abs(float(values["bias_deg"]))
+    if effect == "wind":
+        return abs(float(values["scale"]))
+    if effect == "shallow_water":
+        h = float(values["depth_to_draft"])
+        return 0.0 if not math.isfinite(h) or h <= 0 else 1.0 / h
+    return math.nan
+
+
+def record_kind(headings) -> str:
+    """``"turn"`` when any record's heading (logged, [rad]) sweeps more than 180 deg, else ``"zigzag"``.
+
+    Parameters
+    ----------
+    headings : sequence of arrays
+        Each record's logged heading [rad].
+    """
+    span = max(float(np.ptp(np.unwrap(np.asarray(h, float)))) for h in headings)
+    return "turn" if span > math.pi else "zigzag"
+
+
+@lru_cache(maxsize=1)
+def calibration() -> dict:
+    """The packaged calibration (``configs/calibration/diagnose.yaml``): ``{"floors": {effect:
+    {kind: value}}, "clean": {effect: {kind: [magnitudes]}}, ...}``; empty when absent."""
+    import yaml
+
+    from mmg.resources import config_dir
+
+    p = config_dir() / "calibration" / "diagnose.yaml"
+    if not p.is_file():
+        return {}
+    return yaml.safe_load(p.read_text()) or {}
+
+
+def floor(effect: str, kind: str) -> float:
+    """The calibrated magnitude an effect must exceed on a record of ``kind`` (0 where not calibrated)."""
+    return float(((calibration().get("floors") or {}).get(effect) or {}).get(kind, 0.0))
+
+
+def false_alarm_probability(effect_name: str, kind: str, statistic_value: float):
+    """The calibrated probability that a candidate reaches ``statistic_value`` on records without it.
+
+    Parameters
+    ----------
+    effect_name : str
+        The effect (``current``, ``wind``, ...).
+    kind : str
+        The kind of record (:data:`KINDS`).
+    statistic_value : float
+        The effect's :func:`magnitude`.
+
+    Returns
+    -------
+    float or None
+        (k + 1) / (n + 1), k of the n clean calibration records on which the candidate's magnitude
+        was at least the value; None where the effect and kind are not calibrated.
+    """
+    clean = ((calibration().get("clean") or {}).get(effect_name) or {}).get(kind)
+    if not clean or statistic_value is None or not math.isfinite(statistic_value):
+        return None
+    a = np.asarray(clean, float)
+    return float((np.sum(a >= statistic_value) + 1) / (len(a) + 1))

@@ -57,7 +57,7 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-from .decision import BIC_THRESHOLD, Z_THRESHOLD
+from .decision import BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, floor, magnitude, record_kind
 from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
 
@@ -165,6 +165,35 @@ def _ship_values(ship: Ship, free, theta) -> dict:
     return out
 
 
+BASELINE_PRIOR_REL_STD = {"linear": 0.15, "nonlinear": 0.30, "resistance": 0.10, "w_P0": 0.20}
+"""Prior std of the ship coefficients the diagnosis frees, relative to the config value, by what is
+known of such a config's source: linear sway/yaw derivatives from captive tests or Kijima-type
+regressions are good to 10-15 %, their nonlinear terms (the yaw damping r|r|) to about 30 %, the
+resistance and the wake fraction w_P0 to 10 % and 20 % (Kijima et al. 1990 quote their regression's
+scatter at this order; the ITTC Manoeuvring Committee's benchmark of predicted and measured turns
+the same).  The added masses: :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`.  Every hull coefficient
+also keeps its config sign (the signs that define the ship: a positive Y_beta, a negative N_r)."""
+LINEAR_TERMS = ("beta", "r", "v")
+RESISTANCE_TERMS = ("cos(beta)^2", "u^2")
+HULL_PRIOR_FLOOR = 0.002
+"""Smallest prior std of a freed hull coefficient (primed)."""
+MISMATCH_Z = 3.0
+"""A fitted ship coefficient more than this many prior std from its config value is reported as
+model-form mismatch (:attr:`Diagnosis.model_form_mismatch`) and not written to ``--out-ship``."""
+
+
+def _baseline_prior(f, term):
+    """``f`` (a :class:`ekf.identify.FreeParameter`) with the diagnosis's prior width and sign bounds."""
+    if f.kind == "hull":
+        fam = "linear" if term in LINEAR_TERMS else "resistance" if term in RESISTANCE_TERMS else "nonlinear"
+        lo, hi = (0.0, np.inf) if f.prior > 0 else (-np.inf, 0.0) if f.prior < 0 else (f.lower, f.upper)
+        return replace(f, sigma=max(BASELINE_PRIOR_REL_STD[fam] * abs(f.prior), HULL_PRIOR_FLOOR),
+                       lower=max(lo, f.lower), upper=min(hi, f.upper))
+    if f.kind == "w_P0":
+        return replace(f, sigma=max(BASELINE_PRIOR_REL_STD["w_P0"] * abs(f.prior), 0.01))
+    return f
+
+
 def _ship_free(ship: Ship, packed, names=None):
     from ekf.identify import DIAGNOSIS_PRIOR_REL_STD, free_parameters
 
@@ -174,7 +203,25 @@ def _ship_free(ship: Ship, packed, names=None):
     else:
         mass = [n for n in names if n in MASS_FREE]
         names = [n for n in names if n not in MASS_FREE]
-    return free_parameters(packed, ship.hull.names, names + mass, priors=DIAGNOSIS_PRIOR_REL_STD)
+    free = free_parameters(packed, ship.hull.names, names + mass, priors=DIAGNOSIS_PRIOR_REL_STD)
+    terms = dict(zip(ship.hull.names, ship.hull.terms))
+    return [_baseline_prior(f, terms.get(f.name)) for f in free]
+
+
+def ship_fit_table(free, theta) -> list:
+    """[{"name", "config", "fitted", "prior_std", "z"}] of the freed ship coefficients (added masses
+    and moment in kg, kg m^2; hull coefficients primed), z their distance from the config in prior std."""
+    return [{"name": f.name, "config": float(f"{f.prior:.5g}"), "fitted": float(f"{float(v):.5g}"),
+             "prior_std": float(f"{f.sigma:.3g}"), "z": round((float(v) - f.prior) / f.sigma, 2) if f.sigma > 0 else 0.0}
+            for f, v in zip(free, theta)]
+
+
+def model_form_mismatch(free, theta) -> dict:
+    """{coefficient: {"config", "fitted", "prior_std", "z"}} of the ship coefficients the fit took
+    more than :data:`MISMATCH_Z` prior std from the config: the data ask for another model form (or
+    an effect the candidates lack), not for these values."""
+    return {r["name"]: {k: r[k] for k in ("config", "fitted", "prior_std", "z")}
+            for r in ship_fit_table(free, theta) if abs(r["z"]) > MISMATCH_Z}
 
 
 class _Fitter:
@@ -331,7 +378,11 @@ class Diagnosis:
     identifiability: list = field(default_factory=list)
     """Every candidate's correlation with the rest, std and detection size (:mod:`trials.measured.identifiability`)."""
     model_form_mismatch: dict = field(default_factory=dict)
-    """Ship coefficients the fit took far outside their priors (which, how far)."""
+    """Ship coefficients the fit took far outside their priors (which, how far): :func:`model_form_mismatch`."""
+    ship_fit: list = field(default_factory=list)
+    """The freed ship coefficients: config, fitted, prior std, z (:func:`ship_fit_table`)."""
+    baseline: str = "fitted"
+    """"fitted", or "config (the fit replayed worse)" when the baseline fit was not kept."""
 
     def summary_lines(self) -> list:
         """The console text (:func:`trials.measured.diagnose_report.summary_lines`)."""
@@ -343,7 +394,8 @@ class Diagnosis:
         out = {"named_effects": list(self.named), "parameters": self.parameters,
                "standard_errors": self.standard_errors, "intervals_95": self.intervals_95,
                "evidence": self.evidence, "not_identifiable": list(self.not_identifiable),
-               "model_form_mismatch": self.model_form_mismatch,
+               "model_form_mismatch": self.model_form_mismatch, "baseline": self.baseline,
+               "ship_fit": self.ship_fit,
                "rms_before": self.rms_before, "rms_after": self.rms_after, "rms_config": self.rms_config,
                "rms_units": {"u": "m/s", "v": "m/s", "r": "deg/s", "heading": "deg", "position": "m"},
                "unexplained": bool(self.unexplained), "unexplained_description": self.unexplained_description,
@@ -426,9 +478,29 @@ def _candidates(recs, names, say):
     return cand, cand_log
 
 
+def _scaled_rss(diffs, scales) -> float:
+    """Sum of the squared residuals of every channel over its scale (the fit's cost without the prior)."""
+    D = _stack(diffs, 1)
+    sc = np.array([scales.u, scales.v, scales.r, scales.pos, scales.pos, scales.psi])
+    return float(np.sum((D / sc) ** 2))
+
+
+def _config_model(fitter, d_config) -> _Model:
+    """The config as it is, as a :class:`_Model` (its standard errors the priors')."""
+    from ekf.identify import IdentifyResult
+
+    free = list(fitter.ship_free)
+    th = np.array([f.prior for f in free])
+    fit = IdentifyResult(free=free, theta=th, std=np.array([f.sigma for f in free]), corr=np.eye(len(free)),
+                         cost_initial=math.nan, cost_final=math.nan, n_residuals=0, iterations=0,
+                         message="the config as given (the fit replayed worse)")
+    return _Model([], free, fit, d_config)
+
+
 def _baseline(fitter, noise, say):
-    """(the config's differences, the baseline fit): fitted, every channel rescaled by the first fit's
-    own residual (floored at the noise), fitted again."""
+    """(the config's differences, the baseline fit, whether the fit was kept): fitted, every channel
+    rescaled by the first fit's own residual (floored at the noise), fitted again; a fit that replays
+    the records worse than the config as given (scaled residuals, no prior) is not kept: the config is."""
     from ekf.identify import Scales
 
     d_config = fitter.diffs([], [], [])
@@ -438,8 +510,12 @@ def _baseline(fitter, noise, say):
     fl = np.maximum(rm, np.maximum(noise, 1e-9))
     fitter.scales = Scales(u=fl[0], v=fl[1], r=fl[2], psi=fl[5], pos=float(np.hypot(fl[3], fl[4])) / math.sqrt(2))
     base = fitter.fit([], start_ship=base.theta)
+    kept = _scaled_rss(base.diffs, fitter.scales) <= _scaled_rss(d_config, fitter.scales)
+    if not kept:
+        say("baseline: the fitted ship replays worse than the config: the config is kept")
+        base = _config_model(fitter, d_config)
     say(f"baseline (ship fitted, no effect): residual RMS {format_rms(_rms(base.diffs))}")
-    return d_config, base
+    return d_config, base, kept
 
 
 def _taus(current, stride):
@@ -449,8 +525,9 @@ def _taus(current, stride):
 
 
 def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
-    """(dBIC, clears the thresholds, cls, fit, values, standard errors, z) of ``current`` plus ``cls``:
-    screened with ``screen_nfev``, a promising one the budget stopped fitted on to ``max_nfev``."""
+    """(dBIC, clears the thresholds, cls, fit, values, standard errors, z, magnitude) of ``current``
+    plus ``cls``: screened with ``screen_nfev``, a promising one the budget stopped fitted on to
+    ``max_nfev``; named only above the calibrated floor of its magnitude (:mod:`.decision`)."""
     effs = current.effects + [cls]
     m = fitter.fit(effs, start_ship=current.theta[:ns], start_eff=list(current.theta[ns:]), max_nfev=o.screen_nfev)
     k = len(cls.fit_parameters())
@@ -460,7 +537,9 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
         m = fitter.fit(effs, start=m.theta, max_nfev=o.max_nfev - o.screen_nfev)
         dbic = _delta_bic(current, m, k, taus, o.stride)
         vals, se, z = _effect_report(m, cls, inflate)
-    return dbic, dbic > BIC_THRESHOLD and z > Z_THRESHOLD, cls, m, vals, se, z
+    mag = magnitude(cls.name, vals, fitter.ship.particulars.L)
+    ok = dbic > BIC_THRESHOLD and z > Z_THRESHOLD and not mag <= floor(cls.name, fitter.kind)
+    return dbic, ok, cls, m, vals, se, z, mag
 
 
 def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
@@ -472,13 +551,16 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
         results = []
         for cls in remaining:
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
-            dbic, _, _, _, vals, _, z = results[-1]
-            say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}")
+            dbic, _, _, _, vals, _, z, mag = results[-1]
+            say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}, size {fmt3(mag)} "
+                f"{MAGNITUDE_UNITS.get(cls.name, '')} (floor {fmt3(floor(cls.name, fitter.kind))})")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
                        "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
+                       "kind": fitter.kind,
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
+                                       "magnitude": float(f"{g:.4g}"), "floor": floor(c.name, fitter.kind),
                                        "clears_threshold": bool(ok), "parameters": v, "standard_errors": s}
-                                      for d, ok, c, m, v, s, z in results]})
+                                      for d, ok, c, m, v, s, z, g in results]})
         ok = [r for r in results if r[1]]
         if not ok:
             break
@@ -526,11 +608,13 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     sfree = _ship_free(ship, packed, o.ship_free)
     sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
     fitter = _Fitter(ship, packed, recs, sc0, o.stride, o.max_nfev, sfree)
-    d_config, base = _baseline(fitter, noise, say)
+    fitter.kind = record_kind([r.seg.meas[:, 5] for r in recs])
+    d_config, base, kept = _baseline(fitter, noise, say)
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
     res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
                      o.stride)
     res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o)
+    res.baseline = "fitted" if kept else "config (the fit replayed worse)"
     res.seconds = time.perf_counter() - t0
     if o.per_run and len(recs) > 1:
         res.runs = [diagnose(ship, [r], replace(o, per_run=False, say=None)) for r in recs]
@@ -564,10 +648,13 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
         ivs[cls.name] = effect_intervals(cls, *effect_estimate(current, cls, inflate))
     cand_log = cand_log + [{"effect": c.name, "named": c.name in named} for c in cand]
     unexpl, desc, _ = _describe(recs, current.diffs, noise, None)
-    ship_vals = _ship_values(ship, current.free[:ns], current.theta[:ns])
+    mfm = model_form_mismatch(current.free[:ns], current.theta[:ns])
+    th_out = [f.prior if f.name in mfm else v for f, v in zip(current.free[:ns], current.theta[:ns])]
+    ship_vals = _ship_values(ship, current.free[:ns], th_out)        # mismatched: the config's, not written as fitted
     return Diagnosis(named=named, parameters=params, standard_errors=ses, rms_config=_rms(d_config),
                      rms_before=_rms(base.diffs), rms_after=_rms(current.diffs), unexplained=unexpl,
                      unexplained_description=desc, candidates=cand_log, rounds=rounds, ship_values=ship_vals,
                      records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
                      pred_after=[r.seg.meas + d for r, d in zip(recs, current.diffs)],
-                     seconds=0.0, effects=current.effects, intervals_95=ivs, evidence=effect_evidence(named, rounds))
+                     seconds=0.0, effects=current.effects, intervals_95=ivs, evidence=effect_evidence(named, rounds),
+                     model_form_mismatch=mfm, ship_fit=ship_fit_table(current.free[:ns], current.theta[:ns]))

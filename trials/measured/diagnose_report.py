@@ -10,7 +10,7 @@ behind it, and the console lines (units, three significant figures, a legend for
   includes 0).  Other parameters: the fitted value +- 1.96 standard errors in the fitted parameter,
   mapped to the named one (a monotone map, e.g. T/H -> H/T), clipped to the parameter's bounds.
 * :func:`effect_evidence`: dBIC and z of the round in which the effect was named, and
-  :func:`false_alarm_probability` at that dBIC.
+  the calibrated :func:`~trials.measured.decision.false_alarm_probability` at its magnitude.
 * :func:`summary_lines`: the console text of a :class:`trials.measured.diagnose.Diagnosis`.
 """
 from __future__ import annotations
@@ -19,8 +19,10 @@ import math
 
 import numpy as np
 
+from .decision import false_alarm_probability  # noqa: F401  (re-exported: the report's evidence)
+
 __all__ = ["Z95", "effect_estimate", "effect_intervals", "polar_interval", "effect_evidence",
-           "false_alarm_probability", "summary_lines", "fmt3", "format_rms", "format_values", "channel_text"]
+           "summary_lines", "fmt3", "format_rms", "format_values", "channel_text"]
 
 Z95 = 1.959963984540054
 """The two-sided 95 % point of the standard normal."""
@@ -172,29 +174,6 @@ def _same(a, b) -> bool:
 # --------------------------------------------------------------------------- evidence
 
 
-def false_alarm_probability(effect_name: str, kind: str, statistic_value: float):
-    """The calibrated probability that ``mmg diagnose`` names ``effect_name`` with a statistic at least
-    ``statistic_value`` on records that do not have it (a ship that differs from its config as real
-    ships do, no such effect).
-
-    Filled by the calibration (bench/bench_diagnose.py --mismatch); until then None (not calibrated).
-
-    Parameters
-    ----------
-    effect_name : str
-        The effect (``current``, ``wind``, ...).
-    kind : str
-        Which statistic ``statistic_value`` is: ``"delta_bic"`` (the naming rule's).
-    statistic_value : float
-        Its value in the round the effect was named.
-
-    Returns
-    -------
-    float or None
-    """
-    return None
-
-
 def effect_evidence(named, rounds) -> dict:
     """{effect: {"delta_bic", "z", "false_alarm_probability"}} of each named effect, from the search
     round in which it was named (round k names the k-th effect; else its last round that cleared)."""
@@ -205,12 +184,14 @@ def effect_evidence(named, rounds) -> dict:
         cleared = [c for _, c in hits if c.get("clears_threshold")]
         pick = in_k or cleared or [c for _, c in hits]
         if not pick:
-            out[e] = {"delta_bic": None, "z": None, "false_alarm_probability": None}
+            out[e] = {"delta_bic": None, "z": None, "magnitude": None, "floor": None, "false_alarm_probability": None}
             continue
         c = pick[0] if in_k else pick[-1]
-        dbic, z = c.get("delta_bic"), c.get("z")
-        out[e] = {"delta_bic": dbic, "z": z,
-                  "false_alarm_probability": None if dbic is None else false_alarm_probability(e, "delta_bic", dbic)}
+        dbic, z, mag = c.get("delta_bic"), c.get("z"), c.get("magnitude")
+        kind = rounds[min(k, len(rounds) - 1)].get("kind")
+        out[e] = {"delta_bic": dbic, "z": z, "magnitude": mag, "floor": c.get("floor"),
+                  "false_alarm_probability": None if mag is None or kind is None else
+                  false_alarm_probability(e, kind, mag)}
     return out
 
 
@@ -295,7 +276,8 @@ def summary_lines(diag) -> list[str]:
         lines.append(f"{ni.get('effect')}: not identifiable from these records ({why}): "
                      f"{ni.get('what_would_separate', '')}".rstrip(": "))
     for k, v in (diag.model_form_mismatch or {}).items():
-        lines.append(f"model-form mismatch: {k}: {_plain(v)}")
+        lines.append(f"model-form mismatch: {k} fitted {fmt3(v['fitted'])} against the config's {fmt3(v['config'])} "
+                     f"({fmt3(v['z'])} prior std away): not written to --out-ship")
     lines.append(f"{'residual RMS (replay - log)':<28}{'config':>10}{'ship fitted':>13}{'+ named':>10}")
     for c in diag.rms_after:
         u = CHANNEL_UNITS.get(c, "")

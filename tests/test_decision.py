@@ -1,0 +1,73 @@
+"""The naming decision of mmg diagnose (trials/measured/decision.py): the size measure against plain
+formulas, the kind of record, the calibrated false-alarm probability, and the floor acting on a
+diagnosis (a floor above the fitted size must stop the naming; no floor must let it through)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+
+def test_magnitude_plain_formulas():
+    from trials.measured.decision import magnitude
+
+    assert magnitude("current", {"speed_mps": 0.15, "direction_deg": 30.0}, 325.0) == \
+        pytest.approx(0.15 / math.sqrt(9.80665 * 325.0))
+    assert magnitude("rudder_offset", {"offset_deg": -1.2}, 325.0) == 1.2
+    assert magnitude("heading_bias", {"bias_deg": 0.6}, 3.0) == 0.6
+    assert magnitude("wind", {"scale": 0.8, "sway_factor": 2.0, "yaw_factor": 1.0}, 325.0) == 0.8
+    assert magnitude("shallow_water", {"depth_to_draft": 2.0}, 325.0) == 0.5
+    assert magnitude("shallow_water", {"depth_to_draft": math.inf}, 325.0) == 0.0
+
+
+def test_record_kind_turn_and_zigzag_across_north():
+    from trials.measured.decision import record_kind
+
+    t = np.linspace(0.0, 1000.0, 2001)
+    turn = np.mod(np.radians(0.8 * t), 2 * np.pi)                       # 800 deg, wrapped
+    zig = np.mod(np.radians(20.0 * np.sin(t / 60.0)), 2 * np.pi)       # +-20 deg about north: wraps at 0
+    assert record_kind([turn]) == "turn"
+    assert record_kind([zig]) == "zigzag"
+    assert record_kind([zig, turn]) == "turn"
+
+
+@pytest.fixture
+def calib(monkeypatch):
+    import trials.measured.decision as D
+
+    table = {"floors": {"current": {"zigzag": 1.0, "turn": 1.0}},
+             "clean": {"current": {"zigzag": [0.1, 0.2, 0.3, 0.4]}}}
+    monkeypatch.setattr(D, "calibration", lambda: table)
+    return table
+
+
+def test_false_alarm_probability_counts_the_clean_records(calib):
+    from trials.measured.decision import false_alarm_probability, floor
+
+    assert false_alarm_probability("current", "zigzag", 0.25) == pytest.approx(3 / 5)   # 0.3, 0.4 and itself
+    assert false_alarm_probability("current", "zigzag", 0.5) == pytest.approx(1 / 5)
+    assert false_alarm_probability("current", "turn", 0.5) is None                      # not calibrated
+    assert floor("current", "turn") == 1.0 and floor("wind", "turn") == 0.0
+
+
+def test_the_floor_decides(monkeypatch):
+    """A clear current (2.4 % of the speed) on a 3 m zigzag: named with no floor, not named when the
+    floor is above its size (same fit, same dBIC and z)."""
+    import mmg
+    import trials.measured.decision as D
+    from trials.measured.diagnose import diagnose, synthetic_record
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    rec = synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.012, "direction_deg": 70.0}}, seed=4)
+    L = ship.particulars.L
+    size = 0.012 / math.sqrt(9.80665 * L)
+    monkeypatch.setattr(D, "calibration", lambda: {})
+    d0 = diagnose(ship, [rec], candidates=["current"])
+    assert d0.named == ["current"]
+    assert d0.evidence["current"]["magnitude"] == pytest.approx(size, rel=0.2)
+    monkeypatch.setattr(D, "calibration", lambda: {"floors": {"current": {"zigzag": 2.0 * size}}})
+    d1 = diagnose(ship, [rec], candidates=["current"])
+    assert d1.named == []
+    c = d1.rounds[0]["candidates"][0]
+    assert c["delta_bic"] > D.BIC_THRESHOLD and c["z"] > D.Z_THRESHOLD and c["floor"] == 2.0 * size
