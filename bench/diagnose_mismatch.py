@@ -148,9 +148,10 @@ def summarise(rows: list) -> dict:
             sr = [r for r in er if r["size"] == size]
             zz = [r for r in sr if r["trial"].startswith("zz")]
             tu = [r for r in sr if r["trial"].startswith("turn")]
-            dz, dt = _rate(zz, lambda r: eff in r["named"]), _rate(tu, lambda r: eff in r["named"])
-            ex = _rate(sr, lambda r: set(r["named"]) == {eff})
-            ni = _rate(tu, lambda r: eff not in r["named"] and eff in r["not_identifiable"])
+            hit = lambda r, e=eff: e in r["named"]  # noqa: E731
+            dz, dt = _rate(zz, hit), _rate(tu, hit)
+            ex = _rate(sr, lambda r, e=eff: set(r["named"]) == {e})
+            ni = _rate(tu, lambda r, e=eff: e not in r["named"] and e in r["not_identifiable"])
             print(f"{eff:14s} {size:6g} {unit:3s} {_pct(*dz):>12s} {_pct(*dt):>12s} {_pct(*ex):>12s} {_pct(*ni):>17s}")
             table["detection"][eff].append({"size": size, "zigzag": list(dz), "turn": list(dt), "exact": list(ex),
                                             "turn_not_identifiable": list(ni)})

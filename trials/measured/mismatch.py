@@ -24,8 +24,8 @@ import numpy as np
 
 from mmg.ship import Ship
 
-__all__ = ["MismatchSpec", "mismatch_member", "mismatch_ship", "mismatch_family", "crossflow_fit",
-           "trial_records", "TRIALS", "DEV_NOISE_HALF_WIDTHS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS"]
+__all__ = ["DEV_NOISE_HALF_WIDTHS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS", "TRIALS", "MismatchSpec", "crossflow_fit",
+           "mismatch_family", "mismatch_member", "mismatch_ship", "trial_records"]
 
 HULL_LINEAR_TERMS = ("beta", "r", "cos(beta)^2")
 """Hull terms counted as linear (with the resistance): the rest, but the constant ``"1"``, are nonlinear."""
@@ -211,7 +211,7 @@ def mismatch_family(ship: Ship, n: int, seed: int, spec: MismatchSpec = Mismatch
 
     Exactly ``round(n * spec.crossflow_fraction)`` of them, at random places, have the cross-flow hull."""
     rng = np.random.default_rng(seed)
-    cross = set(rng.permutation(n)[:int(round(n * spec.crossflow_fraction))].tolist())
+    cross = set(rng.permutation(n)[:round(n * spec.crossflow_fraction)].tolist())
     return [mismatch_member(ship, rng, spec, crossflow=i in cross) for i in range(n)]
 
 
