@@ -9,6 +9,16 @@ bench/out/diagnose_detection.png and prints a table.
     python bench/bench_diagnose.py [--clean 20] [--seeds 5] [--effects ...] [--quick] [--timing-only] [--no-timing]
 
 bench/out/diagnose_bench.json keeps the figures as they come.
+
+``--mismatch`` (issue 26): full-scale trials of the mismatch family (:mod:`trials.measured.mismatch`),
+each record diagnosed alone with the bundled config; false alarms over ``--clean`` (default 40) clean
+records, detection per effect and size split zigzag / turn (``bench/diagnose_mismatch.py``):
+
+    python bench/bench_diagnose.py --mismatch [--clean 40] [--seeds 5] [--seed0 0] [--jobs 2] [--effects ...]
+        [--quick] [--tag _cal]
+
+writes bench/out/diagnose_mismatch<tag>.json (every record's factors, truth, named effects and
+candidate rounds) and bench/out/diagnose_detection_mismatch<tag>.png.
 """
 from __future__ import annotations
 
@@ -67,17 +77,30 @@ def timing():
 
 def main(argv=None):
     ap = argparse.ArgumentParser()
-    ap.add_argument("--clean", type=int, default=20, help="clean record pairs (false alarms)")
+    ap.add_argument("--clean", type=int, default=None,
+                    help="clean record pairs (false alarms; default 20), with --mismatch clean records (default 40)")
     ap.add_argument("--clean-first", type=int, default=20,
                     help="first clean seed (seeds 0-19 calibrated the threshold; the default tests fresh ones)")
     ap.add_argument("--seeds", type=int, default=5, help="seeds per effect size")
-    ap.add_argument("--effects", nargs="*", default=list(SIZES))
+    ap.add_argument("--effects", nargs="*", default=None)
     ap.add_argument("--sizes", type=float, nargs="*", help="effect sizes to try instead of SIZES (with one --effects)")
     ap.add_argument("--quick", action="store_true", help="4 clean pairs, 2 seeds")
     ap.add_argument("--timing-only", action="store_true")
     ap.add_argument("--no-timing", action="store_true")
     ap.add_argument("--tag", default="", help="suffix of the output names (bench/out/diagnose_bench<tag>.json, ...)")
+    ap.add_argument("--mismatch", action="store_true",
+                    help="full-scale trials of the mismatch family, one record per diagnose (bench/diagnose_mismatch.py)")
+    ap.add_argument("--seed0", type=int, default=0, help="--mismatch: the family's and the noise seeds' offset")
+    ap.add_argument("--jobs", type=int, default=2, help="--mismatch: parallel processes")
     a = ap.parse_args(argv)
+    if a.mismatch:
+        sys.path.insert(0, str(REPO / "bench"))
+        from diagnose_mismatch import main_mismatch
+
+        main_mismatch(a)
+        return
+    a.clean = 20 if a.clean is None else a.clean
+    a.effects = list(SIZES) if a.effects is None else a.effects
     if a.timing_only:
         timing()
         return

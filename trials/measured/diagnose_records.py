@@ -98,7 +98,8 @@ def _smoothed(t: np.ndarray, meas: np.ndarray, window_s: float) -> np.ndarray:
 
 def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | None = None, speed: float | None = None,
                      duration: float | None = None, dt: float = 0.5, rudder_deg: float = 20.0,
-                     true_wind=(0.0, 0.0), noise=None, seed: int = 0, name: str | None = None):
+                     true_wind=(0.0, 0.0), noise=None, seed: int = 0, name: str | None = None,
+                     heading_deg: float | None = None, t_execute: float | None = None, noise_dist: str = "normal"):
     """A record as a trial would log it, with hidden effects: a turning or zigzag of ``truth_ship``
     (default ``ship``) simulated closed loop (the rudder orders from its own heading), then
     replayed with its rudder and revolutions and the ``effects`` (an :class:`mmg.effects.EffectSet`
@@ -107,7 +108,14 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     logged (u, v over ground resolved in the logged heading, heading with its bias) with white
     noise (``noise``: std per column u, v, r, x, y, psi; default small).  Returns a
     :class:`trials.files.records.TrialRecord` with rudder, revolutions and, when wind is on, the relative
-    and true wind channels."""
+    and true wind channels.
+
+    A negative ``rudder_deg`` turns to port (a zigzag: port first); ``heading_deg`` is a zigzag's
+    switching heading change (default ``|rudder_deg|``); ``t_execute`` [s] the time of the rudder
+    execute (default 5 sqrt(L/g) for a turning, 0 for a zigzag); ``noise_dist="uniform"`` draws
+    the noise uniform with ``noise`` as the half-widths instead of the standard deviations.  A
+    steady true wind in the effects (``true_speed_mps`` > 0) acts in the closed-loop run too, so
+    a zigzag's rudder answers the wind as a helmsman's would."""
     import mmg.effects as E
     from mmg.integrate import CommandLaw
     from mmg.replay import ReplayInputs, replay_states
@@ -124,16 +132,20 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     a = math.radians(rudder_deg)
     if kind == "turning":
         T = duration or 120.0 * s
-        law = CommandLaw.schedule([0.0, 5.0 * s, 5.0 * s + 1e-6, T], [0.0, 0.0, a, a])
+        te = 5.0 * s if t_execute is None else t_execute
+        law = CommandLaw.schedule([0.0, te, te + 1e-6, max(T, te + 1.0)], [0.0, 0.0, a, a])
     elif kind == "zigzag":
         T = duration or 160.0 * s
-        law = CommandLaw.heading_switch(a, a, -a, 1.0, psi0=0.0)
+        h = abs(a) if heading_deg is None else math.radians(heading_deg)
+        law = CommandLaw.heading_switch(abs(a), h, -h, 1.0 if a >= 0 else -1.0, psi0=0.0, t_start=t_execute or 0.0)
     else:
         raise ValueError(kind)
     # the closed-loop run that makes the rudder history has the effects that act on the dynamics
-    # through the parameter vector (current, rudder offset); the record's states are the replay's below
+    # through the parameter vector (current, rudder offset, a steady true wind); the record's states
+    # are the replay's below
+    acts = lambda c, v: bool(c.slots(v)) or (c.name == "wind" and c.steady(v))  # noqa: E731
     sim = simulate(truth, law, T, min(dt, 0.05 * s), U0, trim=False,
-                   effects=E.EffectSet(tuple(it for it in es.items if it[0].slots(it[1]))))
+                   effects=E.EffectSet(tuple(it for it in es.items if acts(*it))))
     t = np.arange(0.0, T + 1e-9, dt)
     idx = np.searchsorted(sim.t, t - 1e-9)
     idx = np.minimum(idx, len(sim.t) - 1)
@@ -161,8 +173,23 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(9.80665 / L), 0.002 * L,
                                                     0.002 * L, math.radians(0.05)])
     label = name or f"synthetic_{kind}"
+    if noise_dist == "uniform":
+        rec = logged_record(t, states, delta, n, es, None, None, wind_rel, name=label, source=label,
+                            meta={"format": "synthetic"})
+        return _uniform_noise(rec, sd, np.random.default_rng(seed))
+    if noise_dist != "normal":
+        raise ValueError(f"noise_dist {noise_dist!r}: 'normal' or 'uniform'")
     return logged_record(t, states, delta, n, es, sd, np.random.default_rng(seed), wind_rel,
                          name=label, source=label, meta={"format": "synthetic"})
+
+
+def _uniform_noise(rec, half_widths, rng):
+    """``rec`` with uniform noise of ``half_widths`` (u, v, r, x, y, psi) on its logged states."""
+    from dataclasses import replace
+
+    cols = ("u", "v", "r", "x", "y", "psi")
+    new = {c: getattr(rec, c) + rng.uniform(-1.0, 1.0, len(rec.t)) * float(w) for c, w in zip(cols, half_widths)}
+    return replace(rec, U=np.hypot(new["u"], new["v"]), **new)
 
 
 def write_frt_csv(rec, path) -> None:

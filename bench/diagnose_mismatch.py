@@ -1,0 +1,222 @@
+"""``bench/bench_diagnose.py --mismatch``: mmg diagnose on full-scale trials of ships that are not its model.
+
+Records: the development set's trials (:data:`trials.measured.mismatch.TRIALS`: 35 deg turns to
+starboard and port, 10/10, 15/15, 20/20 zigzags; 10 kn, constant revolutions, 1 s, uniform noise
+of the set's half-widths) of members of the mismatch family (:mod:`trials.measured.mismatch`:
+hull +-10 % linear, +-25 % nonlinear, a quarter with the cross-flow hull form, rudder and propeller
++-15 %, added masses +-10 %, wind loads +-30 %), each diagnosed alone as a user would
+(``diagnose(load_ship(ship_path("esso_osaka")), [record])``).  Clean records give the false-alarm
+rate; records with one effect (current, wind, heading bias, rudder offset, at several sizes, random
+direction or sign, random member and trial) the detection rate.  The JSON keeps every record's
+candidate statistics per round (``rounds``), to calibrate the naming decision on the clean ones.
+"""
+from __future__ import annotations
+
+import functools
+import json
+import math
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+KINDS = ("turn35", "turn35p", "zz10", "zz15", "zz20")
+
+SIZES = {
+    "current": ("speed_mps", "m/s", [0.05, 0.1, 0.15, 0.25]),
+    "wind": ("speed_mps", "m/s", [6.0, 10.0, 15.0]),
+    "heading_bias": ("bias_deg", "deg", [0.5, 1.0, 1.5]),
+    "rudder_offset": ("offset_deg", "deg", [0.5, 1.0, 1.5]),
+}
+"""Per effect: the size's name, its unit and the sizes tried (full scale, 10 kn approach)."""
+
+FAMILY_SIZE = 40
+"""Members drawn per family seed; clean record i sails member i mod this, effect records a random one."""
+
+
+@functools.lru_cache(maxsize=4)
+def _family(seed0: int):
+    import mmg
+    from trials.measured.mismatch import mismatch_family
+
+    return mismatch_family(mmg.load_ship("esso_osaka"), FAMILY_SIZE, seed0)
+
+
+def jobs(nclean: int, seeds: int, effects, seed0: int) -> list[dict]:
+    """The records to make and diagnose: ``nclean`` clean ones (member i, trial i mod 5), then per
+    effect, size and seed one with that effect (member, trial, direction or sign drawn from the seeds)."""
+    out = [{"id": f"clean_{i}", "effect": None, "size": 0.0, "member": i % FAMILY_SIZE, "trial": KINDS[i % len(KINDS)],
+            "spec": {}, "true_wind": (0.0, 0.0), "seed": seed0 + i} for i in range(nclean)]
+    for ie, eff in enumerate(effects):
+        for isz, size in enumerate(SIZES[eff][2]):
+            for s in range(seeds):
+                rng = np.random.default_rng([seed0, ie, isz, s])
+                job = {"id": f"{eff}_{size:g}_{s}", "effect": eff, "size": size,
+                       "member": int(rng.integers(FAMILY_SIZE)), "trial": KINDS[int(rng.integers(len(KINDS)))],
+                       "true_wind": (0.0, 0.0), "seed": seed0 + 10000 * (ie + 1) + 100 * isz + s}
+                sign = float(rng.choice([-1.0, 1.0]))
+                direction = float(rng.uniform(0.0, 360.0))
+                if eff == "current":
+                    job["spec"] = {"current": {"speed_mps": size, "direction_deg": direction}}
+                elif eff == "wind":
+                    job["spec"] = {"wind": {}}
+                    job["true_wind"] = (size, math.radians(direction))
+                elif eff == "heading_bias":
+                    job["spec"] = {"heading_bias": {"bias_deg": sign * size}}
+                else:
+                    job["spec"] = {"rudder_offset": {"offset_deg": sign * size}}
+                out.append(job)
+    return out
+
+
+def run_one(job: dict, seed0: int) -> dict:
+    """Make the job's record, diagnose it with the bundled config as a user would, return the row."""
+    import mmg
+    from trials.measured.diagnose import diagnose
+    from trials.measured.mismatch import trial_records
+
+    config = mmg.load_ship(mmg.ship_path("esso_osaka"))
+    member, factors = _family(seed0)[job["member"]]
+    rec = trial_records(config, member, job["trial"], job["spec"], seed=job["seed"], true_wind=job["true_wind"],
+                        name=job["id"])
+    t0 = time.perf_counter()
+    d = diagnose(config, [rec])
+    js = d.to_json()
+    truth = {k: dict(v) for k, v in job["spec"].items()}
+    if "wind" in truth:
+        truth["wind"] = {"speed_mps": job["true_wind"][0], "from_deg": math.degrees(job["true_wind"][1]),
+                         **member.wind.values()}
+    return {**{k: job[k] for k in ("id", "seed", "member", "trial", "effect", "size")},
+            "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
+            "parameters": d.parameters, "not_identifiable": [n["effect"] for n in d.not_identifiable],
+            "unexplained": bool(d.unexplained), "rounds": js["rounds"], "duration_s": float(rec.t[-1]),
+            "seconds": round(time.perf_counter() - t0, 1)}
+
+
+def _execute(todo: list, seed0: int, njobs: int, save) -> list:
+    rows = []
+
+    def done(row):
+        rows.append(row)
+        save(rows)
+        print(f"[{len(rows)}/{len(todo)}] {row['id']} {row['trial']} member {row['member']} "
+              f"({row['factors']['hull_form']}): named {row['named']} "
+              f"{'not identifiable ' + str(row['not_identifiable']) + ' ' if row['not_identifiable'] else ''}"
+              f"{row['seconds']:.0f} s", file=sys.stderr, flush=True)
+
+    if njobs <= 1:
+        for job in todo:
+            done(run_one(job, seed0))
+    else:
+        with ProcessPoolExecutor(njobs) as ex:
+            for fut in as_completed([ex.submit(run_one, job, seed0) for job in todo]):
+                done(fut.result())
+    order = {j["id"]: i for i, j in enumerate(todo)}
+    return sorted(rows, key=lambda r: order[r["id"]])
+
+
+def _rate(rows, pred) -> tuple[int, int]:
+    return sum(bool(pred(r)) for r in rows), len(rows)
+
+
+def _pct(k: int, n: int) -> str:
+    return f"{k}/{n} ({100 * k / n:.0f} %)" if n else "-"
+
+
+def summarise(rows: list) -> dict:
+    """Print and return the false-alarm rate, detection (zigzag / turn), exact naming."""
+    clean = [r for r in rows if r["effect"] is None]
+    fa = _rate(clean, lambda r: r["named"])
+    print(f"\nfalse alarms: {_pct(*fa)} clean records named an effect")
+    for r in clean:
+        if r["named"]:
+            print(f"  {r['id']} {r['trial']} ({r['factors']['hull_form']}): {r['named']} {r['parameters']}")
+    print(f"\n{'effect':14s} {'size':>9s} {'zigzag det':>12s} {'turn det':>12s} {'exact':>12s} {'not ident (turn)':>17s}")
+    table = {"false_alarms": list(fa), "detection": {}}
+    for eff, (par, unit, sizes) in SIZES.items():
+        er = [r for r in rows if r["effect"] == eff]
+        if not er:
+            continue
+        table["detection"][eff] = []
+        for size in sizes:
+            sr = [r for r in er if r["size"] == size]
+            zz = [r for r in sr if r["trial"].startswith("zz")]
+            tu = [r for r in sr if r["trial"].startswith("turn")]
+            hit = lambda r, e=eff: e in r["named"]  # noqa: E731
+            dz, dt = _rate(zz, hit), _rate(tu, hit)
+            ex = _rate(sr, lambda r, e=eff: set(r["named"]) == {e})
+            ni = _rate(tu, lambda r, e=eff: e not in r["named"] and e in r["not_identifiable"])
+            print(f"{eff:14s} {size:6g} {unit:3s} {_pct(*dz):>12s} {_pct(*dt):>12s} {_pct(*ex):>12s} {_pct(*ni):>17s}")
+            table["detection"][eff].append({"size": size, "zigzag": list(dz), "turn": list(dt), "exact": list(ex),
+                                            "turn_not_identifiable": list(ni)})
+    allr = _rate(rows, lambda r: set(r["named"]) == ({r["effect"]} if r["effect"] else set()))
+    print(f"\nexact (named set == true set) over all records: {_pct(*allr)}")
+    table["exact"] = list(allr)
+    return table
+
+
+def plot(table: dict, path: Path, title: str) -> None:
+    """Detection rate against size per effect, zigzag and turn lines."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    det = table["detection"]
+    if not det:
+        return
+    fig, axs = plt.subplots(1, len(det), figsize=(3.6 * len(det), 3.4), layout="constrained", squeeze=False)
+    for ax, (eff, rows) in zip(axs[0], det.items()):
+        par, unit, _ = SIZES[eff]
+        for key, style, lab in (("zigzag", "o-", "zigzag"), ("turn", "s--", "35° turn")):
+            pts = [(r["size"], r[key][0] / r[key][1]) for r in rows if r[key][1]]
+            if pts:
+                ax.plot(*zip(*pts), style, label=f"{lab}")
+        if eff == "rudder_offset":
+            pts = [(r["size"], r["turn_not_identifiable"][0] / r["turn_not_identifiable"][1]) for r in rows
+                   if r["turn_not_identifiable"][1]]
+            if pts:
+                ax.plot(*zip(*pts), "^:", label="turn: not identifiable")
+        ax.set_ylim(-0.05, 1.05)
+        ax.set_xlabel(f"{eff.replace('_', ' ')} {par.split('_')[0]} [{unit}]")
+        ax.set_ylabel("detection rate [-]")
+        ax.set_title(eff.replace("_", " "), fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fa = table["false_alarms"]
+    fig.suptitle(f"{title}; false alarms {fa[0]}/{fa[1]} clean records", fontsize=9)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main_mismatch(a) -> None:
+    """The ``--mismatch`` mode of bench/bench_diagnose.py (options parsed there)."""
+    nclean = 4 if a.quick and a.clean is None else (a.clean if a.clean is not None else 40)
+    seeds = 1 if a.quick else a.seeds
+    effects = a.effects or (["current", "wind"] if a.quick else list(SIZES))
+    unknown = set(effects) - set(SIZES)
+    if unknown:
+        raise SystemExit(f"--mismatch: unknown effects {sorted(unknown)}; have {list(SIZES)}")
+    out = REPO / "bench" / "out"
+    out.mkdir(exist_ok=True)
+    todo = jobs(nclean, seeds, effects, a.seed0)
+    path = out / f"diagnose_mismatch{a.tag}.json"
+    head = {"family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds, "effects": effects,
+            "sizes": {e: SIZES[e] for e in effects}}
+    save = lambda rows: path.write_text(json.dumps({**head, "records": rows}, indent=1, default=float))  # noqa: E731
+    t0 = time.perf_counter()
+    print(f"mismatch bench: {len(todo)} records ({nclean} clean, {len(todo) - nclean} with an effect), family seed "
+          f"{a.seed0}, {a.jobs} job(s)", flush=True)
+    rows = _execute(todo, a.seed0, a.jobs, save)
+    table = summarise(rows)
+    save(rows)
+    path.write_text(json.dumps({**head, "summary": table, "records": rows}, indent=1, default=float))
+    png = out / f"diagnose_detection_mismatch{a.tag}.png"
+    plot(table, png, f"mmg diagnose on the mismatch family (seed {a.seed0}, {seeds} seed(s)/size)")
+    print(f"wrote {path} and {png}; {time.perf_counter() - t0:.0f} s wall")

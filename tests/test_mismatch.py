@@ -1,0 +1,132 @@
+"""The mismatch family (trials.measured.mismatch): factors within the spec, members built from them,
+records logged as the development set's (noise, port turn, zigzag length).  Expected values come from
+the config YAML and the development set's README, not from the module."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+import mmg
+from trials.measured.mismatch import MismatchSpec, mismatch_family, trial_records
+
+REPO = Path(__file__).resolve().parents[1]
+YAML = yaml.safe_load((REPO / "configs" / "ships" / "esso_osaka.yaml").read_text())
+
+# the development set's README: uniform noise half-widths
+HALF = {"x": 0.5, "y": 0.5, "u": 0.02, "v": 0.02, "psi": math.radians(0.05), "r": 0.0002}
+
+
+@pytest.fixture(scope="module")
+def family():
+    return mismatch_family(mmg.load_ship("esso_osaka"), 12, seed=7)
+
+
+def test_factors_within_the_spec_with_both_signs(family):
+    sp = MismatchSpec()
+    linear = {n for n, c in YAML["hull"]["coefficients"].items() if c["term"] in ("beta", "r", "cos(beta)^2")}
+    groups = {"hull_linear": [], "hull_nonlinear": [], "rudder": [], "propeller": [], "mass": [], "wind": []}
+    for _, f in family:
+        for name, x in f["hull"].items():
+            groups["hull_linear" if name in linear else "hull_nonlinear"].append(x - 1.0)
+        for key in ("rudder", "propeller", "mass", "wind"):
+            groups[key] += [x - 1.0 for x in f[key].values()]
+    half = {"hull_linear": 0.10, "hull_nonlinear": 0.25, "rudder": 0.15, "propeller": 0.15, "mass": 0.10, "wind": 0.30}
+    assert sp.hull_linear == half["hull_linear"] and sp.hull_nonlinear == half["hull_nonlinear"]
+    for key, d in groups.items():
+        d = np.array(d)
+        assert np.all(np.abs(d) <= half[key]), key
+        assert (d > 0).any() and (d < 0).any(), key
+        assert np.abs(d).max() > 0.5 * half[key], key          # the draws fill the range, not a sliver of it
+    forms = [f["hull_form"] for _, f in family]
+    assert forms.count("crossflow") == 3 and forms.count("kijima") == 9          # a quarter of 12
+
+
+def test_members_are_the_config_times_their_factors(family):
+    coef = YAML["hull"]["coefficients"]
+    for ship, f in family:
+        if f["hull_form"] == "kijima":
+            for name, c in coef.items():
+                want = c["value"] * f["hull"].get(name, 1.0)
+                assert ship.hull.value(name) == pytest.approx(want, rel=1e-12), name
+            assert set(f["hull"]) == {n for n, c in coef.items() if c["term"] != "1"}
+        else:
+            # the Kijima nonlinear sway and yaw terms are gone, cross-flow drag terms are in
+            terms = dict(zip(ship.hull.names, ship.hull.terms))
+            assert "int(|v+x*r|*(v+x*r))" in terms.values() and "int(x*|v+x*r|*(v+x*r))" in terms.values()
+            assert "beta^2*r" not in terms.values()
+            for name in ("Y_beta", "Y_r", "N_beta", "N_r", "X_uu", "X_br"):
+                assert ship.hull.value(name) == pytest.approx(coef[name]["value"] * f["hull"][name], rel=1e-12)
+        for k, x in f["rudder"].items():
+            assert getattr(ship.rudder, k) == pytest.approx(YAML["rudder"][k] * x, rel=1e-12), k
+        for k, x in f["mass"].items():
+            assert getattr(ship.mass, k) == pytest.approx(YAML["mass"][k] * x, rel=1e-12), k
+        p = YAML["propeller"]
+        assert ship.propeller.w_P0[0] == pytest.approx(p["w_P0"][0] * f["propeller"]["w_P0"], rel=1e-12)
+        assert ship.propeller.w_P0[1:] == pytest.approx(p["w_P0"][1:], rel=1e-12)
+        assert ship.propeller.t_P[0] == pytest.approx(p["t_P"][0] * f["propeller"]["t_P"], rel=1e-12)
+        assert ship.propeller.K_T == pytest.approx([c * f["propeller"]["K_T"] for c in p["K_T"]], rel=1e-12)
+        w = f["wind"]                                   # surge, sway, yaw loads on their own factors
+        assert ship.wind.scale == pytest.approx(w["surge"])
+        assert ship.wind.scale * ship.wind.sway_factor == pytest.approx(w["sway"])
+        assert ship.wind.scale * ship.wind.yaw_factor == pytest.approx(w["yaw"])
+
+
+def test_crossflow_member_keeps_the_kijima_nonlinear_forces_roughly(family):
+    """The cross-flow hull's nonlinear sway force tracks the Kijima one it was fitted to (within its
+    own +-25 % perturbation and the form's misfit) at a drift of 15 deg in a turn r' = 0.4."""
+    from mmg.terms import crossflow_N, crossflow_Y
+
+    c = {n: v["value"] for n, v in YAML["hull"]["coefficients"].items()}
+    b, r = math.radians(15.0), 0.4
+    kij = c["Y_bb"] * b * abs(b) + c["Y_rr"] * r * abs(r) + c["Y_bbr"] * b * b * r + c["Y_brr"] * b * r * r
+    ship, _ = next(m for m in family if m[1]["hull_form"] == "crossflow")
+    h = dict(zip(ship.hull.names, zip(ship.hull.terms, ship.hull.values)))
+    val = {"int(|v+x*r|*(v+x*r))": crossflow_Y(-math.sin(b), r), "int(x*|v+x*r|*(v+x*r))": crossflow_N(-math.sin(b), r),
+           "r|r|": r * abs(r)}
+    ax = dict(zip(ship.hull.names, ship.hull.axes))
+    cf = sum(v * val[t] for n, (t, v) in h.items() if ax[n] == "Y" and t in val)
+    assert cf == pytest.approx(kij, rel=0.5)
+
+
+@pytest.fixture(scope="module")
+def config():
+    return mmg.load_ship("esso_osaka")
+
+
+def test_records_have_the_dev_sets_uniform_noise(config, family):
+    member = family[0][0]
+    noisy = trial_records(config, member, "turn35", {}, seed=3)
+    clean = trial_records(config, member, "turn35", {}, seed=3, noise=(0.0,) * 6)
+    assert noisy.t[1] - noisy.t[0] == 1.0 and noisy.t[-1] == pytest.approx(1510.0)
+    for ch, h in HALF.items():
+        e = getattr(noisy, ch) - getattr(clean, ch)
+        if ch == "psi":
+            e = np.angle(np.exp(1j * e))
+        assert np.abs(e).max() <= h * (1 + 1e-9), ch
+        assert np.std(e) == pytest.approx(h / math.sqrt(3.0), rel=0.08), ch      # std of a uniform on [-h, h]
+
+
+def test_port_turn_turns_to_port_and_starboard_to_starboard(config, family):
+    member = family[1][0]
+    port = trial_records(config, member, "turn35p", {}, seed=1)
+    stbd = trial_records(config, member, "turn35", {}, seed=1)
+    dpsi = lambda rec: math.degrees(np.unwrap(rec.psi)[-1] - rec.psi[0])  # noqa: E731
+    assert dpsi(port) < -270.0 and dpsi(stbd) > 270.0
+    assert port.delta[-1] == pytest.approx(-math.radians(35.0), abs=1e-6)
+    assert np.all(np.abs(port.delta[port.t < 9.5]) < math.radians(1.0))          # 10 s straight approach
+    assert np.mean(port.u[:10]) == pytest.approx(10 * 1852 / 3600, abs=0.03)       # 10 kn
+
+
+def test_zigzag_ends_sixty_seconds_after_its_ninth_reversal(config, family):
+    rec = trial_records(config, replace(family[2][0]), "zz20", {}, seed=2)
+    d = np.asarray(rec.delta)
+    flips = np.flatnonzero(np.sign(d[1:]) != np.sign(d[:-1])) + 1
+    flips = flips[rec.t[flips] > 11.0]
+    assert len(flips) == 9
+    assert rec.t[-1] == pytest.approx(rec.t[flips[-1]] + 60.0, abs=1.0)
+    assert np.max(np.abs(d)) == pytest.approx(math.radians(20.0), abs=1e-6)

@@ -1,0 +1,290 @@
+"""Ships that are not their model: the mismatch family that ``mmg diagnose``'s naming is calibrated on.
+
+A real ship differs from its predicted model (issue 26, "Calibrated against a ship that is not its
+model"): its hull derivatives, rudder and propeller constants, added masses and wind loads are all
+off by a few to a few tens of per cent, and its hull may not even follow the model's form.  This
+module draws such ships from a config (:func:`mismatch_ship`, :func:`mismatch_family`) and simulates
+full-scale trials of them with hidden effects (:func:`trial_records`) the way the independent
+development set ``../shared/data/diagnose-dev/`` was made: 10 kn approach at constant propeller
+revolutions, 35 deg turns to starboard and port, 10/10, 15/15 and 20/20 zigzags of nine reversals
+and a 60 s tail, 1 s samples, uniform log noise of the set's half-widths.
+
+Every factor is ``1 + u`` with ``u`` uniform in ``[-h, h]`` (a random sign and size), ``h`` the
+relative half-width of :class:`MismatchSpec`.  A fraction of the family has its hull's nonlinear
+part in another form: the low-speed cross-flow form (:func:`mmg.terms.crossflow_Y`,
+:func:`mmg.terms.crossflow_N`), its coefficients fitted by least squares to the config's Kijima
+nonlinear forces over the operating range and then perturbed like the others.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from mmg.ship import Ship
+
+__all__ = ["DEV_NOISE_HALF_WIDTHS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS", "TRIALS", "MismatchSpec", "crossflow_fit",
+           "mismatch_family", "mismatch_member", "mismatch_ship", "trial_records"]
+
+HULL_LINEAR_TERMS = ("beta", "r", "cos(beta)^2")
+"""Hull terms counted as linear (with the resistance): the rest, but the constant ``"1"``, are nonlinear."""
+
+RUDDER_CONSTANTS = ("f_alpha", "epsilon", "kappa", "t_R", "a_H", "x_H_prime", "gamma_R_pos", "gamma_R_neg")
+"""The rudder constants the family moves (the geometry, A_R, H_R, eta, x_R', l_R', is kept)."""
+
+DEV_NOISE_HALF_WIDTHS = (0.02, 0.02, 0.0002, 0.5, 0.5, math.radians(0.05))
+"""Uniform log-noise half-widths of the development set (u, v [m/s], r [rad/s], x, y [m], psi [rad])."""
+
+KNOT = 1852.0 / 3600.0
+
+TRIALS = {
+    "turn35": {"kind": "turning", "rudder_deg": 35.0},
+    "turn35p": {"kind": "turning", "rudder_deg": -35.0},
+    "zz10": {"kind": "zigzag", "rudder_deg": 10.0, "heading_deg": 10.0},
+    "zz15": {"kind": "zigzag", "rudder_deg": 15.0, "heading_deg": 15.0},
+    "zz20": {"kind": "zigzag", "rudder_deg": 20.0, "heading_deg": 20.0},
+}
+"""The development set's trials: 35 deg turns (starboard, port) and zigzags (starboard first)."""
+
+
+@dataclass(frozen=True)
+class MismatchSpec:
+    """Relative half-widths of the uniform, random-sign factors a family member is drawn with.
+
+    Attributes
+    ----------
+    hull_linear : float
+        Hull terms of :data:`HULL_LINEAR_TERMS` (``beta``, ``r``, the resistance ``cos(beta)^2``).
+    hull_nonlinear : float
+        Every other hull term but the constants ``"1"`` (``beta|beta|``, ``r|r|``, ``beta^2*r``,
+        ``beta*r^2``, ``r*sin(beta)``, the cross-flow drags).
+    rudder : float
+        The rudder constants of :data:`RUDDER_CONSTANTS`.
+    propeller : float
+        The wake fraction's and the thrust deduction's first coefficients, the K_T curve as a whole.
+    added_mass : float
+        m_x', m_y', J_z'.
+    wind : float
+        The surge, sway and yaw wind loads, each on its own (ships with a ``wind`` section).
+    crossflow_fraction : float
+        Probability that a member's hull nonlinear part is of the cross-flow form.
+    beta_max_deg, r_max : float
+        The operating range the cross-flow form is fitted over: |beta| <= beta_max_deg, |r'| <= r_max.
+    """
+
+    hull_linear: float = 0.10
+    hull_nonlinear: float = 0.25
+    rudder: float = 0.15
+    propeller: float = 0.15
+    added_mass: float = 0.10
+    wind: float = 0.30
+    crossflow_fraction: float = 0.25
+    beta_max_deg: float = 25.0
+    r_max: float = 0.8
+
+
+def _factor(rng: np.random.Generator, h: float) -> float:
+    """1 + u, u uniform in [-h, h]."""
+    return float(1.0 + rng.uniform(-h, h))
+
+
+def crossflow_fit(ship: Ship, beta_max_deg: float = 25.0, r_max: float = 0.8) -> dict:
+    """The cross-flow form of a Kijima hull's nonlinear sway force and yaw moment.
+
+    Least squares over a grid of |beta| <= ``beta_max_deg``, |r'| <= ``r_max`` (v' = -sin beta):
+    Y_nl ~ Y_CD F(v', r') + Y_rr r'|r'|, N_nl ~ N_CD G(v', r') + N_CDY F(v', r') with F, G the
+    cross-flow integrals (:func:`mmg.terms.crossflow_Y`, :func:`mmg.terms.crossflow_N`).  One drag
+    term per axis leaves 60 % of the yaw moment's nonlinear part unexplained on the Esso Osaka
+    set; the second terms (a sway drag with an arm, and the pure-yaw side force) bring it to about
+    35 % (the Kijima couplings beta^2 r, beta r^2 have no cross-flow counterpart).
+
+    Parameters
+    ----------
+    ship : Ship
+        A ship whose hull has the Kijima nonlinear terms (``beta|beta|``, ``r|r|``, ``beta^2*r``,
+        ``beta*r^2`` on Y and N; absent ones count as 0).
+    beta_max_deg, r_max : float
+        The operating range.
+
+    Returns
+    -------
+    dict
+        ``{"Y": [(name, term, value), ...], "N": [...], "rms_fraction": {"Y": .., "N": ..}}``: the
+        fitted terms and the residual's rms as a fraction of the Kijima nonlinear part's.
+    """
+    from mmg.terms import crossflow_N, crossflow_Y
+
+    b, r = (g.ravel() for g in np.meshgrid(np.radians(np.linspace(-beta_max_deg, beta_max_deg, 41)),
+                                           np.linspace(-r_max, r_max, 33)))
+    kij = {"beta|beta|": b * np.abs(b), "r|r|": r * np.abs(r), "beta^2*r": b * b * r, "beta*r^2": b * r * r}
+    v = -np.sin(b)
+    F = np.array([crossflow_Y(x, y) for x, y in zip(v, r)])
+    G = np.array([crossflow_N(x, y) for x, y in zip(v, r)])
+    basis = {"Y": [("Y_CD", "int(|v+x*r|*(v+x*r))", F), ("Y_rr", "r|r|", r * np.abs(r))],
+             "N": [("N_CD", "int(x*|v+x*r|*(v+x*r))", G), ("N_CDY", "int(|v+x*r|*(v+x*r))", F)]}
+    h = ship.hull
+    out, frac = {}, {}
+    for ax in ("Y", "N"):
+        target = sum(val * kij[term] for a, term, val in zip(h.axes, h.terms, h.values) if a == ax and term in kij)
+        A = np.column_stack([col for _, _, col in basis[ax]])
+        c, *_ = np.linalg.lstsq(A, target, rcond=None)
+        frac[ax] = float(np.sqrt(np.mean((target - A @ c) ** 2)) / max(np.sqrt(np.mean(target ** 2)), 1e-12))
+        out[ax] = [(name, term, float(ci)) for (name, term, _), ci in zip(basis[ax], c)]
+    out["rms_fraction"] = frac
+    return out
+
+
+def _hull(ship: Ship, rng, spec: MismatchSpec, crossflow: bool):
+    """The member's hull and its factors (name -> factor)."""
+    from mmg.ship import HullModel
+
+    h = ship.hull
+    rows = list(zip(h.names, h.axes, h.terms, h.values))
+    if crossflow:
+        fit = crossflow_fit(ship, spec.beta_max_deg, spec.r_max)
+        kij = ("beta|beta|", "r|r|", "beta^2*r", "beta*r^2")
+        rows = [row for row in rows if not (row[1] in ("Y", "N") and row[2] in kij)]
+        rows += [(name, ax, term, val) for ax in ("Y", "N") for name, term, val in fit[ax]]
+    factors = {}
+    for name, _, term, _ in rows:
+        if term != "1":
+            factors[name] = _factor(rng, spec.hull_linear if term in HULL_LINEAR_TERMS else spec.hull_nonlinear)
+    hull = HullModel(names=tuple(r[0] for r in rows), axes=tuple(r[1] for r in rows), terms=tuple(r[2] for r in rows),
+                     values=tuple(r[3] * factors.get(r[0], 1.0) for r in rows))
+    return hull, factors
+
+
+def mismatch_member(ship: Ship, rng: np.random.Generator, spec: MismatchSpec = MismatchSpec(),
+                    crossflow: bool | None = None) -> tuple[Ship, dict]:
+    """One ship of the family and the factors it was drawn with.
+
+    Parameters
+    ----------
+    ship : Ship
+        The config (the model that diagnoses).
+    rng : numpy.random.Generator
+    spec : MismatchSpec
+    crossflow : bool, optional
+        Whether the hull's nonlinear part is of the cross-flow form; drawn with probability
+        ``spec.crossflow_fraction`` when None.
+
+    Returns
+    -------
+    (Ship, dict)
+        The member and ``{"hull_form": "kijima" | "crossflow", "hull": {name: factor}, "rudder":
+        {...}, "propeller": {"w_P0": .., "t_P": .., "K_T": ..}, "mass": {"m_x_prime": .., ...},
+        "wind": {"surge": .., "sway": .., "yaw": ..}}`` (a cross-flow member's hull factors are on
+        its fitted cross-flow values, :func:`crossflow_fit`).
+    """
+    cf = rng.uniform() < spec.crossflow_fraction           # drawn always: the same stream either way
+    crossflow = bool(cf if crossflow is None else crossflow)
+    hull, fh = _hull(ship, rng, spec, crossflow)
+    fr = {k: _factor(rng, spec.rudder) for k in RUDDER_CONSTANTS}
+    fp = {k: _factor(rng, spec.propeller) for k in ("w_P0", "t_P", "K_T")}
+    fm = {k: _factor(rng, spec.added_mass) for k in ("m_x_prime", "m_y_prime", "J_z_prime")}
+    pr = ship.propeller
+    first = lambda c, f: (c[0] * f,) + tuple(c[1:])  # noqa: E731
+    out = replace(ship, name=f"{ship.name} (mismatch member)", hull=hull,
+                  rudder=replace(ship.rudder, **{k: getattr(ship.rudder, k) * f for k, f in fr.items()}),
+                  propeller=replace(pr, w_P0=first(pr.w_P0, fp["w_P0"]), t_P=first(pr.t_P, fp["t_P"]),
+                                    K_T=tuple(c * fp["K_T"] for c in pr.K_T)),
+                  mass=replace(ship.mass, **{k: getattr(ship.mass, k) * f for k, f in fm.items()}))
+    factors = {"hull_form": "crossflow" if crossflow else "kijima", "hull": fh, "rudder": fr, "propeller": fp,
+               "mass": fm}
+    if ship.wind is not None:
+        fw = {k: _factor(rng, spec.wind) for k in ("surge", "sway", "yaw")}
+        w = ship.wind
+        out = replace(out, wind=replace(w, scale=w.scale * fw["surge"], sway_factor=w.sway_factor * fw["sway"] / fw["surge"],
+                                        yaw_factor=w.yaw_factor * fw["yaw"] / fw["surge"]))
+        factors["wind"] = fw
+    return out, factors
+
+
+def mismatch_ship(ship: Ship, rng: np.random.Generator, spec: MismatchSpec = MismatchSpec()) -> Ship:
+    """One ship of the family (:func:`mismatch_member` without its factors)."""
+    return mismatch_member(ship, rng, spec)[0]
+
+
+def mismatch_family(ship: Ship, n: int, seed: int, spec: MismatchSpec = MismatchSpec()) -> list:
+    """``n`` members drawn from ``seed``: a list of (Ship, factors) (:func:`mismatch_member`).
+
+    Exactly ``round(n * spec.crossflow_fraction)`` of them, at random places, have the cross-flow hull."""
+    rng = np.random.default_rng(seed)
+    cross = set(rng.permutation(n)[:round(n * spec.crossflow_fraction)].tolist())
+    return [mismatch_member(ship, rng, spec, crossflow=i in cross) for i in range(n)]
+
+
+def _head(rec, t_end: float):
+    """The record up to ``t_end`` [s] (every array channel cut alike)."""
+    k = int(np.searchsorted(rec.t, t_end + 1e-9))
+    cut = {f: getattr(rec, f)[:k] for f in ("t", "x", "y", "psi", "U", "u", "v", "r", "delta", "n", "wind_speed_rel",
+                                           "wind_dir_rel", "wind_speed_true", "wind_dir_true")
+           if getattr(rec, f) is not None}
+    return replace(rec, **cut)
+
+
+def _zigzag_end(rec, t_execute: float, reversals: int, tail: float) -> float:
+    """The time of the ``reversals``-th rudder reversal after the execute, plus ``tail`` [s]."""
+    d = np.asarray(rec.delta)
+    after = rec.t > t_execute + 1.0
+    s = np.sign(d - np.median(d[rec.t <= t_execute]) if (rec.t <= t_execute).any() else d)
+    flips = np.flatnonzero(after[1:] & (s[1:] != s[:-1]) & (s[1:] != 0)) + 1
+    if len(flips) < reversals:
+        return float(rec.t[-1])
+    return float(rec.t[flips[reversals - 1]]) + tail
+
+
+def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 0, true_wind=(0.0, 0.0),
+                  speed_kn: float = 10.0, noise=DEV_NOISE_HALF_WIDTHS, name: str | None = None):
+    """A full-scale trial of ``truth`` logged as the development set's are.
+
+    10 s straight run at heading 0, then the execute; a turn runs 1500 s after it, a zigzag to its
+    ninth reversal plus 60 s; constant propeller revolutions (the approach's, at ``speed_kn``);
+    1 s samples; uniform noise of half-widths ``noise`` (u, v, r, x, y, psi).
+
+    Parameters
+    ----------
+    ship : Ship
+        The config (for :func:`~trials.measured.diagnose_records.synthetic_record`'s record).
+    truth : Ship
+        The ship that sails (a family member).
+    kind : str
+        A key of :data:`TRIALS`.
+    effects : dict, optional
+        ``{effect: {parameter: value}}`` (mmg.effects); a ``wind`` entry gets the steady
+        ``true_wind`` and ``truth``'s own wind-load factors (its ``wind`` section), so the wind acts
+        through the member's loads, not the config's.
+    seed : int
+        Noise seed.
+    true_wind : (float, float)
+        True wind speed [m/s] and the direction it comes from [rad, clockwise from north].
+    speed_kn : float
+        Approach speed [kn].
+    noise : sequence of 6 floats
+        Uniform half-widths.
+    name : str, optional
+
+    Returns
+    -------
+    trials.files.records.TrialRecord
+    """
+    from .diagnose_records import synthetic_record
+
+    tr = TRIALS[kind]
+    eff = {k: dict(v) for k, v in (effects or {}).items()}
+    if "wind" in eff:
+        if truth.wind is None:
+            raise ValueError("a wind effect needs the truth ship's wind section")
+        eff["wind"] = {**truth.wind.values(), **eff["wind"], "true_speed_mps": float(true_wind[0]),
+                       "true_from_deg": math.degrees(true_wind[1])}
+    rpm = replace(truth, engine=replace(truth.engine, mode="constant_rpm"))
+    te = 10.0
+    zig = tr["kind"] == "zigzag"
+    rec = synthetic_record(ship, tr["kind"], eff, truth_ship=rpm, speed=speed_kn * KNOT,
+                           duration=4000.0 if zig else te + 1500.0, dt=1.0, rudder_deg=tr["rudder_deg"],
+                           heading_deg=tr.get("heading_deg"), t_execute=te, true_wind=true_wind, noise=noise,
+                           noise_dist="uniform", seed=seed, name=name or kind)
+    if zig:
+        rec = _head(rec, _zigzag_end(rec, te, 9, 60.0))
+    return replace(rec, meta={**rec.meta, "trial": kind, "effects": eff})
