@@ -96,6 +96,8 @@ def run_one(job: dict, seed0: int) -> dict:
             "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
             "parameters": d.parameters, "not_identifiable": [n["effect"] for n in d.not_identifiable],
             "unexplained": bool(d.unexplained), "rounds": js["rounds"], "duration_s": float(rec.t[-1]),
+            "rms_after": js["rms_after"], "rms_before": js["rms_before"], "rms_config": js["rms_config"],
+            "speed_mps": float(np.median(np.hypot(rec.u, rec.v))), "L_m": float(config.particulars.L),
             "seconds": round(time.perf_counter() - t0, 1)}
 
 
@@ -199,7 +201,8 @@ def main_mismatch(a) -> None:
     """The ``--mismatch`` mode of bench/bench_diagnose.py (options parsed there)."""
     nclean = 4 if a.quick and a.clean is None else (a.clean if a.clean is not None else 40)
     seeds = 1 if a.quick else a.seeds
-    effects = a.effects or (["current", "wind"] if a.quick else list(SIZES))
+    effects = a.effects if a.effects is not None else (["current", "wind"] if a.quick else list(SIZES))
+    effects = [] if effects == ["none"] else effects           # --effects none: clean records only
     unknown = set(effects) - set(SIZES)
     if unknown:
         raise SystemExit(f"--mismatch: unknown effects {sorted(unknown)}; have {list(SIZES)}")

@@ -32,7 +32,7 @@ from functools import lru_cache
 import numpy as np
 
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "KINDS", "magnitude", "record_kind", "floor",
-           "false_alarm_probability", "calibration"]
+           "false_alarm_probability", "calibration", "residual_floor"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -96,12 +96,20 @@ def record_kind(headings) -> str:
 @lru_cache(maxsize=1)
 def calibration() -> dict:
     """The packaged calibration (``configs/calibration/diagnose.yaml``): ``{"floors": {effect:
-    {kind: value}}, "clean": {effect: {kind: [magnitudes]}}, ...}``; empty when absent."""
+    {kind: value}}, "clean": {effect: {kind: [magnitudes]}}, ...}``; empty when absent.  The
+    environment variable ``MMG_DIAGNOSE_CALIBRATION`` names another file, or ``none`` for no floors
+    (how the calibration runs themselves diagnose)."""
+    import os
+    from pathlib import Path
+
     import yaml
 
     from mmg.resources import config_dir
 
-    p = config_dir() / "calibration" / "diagnose.yaml"
+    env = os.environ.get("MMG_DIAGNOSE_CALIBRATION")
+    if env and env.lower() == "none":
+        return {}
+    p = Path(env) if env else config_dir() / "calibration" / "diagnose.yaml"
     if not p.is_file():
         return {}
     return yaml.safe_load(p.read_text()) or {}
@@ -135,3 +143,30 @@ def false_alarm_probability(effect_name: str, kind: str, statistic_value: float)
         return None
     a = np.asarray(clean, float)
     return float((np.sum(a >= statistic_value) + 1) / (len(a) + 1))
+
+
+def residual_floor(channel: str, U: float, L: float, kind: str = "zigzag") -> float:
+    """The residual RMS the ship's own mismatch leaves in ``channel`` after the diagnosis's fit (SI:
+    m/s for u, v, rad/s for r, rad for heading), from the calibration's ``residual_floors`` (u, v
+    as a fraction of the speed U, r as r L / U, heading in deg) for the kind of record; 0 where not
+    calibrated.
+
+    Parameters
+    ----------
+    channel : str
+        ``"u"``, ``"v"``, ``"r"`` or ``"heading"``.
+    U : float
+        The records' typical speed [m/s].
+    L : float
+        Ship length [m].
+    kind : str
+        The kind of record (:func:`record_kind`).
+    """
+    f = float(((calibration().get("residual_floors") or {}).get(kind) or {}).get(channel, 0.0))
+    if channel in ("u", "v"):
+        return f * U
+    if channel == "r":
+        return f * U / L
+    if channel == "heading":
+        return math.radians(f)
+    return 0.0

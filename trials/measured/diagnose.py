@@ -57,7 +57,7 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-from .decision import BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, floor, magnitude, record_kind
+from .decision import BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, floor, magnitude, record_kind, residual_floor
 from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
 
@@ -292,8 +292,10 @@ def _effect_report(model: _Model, effect, inflate: float):
 # --------------------------------------------------------------------------- description of what is left
 
 
-def _describe(recs, diffs, noise, rms_after) -> tuple[bool, str, dict]:
-    """Unexplained flag, description and per-channel ratio residual / noise."""
+def _describe(recs, diffs, noise, rms_after, L: float | None = None) -> tuple[bool, str, dict]:
+    """Unexplained flag, description and per-channel ratio residual / noise: a channel is unexplained
+    when its residual is above :data:`UNEXPLAINED_FACTOR` times its noise *and* above what the ship's
+    own mismatch leaves (:func:`trials.measured.decision.residual_floor`, with the ship length ``L``)."""
     D = np.vstack(diffs)
     M = np.vstack([r.seg.meas for r in recs])
     delta = np.concatenate([r.seg.inputs.delta for r in recs])
@@ -304,7 +306,11 @@ def _describe(recs, diffs, noise, rms_after) -> tuple[bool, str, dict]:
     for j, c in enumerate(names):
         ratio[c] = float(np.sqrt(np.mean(D[:, j] ** 2)) / max(noise[j], 1e-12))
     # position: the track's own growth within segments is not noise; judge u, v, r, heading
-    big = [c for c in ("u", "v", "r", "heading") if ratio[c] > UNEXPLAINED_FACTOR]
+    U = float(np.median(np.hypot(M[:, 0], M[:, 1]))) if len(M) else 0.0
+    rms = {c: float(np.sqrt(np.mean(D[:, names.index(c)] ** 2))) for c in ("u", "v", "r", "heading")}
+    kind = record_kind([r.seg.meas[:, 5] for r in recs])
+    big = [c for c in ("u", "v", "r", "heading") if ratio[c] > UNEXPLAINED_FACTOR
+           and (L is None or rms[c] > residual_floor(c, U, L, kind))]
     if not big:
         return False, "", ratio
     from .diagnose_report import channel_text
@@ -539,7 +545,27 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
         vals, se, z = _effect_report(m, cls, inflate)
     mag = magnitude(cls.name, vals, fitter.ship.particulars.L)
     ok = dbic > BIC_THRESHOLD and z > Z_THRESHOLD and not mag <= floor(cls.name, fitter.kind)
-    return dbic, ok, cls, m, vals, se, z, mag
+    return dbic, ok, cls, m, vals, se, z, mag, _confounding(m, cls)
+
+
+def _confounding(model: _Model, effect) -> float:
+    """R: the multiple correlation of the effect's presence parameters with every other fitted one
+    (:func:`trials.measured.identifiability.block_confounding` of the fit's covariance); NaN where
+    the covariance is not finite."""
+    from .identifiability import block_confounding
+
+    pres = effect.presence_parameters()
+    idx = [i for i, f in enumerate(model.free) if f.kind == "effect" and f.name.split(".")[0] == effect.name
+           and f.name.split(".")[-1] in pres]
+    std = np.asarray(model.fit.std, float)
+    cov = np.nan_to_num(model.fit.corr, nan=0.0) * np.outer(std, std)
+    np.fill_diagonal(cov, std * std)
+    if not idx or not np.all(np.isfinite(cov)) or np.any(np.diag(cov) <= 0):
+        return math.nan
+    try:
+        return float(block_confounding(cov, idx)["R"])
+    except (np.linalg.LinAlgError, ValueError):
+        return math.nan
 
 
 def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
@@ -551,7 +577,7 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
         results = []
         for cls in remaining:
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
-            dbic, _, _, _, vals, _, z, mag = results[-1]
+            dbic, _, _, _, vals, _, z, mag, _ = results[-1]
             say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}, size {fmt3(mag)} "
                 f"{MAGNITUDE_UNITS.get(cls.name, '')} (floor {fmt3(floor(cls.name, fitter.kind))})")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
@@ -559,8 +585,9 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
                        "kind": fitter.kind,
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
                                        "magnitude": float(f"{g:.4g}"), "floor": floor(c.name, fitter.kind),
+                                       "R": round(rr, 4) if math.isfinite(rr) else None,
                                        "clears_threshold": bool(ok), "parameters": v, "standard_errors": s}
-                                      for d, ok, c, m, v, s, z, g in results]})
+                                      for d, ok, c, m, v, s, z, g, rr in results]})
         ok = [r for r in results if r[1]]
         if not ok:
             break
@@ -613,7 +640,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
     res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
                      o.stride)
-    res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o)
+    res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o, rounds)
     res.baseline = "fitted" if kept else "config (the fit replayed worse)"
     res.seconds = time.perf_counter() - t0
     if o.per_run and len(recs) > 1:
@@ -622,12 +649,33 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     return res
 
 
-def _identifiability(fitter, current, named, cand, o: DiagnoseOptions):
-    """(not_identifiable entries, every candidate's figures): :func:`trials.measured.identifiability.assess`."""
+def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()):
+    """(not_identifiable entries, every candidate's figures): :func:`trials.measured.identifiability.assess`,
+    and a candidate of the last round whose dBIC and z cleared but whose size did not clear its
+    calibrated floor (:func:`within_mismatch`)."""
     from .identifiability import assess
 
     _, inflate = _taus(current, o.stride)
-    return assess(fitter, current, named, cand, inflate, o.segment_s, o.say)
+    entries, table = assess(fitter, current, named, cand, inflate, o.segment_s, o.say)
+    have = {e["effect"] for e in entries}
+    return entries + [e for e in within_mismatch(rounds, fitter.ship.particulars.L) if e["effect"] not in have], table
+
+
+def within_mismatch(rounds, L: float) -> list:
+    """``not_identifiable`` entries of the last round's candidates that the evidence and precision
+    tests passed but the calibrated floor stopped: an effect of that size is there in the statistics,
+    and the ship's own mismatch (:mod:`.decision`) could lend it as much."""
+    out = []
+    last = rounds[-1] if rounds else {"candidates": []}
+    for c in last["candidates"]:
+        if c["delta_bic"] > BIC_THRESHOLD and c["z"] > Z_THRESHOLD and not c["clears_threshold"]:
+            unit = MAGNITUDE_UNITS.get(c["effect"], "")
+            out.append({"effect": c["effect"], "confused_with": ["the ship's own coefficients"], "correlation": None,
+                        "what_would_separate": "a ship model closer to this ship (e.g. identified on other "
+                                               "records) or a larger effect",
+                        "reason": f"size {c['magnitude']:.3g} {unit} at dBIC {c['delta_bic']:.3g}, z {c['z']:.3g}, "
+                                  f"within the {c['floor']:.3g} {unit} the ship's own mismatch lends it (calibrated)"})
+    return out
 
 
 def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int) -> Diagnosis:
@@ -647,7 +695,7 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
         ses[cls.name] = s
         ivs[cls.name] = effect_intervals(cls, *effect_estimate(current, cls, inflate))
     cand_log = cand_log + [{"effect": c.name, "named": c.name in named} for c in cand]
-    unexpl, desc, _ = _describe(recs, current.diffs, noise, None)
+    unexpl, desc, _ = _describe(recs, current.diffs, noise, None, ship.particulars.L)
     mfm = model_form_mismatch(current.free[:ns], current.theta[:ns])
     th_out = [f.prior if f.name in mfm else v for f, v in zip(current.free[:ns], current.theta[:ns])]
     ship_vals = _ship_values(ship, current.free[:ns], th_out)        # mismatched: the config's, not written as fitted

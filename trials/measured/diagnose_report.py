@@ -273,6 +273,10 @@ def summary_lines(diag) -> list[str]:
         corr = ni.get("correlation")
         why = f"correlation {fmt3(corr)} with {', '.join(map(str, conf))}" if corr is not None else \
             f"confused with {', '.join(map(str, conf))}"
+        if ni.get("reason") and corr is None:
+            why = f"{why}: {ni['reason']}"
+        elif ni.get("reason") and not ni["reason"].startswith("its standard error"):
+            why = ni["reason"]
         lines.append(f"{ni.get('effect')}: not identifiable from these records ({why}): "
                      f"{ni.get('what_would_separate', '')}".rstrip(": "))
     for k, v in (diag.model_form_mismatch or {}).items():

@@ -279,6 +279,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         leans on the ship's coefficients or another effect, a check on it).
     """
     from .decision import Z_THRESHOLD as z_name
+    from .decision import floor
 
     say = say or (lambda m: None)
     L = fitter.ship.particulars.L
@@ -307,16 +308,23 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         table.append(row)
         say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
             f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
-        row["confounded"] = bool(max(2.0, z_name) * b["sd"] > det
-                                 and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED))
+        fl = floor(cls.name, getattr(fitter, "kind", ""))
+        statistical = bool(max(2.0, z_name) * b["sd"] > det
+                           and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED))
+        row["confounded"] = statistical or fl > det
+        row["floor"] = fl
         if cls.name in named or not row["confounded"]:
             continue
         if trials is None:
             trials = _trial_segments(fitter, _trial_specs(fitter.recs, L), segment_s)
         text, res = _separation(info_fn, trials, setup, info_rec, idx, inflate, cls)
         entries.append({"effect": cls.name, "confused_with": confused or [_name(free[j]) for j in
-                                                                           np.argsort(-np.abs(b["corr"]))[:1]],
+                                                                           np.argsort(-np.abs(b["corr"]))
+                                                                           if j not in idx][:1],
                         "correlation": round(b["R"], 3), "what_would_separate": text,
+                        "reason": ("its standard error and correlation" if statistical else
+                                   f"the ship's own mismatch lends it up to {fl:.3g} {_unit(cls)} on such a record "
+                                   f"(calibrated floor), more than the {det:.3g} {_unit(cls)} to detect"),
                         "std": row["std"], "std_conditional": row["std_conditional"], "detection_size": row["detection_size"],
                         "unit": row["unit"], "trials": [{"trial": lb, "std": float(f"{sd:.3g}")} for lb, sd in res]})
     return entries, table
