@@ -40,7 +40,8 @@ OUT = REPO / "configs" / "calibration" / "diagnose.yaml"
 
 
 def clean_magnitudes(records, L: float) -> tuple:
-    """({effect: {kind: [clean magnitude]}}, the same of whether dBIC and z cleared).
+    """({effect: {kind: [clean magnitude]}}, the same of whether dBIC and z cleared, the same of
+    the magnitudes whether or not they cleared).
 
     A candidate's sample is *clean* where the record does not have that effect and the model it is
     tried on holds exactly the effects the record has: every first round of a clean record, and the
@@ -52,6 +53,7 @@ def clean_magnitudes(records, L: float) -> tuple:
 
     out: dict = {}
     passes: dict = {}
+    raw: dict = {}
     for rec in records:
         truth = set(rec.get("truth") or {})
         for rd in rec.get("rounds") or []:
@@ -65,12 +67,16 @@ def clean_magnitudes(records, L: float) -> tuple:
                 m = magnitude(c["effect"], c["parameters"], L)
                 out.setdefault(c["effect"], {}).setdefault(kind, []).append(float(m) if ok else 0.0)
                 passes.setdefault(c["effect"], {}).setdefault(kind, []).append(ok)
-    return out, passes
+                raw.setdefault(c["effect"], {}).setdefault(kind, []).append(float(m))
+    return out, passes, raw
 
 
-def floors(clean: dict, alpha: float) -> dict:
-    """{effect: {kind: floor}} (module docstring)."""
-    from scipy.stats import halfnorm
+def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
+    """{effect: {kind: floor}} (module docstring): the passing share p taken at its upper 95 %
+    (Clopper-Pearson) bound, not its estimate (0 of 23 is not a bound of 0); the scale the RMS of
+    the passing sizes, or, with fewer than :data:`MIN_PASSING` of them, of every size the candidate
+    took (``raw``), passing or not (a conservative stand-in)."""
+    from scipy.stats import beta, halfnorm
 
     m = max(len(clean), 1)
     out = {}
@@ -79,12 +85,19 @@ def floors(clean: dict, alpha: float) -> dict:
         for k, v in kinds.items():
             v = np.asarray(v, float)
             on = v[v > 0]
-            p = len(on) / max(len(v), 1)
+            n, kk = len(v), len(on)
+            p_up = float(beta.ppf(0.95, kk + 1, max(n - kk, 1))) if n else 1.0
             f = 0.0
-            if p > alpha / m:
-                f = max(float(np.sqrt(np.mean(on * on))) * float(halfnorm.ppf(1.0 - alpha / (m * p))), float(on.max()))
+            if p_up > alpha / m:
+                pool = on if kk >= MIN_PASSING else np.asarray((raw or {}).get(e, {}).get(k, v), float)
+                scale = float(np.sqrt(np.mean(pool * pool))) if len(pool) else 0.0
+                f = max(scale * float(halfnorm.ppf(1.0 - alpha / (m * p_up))), float(on.max()) if kk else 0.0)
             out[e][k] = float(f"{f:.4g}")
     return out
+
+
+MIN_PASSING = 3
+"""Fewer passing sizes than this: the floor's scale is taken from every size the candidate took."""
 
 
 RESIDUAL_QUANTILE = 95.0
@@ -130,8 +143,8 @@ def main(argv=None):
         data = json.loads(Path(p).read_text())
         records += data["records"] if isinstance(data, dict) else data
     L = mmg.load_ship("esso_osaka").particulars.L
-    clean, passes = clean_magnitudes(records, L)
-    fl = floors(clean, a.alpha)
+    clean, passes, raw = clean_magnitudes(records, L)
+    fl = floors(clean, a.alpha, raw)
     n = sum(1 for r in records if not r.get("truth"))
     n_eff = len(records) - n
     for e, kinds in clean.items():

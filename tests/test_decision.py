@@ -21,15 +21,18 @@ def test_magnitude_plain_formulas():
     assert magnitude("shallow_water", {"depth_to_draft": math.inf}, 325.0) == 0.0
 
 
-def test_record_kind_turn_and_zigzag_across_north():
+def test_record_kind_by_the_rudder():
     from trials.measured.decision import record_kind
 
     t = np.linspace(0.0, 1000.0, 2001)
-    turn = np.mod(np.radians(0.8 * t), 2 * np.pi)                       # 800 deg, wrapped
-    zig = np.mod(np.radians(20.0 * np.sin(t / 60.0)), 2 * np.pi)       # +-20 deg about north: wraps at 0
+    turn = np.where(t > 10.0, math.radians(35.0), 0.0)                   # hold 35 deg to starboard
+    zig = math.radians(20.0) * np.sign(np.sin(t / 60.0))               # +-20 deg
     assert record_kind([turn]) == "turn"
+    assert record_kind([-turn]) == "turn"
     assert record_kind([zig]) == "zigzag"
-    assert record_kind([zig, turn]) == "turn"
+    assert record_kind([zig, turn]) == "zigzag"            # the zigzag pins what it pins alone
+    assert record_kind([turn, -turn]) == "turn_pair"
+    assert record_kind([turn + math.radians(0.5)]) == "turn"          # a trim angle below 2 deg does not count
 
 
 @pytest.fixture

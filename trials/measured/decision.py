@@ -10,15 +10,16 @@ An effect is named when three tests hold:
    :data:`Z_THRESHOLD` standard errors;
 3. **size beyond the ship's own mismatch**: its magnitude (:func:`magnitude`: a current's speed over
    sqrt(g L), a rudder offset's or heading bias's |angle| in deg, a wind's load scale, shallow water's
-   T/H) exceeds the *calibrated floor* for the effect and the kind of record (:func:`record_kind`:
-   turn or zigzag).  A ship is never its config: on records with no effect at all the fit of a
-   candidate still finds a small current, offset or bias that soaks up the hull's, rudder's and
-   propeller's own errors, and with 3500 samples its dBIC and z are large.  The floors are the
-   largest magnitudes the candidates took on clean records of a family of ships that differ from the
-   config as real ships do (:mod:`trials.measured.mismatch`; hull linear terms +-10 %, nonlinear
-   +-25 %, rudder and propeller constants +-15 %, other wind-load factors, another hull form),
-   made by ``python bench/bench_diagnose.py --mismatch --calibrate`` and kept in the packaged
-   ``configs/calibration/diagnose.yaml`` with their seeds and sample counts.
+   T/H) exceeds the *calibrated floor* for the effect and the kind of record set
+   (:func:`record_kind`: turn or zigzag, by the rudder).  A ship is never its config: on records
+   with no effect at all the fit of a candidate still finds a small current, offset or bias that
+   soaks up the hull's, rudder's and propeller's own errors, and with 3500 samples its dBIC and z
+   are large.  The floors bound the sizes the candidates took on clean records of a family of
+   ships that differ from the config as real ships do (:mod:`trials.measured.mismatch`; hull
+   linear terms +-10 %, nonlinear +-25 %, rudder and propeller constants +-15 %, other wind-load
+   factors, another hull form): ``bench/calibrate_diagnose.py`` (its docstring gives the rule)
+   writes them, with their sources and the clean samples, to the packaged
+   ``configs/calibration/diagnose.yaml``.
 
 :func:`false_alarm_probability` reads the same clean magnitudes: the share of clean records on
 which the candidate's magnitude reached the value (with one added record for the value itself,
@@ -41,8 +42,8 @@ perturbed record pairs (bench/bench_diagnose.py, seeds 0-19) was 15.4, 10.9, 9.5
 above 10), so the threshold is set at 20 and the false-alarm rate checked on fresh seeds."""
 Z_THRESHOLD = 3.0
 """|parameter - neutral| / standard error an effect's fit must exceed to be named."""
-KINDS = ("turn", "zigzag")
-"""Kinds of record the floors are calibrated for (:func:`record_kind`)."""
+KINDS = ("turn", "zigzag", "turn_pair")
+"""Kinds of record set (:func:`record_kind`); the floors are calibrated for the first two."""
 MAGNITUDE_UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1",
                    "shallow_water": "T/H"}
 """The unit of each effect's :func:`magnitude`."""
@@ -81,16 +82,30 @@ def magnitude(effect: str, values: dict, L: float) -> float:
     return math.nan
 
 
-def record_kind(headings) -> str:
-    """``"turn"`` when any record's heading (logged, [rad]) sweeps more than 180 deg, else ``"zigzag"``.
+def record_kind(rudders) -> str:
+    """The kind of a set of records, which the floors are calibrated for: ``"zigzag"`` when any
+    record's rudder changes side (a zigzag among turns pins an offset or a bias as a zigzag alone
+    does), else ``"turn_pair"`` for turns to both sides (their symmetric mismatch cancels in a shared
+    offset: not calibrated, no floor), else ``"turn"``.
+
+    A record's rudder is on one side when at least 90 % of its samples beyond 2 deg have one sign.
 
     Parameters
     ----------
-    headings : sequence of arrays
-        Each record's logged heading [rad].
+    rudders : sequence of arrays
+        Each record's rudder angle [rad].
     """
-    span = max(float(np.ptp(np.unwrap(np.asarray(h, float)))) for h in headings)
-    return "turn" if span > math.pi else "zigzag"
+    sides = []
+    for d in rudders:
+        d = np.asarray(d, float)
+        big = d[np.abs(d) > math.radians(2.0)]
+        if len(big) == 0:
+            continue
+        pos = float(np.mean(big > 0))
+        if 0.1 < pos < 0.9:
+            return "zigzag"
+        sides.append(pos >= 0.9)
+    return "turn_pair" if len(set(sides)) > 1 else "turn"
 
 
 @lru_cache(maxsize=1)

@@ -308,7 +308,7 @@ def _describe(recs, diffs, noise, rms_after, L: float | None = None) -> tuple[bo
     # position: the track's own growth within segments is not noise; judge u, v, r, heading
     U = float(np.median(np.hypot(M[:, 0], M[:, 1]))) if len(M) else 0.0
     rms = {c: float(np.sqrt(np.mean(D[:, names.index(c)] ** 2))) for c in ("u", "v", "r", "heading")}
-    kind = record_kind([r.seg.meas[:, 5] for r in recs])
+    kind = record_kind([r.seg.inputs.delta for r in recs])
     big = [c for c in ("u", "v", "r", "heading") if ratio[c] > UNEXPLAINED_FACTOR
            and (L is None or rms[c] > residual_floor(c, U, L, kind))]
     if not big:
@@ -635,7 +635,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     sfree = _ship_free(ship, packed, o.ship_free)
     sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
     fitter = _Fitter(ship, packed, recs, sc0, o.stride, o.max_nfev, sfree)
-    fitter.kind = record_kind([r.seg.meas[:, 5] for r in recs])
+    fitter.kind = record_kind([r.seg.inputs.delta for r in recs])
     d_config, base, kept = _baseline(fitter, noise, say)
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
     res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
