@@ -12,7 +12,7 @@ from the relative wind and the ship's motion over ground (:func:`mmg.wind.true_w
 A record the diagnosis refuses or fails on gets a one-line row saying why; nothing is hidden.
 
     python bench/diagnose_frt.py [--jobs 2] [--folders turning zigzag] [--only turn_cut zigzag_31-Jul-2020_13_04_24]
-                                 [--json bench/out/diagnose_frt.json] [--md docs/diagnose_frt_table.md]
+                                 [--json bench/out/diagnose_frt.json] [--md docs/diagnose.md]
 
 ``--only`` keeps the records whose file stem contains any of the strings given.  The data are read
 from the shared folder and never copied; the script stops with a message where it is absent.
@@ -318,6 +318,22 @@ def records(folders, only) -> list[tuple[str, str]]:
     return out
 
 
+BEGIN, END = "<!-- diagnose_frt: begin -->", "<!-- diagnose_frt: end -->"
+
+
+def write_md(path: Path, text: str) -> None:
+    """Write the table to ``path``: between the markers :data:`BEGIN` and :data:`END` where the file
+    has them (docs/diagnose.md keeps its prose around the generated table), else the whole file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    old = path.read_text() if path.is_file() else ""
+    if BEGIN in old and END in old:
+        head, rest = old.split(BEGIN, 1)
+        _, tail = rest.split(END, 1)
+        text = "\n".join("### " + ln[2:] if ln.startswith("# ") else ln for ln in text.rstrip().splitlines())
+        text = f"{head}{BEGIN}\n{text}\n{END}{tail}"
+    path.write_text(text)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--ship", default="esso_osaka_3m")
@@ -325,12 +341,13 @@ def main(argv=None) -> int:
     ap.add_argument("--folders", nargs="*", default=list(FOLDERS), choices=FOLDERS)
     ap.add_argument("--only", nargs="*", help="keep records whose file stem contains one of these strings")
     ap.add_argument("--json", default=str(REPO / "bench" / "out" / "diagnose_frt.json"))
-    ap.add_argument("--md", default=str(REPO / "docs" / "diagnose_frt_table.md"))
+    ap.add_argument("--md", default=str(REPO / "docs" / "diagnose.md"),
+                    help="where the table goes (between the diagnose_frt markers where the file has them)")
     ap.add_argument("--from-json", action="store_true", help="only rewrite the table from --json (no diagnosis)")
     a = ap.parse_args(argv)
     if a.from_json:
         data = json.loads(Path(a.json).read_text())
-        Path(a.md).write_text(markdown(data["records"], data["command"].strip(), data["ship"], data["wall_s"]))
+        write_md(Path(a.md), markdown(data["records"], data["command"].strip(), data["ship"], data["wall_s"]))
         print("\n".join(summary(data["records"])) + f"\nwrote {a.md}")
         return 0
     if not FRT.is_dir():
@@ -369,8 +386,7 @@ def main(argv=None) -> int:
     out.write_text(json.dumps({"ship": a.ship, "command": cmd, "wall_s": wall, "records": results}, indent=1,
                               default=float))
     md = Path(a.md)
-    md.parent.mkdir(parents=True, exist_ok=True)
-    md.write_text(markdown(results, cmd.strip(), a.ship, wall))
+    write_md(md, markdown(results, cmd.strip(), a.ship, wall))
     for ln in summary(results):
         print(ln)
     print(f"wrote {out} and {md} ({wall:.0f} s wall)")

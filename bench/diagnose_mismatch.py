@@ -176,18 +176,18 @@ def plot(table: dict, path: Path, title: str) -> None:
     fig, axs = plt.subplots(1, len(det), figsize=(3.6 * len(det), 3.4), layout="constrained", squeeze=False)
     for ax, (eff, rows) in zip(axs[0], det.items()):
         par, unit, _ = SIZES[eff]
-        for key, style, lab in (("zigzag", "o-", "zigzag"), ("turn", "s--", "35° turn")):
+        for key, style, lab in (("zigzag", "o-", "zigzag: named"), ("turn", "s--", "35° turn: named")):
             pts = [(r["size"], r[key][0] / r[key][1]) for r in rows if r[key][1]]
             if pts:
                 ax.plot(*zip(*pts), style, label=f"{lab}")
-        if eff == "rudder_offset":
-            pts = [(r["size"], r["turn_not_identifiable"][0] / r["turn_not_identifiable"][1]) for r in rows
-                   if r["turn_not_identifiable"][1]]
-            if pts:
-                ax.plot(*zip(*pts), "^:", label="turn: not identifiable")
+        pts = [(r["size"], r["turn_not_identifiable"][0] / r["turn_not_identifiable"][1]) for r in rows
+               if r.get("turn_not_identifiable", (0, 0))[1]]
+        if pts and any(y > 0 for _, y in pts):
+            ax.plot(*zip(*pts), "^:", label="turn: reported not identifiable")
         ax.set_ylim(-0.05, 1.05)
-        ax.set_xlabel(f"{eff.replace('_', ' ')} {par.split('_')[0]} [{unit}]")
-        ax.set_ylabel("detection rate [-]")
+        what = {"current": "current speed", "wind": "true wind speed"}.get(eff, eff.replace("_", " "))
+        ax.set_xlabel(f"{what} [{unit}]")
+        ax.set_ylabel("share of records [-]")
         ax.set_title(eff.replace("_", " "), fontsize=9)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)

@@ -48,7 +48,12 @@ def test_coefficient_prior_widths_are_one_table(ship):
         assert ident[nm].sigma == pytest.approx(PRIOR_REL_STD["mass"] * ident[nm].prior)
         assert diag[nm].sigma == pytest.approx(DIAGNOSIS_PRIOR_REL_STD["mass"] * diag[nm].prior)
     assert ident["N_r"].sigma == pytest.approx(max(PRIOR_REL_STD["hull"] * abs(ident["N_r"].prior), 0.01))
-    assert diag["N_r"].sigma == pytest.approx(max(DIAGNOSIS_PRIOR_REL_STD["hull"] * abs(diag["N_r"].prior), 0.01))
+    P = DIAGNOSIS_PRIOR_REL_STD
+    assert diag["N_r"].sigma == pytest.approx(max(P["hull"] * abs(diag["N_r"].prior), P["hull_floor"]))
+    assert diag["N_rr"].sigma == pytest.approx(max(P["hull_nonlinear"] * abs(diag["N_rr"].prior), P["hull_floor"]))
+    assert diag["X_uu"].sigma == pytest.approx(max(P["resistance"] * abs(diag["X_uu"].prior), P["hull_floor"]))
+    assert diag["w_P0"].sigma == pytest.approx(P["w_P0"] * diag["w_P0"].prior)
+    assert diag["N_r"].upper == 0.0 and diag["Y_beta"].lower == 0.0        # the signs that define the ship
 
 
 def test_replay_wind_loads_are_the_wind_effects(ship, monkeypatch):

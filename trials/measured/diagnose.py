@@ -165,32 +165,29 @@ def _ship_values(ship: Ship, free, theta) -> dict:
     return out
 
 
-BASELINE_PRIOR_REL_STD = {"linear": 0.15, "nonlinear": 0.30, "resistance": 0.10, "w_P0": 0.20}
-"""Prior std of the ship coefficients the diagnosis frees, relative to the config value, by what is
-known of such a config's source: linear sway/yaw derivatives from captive tests or Kijima-type
-regressions are good to 10-15 %, their nonlinear terms (the yaw damping r|r|) to about 30 %, the
-resistance and the wake fraction w_P0 to 10 % and 20 % (Kijima et al. 1990 quote their regression's
-scatter at this order; the ITTC Manoeuvring Committee's benchmark of predicted and measured turns
-the same).  The added masses: :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`.  Every hull coefficient
-also keeps its config sign (the signs that define the ship: a positive Y_beta, a negative N_r)."""
 LINEAR_TERMS = ("beta", "r", "v")
+"""Hull terms whose coefficients take the ``hull`` (linear) width of
+:data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`."""
 RESISTANCE_TERMS = ("cos(beta)^2", "u^2")
-HULL_PRIOR_FLOOR = 0.002
-"""Smallest prior std of a freed hull coefficient (primed)."""
+"""Hull terms that take its ``resistance`` width; every other freed hull term its ``hull_nonlinear``."""
 MISMATCH_Z = 3.0
 """A fitted ship coefficient more than this many prior std from its config value is reported as
 model-form mismatch (:attr:`Diagnosis.model_form_mismatch`) and not written to ``--out-ship``."""
 
 
 def _baseline_prior(f, term):
-    """``f`` (a :class:`ekf.identify.FreeParameter`) with the diagnosis's prior width and sign bounds."""
+    """``f`` (a :class:`ekf.identify.FreeParameter`) with the diagnosis's prior width
+    (:data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`, by the term's family) and, for a hull coefficient,
+    its config sign kept as a bound (the signs that define the ship: a positive Y_beta, a negative N_r)."""
+    from ekf.identify import DIAGNOSIS_PRIOR_REL_STD as P
+
     if f.kind == "hull":
-        fam = "linear" if term in LINEAR_TERMS else "resistance" if term in RESISTANCE_TERMS else "nonlinear"
+        fam = "hull" if term in LINEAR_TERMS else "resistance" if term in RESISTANCE_TERMS else "hull_nonlinear"
         lo, hi = (0.0, np.inf) if f.prior > 0 else (-np.inf, 0.0) if f.prior < 0 else (f.lower, f.upper)
-        return replace(f, sigma=max(BASELINE_PRIOR_REL_STD[fam] * abs(f.prior), HULL_PRIOR_FLOOR),
-                       lower=max(lo, f.lower), upper=min(hi, f.upper))
+        return replace(f, sigma=max(P[fam] * abs(f.prior), P["hull_floor"]), lower=max(lo, f.lower),
+                       upper=min(hi, f.upper))
     if f.kind == "w_P0":
-        return replace(f, sigma=max(BASELINE_PRIOR_REL_STD["w_P0"] * abs(f.prior), 0.01))
+        return replace(f, sigma=max(P["w_P0"] * abs(f.prior), 0.01))
     return f
 
 
