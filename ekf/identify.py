@@ -41,7 +41,7 @@ from mmg.replay import ReplayInputs, replay_states
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
            "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
            "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled",
-           "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "record_effect_parameters", "effect_set_of",
+           "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "logged_residual", "record_effect_parameters", "effect_set_of",
            "predict_logged"]
 
 RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
@@ -95,6 +95,9 @@ class Segmented:
     fixed: object = None
     """:class:`mmg.effects.EffectSet` of effects the ship config has on (a current, a rudder offset,
     shallow water, a steady wind), applied with their values and not fitted; None: none."""
+    speed_only: bool = False
+    """The record logs the speed over ground, not u and v (``meas`` u is that speed, v a stand-in
+    zero): u is compared as the predicted speed over ground and v not at all (:func:`logged_residual`)."""
 
     @property
     def restart(self) -> np.ndarray:
@@ -298,6 +301,16 @@ def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
     return rec
 
 
+def logged_residual(pred: np.ndarray, rec: Segmented) -> np.ndarray:
+    """Predicted minus measured states (N, 6) of what the record logs: for a record that logs only the
+    speed over ground (:attr:`Segmented.speed_only`), u is that speed on both sides and v is 0."""
+    diff = pred - rec.meas
+    if rec.speed_only:
+        diff[:, 0] = np.hypot(pred[:, 0], pred[:, 1]) - rec.meas[:, 0]
+        diff[:, 1] = 0.0
+    return diff
+
+
 def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=None, free=(), theta=(),
                   ship=None, pos=None, record: int | None = None) -> np.ndarray:
     rec = _wind_scaled(rec, free, theta)
@@ -305,7 +318,7 @@ def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=N
         pred = predict_logged(packed, rec, effects, free, theta, ship, record)
     else:
         pred = replay_states(packed, rec.inputs, rec.restart[0], meas=rec.restart, reset=rec.reset)
-    diff = pred[::stride] - rec.meas[::stride]
+    diff = logged_residual(pred, rec)[::stride]
     d = diff[:, [0, 1, 2, 5]] / sc
     if pos is not None:
         d = np.column_stack([d, diff[:, [3, 4]] / pos])

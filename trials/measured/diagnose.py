@@ -112,10 +112,13 @@ def _noise(meas: np.ndarray) -> np.ndarray:
     return mad / math.sqrt(6.0)
 
 
-def _diffs(pred: np.ndarray, meas: np.ndarray) -> np.ndarray:
-    """Residual columns u, v, r, x, y, heading (logged minus replayed, SI)."""
-    d = pred - meas
-    return d[:, [0, 1, 2, 3, 4, 5]]
+def _diffs(pred: np.ndarray, seg) -> np.ndarray:
+    """Residual columns u, v, r, x, y, heading (replayed minus logged, SI) of what the record logs
+    (:func:`ekf.identify.logged_residual`: a record with only the speed over ground has its u
+    compared as that speed and no v)."""
+    from ekf.identify import logged_residual
+
+    return logged_residual(pred, seg)
 
 
 def _rms(diffs: list) -> dict:
@@ -229,7 +232,7 @@ class _Fitter:
     def diffs(self, effects, free, theta):
         from ekf.identify import predict_logged
 
-        return [_diffs(predict_logged(self.packed, r.seg, effects, free, theta, self.ship), r.seg.meas)
+        return [_diffs(predict_logged(self.packed, r.seg, effects, free, theta, self.ship), r.seg)
                 for r in self.recs]
 
     def fit(self, effects, start_ship=None, start_eff=None, max_nfev=None, start=None) -> _Model:

@@ -69,9 +69,11 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
         if run.inputs.delta is not None and len(run.inputs.t) != len(rec.t):     # rebuilt rudder: resampled
             ch = {c: None for c in ch}
         ctx = Context(t=run.t, delta=run.inputs.delta, n=run.inputs.n, channels=ch, ship=ship)
-        seg = Segmented(run.name, run.meas, run.inputs, segment_resets(run.t, seg_s), context=ctx,
+        # a record without u, v is replayed in one piece: a restart would need the drift it does not log
+        seg = Segmented(run.name, run.meas, run.inputs, segment_resets(run.t, math.inf if run.speed_only else seg_s),
+                        context=ctx,
                         start=_smoothed(run.t, run.meas, RESTART_SMOOTH * math.sqrt(L / 9.80665)),
-                        fixed=run.effects)
+                        fixed=run.effects, speed_only=run.speed_only)
         out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes)))
     return out
 

@@ -62,6 +62,10 @@ class MeasuredRun:
         a rudder offset, a heading bias, shallow water, a steady wind): in the packed ship, the
         replay's start state (:meth:`~mmg.effects.EffectSet.to_model`) and its output
         (:meth:`~mmg.effects.EffectSet.to_logged`).
+    speed_only : bool
+        The record logs the speed over ground, not u and v (``meas`` u is that speed, v zero):
+        fits compare the predicted speed over ground with it and leave v out
+        (:attr:`ekf.identify.Segmented.speed_only`).
     """
 
     name: str
@@ -71,6 +75,7 @@ class MeasuredRun:
     wind: str = "off"
     notes: list = field(default_factory=list)
     effects: object = None
+    speed_only: bool = False
 
     @property
     def t(self) -> np.ndarray:
@@ -153,7 +158,8 @@ def measured_run(ship: Ship, rec: TrialRecord, start: float | None = None, wind:
         u, v = rec.u, rec.v
     else:
         u, v = rec.speed(), np.zeros_like(rec.t)
-        notes.append("u taken as the speed over ground, v as zero (the record has no u, v)")
+        notes.append("u taken as the speed over ground, v as zero (the record has no u, v); "
+                     "fits compare the predicted speed over ground with it and leave v out")
     meas = np.column_stack([u, v, r, rec.x, rec.y, rec.psi]).astype(float)
     es, skipped = run_effects(ship, wind).usable({c: getattr(rec, c) for c in WIND_CHANNELS})
     for name, why in skipped:                        # one rule for every command (EffectSet.usable)
@@ -167,7 +173,7 @@ def measured_run(ship: Ship, rec: TrialRecord, start: float | None = None, wind:
     return MeasuredRun(name=rec.name, source=rec.source, meas=meas,
                        inputs=ReplayInputs(t=np.asarray(rec.t, float), delta=np.asarray(rec.delta, float),
                                            n=np.asarray(rec.n, float), ext=ext), wind=w, notes=notes,
-                       effects=es if es.items else None)
+                       effects=es if es.items else None, speed_only=rec.u is None or rec.v is None)
 
 
 @dataclass(frozen=True)
