@@ -71,7 +71,7 @@ def timing():
     d = diagnose(ship, [rec])
     dt = time.perf_counter() - t0
     print(f"timing: one diagnose of a {rec.t[-1]:.0f} s full-scale record at 1 s ({len(rec.t)} samples): {dt:.1f} s "
-          f"wall (target <= 30 s); named {d.named} {d.parameters}")
+          f"wall (issue 26: <= 15 s); named {d.named} {d.parameters}")
     return dt
 
 
