@@ -92,6 +92,8 @@ def main(argv=None):
                     help="full-scale trials of the mismatch family, one record per diagnose (bench/diagnose_mismatch.py)")
     ap.add_argument("--seed0", type=int, default=0, help="--mismatch: the family's and the noise seeds' offset")
     ap.add_argument("--jobs", type=int, default=2, help="--mismatch: parallel processes")
+    ap.add_argument("--trials", nargs="*", default=None,
+                    help="--mismatch: the trials to draw from (default all: turn35 turn35p zz10 zz15 zz20)")
     a = ap.parse_args(argv)
     if a.mismatch:
         sys.path.insert(0, str(REPO / "bench"))

@@ -48,17 +48,18 @@ def _family(seed0: int):
     return mismatch_family(mmg.load_ship("esso_osaka"), FAMILY_SIZE, seed0)
 
 
-def jobs(nclean: int, seeds: int, effects, seed0: int) -> list[dict]:
+def jobs(nclean: int, seeds: int, effects, seed0: int, trials=None) -> list[dict]:
     """The records to make and diagnose: ``nclean`` clean ones (member i, trial i mod 5), then per
     effect, size and seed one with that effect (member, trial, direction or sign drawn from the seeds)."""
-    out = [{"id": f"clean_{i}", "effect": None, "size": 0.0, "member": i % FAMILY_SIZE, "trial": KINDS[i % len(KINDS)],
+    kinds = list(trials or KINDS)
+    out = [{"id": f"clean_{i}", "effect": None, "size": 0.0, "member": i % FAMILY_SIZE, "trial": kinds[i % len(kinds)],
             "spec": {}, "true_wind": (0.0, 0.0), "seed": seed0 + i} for i in range(nclean)]
     for ie, eff in enumerate(effects):
         for isz, size in enumerate(SIZES[eff][2]):
             for s in range(seeds):
                 rng = np.random.default_rng([seed0, ie, isz, s])
                 job = {"id": f"{eff}_{size:g}_{s}", "effect": eff, "size": size,
-                       "member": int(rng.integers(FAMILY_SIZE)), "trial": KINDS[int(rng.integers(len(KINDS)))],
+                       "member": int(rng.integers(FAMILY_SIZE)), "trial": kinds[int(rng.integers(len(kinds)))],
                        "true_wind": (0.0, 0.0), "seed": seed0 + 10000 * (ie + 1) + 100 * isz + s}
                 sign = float(rng.choice([-1.0, 1.0]))
                 direction = float(rng.uniform(0.0, 360.0))
@@ -208,7 +209,7 @@ def main_mismatch(a) -> None:
         raise SystemExit(f"--mismatch: unknown effects {sorted(unknown)}; have {list(SIZES)}")
     out = REPO / "bench" / "out"
     out.mkdir(exist_ok=True)
-    todo = jobs(nclean, seeds, effects, a.seed0)
+    todo = jobs(nclean, seeds, effects, a.seed0, getattr(a, "trials", None))
     path = out / f"diagnose_mismatch{a.tag}.json"
     head = {"family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds, "effects": effects,
             "sizes": {e: SIZES[e] for e in effects}}
