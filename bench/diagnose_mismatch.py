@@ -209,7 +209,7 @@ def main_mismatch(a) -> None:
         raise SystemExit(f"--mismatch: unknown effects {sorted(unknown)}; have {list(SIZES)}")
     out = REPO / "bench" / "out"
     out.mkdir(exist_ok=True)
-    todo = jobs(nclean, seeds, effects, a.seed0, getattr(a, "trials", None))
+    todo = jobs(nclean, seeds, effects, a.seed0, a.trials)
     path = out / f"diagnose_mismatch{a.tag}.json"
     head = {"family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds, "effects": effects,
             "sizes": {e: SIZES[e] for e in effects}}

@@ -74,3 +74,28 @@ def test_the_floor_decides(monkeypatch):
     assert d1.named == []
     c = d1.rounds[0]["candidates"][0]
     assert c["delta_bic"] > D.BIC_THRESHOLD and c["z"] > D.Z_THRESHOLD and c["floor"] == 2.0 * size
+
+
+def test_a_named_calibration_file_that_is_not_there_is_refused(tmp_path, monkeypatch):
+    """MMG_DIAGNOSE_CALIBRATION naming a missing or malformed file: one line naming it, exit 2, no
+    output written (silently diagnosing with no floors would be the wrong answer)."""
+    import subprocess
+    import sys
+
+    from mmg.resources import config_path
+
+    log = tmp_path / "log.csv"
+    subprocess.run([sys.executable, "-m", "trials.cli", "simulate", str(config_path("trials", "st35.yaml")),
+                    "--out", str(tmp_path / "sim")], check=True, capture_output=True)
+    log = tmp_path / "sim" / "log.csv"
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("floors: [1, 2\n")
+    for env in (str(tmp_path / "absent.yaml"), str(bad)):
+        out = tmp_path / "d.json"
+        r = subprocess.run([sys.executable, "-m", "trials.cli", "diagnose", "--ship", "esso_osaka", str(log),
+                            "--json", str(out)], capture_output=True, text=True,
+                           env={**__import__("os").environ, "MMG_DIAGNOSE_CALIBRATION": env})
+        assert r.returncode == 2, r.stderr
+        lines = [ln for ln in r.stderr.strip().splitlines() if ln.strip()]
+        assert len(lines) == 1 and env in lines[0] and "Traceback" not in r.stderr, r.stderr
+        assert not out.exists()

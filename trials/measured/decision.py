@@ -121,13 +121,23 @@ def calibration() -> dict:
 
     from mmg.resources import config_dir
 
+    from mmg.errors import InputError
+
     env = os.environ.get("MMG_DIAGNOSE_CALIBRATION")
     if env and env.lower() == "none":
         return {}
     p = Path(env) if env else config_dir() / "calibration" / "diagnose.yaml"
     if not p.is_file():
+        if env:                           # a file the user named and that is not there: refused, not ignored
+            raise InputError(str(p), "MMG_DIAGNOSE_CALIBRATION", "no such calibration file (or 'none' for no floors)")
         return {}
-    return yaml.safe_load(p.read_text()) or {}
+    try:
+        data = yaml.safe_load(p.read_text()) or {}
+    except yaml.YAMLError as e:
+        raise InputError(str(p), "", f"not a calibration YAML: {str(e).splitlines()[0]}") from None
+    if not isinstance(data, dict) or not isinstance(data.get("floors", {}), dict):
+        raise InputError(str(p), "floors", "a calibration file maps effect -> kind -> floor")
+    return data
 
 
 def floor(effect: str, kind: str) -> float:

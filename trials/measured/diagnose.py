@@ -57,7 +57,8 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-from .decision import BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, floor, magnitude, record_kind, residual_floor
+from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, floor, magnitude, record_kind,
+                       residual_floor)
 from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
 
@@ -274,8 +275,16 @@ def _delta_bic(before, after, k, taus, stride):
     return float(np.sum(neff * np.log(rss0 / rss1)) - k * math.log(float(np.sum(neff))))
 
 
+def _effect_index(model: _Model, effect, presence_only: bool = False) -> list:
+    """Indices of ``effect``'s fitted parameters in ``model.free`` (only those that say it is there,
+    :meth:`mmg.effects.Effect.presence_parameters`, with ``presence_only``)."""
+    pres = effect.presence_parameters()
+    return [i for i, f in enumerate(model.free) if f.kind == "effect" and f.name.split(".")[0] == effect.name
+            and (not presence_only or f.name.split(".")[-1] in pres)]
+
+
 def _effect_report(model: _Model, effect, inflate: float):
-    idx = [i for i, f in enumerate(model.free) if f.kind == "effect" and f.name.split(".")[0] == effect.name]
+    idx = _effect_index(model, effect)
     th = model.fit.theta[idx]
     std = model.fit.std[idx] * inflate
     corr = np.nan_to_num(model.fit.corr[np.ix_(idx, idx)], nan=0.0)
@@ -292,10 +301,11 @@ def _effect_report(model: _Model, effect, inflate: float):
 # --------------------------------------------------------------------------- description of what is left
 
 
-def _describe(recs, diffs, noise, rms_after, L: float | None = None) -> tuple[bool, str, dict]:
+def _describe(recs, diffs, noise, rms_after, L: float | None = None, kind: str | None = None) -> tuple[bool, str, dict]:
     """Unexplained flag, description and per-channel ratio residual / noise: a channel is unexplained
     when its residual is above :data:`UNEXPLAINED_FACTOR` times its noise *and* above what the ship's
-    own mismatch leaves (:func:`trials.measured.decision.residual_floor`, with the ship length ``L``)."""
+    own mismatch leaves (:func:`trials.measured.decision.residual_floor`, with the ship length ``L``
+    and the kind of record set, :func:`~trials.measured.decision.record_kind` when not given)."""
     D = np.vstack(diffs)
     M = np.vstack([r.seg.meas for r in recs])
     delta = np.concatenate([r.seg.inputs.delta for r in recs])
@@ -308,7 +318,7 @@ def _describe(recs, diffs, noise, rms_after, L: float | None = None) -> tuple[bo
     # position: the track's own growth within segments is not noise; judge u, v, r, heading
     U = float(np.median(np.hypot(M[:, 0], M[:, 1]))) if len(M) else 0.0
     rms = {c: float(np.sqrt(np.mean(D[:, names.index(c)] ** 2))) for c in ("u", "v", "r", "heading")}
-    kind = record_kind([r.seg.inputs.delta for r in recs])
+    kind = kind or record_kind([r.seg.inputs.delta for r in recs])
     big = [c for c in ("u", "v", "r", "heading") if ratio[c] > UNEXPLAINED_FACTOR
            and (L is None or rms[c] > residual_floor(c, U, L, kind))]
     if not big:
@@ -554,9 +564,7 @@ def _confounding(model: _Model, effect) -> float:
     the covariance is not finite."""
     from .identifiability import block_confounding
 
-    pres = effect.presence_parameters()
-    idx = [i for i, f in enumerate(model.free) if f.kind == "effect" and f.name.split(".")[0] == effect.name
-           and f.name.split(".")[-1] in pres]
+    idx = _effect_index(model, effect, presence_only=True)
     std = np.asarray(model.fit.std, float)
     cov = np.nan_to_num(model.fit.corr, nan=0.0) * np.outer(std, std)
     np.fill_diagonal(cov, std * std)
@@ -621,6 +629,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     t0 = time.perf_counter()
     o = DiagnoseOptions(**kwargs) if options is None else replace(options, **kwargs)
     say = o.say or (lambda m: None)
+    calibration()                               # a bad calibration file: refused before any work
     recs = prepare(ship, items, wind=o.wind, segment_s=o.segment_s)
     if not recs:
         raise InputError("diagnose", "", "no record")
@@ -695,7 +704,8 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
         ses[cls.name] = s
         ivs[cls.name] = effect_intervals(cls, *effect_estimate(current, cls, inflate))
     cand_log = cand_log + [{"effect": c.name, "named": c.name in named} for c in cand]
-    unexpl, desc, _ = _describe(recs, current.diffs, noise, None, ship.particulars.L)
+    unexpl, desc, _ = _describe(recs, current.diffs, noise, None, ship.particulars.L,
+                                rounds[0].get("kind") if rounds else None)
     mfm = model_form_mismatch(current.free[:ns], current.theta[:ns])
     th_out = [f.prior if f.name in mfm else v for f, v in zip(current.free[:ns], current.theta[:ns])]
     ship_vals = _ship_values(ship, current.free[:ns], th_out)        # mismatched: the config's, not written as fitted

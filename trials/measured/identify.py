@@ -347,8 +347,8 @@ def _fit_stage(problem: tuple, seg: float, label: str, last: bool, fit, o: Ident
 
     ship, packed, runs, fp, nuisance = problem
     stage_progress = None if o.progress is None else (lambda i, c, _l=label: o.progress(i, c, _l))
-    segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects,
-                      speed_only=getattr(r, "speed_only", False)) for r in runs]
+    segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects, speed_only=r.speed_only)
+            for r in runs]
     sc = _scales(runs, ship.particulars.L, o.velocity_weight)
     theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
     rms = (record_residual_rms(packed, segs, fp, theta, sc, effects=nuisance, ship=ship)

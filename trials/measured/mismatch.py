@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mmg.ship import Ship
+from mmg.units import KNOT
 
 __all__ = ["DEV_NOISE_HALF_WIDTHS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS", "TRIALS", "MismatchSpec", "crossflow_fit",
            "mismatch_family", "mismatch_member", "mismatch_ship", "trial_records"]
@@ -36,7 +37,6 @@ RUDDER_CONSTANTS = ("f_alpha", "epsilon", "kappa", "t_R", "a_H", "x_H_prime", "g
 DEV_NOISE_HALF_WIDTHS = (0.02, 0.02, 0.0002, 0.5, 0.5, math.radians(0.05))
 """Uniform log-noise half-widths of the development set (u, v [m/s], r [rad/s], x, y [m], psi [rad])."""
 
-KNOT = 1852.0 / 3600.0
 
 TRIALS = {
     "turn35": {"kind": "turning", "rudder_deg": 35.0},
@@ -215,15 +215,6 @@ def mismatch_family(ship: Ship, n: int, seed: int, spec: MismatchSpec = Mismatch
     return [mismatch_member(ship, rng, spec, crossflow=i in cross) for i in range(n)]
 
 
-def _head(rec, t_end: float):
-    """The record up to ``t_end`` [s] (every array channel cut alike)."""
-    k = int(np.searchsorted(rec.t, t_end + 1e-9))
-    cut = {f: getattr(rec, f)[:k] for f in ("t", "x", "y", "psi", "U", "u", "v", "r", "delta", "n", "wind_speed_rel",
-                                           "wind_dir_rel", "wind_speed_true", "wind_dir_true")
-           if getattr(rec, f) is not None}
-    return replace(rec, **cut)
-
-
 def _zigzag_end(rec, t_execute: float, reversals: int, tail: float) -> float:
     """The time of the ``reversals``-th rudder reversal after the execute, plus ``tail`` [s]."""
     d = np.asarray(rec.delta)
@@ -286,5 +277,5 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
                            heading_deg=tr.get("heading_deg"), t_execute=te, true_wind=true_wind, noise=noise,
                            noise_dist="uniform", seed=seed, name=name or kind)
     if zig:
-        rec = _head(rec, _zigzag_end(rec, te, 9, 60.0))
+        rec = rec.slice_time(-math.inf, _zigzag_end(rec, te, 9, 60.0) + 1e-9)
     return replace(rec, meta={**rec.meta, "trial": kind, "effects": eff})
