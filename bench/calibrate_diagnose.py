@@ -49,7 +49,9 @@ def clean_magnitudes(records, L: float) -> tuple:
     the ship's mismatch lend a shallow-water candidate on top of it).  Before the true effects are
     in, the other candidates soak up theirs (a current takes a heading bias on a zigzag): that is
     the confusion :mod:`trials.measured.identifiability` reports, not the ship's mismatch."""
-    from trials.measured.decision import BIC_THRESHOLD, Z_THRESHOLD, magnitude
+    import math
+
+    from trials.measured.decision import BIC_THRESHOLD, COMPONENT_FLOORS, Z_THRESHOLD, current_components, magnitude
 
     out: dict = {}
     passes: dict = {}
@@ -64,10 +66,15 @@ def clean_magnitudes(records, L: float) -> tuple:
                 if c["effect"] in truth:
                     continue
                 ok = bool(c["delta_bic"] > BIC_THRESHOLD and c["z"] > Z_THRESHOLD)
-                m = magnitude(c["effect"], c["parameters"], L)
-                out.setdefault(c["effect"], {}).setdefault(kind, []).append(float(m) if ok else 0.0)
-                passes.setdefault(c["effect"], {}).setdefault(kind, []).append(ok)
-                raw.setdefault(c["effect"], {}).setdefault(kind, []).append(float(m))
+                sizes = [(c["effect"], magnitude(c["effect"], c["parameters"], L))]
+                if c["effect"] == "current" and kind in COMPONENT_FLOORS:
+                    # bench runs of the family sail at heading 0 (trials.measured.mismatch.trial_records)
+                    parts = current_components(c["parameters"], L, math.radians(rd.get("heading_deg", 0.0)))
+                    sizes += [(k, abs(x)) for k, x in zip(COMPONENT_FLOORS[kind], parts)]
+                for e, m in sizes:
+                    out.setdefault(e, {}).setdefault(kind, []).append(float(m) if ok else 0.0)
+                    passes.setdefault(e, {}).setdefault(kind, []).append(ok)
+                    raw.setdefault(e, {}).setdefault(kind, []).append(float(m))
     return out, passes, raw
 
 
@@ -78,10 +85,14 @@ def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
     took (``raw``), passing or not (a conservative stand-in)."""
     from scipy.stats import beta, halfnorm
 
-    m = max(len(clean), 1)
+    from trials.measured.decision import COMPONENT_FLOORS
+
+    comps = {c for cs in COMPONENT_FLOORS.values() for c in cs}
+    m0 = max(len([e for e in clean if e not in comps]), 1)
     out = {}
     for e, kinds in clean.items():
         out[e] = {}
+        m = m0 * (2 if e in comps else 1)       # a current named when either component clears: alpha split
         for k, v in kinds.items():
             v = np.asarray(v, float)
             on = v[v > 0]
@@ -156,7 +167,8 @@ def main(argv=None):
                      f"({n} clean records and {n_eff} with effects of the mismatch family, seeds of those bench runs; "
                      f"{datetime.date.today().isoformat()})",
            "alpha": a.alpha, "units": {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg",
-                                       "wind": "1", "shallow_water": "T/H"},
+                                       "wind": "1", "shallow_water": "T/H",
+                                       "current_along": "sqrt(gL)", "current_across": "sqrt(gL)"},
            "floors": fl, "residual_floors": residual_floors(records),
            "residual_floor_units": {"u": "fraction of U", "v": "fraction of U", "r": "r L / U", "heading": "deg"},
            "clean": {e: {k: [float(f"{x:.4g}") for x in v] for k, v in kinds.items()}

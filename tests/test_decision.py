@@ -74,6 +74,16 @@ def test_the_floor_decides(monkeypatch):
     assert d1.named == []
     c = d1.rounds[0]["candidates"][0]
     assert c["delta_bic"] > D.BIC_THRESHOLD and c["z"] > D.Z_THRESHOLD and c["floor"] == 2.0 * size
+    # the same current judged by its components along and across the zigzag's mean heading: named
+    # where its across part (70 deg off the heading) clears its floor, not where neither part does
+    h = math.radians(d1.rounds[0]["heading_deg"])
+    al, ac = D.current_components(d1.parameters.get("current") or c["parameters"], L, h)
+    assert abs(ac) > 0.8 * size and abs(al) < 0.5 * size
+    for across_floor, named in ((0.5 * size, ["current"]), (2.0 * size, [])):
+        monkeypatch.setattr(D, "calibration", lambda f=across_floor: {"floors": {
+            "current": {"zigzag": 2.0 * size}, "current_along": {"zigzag": 2.0 * size},
+            "current_across": {"zigzag": f}}})
+        assert diagnose(ship, [rec], candidates=["current"]).named == named
 
 
 def test_a_named_calibration_file_that_is_not_there_is_refused(tmp_path, monkeypatch):
@@ -99,3 +109,79 @@ def test_a_named_calibration_file_that_is_not_there_is_refused(tmp_path, monkeyp
         lines = [ln for ln in r.stderr.strip().splitlines() if ln.strip()]
         assert len(lines) == 1 and env in lines[0] and "Traceback" not in r.stderr, r.stderr
         assert not out.exists()
+
+
+def test_current_components_plain_formulas():
+    """Along and across a heading: a current setting east seen from a ship heading north is all across
+    (to starboard); from a ship heading east all along; speeds over sqrt(gL)."""
+    from trials.measured.decision import current_components
+
+    L = 325.0
+    s = 0.2 / math.sqrt(9.80665 * L)
+    al, ac = current_components({"speed_mps": 0.2, "direction_deg": 90.0}, L, 0.0)
+    assert al == pytest.approx(0.0, abs=1e-12) and ac == pytest.approx(s)
+    al, ac = current_components({"speed_mps": 0.2, "direction_deg": 90.0}, L, math.radians(90.0))
+    assert al == pytest.approx(s) and ac == pytest.approx(0.0, abs=1e-12)
+    al, ac = current_components({"speed_mps": 0.2, "direction_deg": 0.0}, L, math.radians(90.0))
+    assert al == pytest.approx(0.0, abs=1e-12) and ac == pytest.approx(-s)          # from the port side
+    al, ac = current_components({"speed_mps": 0.2, "direction_deg": 210.0}, L, math.radians(30.0))
+    assert al == pytest.approx(-s) and ac == pytest.approx(0.0, abs=1e-12)          # head current
+
+
+def test_mean_heading_is_circular():
+    from trials.measured.decision import mean_heading
+
+    assert mean_heading([np.radians([359.0, 1.0, 358.0, 2.0])]) == pytest.approx(0.0, abs=1e-12)
+    assert math.degrees(mean_heading([np.radians([170.0, -170.0]), np.array([math.pi])])) == pytest.approx(180.0)
+    assert math.degrees(mean_heading([np.radians([80.0, 100.0, np.nan])])) == pytest.approx(90.0)
+
+
+def test_component_floors_judge_a_current_on_a_zigzag(monkeypatch):
+    """A current across the heading below the speed's floor is named where the across floor (what the
+    ship's own speed mismatch cannot lend) is below it, and not where both component floors are above;
+    on a turn the speed's floor alone decides."""
+    import trials.measured.decision as D
+
+    L = 325.0
+    across = {"speed_mps": 0.1, "direction_deg": 90.0}          # heading north: all across
+    along = {"speed_mps": 0.1, "direction_deg": 180.0}          # a head current: all along
+    f = 0.15 / math.sqrt(9.80665 * L)                           # the speed's floor: 0.15 m/s
+    table = {"floors": {"current": {"zigzag": f, "turn": f},
+                        "current_along": {"zigzag": f}, "current_across": {"zigzag": 0.02 / math.sqrt(9.80665 * L)}}}
+    monkeypatch.setattr(D, "calibration", lambda: table)
+    assert D.clears_floor("current", across, L, "zigzag", 0.0)
+    assert not D.clears_floor("current", along, L, "zigzag", 0.0)
+    assert not D.clears_floor("current", across, L, "turn", 0.0)
+    assert not D.clears_floor("current", across, L, "zigzag", None)          # no heading: the speed's floor
+    assert D.clears_floor("current", across, L, "zigzag", math.radians(40.0))   # 0.064 m/s across
+    assert not D.clears_floor("current", across, L, "zigzag", math.radians(85.0))  # 0.009 m/s across
+    table["floors"]["current_across"]["zigzag"] = f
+    assert not D.clears_floor("current", across, L, "zigzag", 0.0)
+    del table["floors"]["current_across"]
+    assert not D.clears_floor("current", across, L, "zigzag", 0.0)           # components not calibrated
+    assert D.clears_floor("rudder_offset", {"offset_deg": -1.0}, L, "zigzag", 0.0)   # not calibrated: no floor
+
+
+def test_an_effect_that_loses_its_evidence_is_dropped(monkeypatch):
+    """Forward selection's final check: a zigzag with a heading bias only, the search forced to name
+    a current and the bias (the confusion of a cross current with a bias): in the joint fit the
+    current has nothing left to explain, and the diagnosis must drop it and keep the bias."""
+    import mmg
+    import mmg.effects as E
+    import trials.measured.decision as D
+    import trials.measured.diagnose as G
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    rec = G.synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, seed=5)
+    monkeypatch.setattr(D, "calibration", lambda: {})
+
+    def forced(fitter, base, cand, ns, o, say):
+        effs = [E.get("current"), E.get("heading_bias")]
+        m = fitter.fit(effs, start_ship=base.theta[:ns])
+        return m, ["current", "heading_bias"], [{"round": 1, "model": [], "candidates": []}]
+
+    monkeypatch.setattr(G, "_search", forced)
+    d = G.diagnose(ship, [rec], candidates=["current", "heading_bias"])
+    assert d.named == ["heading_bias"]
+    assert [x["effect"] for x in d.rounds[-1]["dropped"]] == ["current"]
+    assert d.parameters["heading_bias"]["bias_deg"] == pytest.approx(1.5, abs=0.3)

@@ -19,7 +19,9 @@ An effect is named when three tests hold:
    linear terms +-10 %, nonlinear +-25 %, rudder and propeller constants +-15 %, other wind-load
    factors, another hull form): ``bench/calibrate_diagnose.py`` (its docstring gives the rule)
    writes them, with their sources and the clean samples, to the packaged
-   ``configs/calibration/diagnose.yaml``.
+   ``configs/calibration/diagnose.yaml``.  On a zigzag a current is judged by its components along
+   and across the records' mean heading, each against its own floor (:func:`clears_floor`): the
+   ship's own speed mismatch lends a current along the heading, hardly any across it.
 
 :func:`false_alarm_probability` reads the same clean magnitudes: the share of clean records on
 which the candidate's magnitude reached the value (with one added record for the value itself,
@@ -33,7 +35,8 @@ from functools import lru_cache
 import numpy as np
 
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "KINDS", "magnitude", "record_kind", "floor",
-           "false_alarm_probability", "calibration", "residual_floor"]
+           "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
+           "clears_floor", "COMPONENT_FLOORS"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -80,6 +83,70 @@ def magnitude(effect: str, values: dict, L: float) -> float:
         h = float(values["depth_to_draft"])
         return 0.0 if not math.isfinite(h) or h <= 0 else 1.0 / h
     return math.nan
+
+
+def current_components(values: dict, L: float, heading: float) -> tuple[float, float]:
+    """A current's components along and across a heading, over sqrt(g L).
+
+    Parameters
+    ----------
+    values : dict
+        The current's reported values (``speed_mps``, ``direction_deg``: the direction it sets
+        towards, clockwise from north).
+    L : float
+        Ship length [m].
+    heading : float
+        The heading [rad, clockwise from north] (:func:`mean_heading` of the records).
+
+    Returns
+    -------
+    (float, float)
+        Along (positive ahead) and across (positive to starboard) components over sqrt(g L).
+    """
+    s = float(values["speed_mps"]) / math.sqrt(9.80665 * L)
+    a = math.radians(float(values["direction_deg"])) - heading
+    return s * math.cos(a), s * math.sin(a)
+
+
+def mean_heading(psis) -> float:
+    """The circular mean [rad] of the logged headings of a set of records (arrays in rad)."""
+    a = np.concatenate([np.asarray(p, float).ravel() for p in psis])
+    a = a[np.isfinite(a)]
+    return float(math.atan2(np.mean(np.sin(a)), np.mean(np.cos(a)))) if len(a) else 0.0
+
+
+COMPONENT_FLOORS = {"zigzag": ("current_along", "current_across")}
+"""Kinds of record on which a current's size is judged by its components along and across the mean
+heading, each against a floor of its own (the calibration's ``current_along``, ``current_across``).
+On a zigzag the ship's own speed mismatch (resistance, thrust, wake) lends a current along the
+heading: on the family's clean zigzags up to 0.11 m/s along, never above 0.011 m/s across (see
+``bench/calibrate_diagnose.py``); a turn sweeps every heading and keeps the speed's floor."""
+
+
+def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float | None = None) -> bool:
+    """Whether an effect's size exceeds the calibrated floor on a record set of ``kind``: its
+    :func:`magnitude` over :func:`floor`, or, for a current on a kind of :data:`COMPONENT_FLOORS`
+    with its component floors calibrated and ``heading`` given, either component
+    (:func:`current_components`) over its own floor.
+
+    Parameters
+    ----------
+    effect : str
+    values : dict
+        Its reported values.
+    L : float
+        Ship length [m].
+    kind : str
+        :func:`record_kind`.
+    heading : float, optional
+        The records' mean heading [rad] (:func:`mean_heading`).
+    """
+    comp = COMPONENT_FLOORS.get(kind) if effect == "current" else None
+    floors = (calibration().get("floors") or {})
+    if comp and heading is not None and all(kind in (floors.get(c) or {}) for c in comp):
+        parts = current_components(values, L, heading)
+        return any(abs(x) > floor(c, kind) for x, c in zip(parts, comp))
+    return not magnitude(effect, values, L) <= floor(effect, kind)
 
 
 def record_kind(rudders) -> str:

@@ -28,8 +28,11 @@ checking the scale) and the ship config:
 
    An effect is **named** when dBIC > :data:`BIC_THRESHOLD` (20: twice Kass & Raftery's "very
    strong", calibrated on clean records by the bench) and its parameters differ from their neutral values by more than
-   :data:`Z_THRESHOLD` standard errors (Gauss-Newton, inflated by sqrt(tau)).  The best named
+   :data:`Z_THRESHOLD` standard errors (Gauss-Newton, inflated by sqrt(tau)) and its size clears
+   the floor calibrated on ships that are not the model (:mod:`.decision`).  The best named
    candidate is added and the search repeats over the rest until none clears the threshold.
+   **Final check** (:func:`_prune`): every named effect must still clear z and its floor in the
+   final joint fit; one that lost its evidence to an effect named after it is dropped.
 4. **Report**: ``rms_after`` with the named effects; each effect's parameters and standard
    errors; ``unexplained`` when a channel's residual stays above :data:`UNEXPLAINED_FACTOR` times
    its noise level (estimated from the record's own second differences) and
@@ -57,7 +60,8 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, floor, magnitude, record_kind,
+from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, clears_floor, floor, magnitude,
+                       mean_heading, record_kind,
                        residual_floor)
 from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
@@ -553,8 +557,9 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
         m = fitter.fit(effs, start=m.theta, max_nfev=o.max_nfev - o.screen_nfev)
         dbic = _delta_bic(current, m, k, taus, o.stride)
         vals, se, z = _effect_report(m, cls, inflate)
-    mag = magnitude(cls.name, vals, fitter.ship.particulars.L)
-    ok = dbic > BIC_THRESHOLD and z > Z_THRESHOLD and not mag <= floor(cls.name, fitter.kind)
+    L = fitter.ship.particulars.L
+    mag = magnitude(cls.name, vals, L)
+    ok = dbic > BIC_THRESHOLD and z > Z_THRESHOLD and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
     return dbic, ok, cls, m, vals, se, z, mag, _confounding(m, cls)
 
 
@@ -590,7 +595,7 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
                 f"{MAGNITUDE_UNITS.get(cls.name, '')} (floor {fmt3(floor(cls.name, fitter.kind))})")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
                        "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
-                       "kind": fitter.kind,
+                       "kind": fitter.kind, "heading_deg": round(math.degrees(fitter.heading), 2),
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
                                        "magnitude": float(f"{g:.4g}"), "floor": floor(c.name, fitter.kind),
                                        "R": round(rr, 4) if math.isfinite(rr) else None,
@@ -604,6 +609,39 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
         current = best[3]
         remaining.remove(best[2])
     return current, named, rounds
+
+
+def _holds(fitter, model: _Model, cls, inflate: float) -> tuple[bool, float, dict]:
+    """(whether a named effect still clears z and its floor in ``model``, its z, its values)."""
+    vals, _, z = _effect_report(model, cls, inflate)
+    ok = z > Z_THRESHOLD and clears_floor(cls.name, vals, fitter.ship.particulars.L, fitter.kind, fitter.heading)
+    return ok, z, vals
+
+
+def _prune(fitter, current, named, rounds, ns: int, o: DiagnoseOptions, say):
+    """The final check of forward selection: an effect named early can lose its evidence to one named
+    after it (a heading bias on a zigzag is first taken for a cross current; once the bias is in, the
+    current shrinks to nothing).  Every named effect must still clear z and its floor in the final
+    joint fit; the weakest that does not is dropped (the rest refitted from where they were) and
+    the check repeated.  Each drop is logged in the last round's ``dropped`` list."""
+    while len(current.effects) > 1:
+        _, inflate = _taus(current, o.stride)
+        checks = [(cls, *_holds(fitter, current, cls, inflate)) for cls in current.effects]
+        weak = [c for c in checks if not c[1]]
+        if not weak:
+            break
+        cls, _, z, vals = min(weak, key=lambda c: c[2])
+        keep = [e for e in current.effects if e is not cls]
+        idx = set(_effect_index(current, cls))
+        start = [v for i, v in enumerate(current.theta) if i not in idx]
+        m = fitter.fit(keep, start=np.asarray(start), max_nfev=o.max_nfev)
+        say(f"dropped {cls.name}: in the joint fit z {fmt3(z)}, {format_values(cls.name, vals)} "
+            f"(no longer clears z or its floor)")
+        if rounds:
+            rounds[-1].setdefault("dropped", []).append({"effect": cls.name, "z": round(z, 2), "parameters": vals})
+        current = m
+        named = [n for n in named if n != cls.name]
+    return current, named
 
 
 def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs) -> Diagnosis:
@@ -645,8 +683,10 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
     fitter = _Fitter(ship, packed, recs, sc0, o.stride, o.max_nfev, sfree)
     fitter.kind = record_kind([r.seg.inputs.delta for r in recs])
+    fitter.heading = mean_heading([r.seg.meas[:, 5] for r in recs])
     d_config, base, kept = _baseline(fitter, noise, say)
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
+    current, named = _prune(fitter, current, named, rounds, len(sfree), o, say)
     res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
                      o.stride)
     res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o, rounds)
