@@ -200,3 +200,68 @@ def release_notes() -> None:
     """Print the notes held so far (the command proceeds: its inputs are read and accepted)."""
     for h in _held:
         h.print_held()
+
+
+def add_backend_options(p, what: str) -> None:
+    """``--backend``, ``--scheduler``, ``--jobs``: where ``what`` runs (the same numbers on every backend)."""
+    p.add_argument("--backend", choices=("serial", "loky", "dask"), default="loky",
+                   help=f"where {what} run: serial, loky (this machine's cores, default) or dask (a cluster: "
+                        "--scheduler ADDRESS, or a local one; optional extra mmg-toolkit[dask])")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="with --backend dask: the address of a running dask scheduler (tcp://host:8786); "
+                        "default a local cluster of --jobs workers")
+    p.add_argument("--jobs", type=_whole(1, "--jobs"), default=None,
+                   help="local workers (default: every core this process may use)")
+
+
+def check_backend_options(args) -> None:
+    """Refuse, before any work, ``--scheduler`` without ``--backend dask`` and dask without its extra."""
+    from mmg.errors import InputError
+
+    if args.backend != "dask" and getattr(args, "scheduler", None):
+        raise InputError("--scheduler", args.scheduler, "needs --backend dask")
+    if args.backend == "dask":
+        try:
+            import distributed  # noqa: F401
+        except ImportError:
+            raise InputError("--backend", "dask", "needs the optional extra: pip install 'mmg-toolkit[dask]'") from None
+
+
+class backend_client:
+    """Context manager: the ``distributed.Client`` of ``args.backend == "dask"`` (``args.scheduler``'s
+    cluster, or a local one of ``args.jobs`` workers that it closes on exit); None otherwise.  A missing
+    extra or an unreachable scheduler: one line naming the option."""
+
+    def __init__(self, args):
+        self.args, self.client, self.cluster = args, None, None
+
+    def __enter__(self):
+        from mmg.errors import InputError
+
+        a = self.args
+        check_backend_options(a)
+        if a.backend != "dask":
+            return None
+        from distributed import Client, LocalCluster
+        from ..files.output import children_ignore_sigint
+
+        with children_ignore_sigint():      # a terminal's Ctrl-C reaches this process only, which closes them
+            if a.scheduler:
+                try:
+                    self.client = Client(a.scheduler, timeout="10s")
+                except (OSError, TimeoutError) as e:
+                    raise InputError("--scheduler", a.scheduler, f"no dask scheduler answers there ({e})") from None
+            else:
+                from ..runs.sweep import default_jobs
+
+                self.cluster = LocalCluster(n_workers=a.jobs or default_jobs(), processes=True, threads_per_worker=1,
+                                            dashboard_address=None)
+                self.client = Client(self.cluster)
+        return self.client
+
+    def __exit__(self, *exc):
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+        return False

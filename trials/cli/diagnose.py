@@ -7,7 +7,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _output_path, release_notes
+from .common import _output_path, add_backend_options, backend_client, check_backend_options, release_notes
 
 
 def cmd_diagnose(args) -> int:
@@ -19,6 +19,7 @@ def cmd_diagnose(args) -> int:
     from ..measured.diagnose import diagnose, prepare
     from ..files.output import StagedFile, StagedOutput, check_output_dir, check_output_file, dumps_json
 
+    check_backend_options(args)
     check_output_file(args.json)
     if args.plots is not None:
         check_output_dir(args.plots, "--plots")
@@ -33,7 +34,9 @@ def cmd_diagnose(args) -> int:
     recs = prepare(ship, args.logs, wind=wind)           # every record read (a bad one: one line) first
     release_notes()                                      # accepted: their notes, then the progress
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
-    d = diagnose(ship, recs, wind=wind, per_run=len(recs) > 1, say=say)
+    with backend_client(args) as client:
+        d = diagnose(ship, recs, wind=wind, per_run=len(recs) > 1, say=say,
+                     backend=args.backend, client=client, n_jobs=args.jobs)
     text = dumps_json(d.to_json())
     ship_text = None
     if args.out_ship is not None:
@@ -97,4 +100,5 @@ def add_parser(sub) -> None:
                    help="write the ship config with the fitted coefficients (and a named wind scale)")
     p.add_argument("--wind", choices=("on", "off"), default=None,
                    help="wind loads in the model from the start (default off: wind is then a candidate effect)")
+    add_backend_options(p, "the per-record diagnoses of several logs (JSON runs)")
     p.set_defaults(func=cmd_diagnose)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _output_path, _positive_int, _rudder_timing
+from .common import _output_path, _positive_int, _rudder_timing, backend_client, check_backend_options
 
 
 def cmd_sensitivity(args) -> int:
@@ -30,20 +30,9 @@ def cmd_sensitivity(args) -> int:
     for p in args.trials:
         if not Path(p).is_file():
             raise InputError(p, "", "file not found")
-    if args.backend == "dask":
-        try:
-            from distributed import Client, LocalCluster
-        except ImportError:
-            raise InputError("--backend", "dask", "needs the optional extra: pip install 'mmg-toolkit[dask]'") from None
+    check_backend_options(args)
     t0 = time.perf_counter()
-    cluster = client = None
-    if args.backend == "dask":
-        from ..files.output import children_ignore_sigint
-
-        with children_ignore_sigint():     # a terminal's Ctrl-C reaches this process only, which closes them
-            cluster = LocalCluster(n_workers=args.jobs or 2, processes=True, threads_per_worker=1)
-            client = Client(cluster)
-    try:
+    with backend_client(args):
         with ExitStack() as stack:
             stage = stack.enter_context(StagedOutput(args.out))
             if args.trials:
@@ -56,10 +45,6 @@ def cmd_sensitivity(args) -> int:
                 sr.crb_table(mc, stage, n_seeds=args.mc_seeds, rudder_timing=args.rudder_timing)
             else:
                 sr.design(stage, backend=args.backend, n_jobs=args.jobs, rudder_timing=args.rudder_timing)
-    finally:
-        if client is not None:
-            client.close()
-            cluster.close()
     print(f"wrote {args.out} ({time.perf_counter() - t0:.1f} s)")
     return 0
 
@@ -82,6 +67,8 @@ def add_parser(sub) -> None:
                         "second log bound (default 0.15, the raw-log EKF's; 'inf' no prior; 'none' leaves that bound out)")
     p.add_argument("--design", action="store_true", help="trial-design search (S-type psi_S, zigzag angles)")
     p.add_argument("--backend", choices=["serial", "loky", "threads", "dask"], default="loky",
-                   help="parallel backend of the sweeps (dask: a local distributed cluster; optional extra)")
+                   help="parallel backend of the sweeps (dask: --scheduler's cluster or a local one; optional extra)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="with --backend dask: a running dask scheduler (tcp://host:8786); default a local cluster")
     p.add_argument("--jobs", type=_positive_int, default=None, help="workers (default: all cores)")
     p.set_defaults(func=cmd_sensitivity)

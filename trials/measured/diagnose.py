@@ -67,7 +67,7 @@ from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv
 from .diagnose_report import fmt3, format_rms, format_values
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis",
-           "prepare", "synthetic_record", "write_frt_csv", "SHIP_FREE_TERMS", "MASS_FREE",
+           "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
@@ -456,6 +456,14 @@ class DiagnoseOptions:
         The ship's own parameters fitted with the effects (:func:`_ship_free`).
     say : callable, optional
         Where the progress lines go (nowhere when omitted).
+    backend : str
+        How the per-record diagnoses (``per_run``) are spread: ``"serial"`` (default), ``"loky"``
+        (this machine's cores) or ``"dask"`` (the workers of ``client``): the same numbers either way
+        (:func:`diagnose_each`).
+    client : distributed.Client, optional
+        The dask client for ``backend="dask"`` (default: the current one).
+    n_jobs : int, optional
+        Local workers of ``backend="loky"`` (default: every usable core).
     """
 
     wind: bool | None = False
@@ -467,6 +475,9 @@ class DiagnoseOptions:
     ship_free: object = None
     say: object = None
     screen_nfev: int = SCREEN_NFEV
+    backend: str = "serial"
+    client: object = None
+    n_jobs: int | None = None
 
 
 def _default_stride(recs, L: float) -> int:
@@ -693,9 +704,41 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     res.baseline = "fitted" if kept else "config (the fit replayed worse)"
     res.seconds = time.perf_counter() - t0
     if o.per_run and len(recs) > 1:
-        res.runs = [diagnose(ship, [r], replace(o, per_run=False, say=None)) for r in recs]
+        res.runs = diagnose_each(ship, recs, o, progress=o.say is not None)
         res.seconds = time.perf_counter() - t0
     return res
+
+
+def _diagnose_one(task) -> "Diagnosis":
+    ship, rec, o = task
+    return diagnose(ship, [rec], o)
+
+
+def diagnose_each(ship: Ship, items, options: DiagnoseOptions | None = None, progress: bool = False) -> list:
+    """Each record diagnosed alone, in record order, spread by ``options.backend`` (serial, this
+    machine's cores, or a dask cluster: :func:`trials.runs.sweep.run_sweep`, one progress line per
+    record).  Every diagnosis is deterministic, so the backend does not change a number.
+
+    Parameters
+    ----------
+    ship : Ship
+    items : list of paths, TrialRecord or Prepared
+    options : DiagnoseOptions, optional
+        How each is diagnosed (``per_run``, ``say``, ``client`` are not passed on).
+    progress : bool
+        One line per finished record on stderr.
+
+    Returns
+    -------
+    list of Diagnosis
+    """
+    from ..runs.sweep import run_sweep
+
+    o = options or DiagnoseOptions()
+    recs = prepare(ship, items, wind=o.wind, segment_s=o.segment_s)
+    each = replace(o, per_run=False, say=None, backend="serial", client=None)
+    return run_sweep(_diagnose_one, [(ship, r, each) for r in recs], backend=o.backend, client=o.client,
+                     n_jobs=o.n_jobs, labels=[r.name for r in recs], progress=progress)
 
 
 def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()):
