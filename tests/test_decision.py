@@ -185,3 +185,24 @@ def test_an_effect_that_loses_its_evidence_is_dropped(monkeypatch):
     assert d.named == ["heading_bias"]
     assert [x["effect"] for x in d.rounds[-1]["dropped"]] == ["current"]
     assert d.parameters["heading_bias"]["bias_deg"] == pytest.approx(1.5, abs=0.3)
+
+
+def test_floor_parts_and_the_reason_given(monkeypatch):
+    """The parts a current is judged by, as the rounds log them, and the not_identifiable reason that
+    cites them (not the speed's floor, which did not decide)."""
+    import trials.measured.decision as D
+    from trials.measured.diagnose import within_mismatch
+
+    L = 325.0
+    g = math.sqrt(9.80665 * L)
+    monkeypatch.setattr(D, "calibration", lambda: {"floors": {
+        "current": {"zigzag": 0.1 / g}, "current_along": {"zigzag": 0.12 / g}, "current_across": {"zigzag": 0.02 / g}}})
+    parts = D.floor_parts("current", {"speed_mps": 0.1, "direction_deg": 0.0}, L, "zigzag", 0.0)
+    assert parts["along"][0] == pytest.approx(0.1 / g, rel=1e-3) and parts["along"][1] == pytest.approx(0.12 / g)
+    assert parts["across"][0] == pytest.approx(0.0, abs=1e-9)
+    assert D.floor_parts("current", {"speed_mps": 0.1, "direction_deg": 0.0}, L, "turn", 0.0) == {}
+    assert D.floor_parts("rudder_offset", {"offset_deg": 1.0}, L, "zigzag", 0.0) == {}
+    cand = {"effect": "current", "delta_bic": 50.0, "z": 9.0, "magnitude": 0.1 / g, "floor": 0.1 / g,
+            "parts": {k: list(v) for k, v in parts.items()}, "clears_threshold": False}
+    (entry,) = within_mismatch([{"candidates": [cand]}], L)
+    assert "along" in entry["reason"] and "across" in entry["reason"]

@@ -36,7 +36,7 @@ import numpy as np
 
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
-           "clears_floor", "COMPONENT_FLOORS"]
+           "clears_floor", "floor_parts", "COMPONENT_FLOORS"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -141,12 +141,21 @@ def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float 
     heading : float, optional
         The records' mean heading [rad] (:func:`mean_heading`).
     """
+    parts = floor_parts(effect, values, L, kind, heading)
+    if parts:
+        return any(abs(x) > f for x, f in parts.values())
+    return not magnitude(effect, values, L) <= floor(effect, kind)
+
+
+def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float | None = None) -> dict:
+    """``{part: (size, floor)}`` of a current judged by its parts (:func:`clears_floor`): ``along`` and
+    ``across`` over sqrt(gL); empty where the effect is judged by its :func:`magnitude` alone."""
     comp = COMPONENT_FLOORS.get(kind) if effect == "current" else None
     floors = (calibration().get("floors") or {})
-    if comp and heading is not None and all(kind in (floors.get(c) or {}) for c in comp):
-        parts = current_components(values, L, heading)
-        return any(abs(x) > floor(c, kind) for x, c in zip(parts, comp))
-    return not magnitude(effect, values, L) <= floor(effect, kind)
+    if not comp or heading is None or not all(kind in (floors.get(c) or {}) for c in comp):
+        return {}
+    parts = current_components(values, L, heading)
+    return {c.split("_")[-1]: (float(f"{x:.4g}"), floor(c, kind)) for x, c in zip(parts, comp)}
 
 
 def record_kind(rudders) -> str:

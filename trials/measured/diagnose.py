@@ -60,8 +60,8 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, clears_floor, floor, magnitude,
-                       mean_heading, record_kind,
+from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, clears_floor, floor, floor_parts,
+                       magnitude, mean_heading, record_kind,
                        residual_floor)
 from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
@@ -592,6 +592,13 @@ def _confounding(model: _Model, effect) -> float:
         return math.nan
 
 
+def _parts(fitter, name: str, values: dict) -> dict:
+    """``{"parts": {part: [size, floor]}}`` of a candidate judged by its parts (a current on a
+    zigzag: :func:`~trials.measured.decision.floor_parts`), else ``{}``."""
+    p = floor_parts(name, values, fitter.ship.particulars.L, fitter.kind, fitter.heading)
+    return {"parts": {k: list(v) for k, v in p.items()}} if p else {}
+
+
 def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
     """Forward selection from the baseline: each round tries every remaining candidate and names the
     best that clears the thresholds.  Returns (final fit, named effects, the rounds' log)."""
@@ -602,13 +609,17 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
         for cls in remaining:
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
             dbic, _, _, _, vals, _, z, mag, _ = results[-1]
-            say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}, size {fmt3(mag)} "
-                f"{MAGNITUDE_UNITS.get(cls.name, '')} (floor {fmt3(floor(cls.name, fitter.kind))})")
+            pt = _parts(fitter, cls.name, vals).get("parts")
+            size = (", ".join(f"{k} {fmt3(abs(a))} (floor {fmt3(f)})" for k, (a, f) in pt.items()) if pt else
+                    f"{fmt3(mag)} (floor {fmt3(floor(cls.name, fitter.kind))})")
+            say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}, size {size} "
+                f"{MAGNITUDE_UNITS.get(cls.name, '')}")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
                        "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
                        "kind": fitter.kind, "heading_deg": round(math.degrees(fitter.heading), 2),
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
                                        "magnitude": float(f"{g:.4g}"), "floor": floor(c.name, fitter.kind),
+                                       **_parts(fitter, c.name, v),
                                        "R": round(rr, 4) if math.isfinite(rr) else None,
                                        "clears_threshold": bool(ok), "parameters": v, "standard_errors": s}
                                       for d, ok, c, m, v, s, z, g, rr in results]})
@@ -765,9 +776,19 @@ def within_mismatch(rounds, L: float) -> list:
             out.append({"effect": c["effect"], "confused_with": ["the ship's own coefficients"], "correlation": None,
                         "what_would_separate": "a ship model closer to this ship (e.g. identified on other "
                                                "records) or a larger effect",
-                        "reason": f"size {c['magnitude']:.3g} {unit} at dBIC {c['delta_bic']:.3g}, z {c['z']:.3g}, "
-                                  f"within the {c['floor']:.3g} {unit} the ship's own mismatch lends it (calibrated)"})
+                        "reason": _within_reason(c, unit)})
     return out
+
+
+def _within_reason(c: dict, unit: str) -> str:
+    """Why a candidate that cleared dBIC and z was not named: its size (or parts) and floor(s)."""
+    head = f"at dBIC {c['delta_bic']:.3g}, z {c['z']:.3g}, "
+    if c.get("parts"):
+        sizes = ", ".join(f"{k} {abs(v[0]):.3g} (floor {v[1]:.3g})" for k, v in c["parts"].items())
+        return head + f"its parts along and across the heading, {sizes} {unit}, within what the ship's own " \
+                      "mismatch lends them (calibrated)"
+    return head + f"size {c['magnitude']:.3g} {unit}, within the {c['floor']:.3g} {unit} the ship's own mismatch " \
+                  "lends it (calibrated)"
 
 
 def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int) -> Diagnosis:
