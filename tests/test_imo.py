@@ -132,3 +132,187 @@ def test_bad_input_is_one_line(argv, names, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:") and names in err[0]
     assert not out.exists()
+
+
+# ----------------------------------------------------------------- uncertainty
+
+from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
+
+
+def serial(func, tasks):
+    """An executor of our own: a plain loop (the plug-in point a distributed one uses)."""
+    serial.calls += 1
+    return [func(t) for t in tasks]
+
+
+serial.calls = 0
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(n=st.integers(2, 5), seed=st.integers(0, 2**31 - 1))
+def test_sampled_parameters_have_the_given_covariance(n, seed):
+    from trials.imo.sampling import draw
+
+    rng = np.random.default_rng(seed)
+    a = rng.normal(size=(n, n))
+    scale = 10.0 ** rng.uniform(-4, 1, n)                    # parameters of very different sizes
+    cov = (a @ a.T + 0.05 * np.eye(n)) * np.outer(scale, scale)
+    mean = rng.normal(size=n) * scale
+    N = 20000
+    x = draw(mean, cov, N, seed=seed + 1)
+    assert x.shape == (N, n)
+    S = np.cov(x, rowvar=False)
+    sd = np.sqrt(np.diag(cov))
+    # standard error of a sample covariance: sqrt((C_ii C_jj + C_ij^2) / N); 5 of them
+    tol = 5.0 * np.sqrt((np.outer(sd, sd) ** 2 + cov ** 2) / N)
+    assert np.all(np.abs(S - cov) <= tol)
+    assert np.all(np.abs(x.mean(axis=0) - mean) <= 5.0 * sd / np.sqrt(N))
+
+
+@settings(max_examples=200, deadline=None)
+@given(v=st.lists(st.one_of(st.none(), st.floats(-1e3, 1e3)), min_size=1, max_size=60),
+       limit=st.floats(-1e3, 1e3))
+def test_probability_and_verdict(v, limit):
+    from trials.imo.sampling import summarise
+
+    s = summarise(v, limit)
+    met = [x is not None and x <= limit for x in v]
+    assert s["probability"] == pytest.approx(sum(met) / len(v), abs=1e-12)
+    want = "pass" if s["probability"] >= 0.95 else "fail" if s["probability"] <= 0.05 else "undecided"
+    assert s["verdict"] == want
+    if all(met):                                      # every sample (so the whole interval) below the limit
+        assert s["probability"] == 1.0 and s["verdict"] == "pass"
+    if not any(met):                                  # every sample above it (or none gave the figure)
+        assert s["probability"] == 0.0 and s["verdict"] == "fail"
+    lo, hi = s["interval"]
+    if None not in (lo, hi, s["median"]):
+        assert lo <= s["median"] <= hi
+        finite = [x for x in v if x is not None]
+        assert min(finite) <= lo and hi <= max(finite)
+
+
+def test_covariance_refused_or_marginalised():
+    from mmg.errors import InputError
+    from trials.imo.sampling import covariance_of
+
+    ship = mmg.load_ship("esso_osaka")
+    c = [[4.0, 1.0, 0.5], [1.0, 9.0, 2.0], [0.5, 2.0, 1.0]]
+    names, mean, mat, notes = covariance_of(ship, {"names": ["N_r", "wind_scale", "kappa"], "matrix": c})
+    assert names == ["N_r", "kappa"] and len(notes) == 1 and "wind_scale" in notes[0]
+    assert mat.tolist() == [[4.0, 0.5], [0.5, 1.0]]           # the marginal: correlations of the rest kept
+    assert mean.tolist() == [ship.hull.value("N_r"), ship.rudder.kappa]
+    for bad in ({"names": ["N_r", "Y_r"], "matrix": [[1.0, 2.0], [2.0, 1.0]]},   # not positive semi-definite
+                {"names": ["N_r", "Y_r"], "matrix": [[1.0, 0.5], [0.4, 1.0]]},   # not symmetric
+                {"names": ["N_r"], "matrix": [[1.0, 0.0], [0.0, 1.0]]},          # wrong shape
+                {"names": ["no_such"], "matrix": [[1.0]]}):
+        with pytest.raises(InputError):
+            covariance_of(ship, bad)
+
+
+def test_samples_are_written_into_the_ship():
+    """Samples at one point (zero variance) about another N_r give that ship's figures, as mmg.simulate
+    runs it; the interval closes on them and the probability is 1 or 0."""
+    ship = mmg.load_ship("esso_osaka")
+    nr = 0.8 * ship.hull.value("N_r")
+    before = serial.calls
+    res = mmg.imo(ship, samples=3, cov={"names": ["N_r"], "values": [nr], "matrix": [[0.0]]}, executor=serial)
+    assert serial.calls == before + 1
+    want = mmg.simulate(mmg.turning(ship.with_hull({"N_r": nr}), rudder="35 deg", speed="10 kn",
+                                    duration="3000 s")).metrics()["tactical_diameter_L"]
+    own = mmg.simulate("st35").metrics()["tactical_diameter_L"]
+    assert abs(want - own) > 0.05                          # the change shows
+    row = {r["name"]: r for r in res.rows()}["tactical diameter, starboard"]
+    assert row["value"] == pytest.approx(want, rel=1e-9)
+    assert row["interval"] == pytest.approx([want, want], rel=1e-9)
+    assert row["probability"] == (1.0 if want <= 5.0 else 0.0)
+    assert res.nominal["tactical diameter, starboard"] == pytest.approx(own, rel=1e-9)
+
+
+def test_identify_writes_the_covariance_imo_samples(tmp_path):
+    """mmg identify's ship.yaml carries the fit's covariance (names, units, values, corr * std std^T),
+    and imo samples that ship from it."""
+    from tests.test_identify import SHIP, _synthetic_runs
+    from trials.measured.identify import identify, write_identification
+
+    ship = mmg.load_ship(SHIP)
+    runs = _synthetic_runs(ship, seeds=(0,), duration=40.0)
+    free = ["N_r", "Y_r", "kappa", "m_y"]
+    ident = identify(ship, runs, free=free, segment_s=(20.0,), say=lambda m: None, max_nfev=3)
+    path = write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)["ship"]
+    back = mmg.load_ship(path)
+    c = back.covariance
+    f = ident.fit
+    assert list(c.names) == free and list(c.units) == ["1", "1", "1", "kg"]
+    assert np.allclose(c.values, f.theta, rtol=1e-8)
+    want = np.asarray(f.corr) * np.outer(f.std, f.std)
+    assert np.allclose(np.asarray(c.matrix), want, rtol=1e-8, atol=0)
+    assert np.allclose(c.std(), f.std, rtol=1e-8)
+    res = mmg.imo(path, speed="0.5 m/s", samples=4, executor=serial, seed=3)
+    assert res.parameters["names"] == free and res.n_samples == 4
+    for r in res.rows():
+        if r["name"] != "stopping track reach":
+            lo, hi = r["interval"]
+            assert lo <= r["value"] <= hi and 0.0 <= r["probability"] <= 1.0
+
+
+def test_cli_samples_on_both_cores_match_a_serial_run(tmp_path):
+    """mmg imo --samples on a ship.yaml with a covariance: the schema with intervals, the convergence
+    in imo.md, the distributions figure; the process pool gives the serial executor's numbers."""
+    from trials.measured.identify import ship_yaml
+
+    ship = mmg.load_ship("esso_osaka")
+    names = ["N_r", "Y_r", "epsilon"]
+    vals = [ship.hull.value("N_r"), ship.hull.value("Y_r"), ship.rudder.epsilon]
+    sd = np.abs(vals) * np.array([0.15, 0.1, 0.05])
+    corr = np.array([[1.0, 0.6, 0.2], [0.6, 1.0, 0.0], [0.2, 0.0, 1.0]])
+    cov = {"names": names, "units": ["1"] * 3, "values": vals, "matrix": (corr * np.outer(sd, sd)).tolist()}
+    yml = tmp_path / "ship.yaml"
+    yml.write_text(ship_yaml(mmg.config_path("ships", "esso_osaka.yaml"), {}, "a covariance (test)", cov))
+    out = tmp_path / "out"
+    assert main(["imo", str(yml), "--speed", "10 kn", "--samples", "16", "--seed", "5", "--jobs", "2",
+                 "--out", str(out)]) == 0
+    doc = json.loads((out / "imo.json").read_text())
+    ser = mmg.imo(str(yml), speed="10 kn", samples=16, seed=5, executor=serial)
+    assert doc == ser.as_dict()
+    for c in doc["criteria"]:
+        assert list(c) == ["name", "value", "unit", "limit", "interval", "probability", "verdict"]
+        if c["name"] != "stopping track reach":
+            assert len(c["interval"]) == 2 and 0.0 <= c["probability"] <= 1.0
+            assert c["verdict"] in ("pass", "fail", "undecided")
+    md = (out / "imo.md").read_text()
+    assert "## Convergence" in md and "N = 2" in md and "N = 16" in md and ">= 0.95" in md
+    assert (out / "distributions.png").stat().st_size > 10000
+    conv = ser.convergence("advance, port")
+    assert [x["n"] for x in conv] == [2, 4, 8, 16]
+
+
+@pytest.mark.parametrize("below, above, verdict", [(100, 0, "pass"), (95, 5, "pass"), (94, 6, "undecided"),
+                                                   (93, 7, "undecided"), (50, 50, "undecided"), (6, 94, "undecided"),
+                                                   (5, 95, "fail"), (0, 100, "fail")])
+def test_verdict_thresholds(below, above, verdict):
+    """pass from a probability of 0.95, fail up to 0.05 (the rule in the docstring and the report)."""
+    from trials.imo.sampling import summarise
+
+    s = summarise([1.0] * below + [3.0] * above, 2.0)
+    assert s["probability"] == pytest.approx(below / 100.0) and s["verdict"] == verdict
+
+
+@pytest.mark.parametrize("cov, field", [
+    ({"names": ["N_r", "Y_r"], "units": ["1", "1"], "values": [0.0, 0.0], "matrix": [[1.0, 0.5], [0.4, 1.0]]},
+     "covariance.matrix.1.0"),
+    ({"names": ["N_r", "Y_r"], "units": ["1", "1"], "values": [0.0, 0.0], "matrix": [[1.0, 2.0], [2.0, 1.0]]},
+     "covariance.matrix"),
+    ({"names": ["N_r", "N_r"], "units": ["1", "1"], "values": [0.0, 0.0], "matrix": [[1.0, 0.0], [0.0, 1.0]]},
+     "covariance.names"),
+    ({"names": ["N_r"], "units": ["1", "1"], "values": [0.0], "matrix": [[1.0]]}, "covariance.units"),
+    ({"names": ["N_r"], "units": ["1"], "values": [0.0], "matrix": [[-1.0]]}, "covariance.matrix.0.0"),
+])
+def test_a_bad_covariance_section_is_refused_naming_it(cov, field, tmp_path):
+    from mmg.errors import InputError
+    from trials.measured.identify import ship_yaml
+
+    yml = tmp_path / "ship.yaml"
+    yml.write_text(ship_yaml(mmg.config_path("ships", "esso_osaka.yaml"), {}, "bad covariance (test)", cov))
+    with pytest.raises(InputError) as e:
+        mmg.load_ship(yml)
+    assert e.value.field == field and "\n" not in str(e.value)

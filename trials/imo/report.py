@@ -17,6 +17,10 @@ def _num(v, nd: int = 3) -> str:
     return "-" if v is None else f"{v:.{nd}g}" if abs(v) < 1e4 else f"{v:.4g}"
 
 
+def _prob(p) -> str:
+    return "-" if p is None else f"{p:.3f}"
+
+
 def _interval(iv) -> str:
     return "-" if not iv else f"[{_num(iv[0])}, {_num(iv[1])}]"
 
@@ -31,7 +35,7 @@ def _table(res) -> list[str]:
         if sampled:
             lines.append(f"| {r['name']} | {_num(r['value'])}{unit if r['value'] is not None else ''} | "
                          f"{_num(res.nominal.get(r['name']))} | {_interval(r['interval'])} | {r['limit']:.3g}{unit} | "
-                         f"{_num(r['probability'])} | {r['verdict']} |")
+                         f"{_prob(r['probability'])} | {r['verdict']} |")
         else:
             lines.append(f"| {r['name']} | {_num(r['value'])}{unit if r['value'] is not None else ''} | "
                          f"{r['limit']:.3g}{unit} | {r['verdict']} |")
@@ -50,7 +54,7 @@ def _convergence(res) -> list[str]:
         if c.name == STOPPING:
             continue
         conv = res.convergence(c.name)
-        lines.append(f"| {c.name} | " + " | ".join(_num(x["probability"]) for x in conv) + " | " +
+        lines.append(f"| {c.name} | " + " | ".join(_prob(x["probability"]) for x in conv) + " | " +
                      " | ".join(_interval(x["interval"]) for x in conv) + " |")
     return lines
 
