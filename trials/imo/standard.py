@@ -34,7 +34,7 @@ from mmg.ship import Ship, load_ship, read_yaml
 from mmg.units import DEG, MAX_SHIP_SPEED, to_si
 
 from ..analysis import metrics as MET
-from ..runs.run import run_trial
+from ..runs.run import prepare_trial, run_trial
 from ..runs.trial import Trial, turning, zigzag
 
 __all__ = ["Criterion", "Plan", "criteria", "plan", "run_manoeuvres", "criterion_values", "approach_speed",
@@ -201,13 +201,14 @@ def run_manoeuvres(p: Plan, ship: Ship | None = None) -> dict:
     dict
         Run name -> (:class:`~trials.runs.run.TrialRun`, its metrics dict).
     """
-    out = {}
+    out, prepared = {}, None
     L, max_s = p.ship.particulars.L, MAX_RUN_LENGTHS_L * p.ship.particulars.L / p.u0
     for name, trial in p.trials.items():
         tr: Trial = trial if ship is None else replace(trial, ship=ship)
+        prepared = prepared or prepare_trial(tr)          # one approach for all: same ship, speed, effects
         keys = _needed(name, p.L_over_V)
         while True:
-            run = run_trial(tr)
+            run = run_trial(tr, prepared)
             m = run.metrics()
             if (all(_metric(m, k) is not None for k in keys) or not run.result.completed
                     or 2 * tr.duration > max_s + 1e-9 * L):
