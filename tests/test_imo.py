@@ -85,8 +85,8 @@ def test_figures_equal_those_of_simulate(cli_run):
             "port": (_simulated(mmg.turning(ship, rudder="-35 deg", **kw)),
                      _simulated(mmg.zigzag(ship, rudder="10 deg", heading="10 deg", first="port", **kw)),
                      _simulated(mmg.zigzag(ship, rudder="20 deg", heading="20 deg", first="port", **kw)))}
-    for side, ((st, _), (z10, ov10), (_, ov20)) in runs.items():
-        want = {"advance": st["advance_L"], "tactical diameter": st["tactical_diameter_L"],
+    for side, ((turn, _), (z10, ov10), (_, ov20)) in runs.items():
+        want = {"advance": turn["advance_L"], "tactical diameter": turn["tactical_diameter_L"],
                 "initial turning track reach": z10["distance_to_second_execute_L"],
                 "10/10 first overshoot": ov10[0], "10/10 second overshoot": ov10[1], "20/20 first overshoot": ov20[0]}
         for name, v in want.items():

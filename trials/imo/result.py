@@ -19,8 +19,8 @@ from mmg.ship import Ship, load_ship
 
 from ..analysis.metrics import IMO_STANDARD
 from . import sampling as S
-from .standard import STOPPING, STOPPING_REASON, Criterion, approach_speed, criteria, criterion_values, plan, \
-    run_manoeuvres
+from .standard import MAX_RUN_LENGTHS_L, STOPPING, STOPPING_REASON, Criterion, approach_speed, criteria, \
+    criterion_values, plan, run_manoeuvres
 
 __all__ = ["imo", "ImoResult", "VERDICTS"]
 
@@ -185,7 +185,7 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
         With samples each criterion's value is the median of the samples, its interval the 5th-95th
         percentiles, its probability the share of samples meeting the limit; verdict ``"pass"`` if that
         probability is >= 0.95, ``"fail"`` if <= 0.05, else ``"undecided"``.  Without samples the verdict
-        is the value against the limit.
+        is the value against the limit (a manoeuvre that does not give its figure fails, with a note).
 
     Raises
     ------
@@ -210,6 +210,8 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
     runs = run_manoeuvres(p)
     nominal = criterion_values(p, runs)
     crit = tuple(criteria(p.L_over_V))
+    notes += [f"{c.name}: the manoeuvre does not give it (no 180 deg of turn, no overshoot) within "
+              f"{MAX_RUN_LENGTHS_L:g} L/V: it fails" for c in crit if c.name != STOPPING and nominal[c.name] is None]
     sampled = None
     if samples:
         out = S.run_samples(p, params["names"], draws, executor)

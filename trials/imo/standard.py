@@ -202,7 +202,7 @@ def run_manoeuvres(p: Plan, ship: Ship | None = None) -> dict:
         Run name -> (:class:`~trials.runs.run.TrialRun`, its metrics dict).
     """
     out, prepared = {}, None
-    L, max_s = p.ship.particulars.L, MAX_RUN_LENGTHS_L * p.ship.particulars.L / p.u0
+    max_s = MAX_RUN_LENGTHS_L * p.L_over_V
     for name, trial in p.trials.items():
         tr: Trial = trial if ship is None else replace(trial, ship=ship)
         prepared = prepared or prepare_trial(tr)          # one approach for all: same ship, speed, effects
@@ -211,7 +211,7 @@ def run_manoeuvres(p: Plan, ship: Ship | None = None) -> dict:
             run = run_trial(tr, prepared)
             m = run.metrics()
             if (all(_metric(m, k) is not None for k in keys) or not run.result.completed
-                    or 2 * tr.duration > max_s + 1e-9 * L):
+                    or 2 * tr.duration > max_s * (1 + 1e-9)):
                 break
             tr = replace(tr, duration=2 * tr.duration)
         out[name] = (run, m)
