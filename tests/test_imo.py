@@ -284,6 +284,12 @@ def test_cli_samples_on_both_cores_match_a_serial_run(tmp_path):
     assert (out / "distributions.png").stat().st_size > 10000
     conv = ser.convergence("advance, port")
     assert [x["n"] for x in conv] == [2, 4, 8, 16]
+    for side in ("starboard", "port"):                # the extreme samples' turns, run again, for the tracks figure
+        v = ser.samples[f"tactical diameter, {side}"]
+        got = {w: ser.sample_runs[f"turning circle, {side}: {w} sample"][1]["tactical_diameter_L"]
+               for w in ("smallest", "median", "largest")}
+        assert got["smallest"] == pytest.approx(min(v), rel=1e-12) and got["largest"] == pytest.approx(max(v), rel=1e-12)
+        assert got["median"] == pytest.approx(sorted(v)[len(v) // 2], rel=1e-12)
 
 
 @pytest.mark.parametrize("below, above, verdict", [(100, 0, "pass"), (95, 5, "pass"), (94, 6, "undecided"),

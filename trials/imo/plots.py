@@ -12,12 +12,14 @@ from .standard import SIDES, STOPPING
 __all__ = ["tracks_figure", "zigzags_figure", "distributions_figure"]
 
 COLOURS = {"starboard": "tab:green", "port": "tab:red"}
+_STYLE = {"smallest": (0, (1, 1)), "median": "-.", "largest": (0, (5, 2))}
 
 
 def tracks_figure(res, pyplot: bool = True):
     """Both turning circles of ``res`` in ship lengths (x north, y east from the execute point), hull
-    outlines every quarter of the time to 180 deg, the advance and tactical diameter in the legend."""
-    fig = _figure((8.0, 7.0), pyplot)
+    outlines every quarter of the time to 180 deg, the advance and tactical diameter in the legend; with
+    samples also the samples' smallest, median and largest turns (outlines at 180 deg)."""
+    fig = _figure((9.0, 8.0) if res.sample_runs else (8.0, 7.0), pyplot)
     ax = fig.add_subplot(1, 1, 1)
     L, B = res.L, res.B
     for s in SIDES:
@@ -35,6 +37,18 @@ def tracks_figure(res, pyplot: bool = True):
             i = min(i, len(t) - 1)
             px, py = ship_outline(x[i], y[i], psi[i], 1.0, B / L)
             ax.fill(py, px, facecolor="none", edgecolor=COLOURS[s], lw=0.8)
+    for label, (run, m) in res.sample_runs.items():
+        side = "starboard" if "starboard" in label else "port"
+        t180 = m.get("time_to_180_s") or run.t[-1]
+        keep = run.t <= min(run.t[-1], 1.6 * t180)
+        which = label.split(": ")[1].split()[0]
+        tac = m.get("tactical_diameter_L")
+        ax.plot(run.y[keep] / L, run.x[keep] / L, color=COLOURS[side], lw=0.8, ls=_STYLE[which],
+                label=f"{side}, {which} sampled tactical diameter ({tac:.2f} L)" if tac is not None else None)
+        if which != "median":
+            i = min(int(np.searchsorted(run.t, t180)), len(run.t) - 1)
+            px, py = ship_outline(run.x[i] / L, run.y[i] / L, run.psi[i], 1.0, B / L)
+            ax.fill(py, px, facecolor="none", edgecolor=COLOURS[side], lw=0.6, ls=_STYLE[which])
     ax.axhline(4.5, color="k", ls=":", lw=0.8, label="advance limit 4.5 L (MSC.137(76) 5.3.1)")
     for v in (-5.0, 5.0):
         ax.axvline(v, color="k", ls="--", lw=0.8)
@@ -44,8 +58,9 @@ def tracks_figure(res, pyplot: bool = True):
     ax.set_ylabel("x, north (L)")
     ax.set_title(f"{res.ship}: turning circles at {res.speed} (approach heading north)")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="lower center", fontsize=8, bbox_to_anchor=(0.5, -0.32), ncol=1)
-    fig.subplots_adjust(bottom=0.27)
+    n = len(ax.get_legend_handles_labels()[1])
+    ax.legend(loc="upper center", fontsize=7, bbox_to_anchor=(0.5, -0.1), ncol=1 if n <= 5 else 2)
+    fig.subplots_adjust(bottom=0.3 if n > 5 else 0.27)
     return fig
 
 

@@ -89,7 +89,8 @@ def report_lines(res) -> list[str]:
         lines += ["## Notes", ""] + [f"- {n}" for n in other] + [""]
     if sampled:
         lines += _convergence(res) + [""]
-    lines += ["## Figures", "", "- [turning circles with ship outlines](tracks.png)",
+    lines += ["## Figures", "", "- [turning circles with ship outlines](tracks.png)" +
+              (" (with the samples' smallest, median and largest tactical diameter)" if sampled else ""),
               "- [zigzag heading and rudder histories](zigzags.png)"]
     if sampled:
         lines.append("- [distributions of the sampled criteria with their limits](distributions.png)")

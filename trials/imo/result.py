@@ -69,6 +69,9 @@ class ImoResult:
     parameters: dict | None = None
     notes: tuple = ()
     runs: dict = field(default_factory=dict, repr=False, compare=False)
+    sample_runs: dict = field(default_factory=dict, repr=False, compare=False)
+    """With samples: the turning circles of the samples with the smallest, the median and the largest
+    tactical diameter on each side, ``"turning circle, starboard: median sample"`` -> (TrialRun, metrics)."""
 
     @property
     def n_samples(self) -> int:
@@ -222,8 +225,32 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
                          f"e.g. {bad[0]}")
     notes.append(f"{STOPPING}: not available: {STOPPING_REASON}")
     pa = p.ship.particulars
+    extremes = _extreme_turns(p, params, sampled) if samples else {}
     return ImoResult(ship=sh.name, speed=str(speed), u0=p.u0, L_over_V=p.L_over_V, L=pa.L, B=pa.B, criteria=crit,
-                     nominal=nominal, samples=sampled, parameters=params, notes=tuple(notes), runs=runs)
+                     nominal=nominal, samples=sampled, parameters=params, notes=tuple(notes), runs=runs,
+                     sample_runs=extremes)
+
+
+def _extreme_turns(p, params: dict, sampled: dict) -> dict:
+    """The turning circles of the samples with the smallest, median and largest tactical diameter per side
+    (run again: a few runs, not kept from the pool)."""
+    from dataclasses import replace
+
+    from ..measured.identify import ship_with_values
+
+    out = {}
+    for side in ("starboard", "port"):
+        name = f"turning circle, {side}"
+        v = np.array([np.nan if x is None else x for x in sampled[f"tactical diameter, {side}"]], dtype=float)
+        ok = np.flatnonzero(np.isfinite(v))
+        if ok.size == 0:
+            continue
+        order = ok[np.argsort(v[ok])]
+        one = replace(p, trials={name: p.trials[name]})
+        for label, k in (("smallest", order[0]), ("median", order[len(order) // 2]), ("largest", order[-1])):
+            ship = ship_with_values(p.ship, dict(zip(params["names"], (float(x) for x in params["draws"][k]))))
+            out[f"{name}: {label} sample"] = run_manoeuvres(one, ship)[name]
+    return out
 
 
 SOURCE = IMO_STANDARD
