@@ -14,6 +14,7 @@ The public API, in one namespace::
     pred = mmg.predict(m3, ["turn.csv"]); pred.to_pandas(); pred.runs[0].plot()
     ident = mmg.identify(m3, ["turn.csv", "zigzag.csv"]); ident.fit.to_pandas(); ident.scores()
     diag = mmg.diagnose(m3, ["turn.csv"])               # which effect the model misses
+    rep = mmg.imo("esso_osaka"); rep.to_pandas()         # the IMO manoeuvring standards (samples=N: uncertain)
 
 Values with a dimension are strings with their unit, as in the YAML configs
 (``"20 deg"``, ``"10 kn"``, ``"3000 s"``); plain numbers and wrong units are refused
@@ -53,6 +54,8 @@ _LAZY = {
     "identify": ("trials.measured.identify", "identify"),
     "cross_validate": ("trials.measured.identify", "cross_validate"),
     "diagnose": ("trials.measured.diagnose", "diagnose"),
+    "imo": ("trials.imo.result", "imo"),
+    "ImoResult": ("trials.imo.result", "ImoResult"),
     "config_dir": ("mmg.resources", "config_dir"),
     "config_path": ("mmg.resources", "config_path"),
     "ship_path": ("mmg.resources", "ship_path"),

@@ -203,6 +203,40 @@ class Wind:
 
 
 @dataclass(frozen=True)
+class ParameterCovariance:
+    """The covariance of a ship's identified parameters: the ``covariance:`` section of a ship YAML.
+
+    ``mmg identify`` writes it beside the fitted values (the Gauss-Newton covariance of the fit, in
+    the fit's own parameter names and units); ``mmg imo --samples`` samples the ship from it.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Parameter names as ``mmg identify --free`` takes them: hull coefficients (``N_r``) and ship
+        constants (``w_P0``, ``epsilon``, ``kappa``, ``gamma_R_pos``, ``rudder_offset``, ``m_x``, ...).
+    units : tuple of str
+        The unit of each value (``"1"``: non-dimensional, as the primed coefficients; ``"rad"``,
+        ``"kg"``, ``"kg m^2"``).
+    values : tuple of float
+        The values the covariance is about (the fitted values, in ``units``).
+    matrix : tuple of tuples of float
+        The covariance, in the products of ``units``; symmetric, positive semi-definite.
+    source : str
+        How it was obtained.
+    """
+
+    names: tuple
+    units: tuple
+    values: tuple
+    matrix: tuple
+    source: str = ""
+
+    def std(self) -> tuple:
+        """Standard deviation of each parameter (the square roots of the diagonal), in ``units``."""
+        return tuple(math.sqrt(max(self.matrix[i][i], 0.0)) for i in range(len(self.names)))
+
+
+@dataclass(frozen=True)
 class Ship:
     """A ship: everything the simulator needs, in SI and primes."""
 
@@ -224,6 +258,8 @@ class Ship:
     """The effect values the ship file states itself, ``(effect, parameter, file, field, value)``
     (``wind.scale``, ``effects.current.speed_mps``, ...): a trial on this ship may not give them
     again (:func:`trials.runs.trial.trial_from_dict`)."""
+    covariance: ParameterCovariance | None = field(default=None, compare=False, repr=False)
+    """The covariance of the identified parameters (the ``covariance:`` section), or None."""
 
     def effect_set(self):
         """:attr:`effects` as an :class:`mmg.effects.EffectSet` (an empty one when None)."""
@@ -375,6 +411,14 @@ class _Wind(_Strict):
     yaw_factor: float = 1.0
 
 
+class _Covariance(_Strict):
+    names: list[str]
+    units: list[str]
+    values: list[float]
+    matrix: list[list[float]]
+    source: str = ""
+
+
 class _ShipFile(_Strict):
     name: str = Field(min_length=1)
     source: str = ""
@@ -387,6 +431,7 @@ class _ShipFile(_Strict):
     engine: _Engine
     wind: Optional[_Wind] = None
     effects: Optional[dict] = None
+    covariance: Optional[_Covariance] = None
 
 
 _UNIT_HINT = {"L": "m", "B": "m", "T": "m", "S_wetted": "m^2", "x_G": "m", "rho": "kg/m^3", "D": "m", "P": "m",
@@ -635,7 +680,39 @@ def _build(f: _ShipFile, src: str) -> Ship:
     if effects is not None and effects.get("wind") is not None:
         wind = replace(wind, enabled=True, **{k: effects.get("wind")[k] for k in wind.values()})
     return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
-                steering=steering, engine=engine, source=f.source, wind=wind, effects=effects, stated=stated)
+                steering=steering, engine=engine, source=f.source, wind=wind, effects=effects, stated=stated,
+                covariance=_covariance(f, src))
+
+
+def _covariance(f: _ShipFile, src: str) -> ParameterCovariance | None:
+    """covariance: one name, unit and value per row of a square, symmetric, positive semi-definite matrix."""
+    c = f.covariance
+    if c is None:
+        return None
+    n = len(c.names)
+    if n == 0:
+        raise InputError(src, "covariance.names", "no parameter named")
+    if len(set(c.names)) != n:
+        raise InputError(src, "covariance.names", "a parameter is named twice")
+    for key in ("units", "values", "matrix"):
+        if len(getattr(c, key)) != n:
+            raise InputError(src, f"covariance.{key}", f"{len(getattr(c, key))} entries for {n} names")
+    for i, row in enumerate(c.matrix):
+        if len(row) != n:
+            raise InputError(src, f"covariance.matrix.{i}", f"{len(row)} columns in a {n} x {n} matrix")
+    big = max(abs(c.matrix[i][i]) for i in range(n)) or 1.0
+    for i in range(n):
+        if c.matrix[i][i] < 0:
+            raise InputError(src, f"covariance.matrix.{i}.{i}", f"a negative variance {c.matrix[i][i]:g}")
+        for j in range(i):
+            if abs(c.matrix[i][j] - c.matrix[j][i]) > 1e-9 * big:
+                raise InputError(src, f"covariance.matrix.{i}.{j}", "the matrix is not symmetric")
+    import numpy as np
+
+    if float(np.linalg.eigvalsh(np.asarray(c.matrix, dtype=float)).min()) < -1e-9 * big:
+        raise InputError(src, "covariance.matrix", "not positive semi-definite (a negative eigenvalue): not a covariance")
+    return ParameterCovariance(tuple(c.names), tuple(c.units), tuple(float(v) for v in c.values),
+                               tuple(tuple(float(x) for x in row) for row in c.matrix), c.source)
 
 
 def _effects(f: _ShipFile, wind: Wind | None, src: str):

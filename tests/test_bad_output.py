@@ -54,11 +54,12 @@ def no_computation(monkeypatch):
     import trials.papers.reproduce
     import trials.runs.run
     import trials.planning.sensitivity_report
+    import trials.imo.result
 
     def boom(*a, **k):
         raise AssertionError("computation started before the output target was checked")
 
-    for mod, names in [(trials.runs.run, ["run_trial"]), (trials.papers.reproduce, ["reproduce"]), (trials.papers.artyszuk, ["reproduce"]),
+    for mod, names in [(trials.runs.run, ["run_trial"]), (trials.imo.result, ["imo"]), (trials.papers.reproduce, ["reproduce"]), (trials.papers.artyszuk, ["reproduce"]),
                        (trials.estimates.estimation, ["load_inputs", "estimate_and_report"]),
                        (trials.analysis.nomoto_report, ["identify_log"]),
                        (trials.planning.sensitivity_report, ["trial_sensitivities", "paper_figures", "crb_table", "design"]),
@@ -88,6 +89,7 @@ def _commands(target, log):
         "montecarlo": ["montecarlo", t, "--seeds", "1"],
         "log-filter": ["log-filter", t, "--seeds", "1"],
         "output-error": ["output-error", t, "--seeds", "1"],
+        "imo": ["imo", "esso_osaka", "--out", t],
     }
 
 
@@ -474,6 +476,7 @@ def _output_options(zz20_log):
         ("diagnose", "--json"): ["diagnose", log, "--ship", "esso_osaka", "--json", "{}"],
         ("diagnose", "--plots"): ["diagnose", log, "--ship", "esso_osaka", "--json", "d.json", "--plots", "{}"],
         ("diagnose", "--out-ship"): ["diagnose", log, "--ship", "esso_osaka", "--json", "d.json", "--out-ship", "{}"],
+        ("imo", "--out"): ["imo", "esso_osaka", "--out", "{}"],
     }
 
 

@@ -5,7 +5,8 @@ Inside ``trials`` every module belongs to a sub-package, and each sub-package ma
 ones :data:`MAY_IMPORT` names for it (as its ``__init__`` docstring says):
 
     files < analysis < runs < estimates < planning < papers < cli, with measured above analysis
-    (beside runs: it needs no simulated trial) and below cli; ekf only from measured upwards.
+    (beside runs: it needs no simulated trial) and below cli, imo above runs and measured and below
+    cli; ekf only from measured upwards.
 
 No module imports from a layer above its own, no module imports a top-level package facade
 (``import mmg``: that ``__init__`` re-exports from every layer, so it is for users, not for the
@@ -34,7 +35,8 @@ MAY_IMPORT = {
     "estimates": _LOW | {"ekf", "files", "analysis", "runs"},
     "planning": _LOW | {"ekf", "files", "analysis", "runs", "estimates"},
     "papers": _LOW | {"ekf", "files", "analysis", "runs", "estimates", "planning"},
-    "cli": _LOW | {"ekf", "files", "analysis", "runs", "measured", "estimates", "planning", "papers"},
+    "imo": _LOW | {"ekf", "files", "analysis", "runs", "measured"},
+    "cli": _LOW | {"ekf", "files", "analysis", "runs", "measured", "estimates", "planning", "papers", "imo"},
 }
 
 

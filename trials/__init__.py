@@ -11,6 +11,8 @@ the estimators (:mod:`ekf`), in sub-packages by concept.  Which folder for what:
 :mod:`trials.estimates`   estimation from logs and trials (EKF, output error), Table 10, Monte Carlo
 :mod:`trials.planning`    trial design: sensitivities, Fisher information and Cramer-Rao bounds, search
 :mod:`trials.papers`      the papers reproduced: the main job (``mmg reproduce``), Artyszuk's tables
+:mod:`trials.imo`         the IMO manoeuvring standards (MSC.137(76)) on a ship, with their uncertainty
+                          (``mmg imo``, ``mmg.imo``); above runs and measured
 :mod:`trials.cli`         the ``mmg`` command, one module per subcommand; the numba cache warm-up
 ========================  =================================================================================
 

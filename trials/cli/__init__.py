@@ -8,7 +8,7 @@ interrupted by SIGINT / SIGTERM (one line, nothing left behind).  Library code n
 
 Layout: one module per subcommand (:mod:`.simulate`, :mod:`.metrics`, :mod:`.reproduce`,
 :mod:`.nomoto` with ``nomoto-paper``, :mod:`.estimate`, :mod:`.sensitivity`, :mod:`.montecarlo` with
-``log-filter`` and ``output-error``, :mod:`.predict`, :mod:`.identify`, :mod:`.diagnose`), each
+``log-filter`` and ``output-error``, :mod:`.predict`, :mod:`.identify`, :mod:`.diagnose`, :mod:`.imo`), each
 holding its ``cmd_*`` function and its ``add_parser``; :mod:`.common` the argument types they share;
 this module the entry point (:func:`main`, :func:`build_parser` over :data:`COMMANDS`), the exit
 codes and the signal and console handling; :mod:`.warmup` the numba cache warm-up
@@ -58,6 +58,7 @@ output-error  joint output-error Monte Carlo            (:func:`trials.estimates
 identify      identify a ship model from records        (:func:`trials.measured.identify.identify`)
 predict       replay records against their own inputs   (:func:`trials.measured.predict.predict`)
 diagnose      name the effect the model is missing      (:func:`trials.measured.diagnose.diagnose`)
+imo           the IMO manoeuvring standards, uncertain  (:func:`trials.imo.result.imo`)
 """
 from __future__ import annotations
 
@@ -71,9 +72,9 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from . import diagnose, estimate, identify, metrics, montecarlo, nomoto, predict, reproduce, sensitivity, simulate
+from . import diagnose, estimate, identify, imo, metrics, montecarlo, nomoto, predict, reproduce, sensitivity, simulate
 
-COMMANDS = (simulate, metrics, reproduce, nomoto, estimate, sensitivity, montecarlo, predict, identify, diagnose)
+COMMANDS = (simulate, metrics, reproduce, nomoto, estimate, sensitivity, montecarlo, predict, identify, diagnose, imo)
 """The command modules, in the order ``mmg --help`` lists their subcommands."""
 
 

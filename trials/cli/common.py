@@ -94,7 +94,8 @@ OUTPUT_OPTIONS = {"json": "--json", "out_ship": "--out-ship", "out": "--out", "p
 """The argument names of every output (a file or a folder) of every command, with the option shown."""
 
 FOLDER_FILES = {"simulate": {"out": ("log.csv", "truth.csv", "metrics.json", "track.png", "histories.png")},
-                "identify": {"out": ("ship.yaml", "report.md")}}
+                "identify": {"out": ("ship.yaml", "report.md")},
+                "imo": {"out": ("imo.json", "imo.md", "tracks.png", "zigzags.png", "distributions.png")}}
 """The files a command's output folder is known to receive (replaced there when the run succeeds)."""
 
 

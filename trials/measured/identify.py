@@ -49,6 +49,7 @@ from .predict import MeasuredRun, measured_run, replay_record
 
 __all__ = ["identify", "IdentifyOptions",
            "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
+           "fit_covariance", "ship_with_values", "PARAMETER_UNITS",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description"]
 
@@ -201,7 +202,9 @@ def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
     return replace(run, inputs=wind_scaled(run.inputs, values["wind_scale"]))
 
 
-def _ship_with(ship: Ship, values: dict) -> Ship:
+def ship_with_values(ship: Ship, values: dict) -> Ship:
+    """``ship`` with fitted parameter values (by their ``mmg identify --free`` names, in the fit's units:
+    :data:`PARAMETER_UNITS`) written in; ``wind_scale`` multiplies the ship's wind scale."""
     from dataclasses import replace
 
     hull = {k: v for k, v in values.items() if k in ship.hull.names}
@@ -235,6 +238,9 @@ def _ship_with(ship: Ship, values: dict) -> Ship:
 
             s = replace(s, effects=s.effect_set().merged(E.effect_set({"wind": {**w, "scale": scale}})))
     return s
+
+
+_ship_with = ship_with_values
 
 
 def stage_description(segment_s: float) -> str:
@@ -488,9 +494,31 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     return out
 
 
-def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
+PARAMETER_UNITS = {"rudder_offset": "rad", "m_x": "kg", "m_y": "kg", "J_z": "kg m^2"}
+"""The unit of a fitted parameter where it is not non-dimensional (``"1"``): the fit's own (SI)."""
+
+
+def fit_covariance(fit, note: str = "") -> dict | None:
+    """The ``covariance:`` section of a ship YAML from a fit (:class:`ekf.identify.IdentifyResult`):
+    its parameter names, units (:data:`PARAMETER_UNITS`), fitted values and the Gauss-Newton
+    covariance (``corr * std std^T``); None when the covariance is not finite (a singular fit)."""
+    std = np.asarray(fit.std, dtype=float)
+    cov = np.asarray(fit.corr, dtype=float) * np.outer(std, std)
+    if not np.all(np.isfinite(cov)):
+        return None
+    cov = 0.5 * (cov + cov.T)
+    names = [f.name for f in fit.free]
+    return {"names": names, "units": [PARAMETER_UNITS.get(n, "1") for n in names],
+            "values": [float(f"{v:.10g}") for v in fit.theta],
+            "matrix": [[float(f"{x:.10g}") for x in row] for row in cov],
+            "source": note or "Gauss-Newton covariance of the fit scaled by the residual variance"}
+
+
+def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None) -> str:
     """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
-    ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``."""
+    ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``; with
+    ``covariance`` (:func:`fit_covariance`) its ``covariance:`` section (else none: the initial
+    ship's own section, if any, is about other values and is dropped)."""
     import yaml
 
     from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
@@ -524,6 +552,9 @@ def ship_yaml(ship_path: Path, values: dict, note: str) -> str:
                 data["wind"].pop("scale", None)
             else:
                 data["wind"]["scale"] = float(f"{float(data['wind'].get('scale', 1.0)) * v:.6g}")
+    data.pop("covariance", None)
+    if covariance is not None:
+        data["covariance"] = covariance
     data["name"] = f"{data['name']} (identified)"
     data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
     head = "".join(f"# {ln}\n" for ln in note.splitlines())
@@ -653,7 +684,9 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     fit = ident.fit
     note = (f"segment-wise output error over {len(ident.runs)} records "
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
-    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note))
+    cov = fit_covariance(fit, "Gauss-Newton covariance of mmg identify's fit scaled by the residual variance "
+                              "(optimistic: the 10 Hz residuals are correlated)")
+    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov))
     lines = _report_fit(ident) + _report_training(ident)
     if test_runs:
         lines += _report_test(ident, test_runs)

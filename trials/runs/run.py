@@ -325,7 +325,13 @@ class TrialRun:
         return out
 
 
-def run_trial(trial) -> TrialRun:
+def prepare_trial(trial: Trial):
+    """The packed ship and steady approach (:func:`mmg.simulation.prepare`) of ``trial``: the same for
+    every trial of one ship, approach, disturbances and effects (``run_trial(t, prepared=...)`` reuses it)."""
+    return prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances, trial.effects)
+
+
+def run_trial(trial, prepared=None) -> TrialRun:
     """Simulate a trial from its steady approach.
 
     Parameters
@@ -333,6 +339,9 @@ def run_trial(trial) -> TrialRun:
     trial : Trial, str, os.PathLike or mapping
         A :class:`Trial`, or anything :func:`trials.runs.trial.load_trial` accepts (a bundled
         trial name such as ``"zz20"``, a trial YAML path, a mapping).
+    prepared : (PackedShip, Equilibrium), optional
+        :func:`prepare_trial` of a trial with the same ship, approach, disturbances and effects (several
+        manoeuvres of one ship solve their approach once); default solved here.
 
     Returns
     -------
@@ -342,7 +351,7 @@ def run_trial(trial) -> TrialRun:
         from .trial import load_trial
 
         trial = load_trial(trial)
-    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances, trial.effects)
+    pk, eq = prepare_trial(trial) if prepared is None else prepared
     law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
     t, states, orders, done = integrate(pk, eq.state(), law, trial.duration, trial.dt)
     return TrialRun(trial, SimulationResult(t, states, orders, eq, done, trial.ship.name, {"trial": trial.name}))

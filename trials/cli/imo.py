@@ -1,0 +1,64 @@
+"""``mmg imo``: the IMO manoeuvring standards checked on a ship, with their uncertainty
+(:func:`trials.imo.result.imo`, :func:`trials.imo.report.write_report`)."""
+from __future__ import annotations
+
+import sys
+
+from .common import _output_path, _positive_int, _seed, _whole
+
+
+def cmd_imo(args) -> int:
+    from mmg.errors import InputError
+    from mmg.ship import load_ship
+
+    from ..files.output import StagedOutput, check_output_dir
+    from ..imo.report import write_report
+    from ..imo.result import imo
+    from ..imo.sampling import covariance_of, local_executor
+    from ..imo.standard import approach_speed, plan
+
+    check_output_dir(args.out)
+    ship = load_ship(args.ship)
+    try:
+        if args.speed is not None:
+            plan(ship, args.speed)                 # a bad speed: one line before any run
+        else:
+            approach_speed(ship)                   # no speed known: the same
+        if args.samples:
+            covariance_of(ship)                    # no covariance, a bad one: the same
+    except InputError as e:
+        if e.source not in ("speed", "samples"):
+            raise
+        raise InputError(f"--{e.source}", e.field, e.message) from None
+    if args.samples:
+        print(f"{args.samples} parameter samples, every manoeuvre each, on {args.jobs or 'all usable'} cores",
+              file=sys.stderr, flush=True)
+    ex = local_executor(args.jobs, progress=bool(args.samples))
+    res = imo(ship, speed=args.speed, samples=args.samples, seed=args.seed, executor=ex)
+    with StagedOutput(args.out) as stage:
+        names = write_report(res, stage.dir)
+    print(f"{res.ship} at {res.speed} (L/V = {res.L_over_V:.3g} s): wrote {', '.join(names)} to {args.out}")
+    for r in res.rows():
+        val = "-" if r["value"] is None else f"{r['value']:.3g} {r['unit']}"
+        extra = ""
+        if r["interval"]:
+            lo, hi = ("-" if x is None else f"{x:.3g}" for x in r["interval"])
+            extra = f"  90 % [{lo}, {hi}]  P = {r['probability']:.3f}"
+        print(f"  {r['name']:40s} {val:>10s}  limit {r['limit']:.3g} {r['unit']}{extra}  {r['verdict']}")
+    return 0
+
+
+def add_parser(sub) -> None:
+    """The imo subcommand of ``mmg`` (its options, help and function)."""
+    p = sub.add_parser("imo", help="check the IMO manoeuvring standards (MSC.137(76)) on a ship, with their "
+                                   "uncertainty from its parameters' covariance; writes DIR/imo.json, DIR/imo.md")
+    p.add_argument("ship", help="bundled ship name (esso_osaka) or ship YAML (mmg identify's DIR/ship.yaml)")
+    p.add_argument("--out", required=True, metavar="DIR", type=_output_path,
+                   help="output folder (imo.json, imo.md, tracks.png, zigzags.png, distributions.png)")
+    p.add_argument("--speed", default=None,
+                   help="approach speed with its unit, e.g. '10 kn' (default: the ship's bundled trials')")
+    p.add_argument("--samples", type=_whole(0, "--samples"), default=0, metavar="N",
+                   help="parameter samples from the ship's covariance (default 0: its own parameters only)")
+    p.add_argument("--seed", type=_seed, default=0, help="seed of the parameter samples (default 0)")
+    p.add_argument("--jobs", type=_positive_int, default=None, help="worker processes (default: all usable cores)")
+    p.set_defaults(func=cmd_imo)

@@ -1,0 +1,256 @@
+"""``mmg.imo``: the IMO manoeuvring standards checked on a ship, with their uncertainty.
+
+Source of the criteria: IMO Resolution MSC.137(76) (2002), *Standards for Ship Manoeuvrability*,
+Annex section 5.3, with the explanatory notes MSC/Circ.1053 (2002); the limits are defined once in
+:mod:`trials.analysis.metrics`, the manoeuvres and criteria in :mod:`trials.imo.standard`, the
+sampling in :mod:`trials.imo.sampling`.
+"""
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from mmg.errors import InputError
+from mmg.ship import Ship, load_ship
+
+from ..analysis.metrics import IMO_STANDARD
+from . import sampling as S
+from .standard import MAX_RUN_LENGTHS_L, STOPPING, STOPPING_REASON, Criterion, approach_speed, criteria, \
+    criterion_values, plan, run_manoeuvres
+
+__all__ = ["imo", "ImoResult", "VERDICTS"]
+
+VERDICTS = ("pass", "fail", "undecided", "not available")
+"""A criterion's verdict: met, not met, not decided by the samples (probability between
+:data:`~trials.imo.sampling.FAIL_PROBABILITY` and :data:`~trials.imo.sampling.PASS_PROBABILITY`), or not
+computed (the stopping test)."""
+
+
+@dataclass(frozen=True)
+class ImoResult:
+    """The IMO criteria of one ship: values, limits, verdicts and, with samples, their uncertainty.
+
+    Returned by :func:`imo`.  Read it with :meth:`rows` (what ``imo.json`` holds), :meth:`to_pandas`,
+    :meth:`to_json` and :meth:`plot`.
+
+    Attributes
+    ----------
+    ship : str
+        The ship's name.
+    speed : str
+        The approach speed as given (``"10 kn"``); ``u0`` the same in m/s; ``L_over_V`` L / V [s].
+    criteria : tuple of Criterion
+        One per side of each manoeuvre, the stopping test last.
+    nominal : dict
+        Criterion name -> value with the ship's own parameters (None where not available).
+    samples : dict or None
+        Criterion name -> one value per parameter sample (None: no samples).
+    parameters : dict or None
+        With samples: ``names``, ``mean``, ``cov`` (the sampled parameters), ``draws`` (N x names), ``seed``.
+    notes : tuple of str
+        What a reader should know (effects left out, failed samples, the stopping test).
+    runs : dict
+        The nominal runs: run name -> (TrialRun, metrics) (for the figures; not in the JSON).
+    """
+
+    ship: str
+    speed: str
+    u0: float
+    L_over_V: float
+    L: float
+    B: float
+    criteria: tuple
+    nominal: dict
+    samples: dict | None = None
+    parameters: dict | None = None
+    notes: tuple = ()
+    runs: dict = field(default_factory=dict, repr=False, compare=False)
+    sample_runs: dict = field(default_factory=dict, repr=False, compare=False)
+    """With samples: the turning circles of the samples with the smallest, the median and the largest
+    tactical diameter on each side, ``"turning circle, starboard: median sample"`` -> (TrialRun, metrics)."""
+
+    @property
+    def n_samples(self) -> int:
+        """The number of parameter samples (0 without uncertainty)."""
+        return 0 if self.samples is None else len(next(iter(self.samples.values())))
+
+    def _row(self, c: Criterion) -> dict:
+        if c.name == STOPPING:
+            return {"name": c.name, "value": None, "unit": c.unit, "limit": c.limit, "interval": None,
+                    "probability": None, "verdict": "not available"}
+        if self.samples is None:
+            v = self.nominal[c.name]
+            verdict = "fail" if v is None or v > c.limit else "pass"   # a turn or zigzag that never gets there fails
+            return {"name": c.name, "value": v, "unit": c.unit, "limit": c.limit, "interval": None,
+                    "probability": None, "verdict": verdict}
+        s = S.summarise(self.samples[c.name], c.limit)
+        return {"name": c.name, "value": s["median"], "unit": c.unit, "limit": c.limit, "interval": s["interval"],
+                "probability": s["probability"], "verdict": s["verdict"]}
+
+    def rows(self) -> list[dict]:
+        """One dict per criterion, exactly the ``imo.json`` entries: ``name``, ``value`` (the median of the
+        samples with uncertainty, else the ship's own), ``unit``, ``limit``, ``interval`` ([5 %, 95 %]
+        percentiles, None without samples), ``probability`` (of meeting the limit, None without samples),
+        ``verdict`` (:data:`VERDICTS`)."""
+        return [self._row(c) for c in self.criteria]
+
+    def as_dict(self) -> dict:
+        """``{"ship": ..., "criteria": [...]}``: what ``imo.json`` holds."""
+        return {"ship": self.ship, "criteria": self.rows()}
+
+    def to_json(self, path: str | os.PathLike | None = None) -> str:
+        """The JSON of :meth:`as_dict` (written to ``path`` when given); NaN and inf never appear (None)."""
+        text = json.dumps(self.as_dict(), indent=2, allow_nan=False)
+        if path is not None:
+            Path(path).write_text(text + "\n")
+        return text
+
+    def to_pandas(self):
+        """One row per criterion (indexed by name): value, unit, limit, interval_low, interval_high,
+        probability, verdict and ``nominal`` (the ship's own value)."""
+        import pandas as pd
+
+        rows = []
+        for r in self.rows():
+            lo, hi = r["interval"] if r["interval"] else (None, None)
+            rows.append({"name": r["name"], "value": r["value"], "unit": r["unit"], "limit": r["limit"],
+                         "interval_low": lo, "interval_high": hi, "probability": r["probability"],
+                         "verdict": r["verdict"], "nominal": self.nominal.get(r["name"])})
+        return pd.DataFrame(rows).set_index("name")
+
+    def convergence(self, name: str) -> list[dict]:
+        """How the figures of criterion ``name`` settle with the number of samples (N/8, N/4, N/2, N)."""
+        if self.samples is None:
+            raise ValueError("no samples: imo(ship, samples=N) gives the convergence")
+        c = next(c for c in self.criteria if c.name == name)
+        return S.convergence(self.samples[name], c.limit)
+
+    def plot(self, kind: str = "tracks", ax=None, pyplot: bool = True):
+        """A figure: ``"tracks"`` (the turning circles with ship outlines), ``"zigzags"`` (heading and rudder
+        histories) or ``"distributions"`` (the sampled criteria with their limits).  Returns the Figure."""
+        from . import plots
+
+        draw = {"tracks": plots.tracks_figure, "zigzags": plots.zigzags_figure,
+                "distributions": plots.distributions_figure}.get(kind)
+        if draw is None:
+            raise ValueError(f"unknown plot kind {kind!r}: tracks, zigzags or distributions")
+        return draw(self, pyplot=pyplot)
+
+    def __repr__(self) -> str:
+        verdicts = [r["verdict"] for r in self.rows()]
+        count = ", ".join(f"{verdicts.count(v)} {v}" for v in VERDICTS if verdicts.count(v))
+        unc = f", {self.n_samples} samples" if self.samples is not None else ""
+        return f"ImoResult({self.ship!r}, {self.speed}{unc}: {count})"
+
+
+def _ship(ship) -> Ship:
+    if isinstance(ship, Ship):
+        return ship
+    if not isinstance(ship, (str, os.PathLike)):
+        raise InputError("ship", repr(ship)[:40], "expected a Ship, a bundled ship name or a ship YAML path")
+    return load_ship(ship)
+
+
+def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | None = 0, executor=None):
+    """Check the IMO manoeuvring standards on ``ship``, with their uncertainty when ``samples`` > 0.
+
+    Criteria of IMO Resolution MSC.137(76) (2002), Annex 5.3, with the explanatory notes MSC/Circ.1053:
+    advance <= 4.5 L and tactical diameter <= 5 L of the 35 deg (or maximum-rudder) turning circles,
+    the track reach <= 2.5 L by 10 deg of heading change with 10 deg rudder (from the 10/10 zigzag),
+    the 10/10 first and second overshoots (limits in L/V) and the 20/20 first overshoot <= 25 deg, each
+    to starboard and to port; the stopping track reach (<= 15 L) is reported not available (the model
+    has no four-quadrant propeller yet).  See :mod:`trials.imo.standard`.
+
+    Parameters
+    ----------
+    ship : Ship, str or os.PathLike
+        A Ship, a bundled ship name (``"esso_osaka"``) or a ship YAML path (``mmg identify``'s
+        ``DIR/ship.yaml``, with its ``covariance:`` section).
+    speed : str, optional
+        Approach speed with its unit (``"10 kn"``); default the one of the ship's bundled trials.
+    samples : int, default 0
+        Parameter samples; 0: the ship's own parameters only (no interval, no probability).
+    cov : ParameterCovariance, mapping or DataFrame, optional
+        The parameters' covariance (:func:`trials.imo.sampling.covariance_of`); default the ship's.
+    seed : int or None, default 0
+        Seed of the parameter samples.
+    executor : callable, optional
+        ``executor(func, tasks) -> list`` that runs the samples (:mod:`trials.imo.sampling`); default
+        this machine's cores.
+
+    Returns
+    -------
+    ImoResult
+        With samples each criterion's value is the median of the samples, its interval the 5th-95th
+        percentiles, its probability the share of samples meeting the limit; verdict ``"pass"`` if that
+        probability is >= 0.95, ``"fail"`` if <= 0.05, else ``"undecided"``.  Without samples the verdict
+        is the value against the limit (a manoeuvre that does not give its figure fails, with a note).
+
+    Raises
+    ------
+    mmg.errors.InputError
+        An unknown ship, a bad speed (or none known), a negative sample count, a bad covariance.
+    """
+    sh = _ship(ship)
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 0:
+        raise InputError("samples", repr(samples), "expected a whole number of samples, 0 or more")
+    notes = []
+    if speed is None:
+        speed, files = approach_speed(sh)
+        notes.append(f"approach speed {speed} from the bundled trials {', '.join(files)}")
+    p = plan(sh, speed)
+    notes += list(p.notes)
+    params = draws = None
+    if samples:
+        names, mean, mat, more = S.covariance_of(p.ship, cov)
+        notes += more
+        draws = S.draw(mean, mat, samples, seed)
+        params = {"names": names, "mean": mean, "cov": mat, "draws": draws, "seed": seed}
+    runs = run_manoeuvres(p)
+    nominal = criterion_values(p, runs)
+    crit = tuple(criteria(p.L_over_V))
+    notes += [f"{c.name}: the manoeuvre does not give it (no 180 deg of turn, no overshoot) within "
+              f"{MAX_RUN_LENGTHS_L:g} L/V: it fails" for c in crit if c.name != STOPPING and nominal[c.name] is None]
+    sampled = None
+    if samples:
+        out = S.run_samples(p, params["names"], draws, executor)
+        sampled = {c.name: [o["values"][c.name] for o in out] for c in crit}
+        bad = [o["error"] for o in out if o["error"]]
+        if bad:
+            notes.append(f"{len(bad)} of {samples} samples failed to run (counted as not meeting any criterion), "
+                         f"e.g. {bad[0]}")
+    notes.append(f"{STOPPING}: not available: {STOPPING_REASON}")
+    pa = p.ship.particulars
+    extremes = _extreme_turns(p, params, sampled) if samples else {}
+    return ImoResult(ship=sh.name, speed=str(speed), u0=p.u0, L_over_V=p.L_over_V, L=pa.L, B=pa.B, criteria=crit,
+                     nominal=nominal, samples=sampled, parameters=params, notes=tuple(notes), runs=runs,
+                     sample_runs=extremes)
+
+
+def _extreme_turns(p, params: dict, sampled: dict) -> dict:
+    """The turning circles of the samples with the smallest, median and largest tactical diameter per side
+    (run again: a few runs, not kept from the pool)."""
+    from dataclasses import replace
+
+    from ..measured.identify import ship_with_values
+
+    out = {}
+    for side in ("starboard", "port"):
+        name = f"turning circle, {side}"
+        v = np.array([np.nan if x is None else x for x in sampled[f"tactical diameter, {side}"]], dtype=float)
+        ok = np.flatnonzero(np.isfinite(v))
+        if ok.size == 0:
+            continue
+        order = ok[np.argsort(v[ok])]
+        one = replace(p, trials={name: p.trials[name]})
+        for label, k in (("smallest", order[0]), ("median", order[len(order) // 2]), ("largest", order[-1])):
+            ship = ship_with_values(p.ship, dict(zip(params["names"], (float(x) for x in params["draws"][k]))))
+            out[f"{name}: {label} sample"] = run_manoeuvres(one, ship)[name]
+    return out
+
+
+SOURCE = IMO_STANDARD

@@ -1,0 +1,209 @@
+"""The ship's parameters sampled from their covariance, the standard manoeuvres run per sample.
+
+The covariance is the ship config's ``covariance:`` section (:class:`mmg.ship.ParameterCovariance`:
+``mmg identify`` writes it into ``DIR/ship.yaml``) or one given.  Samples are drawn from the
+multivariate normal with that covariance (correlations kept) about the values it gives, written
+into the ship by name (:func:`trials.measured.identify.ship_with_values`), and every manoeuvre of
+the plan is run per sample.  The wind-load scale is left out (the standard's manoeuvres are in calm
+water: it changes nothing) and the others keep their joint distribution (the marginal of a normal).
+
+Where the samples run is an *executor*: a function ``executor(func, tasks) -> list`` returning
+``[func(t) for t in tasks]`` in order (``func`` and the tasks are picklable).  The default,
+:func:`local_executor`, is :func:`trials.runs.sweep.run_sweep` on this machine's cores (joblib's
+process pool); a distributed one (Dask, a cluster) plugs in the same way.
+
+Summaries (:func:`summarise`): the median, the 90 % interval (5th to 95th percentile) and the
+probability of meeting the limit (the share of samples at or below it); a sample whose manoeuvre
+does not give the criterion (a turn that never reaches 180 deg, a zigzag whose heading never turns
+back) counts as not meeting it and as +inf in the percentiles.  Verdict: ``"pass"`` when the
+probability is at least 0.95, ``"fail"`` when at most 0.05, ``"undecided"`` between.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from mmg.errors import InputError
+from mmg.ship import ParameterCovariance, Ship
+
+from .standard import Plan, criteria, criterion_values, run_manoeuvres
+
+__all__ = ["covariance_of", "draw", "sample_tasks", "run_samples", "local_executor", "summarise", "convergence",
+           "PASS_PROBABILITY", "FAIL_PROBABILITY", "INTERVAL", "NOT_SAMPLED"]
+
+PASS_PROBABILITY = 0.95
+"""Verdict ``"pass"``: the probability of meeting the limit is at least this."""
+FAIL_PROBABILITY = 0.05
+"""Verdict ``"fail"``: the probability of meeting the limit is at most this."""
+INTERVAL = (5.0, 95.0)
+"""The percentiles bounding the reported 90 % interval."""
+NOT_SAMPLED = ("wind_scale",)
+"""Parameters of a covariance left out of the sampling: the wind-load scale does nothing in calm water."""
+
+
+def _ship_values(ship: Ship, names) -> np.ndarray:
+    """The ship's own values of the parameters ``names`` (in the fit's units), for a covariance without values."""
+    from mmg.nondim import inertia_scale, mass_scale
+
+    pa, out = ship.particulars, []
+    for n in names:
+        if n in ship.hull.names:
+            out.append(ship.hull.value(n))
+        elif n == "w_P0":
+            out.append(ship.propeller.w_P0[0])
+        elif n in ("m_x", "m_y"):
+            out.append(getattr(ship.mass, f"{n}_prime") * mass_scale(pa.rho, pa.L, pa.T))
+        elif n == "J_z":
+            out.append(ship.mass.J_z_prime * inertia_scale(pa.rho, pa.L, pa.T))
+        elif n == "rudder_offset":
+            off = ship.effect_set().get("rudder_offset")
+            out.append(np.radians(off["offset_deg"]) if off else 0.0)
+        elif n == "wind_scale":
+            out.append(1.0)
+        elif hasattr(ship.rudder, n):
+            out.append(getattr(ship.rudder, n))
+        else:
+            raise InputError("covariance", n, f"not a parameter of {ship.name} (a hull coefficient or one of "
+                                              f"w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, "
+                                              f"rudder_offset, m_x, m_y, J_z)")
+    return np.asarray(out, dtype=float)
+
+
+def covariance_of(ship: Ship, cov=None) -> tuple[list[str], np.ndarray, np.ndarray, list[str]]:
+    """The parameters to sample: (names, mean, covariance, notes).
+
+    Parameters
+    ----------
+    ship : Ship
+    cov : ParameterCovariance, mapping or pandas.DataFrame, optional
+        Default the ship config's ``covariance:`` section.  A mapping has ``names`` and ``matrix``
+        (and optionally ``values``); a DataFrame is indexed and labelled by the names.  Without
+        values the mean is the ship's own.
+
+    Raises
+    ------
+    mmg.errors.InputError
+        No covariance, a matrix of the wrong shape, not symmetric or not positive semi-definite, a
+        name that is no parameter of the ship.
+    """
+    if cov is None:
+        cov = ship.covariance
+        if cov is None:
+            raise InputError("samples", ship.name, "the ship config has no covariance: section (mmg identify "
+                                                   "writes one into DIR/ship.yaml) and none was given")
+    if isinstance(cov, ParameterCovariance):
+        names, values, matrix = list(cov.names), cov.values, cov.matrix
+    elif isinstance(cov, Mapping):
+        names, values, matrix = list(cov["names"]), cov.get("values"), cov["matrix"]
+    else:                                                  # a DataFrame
+        names, values, matrix = [str(x) for x in cov.index], None, cov.to_numpy()
+    matrix = np.asarray(matrix, dtype=float)
+    n = len(names)
+    if matrix.shape != (n, n) or not np.all(np.isfinite(matrix)):
+        raise InputError("covariance", "matrix", f"expected a finite {n} x {n} matrix, got shape {matrix.shape}")
+    if not np.allclose(matrix, matrix.T, rtol=1e-9, atol=1e-12 * max(np.abs(matrix).max(), 1e-300)):
+        raise InputError("covariance", "matrix", "not symmetric")
+    if np.linalg.eigvalsh(matrix).min() < -1e-9 * max(np.abs(np.diag(matrix)).max(), 1e-300):
+        raise InputError("covariance", "matrix", "not positive semi-definite: not a covariance")
+    mean = _ship_values(ship, names) if values is None else np.asarray(values, dtype=float)
+    keep = [i for i, x in enumerate(names) if x not in NOT_SAMPLED]
+    notes = [f"{x} not sampled: no wind in the standard's calm-water manoeuvres" for x in names if x in NOT_SAMPLED]
+    return [names[i] for i in keep], mean[keep], matrix[np.ix_(keep, keep)], notes
+
+
+def draw(mean, matrix, n: int, seed: int | None = None) -> np.ndarray:
+    """``n`` samples (rows) of the normal with ``mean`` and covariance ``matrix`` (correlations kept)."""
+    rng = np.random.default_rng(seed)
+    return rng.multivariate_normal(np.asarray(mean, float), np.asarray(matrix, float), size=int(n), method="eigh")
+
+
+def _one_sample(p: Plan, names, row) -> dict:
+    """Criterion values of one parameter sample (all None, with the reason, when its run fails)."""
+    from ..measured.identify import ship_with_values
+
+    try:
+        ship = ship_with_values(p.ship, dict(zip(names, (float(x) for x in row))))
+        return {"values": criterion_values(p, run_manoeuvres(p, ship)), "error": None}
+    except Exception as e:                  # noqa: BLE001 - one odd sample must not end a run of thousands: counted, named
+        return {"values": {c.name: None for c in criteria(p.L_over_V)}, "error": f"{type(e).__name__}: {e}"}
+
+
+def _chunk_task(task) -> list[dict]:
+    """Worker: the criterion values of each sample of one chunk ``(plan, names, rows)``."""
+    p, names, rows = task
+    return [_one_sample(p, names, r) for r in rows]
+
+
+def sample_tasks(p: Plan, names, samples: np.ndarray, chunks: int) -> list:
+    """The samples cut into ``chunks`` picklable tasks ``(plan, names, rows)`` for :func:`_chunk_task`."""
+    parts = np.array_split(np.asarray(samples), max(1, min(int(chunks), len(samples))))
+    return [(p, list(names), part) for part in parts if len(part)]
+
+
+def local_executor(jobs: int | None = None, progress: bool = False):
+    """The default executor: :func:`trials.runs.sweep.run_sweep` on ``jobs`` local processes (default
+    every usable core), one progress line per finished chunk when ``progress``."""
+    from ..runs.sweep import run_sweep
+
+    def run(func, tasks):
+        return run_sweep(func, tasks, backend="loky", n_jobs=jobs, progress=progress,
+                         labels=[f"{len(t[2])} samples" for t in tasks])
+
+    return run
+
+
+def run_samples(p: Plan, names, samples: np.ndarray, executor=None, chunks: int | None = None) -> list[dict]:
+    """Run every manoeuvre of plan ``p`` for each parameter sample (rows of ``samples``, columns ``names``).
+
+    Parameters
+    ----------
+    p : Plan
+    names : list of str
+    samples : (N, len(names)) array
+    executor : callable, optional
+        ``executor(func, tasks) -> list`` (module docstring); default :func:`local_executor`.
+    chunks : int, optional
+        Tasks to cut the samples into (default 8 per usable core, at most N).
+
+    Returns
+    -------
+    list of dict
+        Per sample, in order: ``values`` (criterion name -> value or None) and ``error`` (None, or why
+        the sample's runs failed).
+    """
+    from ..runs.sweep import default_jobs
+
+    executor = executor or local_executor()
+    tasks = sample_tasks(p, names, samples, chunks or 8 * default_jobs())
+    return [r for part in executor(_chunk_task, tasks) for r in part]
+
+
+def summarise(values, limit: float) -> dict:
+    """Median, 90 % interval, probability of meeting ``limit`` and verdict of one criterion's samples.
+
+    ``values``: one per sample, None or NaN where the sample did not give it (counted as not meeting
+    the limit, +inf in the percentiles; a percentile at +inf is returned as None).
+    """
+    v = np.array([np.inf if (x is None or not np.isfinite(x)) else float(x) for x in values], dtype=float)
+    if v.size == 0:
+        return {"median": None, "interval": None, "probability": None, "verdict": "undecided", "missing": 0}
+    prob = float(np.mean(v <= limit))
+    q = np.percentile(v, [50.0, *INTERVAL], method="linear") if np.all(np.isfinite(v)) else \
+        np.percentile(v, [50.0, *INTERVAL], method="inverted_cdf")
+
+    def num(x):
+        return float(x) if np.isfinite(x) else None
+
+    verdict = "pass" if prob >= PASS_PROBABILITY else ("fail" if prob <= FAIL_PROBABILITY else "undecided")
+    return {"median": num(q[0]), "interval": [num(q[1]), num(q[2])], "probability": prob, "verdict": verdict,
+            "missing": int(np.sum(~np.isfinite(v)))}
+
+
+def convergence(values, limit: float, fractions=(0.125, 0.25, 0.5, 1.0)) -> list[dict]:
+    """:func:`summarise` of the first N/8, N/4, N/2 and N samples (each with ``n``): how the figures settle."""
+    out = []
+    for f in fractions:
+        k = max(1, int(round(f * len(values))))
+        out.append({"n": k, **summarise(list(values)[:k], limit)})
+    return out
