@@ -322,3 +322,19 @@ def test_a_bad_covariance_section_is_refused_naming_it(cov, field, tmp_path):
     with pytest.raises(InputError) as e:
         mmg.load_ship(yml)
     assert e.value.field == field and "\n" not in str(e.value)
+
+
+def test_samples_on_a_dask_cluster_match_a_serial_run(tmp_path):
+    """The same samples through a dask LocalCluster (the executor of --backend dask) give the serial
+    run's numbers, criterion by criterion."""
+    distributed = pytest.importorskip("distributed")
+    from trials.imo.sampling import local_executor
+
+    ship = mmg.load_ship("esso_osaka")
+    cov = {"names": ["N_r"], "values": [ship.hull.value("N_r")], "matrix": [[(0.1 * ship.hull.value("N_r")) ** 2]]}
+    ser = mmg.imo(ship, samples=4, cov=cov, seed=2, executor=serial)
+    with distributed.LocalCluster(n_workers=2, processes=False, threads_per_worker=1,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        par = mmg.imo(ship, samples=4, cov=cov, seed=2, executor=local_executor(backend="dask", client=client))
+    assert par.as_dict() == ser.as_dict()
+    assert par.samples == ser.samples

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from .common import _output_path, _positive_int, _seed, _whole
+from .common import _output_path, _positive_int, _seed, _whole, backend_client, check_backend_options
 
 
 def cmd_imo(args) -> int:
@@ -17,6 +17,7 @@ def cmd_imo(args) -> int:
     from ..imo.sampling import covariance_of, local_executor
     from ..imo.standard import approach_speed, plan
 
+    check_backend_options(args)
     check_output_dir(args.out)
     ship = load_ship(args.ship)
     try:
@@ -33,8 +34,9 @@ def cmd_imo(args) -> int:
     if args.samples:
         print(f"{args.samples} parameter samples, every manoeuvre each, on {args.jobs or 'all usable'} cores",
               file=sys.stderr, flush=True)
-    ex = local_executor(args.jobs, progress=bool(args.samples))
-    res = imo(ship, speed=args.speed, samples=args.samples, seed=args.seed, executor=ex)
+    with backend_client(args) as client:
+        ex = local_executor(args.jobs, progress=bool(args.samples), backend=args.backend, client=client)
+        res = imo(ship, speed=args.speed, samples=args.samples, seed=args.seed, executor=ex)
     with StagedOutput(args.out) as stage:
         names = write_report(res, stage.dir)
     print(f"{res.ship} at {res.speed} (L/V = {res.L_over_V:.3g} s): wrote {', '.join(names)} to {args.out}")
@@ -61,4 +63,9 @@ def add_parser(sub) -> None:
                    help="parameter samples from the ship's covariance (default 0: its own parameters only)")
     p.add_argument("--seed", type=_seed, default=0, help="seed of the parameter samples (default 0)")
     p.add_argument("--jobs", type=_positive_int, default=None, help="worker processes (default: all usable cores)")
+    p.add_argument("--backend", choices=("serial", "loky", "dask"), default="loky",
+                   help="where the samples run: serial, loky (this machine's cores, default) or dask (--scheduler's "
+                        "cluster, or a local one of --jobs workers; optional extra mmg-toolkit[dask])")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="with --backend dask: a running dask scheduler (tcp://host:8786)")
     p.set_defaults(func=cmd_imo)

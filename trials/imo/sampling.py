@@ -141,13 +141,15 @@ def sample_tasks(p: Plan, names, samples: np.ndarray, chunks: int) -> list:
     return [(p, list(names), part) for part in parts if len(part)]
 
 
-def local_executor(jobs: int | None = None, progress: bool = False):
+def local_executor(jobs: int | None = None, progress: bool = False, backend: str = "loky", client=None):
     """The default executor: :func:`trials.runs.sweep.run_sweep` on ``jobs`` local processes (default
-    every usable core), one progress line per finished chunk when ``progress``."""
+    every usable core), one progress line per finished chunk when ``progress``; ``backend="dask"``
+    sends the chunks to the workers of ``client`` (default: the current ``distributed.Client``),
+    ``"serial"`` runs them here, the same numbers either way."""
     from ..runs.sweep import run_sweep
 
     def run(func, tasks):
-        return run_sweep(func, tasks, backend="loky", n_jobs=jobs, progress=progress,
+        return run_sweep(func, tasks, backend=backend, n_jobs=jobs, progress=progress, client=client,
                          labels=[f"{len(t[2])} samples" for t in tasks])
 
     return run
