@@ -80,7 +80,7 @@ def main(argv=None) -> int:
         if a.scheduler:
             cluster, client = None, Client(a.scheduler)
         else:
-            cluster = LocalCluster(n_workers=a.jobs, processes=True, threads_per_worker=1, dashboard_address=None)
+            cluster = LocalCluster(n_workers=a.jobs, processes=True, threads_per_worker=1, dashboard_address=":0")
             client = Client(cluster)
         try:
             t0 = time.perf_counter()

@@ -48,7 +48,7 @@ def test_dask_gives_the_same_diagnoses(records, serial):
 
     ship, recs = records
     with distributed.LocalCluster(n_workers=2, processes=False, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
         par = diagnose_each(ship, recs, DiagnoseOptions(candidates=["current"], backend="dask", client=client))
     assert _summary(par) == _summary(serial)
     assert [r.records[0].name for r in par] == [r.records[0].name for r in serial]   # record order kept

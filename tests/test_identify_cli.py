@@ -233,7 +233,7 @@ def test_cv_folds_on_dask_give_the_serial_numbers(tmp_path):
     runs = load_runs(ship, [a, b])
     ser = cross_validate(ship, runs, folds=2, max_nfev=4)
     with distributed.LocalCluster(n_workers=2, processes=False, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
         par = cross_validate(ship, runs, folds=2, max_nfev=4, backend="dask", client=client)
     assert [(r["name"], r["fold"], r["identified"], r["initial"]) for r in par] == \
         [(r["name"], r["fold"], r["identified"], r["initial"]) for r in ser]

@@ -32,7 +32,7 @@ def test_serial_equals_joblib(serial, capsys):
 def test_serial_equals_dask(serial):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=2, processes=False, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
         par = run_sweep(_task, tasks(), backend="dask", client=client, progress=False)
     for p, s in zip(par, serial):
         assert p.trial == s.trial

@@ -256,7 +256,7 @@ class backend_client:
                 from ..runs.sweep import default_jobs
 
                 self.cluster = LocalCluster(n_workers=a.jobs or default_jobs(), processes=True, threads_per_worker=1,
-                                            dashboard_address=None)
+                                            dashboard_address=":0")
                 self.client = Client(self.cluster)
         return self.client
 
