@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from trials.planning.sensitivity import _task
-from trials.runs.sweep import run_sweep
+from trials.files.sweep import run_sweep
 from trials.runs.trial import load_trial
 
 from .conftest import CONFIGS

@@ -484,7 +484,7 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
 
     The folds are independent: ``backend`` ``"serial"`` (default: one after the other, ``progress(k,
     folds)`` after each), ``"loky"`` (``n_jobs`` local processes) or ``"dask"`` (the workers of
-    ``client``) run them through :func:`trials.runs.sweep.run_sweep`, one progress line per fold, the
+    ``client``) run them through :func:`trials.files.sweep.run_sweep`, one progress line per fold, the
     same numbers either way."""
     ref = ship if initial is None else initial
     if initial is not None:
@@ -503,7 +503,7 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
             if progress:
                 progress(k + 1, folds)
         return out
-    from ..runs.sweep import run_sweep
+    from ..files.sweep import run_sweep
 
     parts = run_sweep(_fold, tasks, backend=backend, client=client, n_jobs=n_jobs,
                       labels=[f"cross-validation fold {k + 1}/{folds}" for k in range(folds)])
