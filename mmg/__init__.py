@@ -46,6 +46,8 @@ _LAZY = {
     "turning": ("trials.runs.trial", "turning"),
     "stype": ("trials.runs.trial", "stype"),
     "schedule": ("trials.runs.trial", "schedule"),
+    "stopping": ("trials.runs.trial", "stopping"),
+    "AsternOrder": ("mmg.engine_order", "AsternOrder"),
     "simulate": ("trials.runs.run", "run_trial"),
     "TrialRun": ("trials.runs.run", "TrialRun"),
     "estimate": ("trials.estimates.estimation", "estimate"),

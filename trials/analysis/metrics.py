@@ -569,6 +569,69 @@ def zigzag_problem(m: dict) -> str | None:
     return None
 
 
+STOPPED_FRACTION = 0.01
+"""A ship is stopped (dead in the water, MSC/Circ.1053 on the stopping test) when its surge speed through
+the water has fallen to this fraction of the approach speed: where the simulator ends a run
+(:func:`mmg.kernel.simulate_kernel`).  The distance still run from there to u = 0 is at most
+(0.01 V)^2 / (2 a): centimetres for a ship braking at any astern thrust."""
+
+
+def stopping_metrics(t, x, y, psi, u, v, L, t_execute: float = 0.0) -> dict:
+    """Full-astern stopping test metrics (MSC.137(76) 5.3.4, MSC/Circ.1053); lengths divided by L.
+
+    From the astern order at ``t_execute`` to the time the surge speed u first falls to
+    :data:`STOPPED_FRACTION` of its value at the order (interpolated between samples; extrapolated
+    from the last two when the record ends less than a step before it, as the simulator ends a run):
+
+    * ``track_reach_L``: the distance along the path (the polyline of the positions);
+    * ``head_reach_L``: the advance along the heading at the order;
+    * ``lateral_deviation_L``: the offset from the approach line at the stop, + to starboard;
+    * ``time_to_stop_s``, ``heading_change_deg`` (at the stop), ``sway_at_stop_mps`` (v there).
+
+    Parameters
+    ----------
+    t, x, y, psi, u, v : arrays
+        Time [s], midship position north / east [m], heading [rad], surge and sway speed through
+        the water [m/s].
+    L : float
+        Ship length [m].
+    t_execute : float
+        Time of the astern order [s].
+
+    Returns
+    -------
+    dict
+        The figures above and ``stopped`` (False, the figures None, when u never falls that low).
+    """
+    t, x, y, psi, u, v = (np.asarray(a, dtype=float) for a in (t, x, y, psi, u, v))
+    i0 = min(int(np.searchsorted(t, t_execute - 1e-9)), len(t) - 1)
+    u_stop = STOPPED_FRACTION * u[i0]
+    below = np.flatnonzero(u[i0:] <= u_stop)
+    out = {"stopped": False, "track_reach_L": None, "head_reach_L": None, "lateral_deviation_L": None,
+           "time_to_stop_s": None, "heading_change_deg": None, "sway_at_stop_mps": None}
+    if below.size:
+        i = i0 + int(below[0])
+    elif len(t) - i0 >= 2 and 0.0 < u[-2] - u[-1] and u[-1] - u_stop <= u[-2] - u[-1]:
+        i = len(t) - 1          # the simulator ends the run before the step that falls to u_stop: extrapolated
+    else:
+        return out
+    if i == i0:
+        return out
+    w = (u[i - 1] - u_stop) / (u[i - 1] - u[i])        # of the way from sample i-1 to i (<= 2: one step on)
+
+    def at(a):
+        return a[i - 1] + w * (a[i] - a[i - 1])
+
+    xs, ys = np.append(x[i0:i], at(x)), np.append(y[i0:i], at(y))
+    c, s = np.cos(psi[i0]), np.sin(psi[i0])
+    dx, dy = xs[-1] - x[i0], ys[-1] - y[i0]
+    out.update(stopped=True, track_reach_L=float(np.sum(np.hypot(np.diff(xs), np.diff(ys)))) / L,
+               head_reach_L=float(dx * c + dy * s) / L, lateral_deviation_L=float(-dx * s + dy * c) / L,
+               time_to_stop_s=float(at(t) - t[i0]), heading_change_deg=float((at(psi) - psi[i0]) / DEG),
+               sway_at_stop_mps=float(at(v)))
+    return out
+
+
 # --------------------------------------------------------------------------- criteria
 
 IMO_STANDARD = ("IMO Resolution MSC.137(76) (2002), Standards for Ship Manoeuvrability, Annex section 5 "

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mmg.errors import InputError
+from mmg.engine_order import prescribed_revolutions
 from mmg.integrate import integrate
 from mmg.model import STATE_NAMES
 from mmg.simulation import SimulationResult, prepare
@@ -310,7 +311,8 @@ class TrialRun:
             ``trim_rudder_deg``, ``completed``, ``duration_s``, ``final_heading_change_deg``.
             Turning: advance, transfer, tactical diameter etc. (:func:`trials.analysis.metrics.turning_metrics`);
             zigzag and S-type: overshoots, times etc. (:func:`trials.analysis.metrics.zigzag_metrics`,
-            e.g. ``overshoots_deg``).
+            e.g. ``overshoots_deg``); stopping: track and head reach, lateral deviation, time to stop
+            (:func:`trials.analysis.metrics.stopping_metrics`).
         """
         r, tr = self.result, self.trial
         L = tr.ship.particulars.L
@@ -322,6 +324,8 @@ class TrialRun:
             out.update(MET.turning_metrics(r.t, r.x, r.y, r.psi, r.U, L, t_execute=tr.manoeuvre["execute"]))
         elif tr.kind in ("zigzag", "stype"):
             out.update(MET.zigzag_metrics(r.t, r.psi, order=r.orders, U=r.U, L=L))
+        elif tr.kind == "stopping":
+            out.update(MET.stopping_metrics(r.t, r.x, r.y, r.psi, r.u, r.v, L, t_execute=tr.manoeuvre["execute"]))
         return out
 
 
@@ -352,7 +356,9 @@ def run_trial(trial, prepared=None) -> TrialRun:
 
         trial = load_trial(trial)
     pk, eq = prepare_trial(trial) if prepared is None else prepared
-    law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
+    if trial.kind == "stopping":                 # revolutions ordered astern: the shaft equation is not integrated
+        pk = prescribed_revolutions(pk)
+    law = trial.command_law(trim_rudder=eq.delta, psi0=0.0, n0=eq.n)
     t, states, orders, done = integrate(pk, eq.state(), law, trial.duration, trial.dt)
     return TrialRun(trial, SimulationResult(t, states, orders, eq, done, trial.ship.name, {"trial": trial.name}))
 

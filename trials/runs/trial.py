@@ -20,6 +20,12 @@ sawtooth  amplitude, period: the order ramps from -A to +A over a period, then i
           at once (the steering gear's rate limit shapes the reversal) (Fig. 9)
 schedule  table of [time_s, rudder_deg] or [time_s, rudder_deg, rpm] rows, inline or from a CSV
           file with columns time_s, rudder_deg[, rpm]; linear interpolation
+stopping  full astern from the approach (IMO MSC.137(76) 5.3.4): the rudder held at ``rudder``
+          (default midships), the revolutions ordered from the approach ones to ``astern_ratio``
+          times them astern along a ramp of ``reversal`` seconds from ``execute``
+          (:class:`mmg.engine_order.AsternOrder`, its constants and sources); the revolutions are
+          prescribed whatever the ship's engine (no four-quadrant torque is needed); the run ends
+          when the ship is stopped (surge speed down to 1 % of the approach speed)
 """
 from __future__ import annotations
 
@@ -33,6 +39,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from mmg.disturbances import RudderOffset, SensorBias, UniformCurrent
+from mmg.engine_order import ASTERN_RPM_RATIO, REVERSAL_TIME_S, AsternOrder
 from mmg.errors import InputError
 from mmg.integrate import CommandLaw
 from mmg.limits import MAX_SAMPLES, check_steps
@@ -112,7 +119,17 @@ class _Schedule(_Strict):
     file: Optional[str] = None
 
 
-_Manoeuvre = Annotated[Union[_Turning, _Zigzag, _SType, _Periodic, _Schedule], Field(discriminator="kind")]
+class _Stopping(_Strict):
+    kind: Literal["stopping"]
+    rudder: str = "0 deg"
+    astern_ratio: float = ASTERN_RPM_RATIO
+    reversal: str = f"{REVERSAL_TIME_S:g} s"
+    execute: str = "0 s"
+    _c = field_validator("rudder")(_q("angle"))
+    _t = field_validator("reversal", "execute")(_q("time"))
+
+
+_Manoeuvre = Annotated[Union[_Turning, _Zigzag, _SType, _Periodic, _Schedule, _Stopping], Field(discriminator="kind")]
 
 
 class _Noise(_Strict):
@@ -253,8 +270,14 @@ class Trial:
         # also for dataclasses.replace(trial, duration=...): refuse a run too big to allocate
         check_steps(self.duration, self.dt, self.path or "Trial", "duration")
 
-    def command_law(self, trim_rudder: float = 0.0, psi0: float = 0.0) -> CommandLaw:
-        """The compiled-loop command law for this manoeuvre (see :mod:`mmg.integrate`)."""
+    def astern_order(self) -> AsternOrder:
+        """The engine order of a ``stopping`` trial (:class:`mmg.engine_order.AsternOrder`)."""
+        m = self.manoeuvre
+        return AsternOrder(m["astern_ratio"], m["reversal"], m["execute"])
+
+    def command_law(self, trim_rudder: float = 0.0, psi0: float = 0.0, n0: float | None = None) -> CommandLaw:
+        """The compiled-loop command law for this manoeuvre (see :mod:`mmg.integrate`); a ``stopping``
+        trial needs the approach revolutions ``n0`` [rps] its astern order starts from."""
         m = self.manoeuvre
         side = 1.0 if m.get("first", "starboard") == "starboard" else -1.0
         if self.kind == "turning":
@@ -270,6 +293,11 @@ class Trial:
             a, h = m["rudder"], m["switch_heading"]
             hi, lo = (h, 0.0) if side > 0 else (0.0, -h)
             return CommandLaw.heading_switch(a, hi, lo, side, psi0=psi0)
+        if self.kind == "stopping":
+            if n0 is None:
+                raise ValueError("a stopping trial's command law needs the approach revolutions n0")
+            t, n = self.astern_order().table(n0, self.duration)
+            return CommandLaw.schedule(t, np.full_like(t, m["rudder"]), n)
         if self.kind in ("sine", "sawtooth"):
             t = np.arange(0.0, self.duration + self.dt / 2, self.dt)
             return CommandLaw.schedule(t, periodic_order(self.kind, t, m["amplitude"], m["period"]))
@@ -282,8 +310,10 @@ class Trial:
         for k, v in self.manoeuvre.items():
             if k in ("rudder", "heading", "switch_heading", "amplitude"):
                 man.append(f"{k}={v / DEG:g} deg")
-            elif k in ("period", "execute"):
+            elif k in ("period", "execute", "reversal"):
                 man.append(f"{k}={v:g} s")
+            elif k == "astern_ratio":
+                man.append(f"{k}={v:g}")
             elif k == "table":
                 man.append(f"table={len(v)} rows")
             elif k == "first":
@@ -327,9 +357,9 @@ class Trial:
         for k, v in self.manoeuvre.items():
             if k in ("rudder", "heading", "switch_heading", "amplitude"):
                 out[f"{k}_deg"] = v / DEG
-            elif k in ("period", "execute"):
+            elif k in ("period", "execute", "reversal"):
                 out[f"{k}_s"] = v
-            elif k == "first":
+            elif k in ("first", "astern_ratio"):
                 out[k] = v
         return out
 
@@ -345,7 +375,8 @@ def periodic_order(kind: str, t: np.ndarray, amplitude: float, period: float) ->
 def _loc(err) -> str:
     loc = list(err.get("loc", ()))
     # drop pydantic's union-tag element (e.g. manoeuvre.turning.rudder -> manoeuvre.rudder)
-    if len(loc) > 1 and loc[0] == "manoeuvre" and loc[1] in ("turning", "zigzag", "stype", "sine", "sawtooth", "schedule"):
+    if len(loc) > 1 and loc[0] == "manoeuvre" and loc[1] in ("turning", "zigzag", "stype", "sine", "sawtooth", "schedule",
+                                                    "stopping"):
         loc.pop(1)
     return field_path(loc)
 
@@ -429,6 +460,7 @@ _UNIT_HINT = {
     "rudder": "deg", "heading": "deg", "switch_heading": "deg", "amplitude": "deg", "direction": "deg",
     "rudder_offset": "deg", "lat": "deg", "lon": "deg", "start_lat": "deg", "start_lon": "deg",
     "speed": "kn", "rpm": "rpm", "duration": "s", "dt": "s", "period": "s", "execute": "s", "interval": "s",
+    "reversal": "s",
 }
 
 
@@ -608,6 +640,13 @@ def _manoeuvre(f: _TrialFile, ship: Ship, label: str, src: str, run: tuple[float
         elif k == "execute":
             conv[k] = _si(src, field, v, "time", 0.0, duration, hi_open=True,
                           why=f"the execute time must lie in [0, {duration:g} s), within the run")
+        elif k == "reversal":
+            conv[k] = _si(src, field, v, "time", 0.0, 3600.0, why="a reversal from ahead to astern takes 0-60 min")
+        elif k == "astern_ratio":
+            if not 0.0 < v <= 1.5:
+                raise InputError(src, field, f"{v!r}: the full-astern revolutions are a fraction (0, 1.5] of the "
+                                             f"approach ones")
+            conv[k] = float(v)
         else:
             conv[k] = v
     if kind == "schedule":
@@ -1112,6 +1151,35 @@ def schedule(ship: Ship | str | Path, *, table=None, file: str | Path | None = N
         man["table"] = np.asarray(table, dtype=float).tolist()
     if file is not None:
         man["file"] = os.fspath(file)
+    return make_trial(ship, man, speed=speed, duration=duration, **kw)
+
+
+def stopping(ship: Ship | str | Path, *, speed: str, duration: str, astern_ratio: float = ASTERN_RPM_RATIO,
+             reversal: str = f"{REVERSAL_TIME_S:g} s", rudder: str = "0 deg", execute: str = "0 s", **kw) -> Trial:
+    """A full-astern stopping trial (IMO MSC.137(76) 5.3.4): the revolutions ordered astern, the rudder held.
+
+    Parameters
+    ----------
+    ship : Ship, str or os.PathLike
+    speed, duration : str
+        Approach speed (``"10 kn"``) and the longest simulated time (the run ends when the ship is stopped).
+    astern_ratio : float, default :data:`mmg.engine_order.ASTERN_RPM_RATIO`
+        Full-astern revolutions over the approach ones.
+    reversal : str, default "120 s"
+        Duration of the linear ramp from the approach revolutions to the full-astern ones.
+    rudder : str, default "0 deg"
+        Rudder held through the test (midships).
+    execute : str, default "0 s"
+        When the astern order is given.
+    **kw
+        See :func:`make_trial`.
+
+    Returns
+    -------
+    Trial
+    """
+    man = {"kind": "stopping", "rudder": rudder, "astern_ratio": float(astern_ratio), "reversal": reversal,
+           "execute": execute}
     return make_trial(ship, man, speed=speed, duration=duration, **kw)
 
 
