@@ -91,11 +91,13 @@ def test_figures_equal_those_of_simulate(cli_run):
                 "10/10 first overshoot": ov10[0], "10/10 second overshoot": ov10[1], "20/20 first overshoot": ov20[0]}
         for name, v in want.items():
             assert got[f"{name}, {side}"] == pytest.approx(v, rel=1e-9, abs=1e-12), (name, side)
+    # the stopping test: the stopping builder's run through mmg.simulate (another duration: it ends at the stop)
+    stop = mmg.simulate(mmg.stopping(ship, **kw)).metrics()
+    assert stop["stopped"] and got["stopping track reach"] == pytest.approx(stop["track_reach_L"], rel=1e-9)
     # and the verdicts are those values against the standard's limits (L/V = 325 m / 10 kn = 63.2 s)
-    lim = {**FIXED, "10/10 first overshoot": 20.0, "10/10 second overshoot": 40.0}
+    lim = {**FIXED, "10/10 first overshoot": 20.0, "10/10 second overshoot": 40.0, "stopping track reach": 15.0}
     for c in doc["criteria"]:
-        if c["name"] != "stopping track reach":
-            assert c["verdict"] == ("pass" if c["value"] <= lim[c["name"].split(",")[0]] else "fail")
+        assert c["verdict"] == ("pass" if c["value"] <= lim[c["name"].split(",")[0]] else "fail")
 
 
 def test_cli_writes_the_exact_schema(cli_run):
@@ -108,15 +110,15 @@ def test_cli_writes_the_exact_schema(cli_run):
         assert list(c) == ["name", "value", "unit", "limit", "interval", "probability", "verdict"]
         assert c["unit"] == UNITS[c["name"].split(",")[0]]
         assert c["interval"] is None and c["probability"] is None
-        if c["name"] == "stopping track reach":
-            assert c["value"] is None and c["verdict"] == "not available" and c["limit"] == 15.0
-        else:
-            assert isinstance(c["value"], float) and c["verdict"] in ("pass", "fail")
+        assert isinstance(c["value"], float) and c["verdict"] in ("pass", "fail")
+    assert {c["name"]: c["limit"] for c in doc["criteria"]}["stopping track reach"] == 15.0
     md = (out / "imo.md").read_text()
     assert "MSC.137(76)" in md and "MSC/Circ.1053" in md and "four-quadrant" in md
+    assert "head reach" in md and "lateral deviation" in md and "20 L" in md and "(stopping.png)" in md
     for name in EXPECTED_NAMES:
         assert f"| {name} |" in md
-    assert (out / "tracks.png").stat().st_size > 10000 and (out / "zigzags.png").stat().st_size > 10000
+    for fig in ("tracks.png", "zigzags.png", "stopping.png"):
+        assert (out / fig).stat().st_size > 10000
 
 
 @pytest.mark.parametrize("argv, names", [
@@ -250,9 +252,8 @@ def test_identify_writes_the_covariance_imo_samples(tmp_path):
     res = mmg.imo(path, speed="0.5 m/s", samples=4, executor=serial, seed=3)
     assert res.parameters["names"] == free and res.n_samples == 4
     for r in res.rows():
-        if r["name"] != "stopping track reach":
-            lo, hi = r["interval"]
-            assert lo <= r["value"] <= hi and 0.0 <= r["probability"] <= 1.0
+        lo, hi = r["interval"]
+        assert lo <= r["value"] <= hi and 0.0 <= r["probability"] <= 1.0
 
 
 def test_cli_samples_on_both_cores_match_a_serial_run(tmp_path):
@@ -276,9 +277,8 @@ def test_cli_samples_on_both_cores_match_a_serial_run(tmp_path):
     assert doc == ser.as_dict()
     for c in doc["criteria"]:
         assert list(c) == ["name", "value", "unit", "limit", "interval", "probability", "verdict"]
-        if c["name"] != "stopping track reach":
-            assert len(c["interval"]) == 2 and 0.0 <= c["probability"] <= 1.0
-            assert c["verdict"] in ("pass", "fail", "undecided")
+        assert len(c["interval"]) == 2 and 0.0 <= c["probability"] <= 1.0
+        assert c["verdict"] in ("pass", "fail", "undecided")
     md = (out / "imo.md").read_text()
     assert "## Convergence" in md and "N = 2" in md and "N = 16" in md and ">= 0.95" in md
     assert (out / "distributions.png").stat().st_size > 10000

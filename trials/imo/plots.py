@@ -7,9 +7,9 @@ import numpy as np
 from mmg.units import DEG
 
 from ..files.plots import _figure, ship_outline
-from .standard import SIDES, STOPPING
+from .standard import SIDES, STOPPING_RUN
 
-__all__ = ["tracks_figure", "zigzags_figure", "distributions_figure"]
+__all__ = ["tracks_figure", "zigzags_figure", "stopping_figure", "distributions_figure"]
 
 COLOURS = {"starboard": "tab:green", "port": "tab:red"}
 _STYLE = {"smallest": (0, (1, 1)), "median": "-.", "largest": (0, (5, 2))}
@@ -86,11 +86,54 @@ def zigzags_figure(res, pyplot: bool = True):
     return fig
 
 
+def stopping_figure(res, pyplot: bool = True):
+    """The full-astern stopping test of ``res``: the track in ship lengths (x north, y east from the point
+    of the astern order) with hull outlines every minute-scale interval and the 15 L / 20 L track-reach
+    limits; beside it the surge speed [kn] and the revolutions [rpm] against time."""
+    from mmg.units import KNOT
+
+    run, m = res.runs[STOPPING_RUN]
+    L, B = res.L, res.B
+    t, x, y, psi = run.t, run.x / L, run.y / L, run.psi
+    fig = _figure((11.0, 6.5), pyplot)
+    ax = fig.add_subplot(1, 2, 1)
+    tr = m.get("track_reach_L")
+    label = ("track" if tr is None else f"track: track reach {tr:.2f} L, head reach {m['head_reach_L']:.2f} L, "
+             f"lateral deviation {m['lateral_deviation_L']:+.2f} L")
+    ax.plot(y, x, color="tab:blue", lw=1.5, label=label)
+    for tk in np.linspace(0.0, t[-1], 7):
+        i = min(int(np.searchsorted(t, tk)), len(t) - 1)
+        px, py = ship_outline(x[i], y[i], psi[i], 1.0, B / L)
+        ax.fill(py, px, facecolor="none", edgecolor="tab:blue", lw=0.8)
+    ax.axhline(15.0, color="tab:red", ls="--", lw=0.8,
+               label="15 L ahead of the order: the track-reach limit (MSC.137(76) 5.3.4)")
+    ax.axhline(20.0, color="tab:red", ls=":", lw=0.8,
+               label="20 L: the most the Administration may accept for large ships")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("y, east (L)")
+    ax.set_ylabel("x, north (L)")
+    ax.set_title(f"{res.ship}: full astern from {res.speed}, rudder midships", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1))
+    a1 = fig.add_subplot(2, 2, 2)
+    a1.plot(t / 60.0, run.u / KNOT, color="tab:blue")
+    a1.set_ylabel("surge speed u (kn)")
+    a1.set_title(f"stopped after {t[-1] / 60:.1f} min (u down to 1 % of V)", fontsize=9)
+    a1.grid(True, alpha=0.3)
+    a2 = fig.add_subplot(2, 2, 4, sharex=a1)
+    a2.plot(t / 60.0, run.n * 60.0, color="tab:orange")
+    a2.set_ylabel("revolutions (rpm)")
+    a2.set_xlabel("time from the astern order (min)")
+    a2.grid(True, alpha=0.3)
+    fig.subplots_adjust(bottom=0.2, wspace=0.35, hspace=0.3)
+    return fig
+
+
 def distributions_figure(res, pyplot: bool = True):
     """A histogram per sampled criterion with its limit (red), the median and the 90 % interval."""
     if res.samples is None:
         raise ValueError("no samples: imo(ship, samples=N) gives the distributions")
-    crit = [c for c in res.criteria if c.name != STOPPING]
+    crit = list(res.criteria)
     cols = 4
     rows = int(np.ceil(len(crit) / cols))
     fig = _figure((4.0 * cols, 2.8 * rows), pyplot)

@@ -3,13 +3,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..analysis.metrics import IMO_STANDARD, STOPPING_LIMIT_LARGE_L
+from ..analysis.metrics import IMO_STANDARD
 from .sampling import FAIL_PROBABILITY, PASS_PROBABILITY
-from .standard import STOPPING, STOPPING_REASON
+from .standard import STOPPING
 
 __all__ = ["write_report", "report_lines", "FIGURES"]
 
-FIGURES = ("tracks.png", "zigzags.png", "distributions.png")
+FIGURES = ("tracks.png", "zigzags.png", "stopping.png", "distributions.png")
 """The figures ``mmg imo`` writes (``distributions.png`` only with samples)."""
 
 
@@ -51,8 +51,6 @@ def _convergence(res) -> list[str]:
                  " | ".join(f"interval (N = {n})" for n in ns) + " |")
     lines.append("|---|" + "---|" * (2 * len(ns)))
     for c in res.criteria:
-        if c.name == STOPPING:
-            continue
         conv = res.convergence(c.name)
         lines.append(f"| {c.name} | " + " | ".join(_prob(x["probability"]) for x in conv) + " | " +
                      " | ".join(_interval(x["interval"]) for x in conv) + " |")
@@ -81,9 +79,8 @@ def report_lines(res) -> list[str]:
     else:
         lines += ["No uncertainty (the ship's own parameters: `mmg imo --samples N` samples them from the "
                   "ship's covariance): value against limit, no interval or probability.", ""]
-    lines += ["## Criteria", "", *_table(res), "",
-              f"Stopping track reach (limit 15 L; the Administration may allow up to {STOPPING_LIMIT_LARGE_L:g} L for "
-              f"ships of large displacement): not available: {STOPPING_REASON}.", ""]
+    stop = [n for n in res.notes if n.startswith(STOPPING)]
+    lines += ["## Criteria", "", *_table(res), "", "Full-astern stopping test: " + " ".join(stop) + ".", ""]
     other = [n for n in res.notes if not n.startswith(STOPPING)]
     if other:
         lines += ["## Notes", ""] + [f"- {n}" for n in other] + [""]
@@ -91,7 +88,8 @@ def report_lines(res) -> list[str]:
         lines += _convergence(res) + [""]
     lines += ["## Figures", "", "- [turning circles with ship outlines](tracks.png)" +
               (" (with the samples' smallest, median and largest tactical diameter)" if sampled else ""),
-              "- [zigzag heading and rudder histories](zigzags.png)"]
+              "- [zigzag heading and rudder histories](zigzags.png)",
+              "- [full-astern stopping track with ship outlines, speed and revolutions](stopping.png)"]
     if sampled:
         lines.append("- [distributions of the sampled criteria with their limits](distributions.png)")
     return lines
@@ -103,7 +101,7 @@ def write_report(res, out_dir) -> list[str]:
     res.to_json(out / "imo.json")
     (out / "imo.md").write_text("\n".join(report_lines(res)) + "\n")
     names = ["imo.json", "imo.md"]
-    kinds = ["tracks", "zigzags"] + (["distributions"] if res.samples is not None else [])
+    kinds = ["tracks", "zigzags", "stopping"] + (["distributions"] if res.samples is not None else [])
     for k in kinds:
         fig = res.plot(k, pyplot=False)
         fig.savefig(out / f"{k}.png", dpi=110)

@@ -19,15 +19,14 @@ from mmg.ship import Ship, load_ship
 
 from ..analysis.metrics import IMO_STANDARD
 from . import sampling as S
-from .standard import MAX_RUN_LENGTHS_L, STOPPING, STOPPING_REASON, Criterion, approach_speed, criteria, \
+from .standard import MAX_RUN_LENGTHS_L, STOPPING, STOPPING_RUN, Criterion, approach_speed, criteria, \
     criterion_values, plan, run_manoeuvres
 
 __all__ = ["imo", "ImoResult", "VERDICTS"]
 
-VERDICTS = ("pass", "fail", "undecided", "not available")
-"""A criterion's verdict: met, not met, not decided by the samples (probability between
-:data:`~trials.imo.sampling.FAIL_PROBABILITY` and :data:`~trials.imo.sampling.PASS_PROBABILITY`), or not
-computed (the stopping test)."""
+VERDICTS = ("pass", "fail", "undecided")
+"""A criterion's verdict: met, not met, or not decided by the samples (probability between
+:data:`~trials.imo.sampling.FAIL_PROBABILITY` and :data:`~trials.imo.sampling.PASS_PROBABILITY`)."""
 
 
 @dataclass(frozen=True)
@@ -79,9 +78,6 @@ class ImoResult:
         return 0 if self.samples is None else len(next(iter(self.samples.values())))
 
     def _row(self, c: Criterion) -> dict:
-        if c.name == STOPPING:
-            return {"name": c.name, "value": None, "unit": c.unit, "limit": c.limit, "interval": None,
-                    "probability": None, "verdict": "not available"}
         if self.samples is None:
             v = self.nominal[c.name]
             verdict = "fail" if v is None or v > c.limit else "pass"   # a turn or zigzag that never gets there fails
@@ -131,13 +127,14 @@ class ImoResult:
 
     def plot(self, kind: str = "tracks", ax=None, pyplot: bool = True):
         """A figure: ``"tracks"`` (the turning circles with ship outlines), ``"zigzags"`` (heading and rudder
-        histories) or ``"distributions"`` (the sampled criteria with their limits).  Returns the Figure."""
+        histories), ``"stopping"`` (the full-astern stopping track with ship outlines and its speed and
+        revolutions) or ``"distributions"`` (the sampled criteria with their limits).  Returns the Figure."""
         from . import plots
 
-        draw = {"tracks": plots.tracks_figure, "zigzags": plots.zigzags_figure,
+        draw = {"tracks": plots.tracks_figure, "zigzags": plots.zigzags_figure, "stopping": plots.stopping_figure,
                 "distributions": plots.distributions_figure}.get(kind)
         if draw is None:
-            raise ValueError(f"unknown plot kind {kind!r}: tracks, zigzags or distributions")
+            raise ValueError(f"unknown plot kind {kind!r}: tracks, zigzags, stopping or distributions")
         return draw(self, pyplot=pyplot)
 
     def __repr__(self) -> str:
@@ -162,8 +159,9 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
     advance <= 4.5 L and tactical diameter <= 5 L of the 35 deg (or maximum-rudder) turning circles,
     the track reach <= 2.5 L by 10 deg of heading change with 10 deg rudder (from the 10/10 zigzag),
     the 10/10 first and second overshoots (limits in L/V) and the 20/20 first overshoot <= 25 deg, each
-    to starboard and to port; the stopping track reach (<= 15 L) is reported not available (the model
-    has no four-quadrant propeller yet).  See :mod:`trials.imo.standard`.
+    to starboard and to port, and the full-astern stopping test's track reach (<= 15 L; the
+    Administration may accept up to 20 L for large ships), the engine ordered astern along
+    :class:`mmg.engine_order.AsternOrder`.  See :mod:`trials.imo.standard`.
 
     Parameters
     ----------
@@ -213,8 +211,8 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
     runs = run_manoeuvres(p)
     nominal = criterion_values(p, runs)
     crit = tuple(criteria(p.L_over_V))
-    notes += [f"{c.name}: the manoeuvre does not give it (no 180 deg of turn, no overshoot) within "
-              f"{MAX_RUN_LENGTHS_L:g} L/V: it fails" for c in crit if c.name != STOPPING and nominal[c.name] is None]
+    notes += [f"{c.name}: the manoeuvre does not give it (no 180 deg of turn, no overshoot, no stop) within "
+              f"{MAX_RUN_LENGTHS_L:g} L/V: it fails" for c in crit if nominal[c.name] is None]
     sampled = None
     if samples:
         out = S.run_samples(p, params["names"], draws, executor)
@@ -223,12 +221,30 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
         if bad:
             notes.append(f"{len(bad)} of {samples} samples failed to run (counted as not meeting any criterion), "
                          f"e.g. {bad[0]}")
-    notes.append(f"{STOPPING}: not available: {STOPPING_REASON}")
+    notes.append(stopping_note(runs[STOPPING_RUN]))
     pa = p.ship.particulars
     extremes = _extreme_turns(p, params, sampled) if samples else {}
     return ImoResult(ship=sh.name, speed=str(speed), u0=p.u0, L_over_V=p.L_over_V, L=pa.L, B=pa.B, criteria=crit,
                      nominal=nominal, samples=sampled, parameters=params, notes=tuple(notes), runs=runs,
                      sample_runs=extremes)
+
+
+def stopping_note(run_metrics) -> str:
+    """What the report says of the stopping test: the engine order, the definition of stopped, the
+    head reach, lateral deviation and time to stop of the ship's own parameters."""
+    run, m = run_metrics
+    o = run.trial.astern_order()
+    head = ("" if not m.get("stopped") else
+            f"; head reach {m['head_reach_L']:.2f} L, lateral deviation {m['lateral_deviation_L']:+.2f} L "
+            f"(+ starboard), heading change {m['heading_change_deg']:+.1f} deg, stopped after "
+            f"{m['time_to_stop_s']:.0f} s ({m['time_to_stop_s'] / 60:.1f} min)")
+    return (f"{STOPPING}: rudder midships, full astern ordered at t = 0 from the approach revolutions "
+            f"{m['approach_rpm']:.1f} rpm: a linear ramp to {o.astern_ratio:g} of them astern "
+            f"({-o.astern_ratio * m['approach_rpm']:.1f} rpm) in {o.ramp_s:g} s (mmg.engine_order.AsternOrder, "
+            f"revolutions prescribed: no propeller torque needed; thrust from the four-quadrant B4-70 curve, "
+            f"mmg.fourquadrant); stopped = surge speed down to 1 % of the "
+            f"approach speed{head}.  Limit 15 L; the Administration may accept up to 20 L for ships of large "
+            f"displacement")
 
 
 def _extreme_turns(p, params: dict, sampled: dict) -> dict:

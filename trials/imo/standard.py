@@ -18,8 +18,14 @@ water are left out):
   the first and second overshoots (10 / 20 / 5 + L/(2V) deg and 25 / 40 / 17.5 + 0.75 L/V deg for
   L/V below 10 s, from 30 s, between; 5.3.3.1-2);
 * 20/20 zigzags to both sides: first overshoot (<= 25 deg, 5.3.3.3);
-* stopping (track reach <= 15 L, up to 20 L where the Administration allows, 5.3.4): not available
-  (:data:`STOPPING_REASON`).
+* the full-astern stopping test (5.3.4): track reach <= 15 L (the Administration may accept up to
+  20 L for ships of large displacement; the verdict is against 15 L), the rudder at midships, the
+  engine ordered full astern from the approach revolutions (:class:`mmg.engine_order.AsternOrder`:
+  a linear ramp to 0.7 of them astern in 120 s, the revolutions prescribed, the constants' sources
+  there); the track reach is the distance along the path from the order to the ship stopped dead in
+  the water, taken as the surge speed down to 1 % of the approach speed
+  (:func:`trials.analysis.metrics.stopping_metrics`, which also gives the head reach and the lateral
+  deviation).
 
 A criterion's side is that of the turn, or of a zigzag's first rudder order.
 """
@@ -35,23 +41,23 @@ from mmg.units import DEG, MAX_SHIP_SPEED, to_si
 
 from ..analysis import metrics as MET
 from ..runs.run import prepare_trial, run_trial
-from ..runs.trial import Trial, turning, zigzag
+from ..runs.trial import Trial, stopping, turning, zigzag
 
 __all__ = ["Criterion", "Plan", "criteria", "plan", "run_manoeuvres", "criterion_values", "approach_speed",
-           "calm_water", "SIDES", "STOPPING", "STOPPING_REASON", "CALM_WATER_DROPS"]
+           "calm_water", "SIDES", "STOPPING", "STOPPING_RUN", "CALM_WATER_DROPS"]
 
 SIDES = ("starboard", "port")
 STOPPING = "stopping track reach"
-STOPPING_REASON = ("the model has no four-quadrant propeller yet (a full-astern propeller's thrust and torque at "
-                   "negative advance ratios; mmg.model's astern thrust is a stand-in), so the full-astern stopping "
-                   "test is not simulated")
+STOPPING_RUN = "full astern stopping"
+"""The run name of the stopping test (its metrics: :func:`trials.analysis.metrics.stopping_metrics`)."""
 CALM_WATER_DROPS = ("wind", "current", "shallow_water")
 """Effects of a ship config left out of the standard manoeuvres (MSC.137(76) 4.2: deep, unrestricted
 water, calm environment)."""
 
-RUN_LENGTHS_L = {"turning circle": 14.0, "10/10 zigzag": 14.0, "20/20 zigzag": 8.0}
+RUN_LENGTHS_L = {"turning circle": 14.0, "10/10 zigzag": 14.0, "20/20 zigzag": 8.0, STOPPING_RUN: 48.0}
 """First simulated run of each manoeuvre [L / V each: ship lengths at the approach speed]: the Esso Osaka
-turns 180 deg in 10.3 L/V, its 10/10 second overshoot is past in 9.5 L/V, its 20/20 first in 4 L/V.  A run
+turns 180 deg in 10.3 L/V, its 10/10 second overshoot is past in 9.5 L/V, its 20/20 first in 4 L/V, it stops from full astern in 36 L/V (a stopping run ends
+when the ship has stopped).  A run
 that ends before its criteria can be read is run again twice as long, up to :data:`MAX_RUN_LENGTHS_L`
 (the figures do not depend on the run's length once it gives them)."""
 MAX_RUN_LENGTHS_L = 200.0
@@ -89,7 +95,7 @@ def criteria(L_over_V: float) -> list[Criterion]:
             for s in SIDES]
     out += [Criterion(f"20/20 first overshoot, {s}", "deg", MET.ZZ20_FIRST_OVERSHOOT_LIMIT_DEG, f"20/20 zigzag, {s}",
                       "overshoots_deg[0]") for s in SIDES]
-    out.append(Criterion(STOPPING, "L", MET.STOPPING_LIMIT_L, None, None))
+    out.append(Criterion(STOPPING, "L", MET.STOPPING_LIMIT_L, STOPPING_RUN, "track_reach_L"))
     return out
 
 
@@ -183,6 +189,7 @@ def plan(ship: Ship, speed: str) -> Plan:
                                               duration=dur["10/10 zigzag"], **kw)
         trials[f"20/20 zigzag, {s}"] = zigzag(calm, rudder="20 deg", heading="20 deg", first=s,
                                               duration=dur["20/20 zigzag"], **kw)
+    trials[STOPPING_RUN] = stopping(calm, speed=speed, dt=dt, duration=dur[STOPPING_RUN])
     return Plan(calm, speed, u0, rud, trials, tuple(notes))
 
 
@@ -219,9 +226,8 @@ def run_manoeuvres(p: Plan, ship: Ship | None = None) -> dict:
 
 
 def criterion_values(p: Plan, runs: dict) -> dict:
-    """Criterion name -> value (None where the run does not give it, and for the stopping test)."""
-    return {c.name: (None if c.manoeuvre is None else _metric(runs[c.manoeuvre][1], c.metric))
-            for c in criteria(p.L_over_V)}
+    """Criterion name -> value (None where the run does not give it)."""
+    return {c.name: _metric(runs[c.manoeuvre][1], c.metric) for c in criteria(p.L_over_V)}
 
 
 def approach_speed(ship: Ship) -> tuple[str, list[str]]:
