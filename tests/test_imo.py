@@ -92,7 +92,7 @@ def test_figures_equal_those_of_simulate(cli_run):
         for name, v in want.items():
             assert got[f"{name}, {side}"] == pytest.approx(v, rel=1e-9, abs=1e-12), (name, side)
     # the stopping test: the stopping builder's run through mmg.simulate (another duration: it ends at the stop)
-    stop = mmg.simulate(mmg.stopping(ship, **kw)).metrics()
+    stop = mmg.simulate(mmg.stopping(ship, dt="0.5 s", **kw)).metrics()      # imo's stopping step (L/V / 120)
     assert stop["stopped"] and got["stopping track reach"] == pytest.approx(stop["track_reach_L"], rel=1e-9)
     # and the verdicts are those values against the standard's limits (L/V = 325 m / 10 kn = 63.2 s)
     lim = {**FIXED, "10/10 first overshoot": 20.0, "10/10 second overshoot": 40.0, "stopping track reach": 15.0}

@@ -9,7 +9,8 @@ import sys
 
 METRIC_KEYS = ["trial", "kind", "execute_s", "approach_speed_mps", "rudder_deg", "approach_speed_kn", "approach_rpm", "trim_rudder_deg", "advance_L", "transfer_L",
                "tactical_diameter_L", "steady_diameter_L", "speed_loss", "overshoots_deg", "initial_turning_time_s",
-               "period_s", "final_heading_change_deg"]
+               "period_s", "final_heading_change_deg", "track_reach_L", "head_reach_L", "lateral_deviation_L",
+               "time_to_stop_s"]
 
 
 def _whole(minimum: int, what: str):

@@ -18,7 +18,9 @@ def cmd_simulate(args) -> int:
         m = write_trial_outputs(run, stage, show=args.show)
     print(f"{trial.name}: wrote log.csv, truth.csv, metrics.json, track.png, histories.png to {args.out}")
     print_metrics(m)
-    if not run.result.completed:
+    if trial.kind == "stopping" and not m.get("stopped"):
+        print(f"warning: {trial.name}: the ship has not stopped within {trial.duration:g} s", file=sys.stderr)
+    elif not run.result.completed and trial.kind != "stopping":     # a stopping run ends when the ship stops
         print(f"warning: {trial.name} stopped early at t = {run.result.t[-1]:g} s (speed collapsed)", file=sys.stderr)
     return 0
 
