@@ -86,7 +86,7 @@ def main() -> None:
     t0 = time.perf_counter()
     res = mmg.imo(ship, samples=a.samples, cov=cov, seed=a.seed, executor=local_executor(a.jobs))
     wall = time.perf_counter() - t0
-    print(f"Esso Osaka, full scale, 10 kn: {a.samples} samples x 6 manoeuvres on {a.jobs} processes")
+    print(f"Esso Osaka, full scale, 10 kn: {a.samples} samples x 7 runs (6 manoeuvres and the stopping test) on {a.jobs} processes")
     print(f"  wall time            {wall:8.1f} s")
     print(f"  per sample (wall)    {1e3 * wall / a.samples:8.1f} ms")
     print(f"  per sample (core)    {1e3 * wall * a.jobs / a.samples:8.1f} ms   (wall x processes)")
