@@ -79,7 +79,7 @@ def report_lines(res) -> list[str]:
     else:
         lines += ["No uncertainty (the ship's own parameters: `mmg imo --samples N` samples them from the "
                   "ship's covariance): value against limit, no interval or probability.", ""]
-    stop = [n for n in res.notes if n.startswith(STOPPING)]
+    stop = [n[len(STOPPING) + 2:] for n in res.notes if n.startswith(f"{STOPPING}: ")]
     lines += ["## Criteria", "", *_table(res), "", "Full-astern stopping test: " + " ".join(stop) + ".", ""]
     other = [n for n in res.notes if not n.startswith(STOPPING)]
     if other:

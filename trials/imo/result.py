@@ -235,7 +235,7 @@ def stopping_note(run_metrics) -> str:
     run, m = run_metrics
     o = run.trial.astern_order()
     head = ("" if not m.get("stopped") else
-            f"; head reach {m['head_reach_L']:.2f} L, lateral deviation {m['lateral_deviation_L']:+.2f} L "
+            f"; track reach {m['track_reach_L']:.2f} L, head reach {m['head_reach_L']:.2f} L, lateral deviation {m['lateral_deviation_L']:+.2f} L "
             f"(+ starboard), heading change {m['heading_change_deg']:+.1f} deg, stopped after "
             f"{m['time_to_stop_s']:.0f} s ({m['time_to_stop_s'] / 60:.1f} min)")
     return (f"{STOPPING}: rudder midships, full astern ordered at t = 0 from the approach revolutions "
