@@ -20,8 +20,10 @@ and their sources:
   down; a diesel would give some 0.9 (0.8^(1/3) = 0.93).
 * :data:`REVERSAL_TIME_S` = 120 s: from full ahead to full astern revolutions.  "Even if the engines
   can be made to go astern within one minute of the order 'stop' ..." (Cockcroft & Lameijer, same
-  passage): a crash reversal of a large ship's engine takes minutes, the 1-3 minutes of large
-  diesels' crash-stop trials; 120 s puts n = 0 at 120 / 1.7 = 71 s after the order.
+  passage): a crash reversal of a large ship's engine takes minutes (1-3 min is the figure usually
+  quoted for large diesels; no primary source for it was at hand); 120 s puts n = 0 at
+  120 / 1.7 = 71 s after the order.  The reach depends on it weakly (60 s: 15.62 L, 180 s: 16.30 L for
+  the Esso Osaka against 15.96 L), on the astern revolutions strongly (docs/imo.md).
 
 Both are parameters of the order, not of the ship: a ship with its own engine data gives its own.
 """
