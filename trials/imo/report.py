@@ -59,6 +59,40 @@ def _convergence(res) -> list[str]:
     return lines
 
 
+_EFFECT_SOURCES = {
+    "friction": "(1 + k)(C_FM - C_FS) S/(L T) added to the resistance coefficient (ITTC-1957 line; ITTC 7.5-02-03-01.4 "
+                "2.4.1); std on the correction",
+    "wake": "w_S = (t + 0.04) + (w_M - t - 0.04)((1 + k) C_FS + dC_F)/((1 + k) C_FM) (ITTC 7.5-02-03-01.4 2.4.3); std "
+            "on the correction",
+    "epsilon": "(1 - w_R)/(1 - w_P) with the rudder's wake scaled by the same formula; std on the value",
+    "kappa": "transferred; the loading itself is the full-scale propeller's and engine's; std on the value"}
+
+
+def _scaling(res) -> list[str]:
+    sc = res.scaling
+    lines = ["## From the model to the ship", "",
+             f"Froude-scaled from {sc['model']} to {sc['ship']} (trials.imo.scaling): lambda = {sc['lambda']:.4g}, model "
+             f"speed {sc['u_model']:.4g} m/s (the ship's {sc['u_ship']:.4g} m/s / sqrt(lambda)).  From the model: the "
+             f"primed hull coefficients, w_P0, epsilon, kappa, gamma_R, l_R', the primed added masses; from the ship's "
+             f"config: geometry, mass, propeller, engine, steering, rudder geometry.  Re {sc['re_model']:.3g} (model) "
+             f"and {sc['re_ship']:.3g} (ship), ITTC-1957 C_F {sc['cf_model']:.5f} and {sc['cf_ship']:.5f}, "
+             f"1 + k = {sc['form_factor']:g}, dC_F = {sc['delta_CF']:g}, t = {sc['t_model']:.3f}.", "",
+             "| scale effect | quantity | model | ship | relative std | formula |", "|---|---|---|---|---|---|"]
+    for k, (q, m, s) in sc["corrections"].items():
+        lines.append(f"| {k} | {q} | {m:.4g} | {s:.4g} | {sc['rel_std'][k]:g} | {_EFFECT_SOURCES[k]} |")
+    widths = res.interval_widths()
+    if widths:
+        lines += ["", "The 90 % intervals' widths with all the uncertainty and with the identified covariance only "
+                  "(the same model draws, the scale-effect corrections fixed at their nominal values): the share the "
+                  "scaling assumptions add.", "",
+                  "| criterion | width | width, identified only | from the scaling |", "|---|---|---|---|"]
+        for w in widths:
+            share = "-" if w["scaling_share"] is None else f"{100 * w['scaling_share']:.0f} %"
+            lines.append(f"| {w['name']} | {_num(w['width'])} {w['unit']} | {_num(w['width_identified'])} {w['unit']} "
+                         f"| {share} |")
+    return lines + [""]
+
+
 def report_lines(res) -> list[str]:
     """The lines of ``imo.md``: the criteria table, the rules, the notes, the convergence and the figures."""
     sampled = res.samples is not None
@@ -81,6 +115,8 @@ def report_lines(res) -> list[str]:
     else:
         lines += ["No uncertainty (the ship's own parameters: `mmg imo --samples N` samples them from the "
                   "ship's covariance): value against limit, no interval or probability.", ""]
+    if res.scaling is not None:
+        lines += _scaling(res)
     lines += ["## Criteria", "", *_table(res), "",
               f"Stopping track reach (limit 15 L; the Administration may allow up to {STOPPING_LIMIT_LARGE_L:g} L for "
               f"ships of large displacement): not available: {STOPPING_REASON}.", ""]
