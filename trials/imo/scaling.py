@@ -208,7 +208,7 @@ class Scaling:
         resistance coefficient, the wake at the approach and epsilon."""
         v = self.values(model)
         w_m = _poly(model.propeller.w_P0, self.u_model)
-        return {"resistance": (self.resistance, model.hull.value(self.resistance), v[self.resistance]),
+        return {"friction": (self.resistance, model.hull.value(self.resistance), v[self.resistance]),
                 "wake": ("w_P0 at the approach", w_m, self.wake_to_ship(w_m)),
                 "epsilon": ("epsilon", model.rudder.epsilon, v["epsilon"]),
                 "kappa": ("kappa", model.rudder.kappa, v["kappa"])}
