@@ -142,3 +142,16 @@ def test_bad_scale_to_is_one_line(argv, names, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:") and names in err[0]
     assert not out.exists()
+
+
+def test_a_model_resistance_below_its_friction_is_refused(ships):
+    """An identified X_uu' smaller in size than the friction-line correction (1.2 (C_FM - C_FS) 3.86 = 0.0137
+    at 10 kn) would leave the ship no resistance: refused, naming --scale-to, before any run."""
+    from mmg.errors import InputError
+
+    m, _ = ships
+    weak = m.with_hull({"X_uu": -0.0112})          # the pond fit with X_uu and w_P0 both free (docs/imo.md)
+    with pytest.raises(InputError) as e:
+        mmg.imo(weak, scale_to="esso_osaka")
+    assert e.value.source == "--scale-to" and "X_uu" in e.value.message
+    mmg.imo(m.with_hull({"X_uu": -0.0150}), scale_to="esso_osaka")   # 0.0013 left: scaled and run

@@ -251,7 +251,8 @@ def scaling(model: Ship, full: Ship, u_ship: float, effects: ScaleEffects | None
     ------
     mmg.errors.InputError
         Not the same hull form, or a model not smaller than the ship (:func:`check_similar`); a hull
-        without one resistance coefficient.
+        without one resistance coefficient, or one the friction correction makes zero or positive (a
+        model resistance below the model's friction alone: no straight run at full scale).
     """
     e = effects or ScaleEffects()
     lam = check_similar(model, full)
@@ -260,6 +261,15 @@ def scaling(model: Ship, full: Ship, u_ship: float, effects: ScaleEffects | None
     re_m = u_m * pm.L / kinematic_viscosity(pm.rho)
     re_s = u_ship * ps.L / kinematic_viscosity(ps.rho)
     name = resistance_coefficient(model)
+    sc0 = model.hull.value(name)
+    dx = e.form_factor * (ittc57_cf(re_m) - ittc57_cf(re_s)) * pm.S_wetted / (pm.L * pm.T)
+    if sc0 + dx >= 0.0:
+        raise InputError("--scale-to", full.name, f"{model.name}'s resistance coefficient {name} = {sc0:.4g} is "
+                                                  f"smaller than the model's friction alone: with the friction-line "
+                                                  f"correction {dx:+.4g} the ship would have none ({sc0 + dx:+.4g}); an "
+                                                  f"identification that traded {name} against w_P0 (both set the "
+                                                  f"straight run at constant revolutions) cannot be scaled: fix them "
+                                                  f"(mmg identify --free without {name}, w_P0)")
     base = replace(full, hull=model.hull, name=f"{full.name} (scaled from {model.name})", covariance=None,
                    source=f"{full.source}; hull and constants Froude-scaled from {model.name} (trials.imo.scaling)")
     return Scaling(model.name, base, lam, u_ship, u_m, re_m, re_s, float(ittc57_cf(re_m)), float(ittc57_cf(re_s)),
