@@ -155,3 +155,58 @@ def test_a_model_resistance_below_its_friction_is_refused(ships):
         mmg.imo(weak, scale_to="esso_osaka")
     assert e.value.source == "--scale-to" and "X_uu" in e.value.message
     mmg.imo(m.with_hull({"X_uu": -0.0150}), scale_to="esso_osaka")   # 0.0013 left: scaled and run
+
+
+# ----------------------------------------------------------------- the coverage bench's covariance variants
+
+def test_coverage_bench_posterior_with_the_stated_prior():
+    """bench/imo_coverage.py's 'prior-stated' covariance, rebuilt from what a fit keeps (std, corr, cost,
+    residual count, priors), equals the linearised posterior (J_d^T J_d / s_d^2 + diag(1/sigma^2))^-1 built
+    here from the Jacobian of a linear least-squares problem with prior rows, as ekf.identify sets it up."""
+    import sys
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
+    from imo_coverage import covariances
+
+    rng = np.random.default_rng(4)
+    N, n = 200, 3
+    Jd = rng.normal(size=(N, n))
+    sig, prior = np.array([0.5, 2.0, 1.0]), np.array([0.1, -0.3, 0.2])
+    y = Jd @ np.array([0.3, 0.1, -0.2]) + rng.normal(0.0, 0.05, N)
+    J = np.vstack([Jd, np.diag(1.0 / sig)])
+    b = np.concatenate([y, prior / sig])
+    theta = np.linalg.lstsq(J, b, rcond=None)[0]
+    r = J @ theta - b
+    s2 = float(r @ r) / (N + n - n)                              # ekf.identify._result: all rows, dof N + n - n
+    cov = np.linalg.inv(J.T @ J) * s2
+    std = np.sqrt(np.diag(cov))
+    free = [SimpleNamespace(sigma=s, prior=p) for s, p in zip(sig, prior)]
+    fit = SimpleNamespace(std=std, corr=cov / np.outer(std, std), n_residuals=N + n, cost_final=0.5 * float(r @ r),
+                          theta=theta, free=free)
+    rd = Jd @ theta - y
+    sd2 = float(rd @ rd) / (N - n)
+    want = np.linalg.inv(Jd.T @ Jd / sd2 + np.diag(1.0 / sig ** 2))
+    got = covariances(fit, tau=1.0)
+    assert np.allclose(got["gauss-newton"], cov, rtol=1e-9)
+    assert np.allclose(got["prior-stated"], want, rtol=1e-6)
+    got3 = covariances(fit, tau=3.0)
+    assert np.allclose(got3["tau"], 3.0 * cov, rtol=1e-9)
+    assert np.allclose(got3["prior-stated-tau"], np.linalg.inv(Jd.T @ Jd / (3.0 * sd2) + np.diag(1.0 / sig ** 2)),
+                       rtol=1e-6)
+
+
+@pytest.mark.slow
+def test_coverage_bench_runs_one_seed():
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
+    from imo_coverage import VARIANTS, one_seed, summary
+
+    r = one_seed(0, 8)
+    assert set(r["variants"]) == set(VARIANTS) and r["tau"] >= 1.0
+    sm = summary([r])
+    for v in VARIANTS:
+        assert len(sm[v]["per_criterion"]) == 12 and 0.0 <= sm[v]["overall"] <= 1.0
