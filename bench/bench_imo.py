@@ -8,7 +8,11 @@ linear hull derivatives and 20 % on the non-linear yaw ones, with correlations o
 serial run's cost per sample beside it (the pool's efficiency) and the criteria with their intervals.
 Timings are never asserted in the test suite.  Run::
 
-    PYTHONPATH=. python bench/bench_imo.py [--samples 1000] [--jobs 2] [--serial-samples 20]
+    PYTHONPATH=. python bench/bench_imo.py [--samples 1000] [--jobs 2] [--serial-samples 20] [--dask]
+
+With ``--dask`` the same samples run again on a Dask ``LocalCluster`` of ``--jobs`` worker processes
+(what ``mmg imo --backend dask`` starts), its start-up timed apart, and the two results are compared
+criterion by criterion (they must be equal: the same tasks, the same compiled code).
 """
 from __future__ import annotations
 
@@ -35,12 +39,34 @@ def covariance(ship) -> dict:
     return {"names": names, "values": vals.tolist(), "matrix": (corr * np.outer(sd, sd)).tolist()}
 
 
+def _dask(ship, cov, a, wall_local: float, res_local) -> None:
+    """The same samples on a LocalCluster: its start-up, the run, the overhead against the local pool."""
+    import mmg
+    from distributed import Client, LocalCluster
+    from trials.imo.sampling import local_executor
+
+    t0 = time.perf_counter()
+    with LocalCluster(n_workers=a.jobs, processes=True, threads_per_worker=1, dashboard_address=":0") as cluster, \
+            Client(cluster) as client:
+        client.run(lambda: None)
+        start = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        res = mmg.imo(ship, samples=a.samples, cov=cov, seed=a.seed,
+                      executor=local_executor(a.jobs, backend="dask", client=client))
+        wall = time.perf_counter() - t0
+    same = res.as_dict() == res_local.as_dict()
+    print(f"  dask LocalCluster     {wall:8.1f} s   ({a.jobs} workers; start-up {start:.1f} s apart; "
+          f"{wall / wall_local:.2f} x the local pool; {1e3 * wall / a.samples:.1f} ms per sample)")
+    print(f"  same criteria, intervals and probabilities as the local pool: {same}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--samples", type=int, default=1000)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--serial-samples", type=int, default=20, help="samples of the serial reference run")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--dask", action="store_true", help="also through a dask LocalCluster, with its overhead")
     a = ap.parse_args()
 
     import mmg
@@ -69,6 +95,8 @@ def main() -> None:
     load = os.getloadavg()
     print(f"  load average         {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} on {os.cpu_count()} cores "
           f"(other processes share them)")
+    if a.dask:
+        _dask(ship, cov, a, wall, res)
     print()
     print(res.to_pandas()[["value", "interval_low", "interval_high", "limit", "probability", "verdict"]].to_string())
 

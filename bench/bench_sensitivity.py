@@ -18,7 +18,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from trials.planning.sensitivity import sensitivity, trial_differences  # noqa: E402
-from trials.runs.sweep import default_jobs  # noqa: E402
+from trials.files.sweep import default_jobs  # noqa: E402
 from trials.runs.trial import load_trial  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]

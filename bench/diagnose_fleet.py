@@ -77,13 +77,13 @@ def main(argv=None) -> int:
         print(f"{len(paths)} records ({len(dev)} of the development set), esso_osaka, {a.jobs} local workers",
               flush=True)
         local, t_local = run(paths, "loky", a.jobs)
+        t0 = time.perf_counter()
         if a.scheduler:
             cluster, client = None, Client(a.scheduler)
         else:
-            cluster = LocalCluster(n_workers=a.jobs, processes=True, threads_per_worker=1, dashboard_address=None)
+            cluster = LocalCluster(n_workers=a.jobs, processes=True, threads_per_worker=1, dashboard_address=":0")
             client = Client(cluster)
         try:
-            t0 = time.perf_counter()
             client.run(lambda: None)                    # the workers up before the clock of the run starts
             t_start = time.perf_counter() - t0
             dask, t_dask = run(paths, "dask", a.jobs, client)

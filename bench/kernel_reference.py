@@ -10,8 +10,10 @@ everything a general model cannot assume taken as known for this ship:
 * every product of ship constants (the force scales, rho D^4, the rudder factors, the
   current's velocity, 1 / masses) computed once before the loop;
 * the state held in scalars, the four RK4 stages in one loop, sin/cos(beta) once per stage;
-* the low-speed floor (:func:`mmg.model.kinematics`), the astern branches of the propeller and
-  rudder and the steering gear as in the model.
+* the low-speed floor (:func:`mmg.model.kinematics`) and the steering gear as in the model; outside
+  the first quadrant (propeller astern, ship astern, J > J_MAX: never met on the full-scale trials
+  this times) the propeller and the reversed rudder inflow are the model's own compiled functions
+  (:func:`mmg.model.propeller`, :func:`mmg.model.rudder_axial_speed`).
 
 It reads the numbers from the packed ship (``p``, ``poly``, ``hull_coef`` of
 :func:`mmg.model.pack`), so it agrees with the model to rounding; it is *not* part of the
@@ -59,9 +61,7 @@ def reference_kernel(x0, dt, nsteps, p, poly, hull_coef, kind, cpar, st, sd, sn,
     tp0, tp1, tp2, tp3 = poly[M.POLY_TP, 0], poly[M.POLY_TP, 1], poly[M.POLY_TP, 2], poly[M.POLY_TP, 3]
     kt0, kt1, kt2, kt3 = poly[M.POLY_KT, 0], poly[M.POLY_KT, 1], poly[M.POLY_KT, 2], poly[M.POLY_KT, 3]
     kq0, kq1, kq2 = poly[M.POLY_KQ, 0], poly[M.POLY_KQ, 1], poly[M.POLY_KQ, 2]
-    kt_astern = M.ASTERN_KT * kt0
     jmax = M.J_MAX
-    kt_jmax = ((kt3 * jmax + kt2) * jmax + kt1) * jmax + kt0
     offset = p[M.P_RUDDER_OFFSET]
     kap, eps, eta = p[M.P_KAPPA], p[M.P_EPS], p[M.P_ETA]
     one_kap, one_eta = 1.0 - kap, 1.0 - eta
@@ -168,37 +168,30 @@ def reference_kernel(x0, dt, nsteps, p, poly, hull_coef, kind, cpar, st, sd, sn,
             owp = 1.0 - w0 * np.exp(-Cw * bp * bp)
             uP = us * owp
             tP = ((tp3 * us + tp2) * us + tp1) * us + tp0
-            if ns < 0.0:
-                J = 0.0
-                KT = kt_astern
-                XP = -(1.0 - tP) * rhoD4 * ns * ns * KT
-            else:
-                if uP < 0.0:
-                    J = 0.0
-                    KT = kt0
-                elif ns * D * jmax > uP:
-                    J = uP / (ns * D)
-                    KT = ((kt3 * J + kt2) * J + kt1) * J + kt0
-                else:
-                    J = jmax
-                    KT = kt_jmax
+            nD = ns * D
+            if ns >= 0.0 and uP >= 0.0 and nD * jmax > uP:
+                J = uP / nD
+                KT = ((kt3 * J + kt2) * J + kt1) * J + kt0
                 XP = (1.0 - tP) * rhoD4 * ns * ns * KT
+                TL = eight_pi * KT * nD * nD
+            else:                                       # the four quadrants: the model's own
+                J, XP, TL = M.propeller(us, ns, owp, p, poly)
             # rudder
             dr_ = ds + offset
-            nD = ns * D
-            if ns < 0.0:
-                q = uP
-            else:
-                q2 = uP * uP + eight_pi * KT * nD * nD
-                q = np.sqrt(q2) if q2 > 0.0 else 0.0
-            uPs = one_kap * uP + kap * q
-            uR = eps * np.sqrt(eta * uPs * uPs + one_eta * uP * uP)
             bR = beta - lR * rp
             vR = U * (gpos if bR >= 0.0 else gneg) * bR
-            if uR > 1e-12:
-                alpha = dr_ - np.arctan(vR / uR)
-            else:
-                alpha = dr_ - (np.pi / 2 if vR > 0.0 else -np.pi / 2 if vR < 0.0 else 0.0)
+            if ns >= 0.0 and us >= 0.0:
+                q2 = uP * uP + TL
+                q = np.sqrt(q2) if q2 > 0.0 else 0.0
+                uPs = one_kap * uP + kap * q
+                uR = eps * np.sqrt(eta * uPs * uPs + one_eta * uP * uP)
+                if uR > 1e-12:
+                    alpha = dr_ - np.arctan(vR / uR)
+                else:
+                    alpha = dr_ - (np.pi / 2 if vR > 0.0 else -np.pi / 2 if vR < 0.0 else 0.0)
+            else:                                       # reversed inflow: the model's own
+                uR = M.rudder_axial_speed(uP if us >= 0.0 else us, TL, p)
+                alpha = dr_ - M.atan2_of(vR, uR)
             FN = fn_c * (uR * uR + vR * vR) * np.sin(alpha)
             cdr = np.cos(dr_)
             Xt = XH * fsc * k * ss + XP + xr_c * FN * np.sin(dr_) + ext_x

@@ -12,6 +12,9 @@ psi     heading [rad], delta rudder angle [rad] (+ to starboard), n propeller re
 Forces follow Rhee & Kim (1999) eqs. (1)-(20) with the MMG rudder and propeller
 model of Yasukawa & Yoshimura (2015); the equations of motion are written about
 midship with the centre of gravity at x_G (x_G = 0 gives Rhee & Kim eqs. 1-3).
+Outside the first quadrant (propeller astern, ship moving astern) the thrust is the Wageningen
+B4-70 four-quadrant curve anchored to the ship's K_T(J) (:func:`thrust_coefficient`,
+:mod:`mmg.fourquadrant`) and the rudder takes reversed inflow (:func:`rudder`).
 
 The ship is packed once into a flat parameter vector ``p`` (layout below), a
 polynomial table ``poly`` and the hull's term tables, so every function here
@@ -27,6 +30,7 @@ from ._jit import njit
 
 from ._inlining import hot_loops_only
 from .nondim import force_scale, inertia_scale, mass_scale, moment_scale, r_prime
+from .fourquadrant import N_HARMONICS, atan2_of, b4_70_coefficients, ct_from_kt, fourier_ct, pitch_angle
 from .terms import AXES, TERMS, sabs, term_value
 from .wind import fujiwara_series
 
@@ -50,18 +54,24 @@ STATE_UNITS = ("m/s", "m/s", "rad/s", "m", "m", "rad", "rad", "rps")
 ) = range(49)
 N_WIND_AMP = 10
 """Slots P_WIND_AMP .. P_WIND_AMP + 9: the Fujiwara amplitudes (:func:`mmg.wind.amplitude_vector`)."""
-N_PARAMS = P_WIND_AMP + N_WIND_AMP
+P_FQ_SCALE = P_WIND_AMP + N_WIND_AMP
+"""Factor on the B4-70 C_T* series: the config's bollard K_T(0) over the series' (:func:`thrust_coefficient`)."""
+P_FQ_BLEND = P_FQ_SCALE + 1
+"""C_T* added at beta_p = :data:`BETA_ANCHOR`, faded out by 90 deg (:func:`thrust_coefficient`)."""
+P_FQ_A = P_FQ_BLEND + 1
+"""Slots P_FQ_A .. + 2 N_HARMONICS - 1: the A_k then the B_k of the ship's B4-70 series (:mod:`mmg.fourquadrant`)."""
+N_PARAMS = P_FQ_A + 2 * N_HARMONICS
 
 LOW_SPEED_FROUDE = 0.01
 """Froude number below which the hull's speed scale is floored (:func:`kinematics`): U_low =
 0.01 sqrt(g L): 0.054 m/s for the 3 m model, 0.57 m/s (1.1 kn) for the 325 m ship, below the 0.75 m/s
 the Esso Osaka keeps in the steady phase of its 35 deg turn (so every full-scale trial stays above it)."""
 J_MAX = 1.2
-"""Largest advance ratio the propeller polynomials are evaluated at (:func:`propeller`); beyond it
-(a propeller barely turning, n -> 0) K_T is held at K_T(J_MAX) so the thrust n^2 K_T fades to 0."""
-ASTERN_KT = 0.6
-"""Bollard thrust astern as a fraction of ahead, K_T = 0.6 K_T(0) for n < 0 (a fixed-pitch propeller
-run astern gives 50-70 % of its ahead thrust); the astern rudder gets no slipstream (:func:`rudder`)."""
+"""Largest advance ratio the ship's own K_T(J) polynomial is evaluated at (:func:`propeller`): the
+first quadrant up to J_MAX is the config's K_T, everything else the four-quadrant curve
+(:func:`thrust_coefficient`)."""
+BETA_ANCHOR = float(np.arctan(J_MAX / (0.7 * np.pi)))
+"""Hydrodynamic pitch angle [rad] of J = J_MAX (28.6 deg): below it C_T* is the config's K_T(J)."""
 G = 9.80665
 
 # polynomial table rows
@@ -127,6 +137,7 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: 
     p[P_POWER] = engine_power_W
     p[P_SHAFT_I] = en.shaft_inertia_coefficient * pr.D**5
     p[P_ULOW] = LOW_SPEED_FROUDE * np.sqrt(G * pa.L)
+    p[P_FQ_SCALE], p[P_FQ_BLEND], p[P_FQ_A:] = four_quadrant_slots(pr.K_T, pr.P_D)
     for k, v in (disturbance_slots or {}).items():
         p[k] = v
     poly = _poly_table([pr.K_T, pr.K_Q, pr.t_P, pr.w_P0])
@@ -138,6 +149,22 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: 
         hull_term=np.array([TERMS[t] for t in h.terms], dtype=np.int64),
         hull_coef=np.array(h.values, dtype=np.float64),
     )
+
+
+def four_quadrant_slots(K_T, P_D):
+    """(scale, blend, series) of :func:`thrust_coefficient` for a propeller of open-water K_T(J)
+    (coefficients lowest power first) and pitch ratio P_D (None: :data:`mmg.fourquadrant.PD_DEFAULT`).
+
+    series: the A_k then the B_k of the B4-70 C_T* curve at P_D (:func:`mmg.fourquadrant.b4_70_coefficients`);
+    scale = C_T*(0) of K_T over the series' (the bollard anchor, so beta_p = 0 = 360 deg joins);
+    blend = C_T* of K_T at J_MAX minus scale x the series there (added at BETA_ANCHOR, faded out by 90 deg)."""
+    a, b = b4_70_coefficients(P_D)
+    series = np.concatenate([a, b])
+    kt = np.polynomial.polynomial.polyval
+    fourier = fourier_ct.py_func
+    scale = ct_from_kt.py_func(kt(0.0, K_T), 0.0) / fourier(0.0, series, 0, N_HARMONICS)
+    blend = ct_from_kt.py_func(kt(J_MAX, K_T), J_MAX) - scale * fourier(BETA_ANCHOR, series, 0, N_HARMONICS)
+    return scale, blend, series
 
 
 # --------------------------------------------------------------------------- force components
@@ -213,50 +240,128 @@ def one_minus_wake(u, beta, rp, p, poly):
 
 
 @njit(cache=True, error_model="numpy", inline=hot_loops_only)
-def propeller(u, n, one_minus_wP, p, poly):
-    """Advance ratio J_P, thrust coefficient K_T and surge force X_P [N] (eq. 12)."""
-    D = p[P_D]
-    uP = u * one_minus_wP
-    tP = polyval(poly, POLY_TP, u)
-    if n.real < 0.0:                     # astern: no open-water data; K_T(0) x ASTERN_KT, thrust aft
-        J = 0.0 * uP
-        KT = ASTERN_KT * polyval(poly, POLY_KT, J)
-        return J, KT, -(1.0 - tP) * p[P_RHO] * n * n * D ** 4 * KT
-    if uP.real < 0.0:                    # ahead propeller, ship moving astern: bollard-like, J held at 0
-        J = 0.0 * uP
-    elif (n * D).real * J_MAX > uP.real:
-        J = uP / (n * D)
-    else:
-        J = J_MAX + 0.0 * uP
-    KT = polyval(poly, POLY_KT, J)
-    XP = (1.0 - tP) * p[P_RHO] * n * n * D ** 4 * KT
-    return J, KT, XP
+def thrust_coefficient(beta, p, poly):
+    """C_T*(beta_p) of the ship's propeller at hydrodynamic pitch angle beta_p [rad] in [0, 2 pi).
+
+    Up to :data:`BETA_ANCHOR` (first quadrant, J <= J_MAX) the config's own K_T(J), J = 0.7 pi tan(beta_p)
+    (:func:`mmg.fourquadrant.ct_from_kt`).  Elsewhere the Wageningen B4-70 four-quadrant curve at the
+    propeller's P/D (:mod:`mmg.fourquadrant`: van Lammeren et al. 1969, Fourier series of Roddy, Hess &
+    Faller 2006) times ``p[P_FQ_SCALE]``, the config's bollard C_T*(0) over the series' (1.156 for the
+    Esso Osaka: its K_T(0) = 0.349 against the B4-70's 0.302 at P/D 0.715), so the curve joins the
+    config's at beta_p = 0 = 360 deg; between BETA_ANCHOR and 90 deg the gap left at J_MAX
+    (``p[P_FQ_BLEND]``) is added with a weight cos^2 going from 1 to 0, so the curve is continuous there too.
+    """
+    if beta.real <= BETA_ANCHOR:
+        J = 0.7 * np.pi * np.tan(beta)
+        return ct_from_kt(polyval(poly, POLY_KT, J), J)
+    c = p[P_FQ_SCALE] * fourier_ct(beta, p, P_FQ_A, N_HARMONICS)
+    if beta.real < 0.5 * np.pi:
+        w = np.cos(0.5 * np.pi * (beta - BETA_ANCHOR) / (0.5 * np.pi - BETA_ANCHOR))
+        c = c + p[P_FQ_BLEND] * w * w
+    return c
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def slipstream_weight(beta):
+    """Share of the propeller's thrust loading that accelerates the flow onto the rudder, by the
+    hydrodynamic pitch angle beta_p [rad]: 1 in the first quadrant up to :data:`BETA_ANCHOR`, falling
+    as cos^2 to 0 at n = 0 (90 deg; 270 deg through the fourth quadrant, ship astern with the
+    propeller ahead: cos^2 beta_p), 0 with the propeller astern (90-270 deg: its race goes forward,
+    away from the rudder).  Continuous, so the rudder force is continuous as n crosses 0."""
+    if beta.real <= BETA_ANCHOR:
+        return 1.0 + 0.0 * beta
+    if beta.real < 0.5 * np.pi:
+        w = np.cos(0.5 * np.pi * (beta - BETA_ANCHOR) / (0.5 * np.pi - BETA_ANCHOR))
+        return w * w
+    if beta.real > 1.5 * np.pi:
+        c = np.cos(beta)
+        return c * c
+    return 0.0 * beta
 
 
 @njit(cache=True, error_model="numpy", inline=hot_loops_only)
-def rudder(u, U, beta, rp, delta, n, one_minus_wP, KT, p):
-    """MMG rudder forces (X_R, Y_R, N_R) [N, N, N m] and the normal force F_N [N].
+def propeller(u, n, one_minus_wP, p, poly):
+    """Advance ratio J_P, surge force X_P [N] (eq. 12) and the slipstream's thrust loading [m^2/s^2].
 
-    The slipstream speed u_P sqrt(1 + 8 K_T / (pi J^2)) is written sqrt(u_P^2 + 8 K_T (n D)^2 / pi)
-    (the same for u_P > 0), which stays defined as u_P or n go to zero; beta, r' are those of
-    :func:`kinematics`, so v_R = U gamma_R beta_R stays bounded at rest."""
+    First quadrant with J <= :data:`J_MAX`: the config's K_T(J), X_P = (1 - t_P) rho n^2 D^4 K_T, as
+    ever.  Everywhere else the four-quadrant form T = C_T*(beta_p) 1/2 rho (V_A^2 + (0.7 pi n D)^2)
+    pi D^2/4 (:func:`thrust_coefficient`, :mod:`mmg.fourquadrant`), which is bounded and continuous
+    across n = 0 and V_A = 0 and zero at rest.  V_A = u (1 - w_P) ahead (0 where a wake polynomial
+    extrapolated far past its speeds gives 1 - w_P < 0: the bollard J = 0 the model always took there);
+    going astern (u < 0) the propeller meets the flow before the hull, V_A = u (no wake), t_P = t_P(0).
+    The loading returned is 8 T / (pi rho D^2) = C_T* (V_A^2 + (0.7 pi n D)^2) (= 8 K_T (n D)^2 / pi)
+    times :func:`slipstream_weight`, what the rudder's slipstream sees (:func:`rudder`).  J_P (for
+    the shaft's torque, :func:`shaft_acceleration`) is J_MAX beyond it ahead and 0 astern, as before.
+    """
+    D = p[P_D]
+    ahead = u.real >= 0.0
+    uP = (u * one_minus_wP if one_minus_wP.real >= 0.0 else 0.0 * u) if ahead else u
+    tP = polyval(poly, POLY_TP, u if ahead else 0.0 * u)
+    if n.real >= 0.0 and uP.real >= 0.0 and (n * D).real * J_MAX > uP.real:
+        J = uP / (n * D)
+        KT = polyval(poly, POLY_KT, J)
+        XP = (1.0 - tP) * p[P_RHO] * n * n * D ** 4 * KT
+        nD = n * D
+        return J, XP, 8.0 * KT * nD * nD / np.pi
+    x07 = 0.7 * np.pi * n * D
+    beta = pitch_angle(uP, x07)
+    TL = thrust_coefficient(beta, p, poly) * (uP * uP + x07 * x07)
+    XP = (1.0 - tP) * 0.125 * np.pi * p[P_RHO] * D * D * TL
+    J = J_MAX + 0.0 * uP if (n.real >= 0.0 and uP.real >= 0.0) else 0.0 * uP
+    return J, XP, TL * slipstream_weight(beta)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rudder_axial_speed(uP, TL, p):
+    """Signed axial inflow speed at the rudder [m/s] (> 0: from the leading edge) for any signs of
+    u_P and the slipstream loading TL [m^2/s^2] (:func:`propeller`).
+
+    The propeller race adds dq = sqrt(u_P^2 + TL) - |u_P| to the axial speed behind the disc (the
+    MMG slipstream, kappa dq of it at the rudder: a_s = u_P + kappa dq), and the rudder's mean
+    axial speed is the signed root of the momentum-weighted mean eta a_s|a_s| + (1 - eta) u_P|u_P|,
+    times epsilon.  For u_P >= 0 this is the MMG u_R = epsilon sqrt(eta a_s^2 + (1 - eta) u_P^2);
+    it goes through 0 continuously when the mean flow reverses (ship astern, race not strong enough)."""
+    s2 = uP * uP + TL
+    au = sabs(uP)
+    dq = (np.sqrt(s2) if s2.real > 0.0 else 0.0 * s2) - au
+    a_s = uP + p[P_KAPPA] * dq
+    m = p[P_ETA] * a_s * sabs(a_s) + (1.0 - p[P_ETA]) * uP * au
+    q = np.sqrt(sabs(m))
+    return p[P_EPS] * (q if m.real >= 0.0 else -q)
+
+
+@njit(cache=True, error_model="numpy", inline=hot_loops_only)
+def rudder(u, U, beta, rp, delta, n, one_minus_wP, TL, p):
+    """MMG rudder forces (X_R, Y_R, N_R) [N, N, N m] and the normal force F_N [N], in all four quadrants.
+
+    Ahead with the propeller ahead (u, n >= 0) the MMG rudder as ever: the slipstream speed
+    u_P sqrt(1 + 8 K_T / (pi J^2)) written sqrt(u_P^2 + TL), TL = 8 K_T (n D)^2 / pi (:func:`propeller`),
+    defined as u_P or n go to zero; beta, r' are those of :func:`kinematics`, so v_R = U gamma_R beta_R
+    stays bounded at rest.  Otherwise (the propeller astern, or the ship moving astern, where
+    u_P = u) the signed axial inflow of :func:`rudder_axial_speed`; the angle of attack
+    alpha_R = delta - atan2(v_R, u_R) then measures the flow from the trailing edge when it comes from
+    behind (u_R < 0), so F_N = 1/2 rho A_R (u_R^2 + v_R^2) f_alpha sin(alpha_R) reverses with the
+    flow, continuously (through the cross flow at u_R = 0).  This is the reversed-inflow form of the
+    Osaka group's low-speed MMG model of the Esso Osaka (u_R = u astern, alpha_R from atan2); the lift
+    slope f_alpha is kept for reversed flow, as there: no published reduction was found to use.
+    """
     d = delta + p[P_RUDDER_OFFSET]
-    uP = u * one_minus_wP
-    nD = n * p[P_D]
-    q2 = uP * uP + 8.0 * KT * nD * nD / np.pi
-    if n.real < 0.0:                     # astern: the slipstream goes forward, away from the rudder
-        q = uP
-    else:
-        q = np.sqrt(q2) if q2.real > 0.0 else 0.0 * q2
-    uPs = (1.0 - p[P_KAPPA]) * uP + p[P_KAPPA] * q            # u_P s
-    uR = p[P_EPS] * np.sqrt(p[P_ETA] * uPs * uPs + (1.0 - p[P_ETA]) * uP * uP)
     bR = beta - p[P_LR] * rp
     g = p[P_GPOS] if bR.real >= 0.0 else p[P_GNEG]
     vR = U * g * bR
-    if uR.real > 1e-12:
-        alpha = d - np.arctan(vR / uR)
-    else:                                                       # no inflow along the blade
-        alpha = d - (np.pi / 2 if vR.real > 0.0 else -np.pi / 2 if vR.real < 0.0 else 0.0) + 0.0 * uR
+    if n.real >= 0.0 and u.real >= 0.0:
+        uP = u * one_minus_wP
+        q2 = uP * uP + TL
+        q = np.sqrt(q2) if q2.real > 0.0 else 0.0 * q2
+        uPs = (1.0 - p[P_KAPPA]) * uP + p[P_KAPPA] * q            # u_P s
+        uR = p[P_EPS] * np.sqrt(p[P_ETA] * uPs * uPs + (1.0 - p[P_ETA]) * uP * uP)
+        if uR.real > 1e-12:
+            alpha = d - np.arctan(vR / uR)
+        else:                                                   # no inflow along the blade
+            alpha = d - (np.pi / 2 if vR.real > 0.0 else -np.pi / 2 if vR.real < 0.0 else 0.0) + 0.0 * uR
+    else:
+        uR = rudder_axial_speed(u * one_minus_wP if u.real >= 0.0 else u, TL, p)
+        alpha = d - atan2_of(vR, uR)
     FN = 0.5 * p[P_RHO] * p[P_AR] * (uR * uR + vR * vR) * p[P_FALPHA] * np.sin(alpha)
     cd = np.cos(d)
     XR = -(1.0 - p[P_TR]) * FN * np.sin(d)
@@ -325,8 +430,8 @@ def forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef):
     XHp, YHp, NHp = hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef)
     sX, sY, sN = hull_scales(U, Uh, p)
     owp = one_minus_wake(u, beta, rp, p, poly)
-    J, KT, XP = propeller(u, n, owp, p, poly)
-    XR, YR, NR, FN = rudder(u, U, beta, rp, delta, n, owp, KT, p)
+    J, XP, TL = propeller(u, n, owp, p, poly)
+    XR, YR, NR, FN = rudder(u, U, beta, rp, delta, n, owp, TL, p)
     X = XHp * sX * surge_sign(u, p) + XP + XR + p[P_EXT_X]
     Y = YHp * sY + YR + p[P_EXT_Y]
     N = NHp * sN + NR + p[P_EXT_N]

@@ -114,6 +114,8 @@ class Propeller:
     wake_model: ``"kijima"`` w_P = w_P0 exp(-C_wake beta_P^2), or ``"mmg2015"``
     (1-w_P) = (1-w_P0)[1 + (1-exp(-C_1|beta_P|))(C_2-1)], with beta_P = beta - x_P' r'.
     K_Q_scale: factor on K_Q (1 unless calibrated to the engine's power, see :mod:`mmg.equilibrium`).
+    P_D: pitch ratio P/D (None when the config gives no pitch): picks the four-quadrant thrust curve
+    (:mod:`mmg.fourquadrant`).
     """
 
     D: float
@@ -128,6 +130,7 @@ class Propeller:
     C_2_pos: float = 1.0
     C_2_neg: float = 1.0
     K_Q_scale: float = 1.0
+    P_D: float | None = None
 
 
 @dataclass(frozen=True)
@@ -559,8 +562,9 @@ def _propeller(f: _ShipFile, src: str, pa: Particulars) -> Propeller:
     T = pa.T
     D = _qty(src, "propeller.D", pr.D, "length", 0.0, 1.5 * T, lo_open=True,
              why=f"0 < D <= 1.5 T = {1.5 * T:g} m: the propeller works under water")
+    P = None
     if pr.P is not None:
-        _qty(src, "propeller.P", pr.P, "length", 0.0, 3 * D, lo_open=True, why=f"0 < P <= 3 D = {3 * D:g} m")
+        P = _qty(src, "propeller.P", pr.P, "length", 0.0, 3 * D, lo_open=True, why=f"0 < P <= 3 D = {3 * D:g} m")
     K_T = _poly(src, "propeller.K_T", pr.K_T, 10.0)
     _num(src, "propeller.K_T.0", K_T[0], 0.0, 1.0, lo_open=True, hi_open=True, why="the bollard K_T(0) is 0-1")
     K_Q = _poly(src, "propeller.K_Q", pr.K_Q, 10.0)
@@ -580,6 +584,7 @@ def _propeller(f: _ShipFile, src: str, pa: Particulars) -> Propeller:
         C_1=_num(src, "propeller.wake.C_1", wk.C_1, 0.0, 50.0),
         C_2_pos=_num(src, "propeller.wake.C_2_pos", wk.C_2_pos, 0.0, 10.0, lo_open=True),
         C_2_neg=_num(src, "propeller.wake.C_2_neg", wk.C_2_neg, 0.0, 10.0, lo_open=True),
+        P_D=None if P is None else P / D,
     )
 
 

@@ -171,7 +171,10 @@ def test_simulation_replay_and_ekf_use_an_edit_in_a_new_module(tmp_path):
         assert np.all(np.isfinite(a)) and np.max(np.abs(a - b)) > 1e-3 * np.max(np.abs(a)), what
     body = _move(root, "rudder", "model.py", "rudder_force.py",
                  "import numpy as np\n\nfrom ._inlining import hot_loops_only\nfrom ._jit import njit\n")
-    names = sorted(set(re.findall(r"\bP_[A-Z0-9_]+\b", body)))
+    import mmg.model as M
+
+    calls = set(re.findall(r"(?<![\w.])([A-Za-z_]\w*)\(", body)) - {"rudder", "njit"}    # model helpers it calls
+    names = sorted(set(re.findall(r"\bP_[A-Z0-9_]+\b", body)) | {c for c in calls if hasattr(M, c)})
     _edit(root, "rudder_force.py", "import numpy as np\n", f"import numpy as np\n\nfrom .model import {', '.join(names)}\n")
     moved = _run(root, WORK, "1.0")["1.0"]
     for what in ("simulate", "replay", "ekf"):                     # moved: the same numbers

@@ -48,7 +48,7 @@ def test_dask_gives_the_same_diagnoses(records, serial):
 
     ship, recs = records
     with distributed.LocalCluster(n_workers=2, processes=False, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
         par = diagnose_each(ship, recs, DiagnoseOptions(candidates=["current"], backend="dask", client=client))
     assert _summary(par) == _summary(serial)
     assert [r.records[0].name for r in par] == [r.records[0].name for r in serial]   # record order kept
@@ -72,3 +72,15 @@ def test_scheduler_without_dask_is_refused(tmp_path):
     lines = [ln for ln in r.stderr.strip().splitlines() if ln.strip()]
     assert len(lines) == 1 and "--scheduler" in lines[0] and "--backend dask" in lines[0], r.stderr
     assert not (tmp_path / "d.json").exists()
+
+
+@pytest.mark.parametrize("cmd", [["montecarlo", "{out}", "--seeds", "1"], ["imo", "esso_osaka", "--out", "{out}"],
+                                 ["output-error", "{out}", "--seeds", "1"]])
+def test_every_cluster_command_refuses_a_scheduler_without_dask(tmp_path, cmd):
+    out = tmp_path / "out"
+    argv = [a.replace("{out}", str(out)) for a in cmd] + ["--scheduler", "tcp://127.0.0.1:1"]
+    r = subprocess.run([sys.executable, "-m", "trials.cli", *argv], capture_output=True, text=True)
+    assert r.returncode == 2, r.stderr
+    lines = [ln for ln in r.stderr.strip().splitlines() if ln.strip()]
+    assert len(lines) == 1 and "--backend dask" in lines[0], r.stderr
+    assert not out.exists()

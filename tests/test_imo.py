@@ -334,7 +334,7 @@ def test_samples_on_a_dask_cluster_match_a_serial_run(tmp_path):
     cov = {"names": ["N_r"], "values": [ship.hull.value("N_r")], "matrix": [[(0.1 * ship.hull.value("N_r")) ** 2]]}
     ser = mmg.imo(ship, samples=4, cov=cov, seed=2, executor=serial)
     with distributed.LocalCluster(n_workers=2, processes=False, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
         par = mmg.imo(ship, samples=4, cov=cov, seed=2, executor=local_executor(backend="dask", client=client))
     assert par.as_dict() == ser.as_dict()
     assert par.samples == ser.samples

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from trials.planning.sensitivity import _task
-from trials.runs.sweep import run_sweep
+from trials.files.sweep import run_sweep
 from trials.runs.trial import load_trial
 
 from .conftest import CONFIGS
@@ -32,7 +32,7 @@ def test_serial_equals_joblib(serial, capsys):
 def test_serial_equals_dask(serial):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=2, processes=False, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
         par = run_sweep(_task, tasks(), backend="dask", client=client, progress=False)
     for p, s in zip(par, serial):
         assert p.trial == s.trial

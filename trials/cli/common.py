@@ -253,10 +253,10 @@ class backend_client:
                 except (OSError, TimeoutError) as e:
                     raise InputError("--scheduler", a.scheduler, f"no dask scheduler answers there ({e})") from None
             else:
-                from ..runs.sweep import default_jobs
+                from ..files.sweep import default_jobs
 
                 self.cluster = LocalCluster(n_workers=a.jobs or default_jobs(), processes=True, threads_per_worker=1,
-                                            dashboard_address=None)
+                                            dashboard_address=":0")
                 self.client = Client(self.cluster)
         return self.client
 

@@ -7,7 +7,8 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _finite_positive, _output_path, _positive_int, _whole, release_notes
+from .common import (_finite_positive, _output_path, _positive_int, _whole, add_backend_options, backend_client,
+                     check_backend_options, release_notes)
 
 
 def _check_free(ship, names) -> None:
@@ -30,6 +31,7 @@ def cmd_identify(args) -> int:
     from ..measured.identify import DEFAULT_MAX_NFEV, cross_validate, cv_folds, identify, load_runs, write_identification
     from ..files.output import StagedOutput, check_output_dir, record_labels
 
+    check_backend_options(args)
     check_output_dir(args.out)
     for log in args.train + (args.test or []):
         if not Path(log).is_file():
@@ -94,9 +96,12 @@ def cmd_identify(args) -> int:
     ident = identify(ship, runs, wind=wind, progress=progress, initial=initial, **kw)
     cv = None
     if args.cv:
-        cv = cross_validate(ship, runs, folds=folds, wind=wind, initial=initial, folds_by=args.folds_by, **kw,
-                            progress=lambda k, n: print(f"cross-validation fold {k}/{n} ({time.perf_counter() - t0:.0f} s)",
-                                                        file=sys.stderr, flush=True))
+        with backend_client(args) as client:
+            cv = cross_validate(ship, runs, folds=folds, wind=wind, initial=initial, folds_by=args.folds_by, **kw,
+                                backend=args.backend, client=client, n_jobs=args.jobs,
+                                progress=lambda k, n: print(f"cross-validation fold {k}/{n} "
+                                                            f"({time.perf_counter() - t0:.0f} s)",
+                                                            file=sys.stderr, flush=True))
     with StagedOutput(args.out) as stage:
         write_identification(ident, src, stage.dir, cv, tests)
     a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
@@ -151,4 +156,5 @@ def add_parser(sub) -> None:
     p.add_argument("--folds-by", choices=("order", "revolutions"), default="order",
                    help="with --cv: deal the records into folds in the order given or stratified by their propeller "
                         "revolutions (a record and its cut copies always share a fold)")
+    add_backend_options(p, "the cross-validation folds (--cv)")
     p.set_defaults(func=cmd_identify)

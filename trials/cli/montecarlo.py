@@ -6,7 +6,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _finite_positive, _output_path, _positive_int, _seed
+from .common import _finite_positive, _output_path, _positive_int, _seed, backend_client, check_backend_options
 
 
 def cmd_montecarlo(args) -> int:
@@ -21,9 +21,11 @@ def cmd_montecarlo(args) -> int:
             raise InputError(str(summary), "", "file not found (mmg montecarlo OUT writes it)")
         print("\n".join(group_table(pd.read_csv(summary))))
         return 0
+    check_backend_options(args)
     check_output_dir(args.out, "OUT")
-    with StagedOutput(args.out) as stage:
-        monte_carlo(stage.dir, n_seeds=args.seeds, n_jobs=args.jobs, first_seed=args.first_seed, config=args.config)
+    with backend_client(args), StagedOutput(args.out) as stage:
+        monte_carlo(stage.dir, n_seeds=args.seeds, n_jobs=args.jobs, first_seed=args.first_seed, config=args.config,
+                    backend=args.backend)
     return 0
 
 
@@ -31,12 +33,13 @@ def cmd_log_filter(args) -> int:
     from ..estimates.montecarlo import log_filter_monte_carlo
     from ..files.output import StagedOutput, check_output_dir
 
+    check_backend_options(args)
     check_output_dir(args.out, "OUT")
     sigma = args.sigma_tau if args.sigma_tau is not None else (1e-4 if args.true_rudder else 0.15)
-    with StagedOutput(args.out) as stage:
+    with backend_client(args), StagedOutput(args.out) as stage:
         log_filter_monte_carlo(stage.dir, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=sigma,
                                first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt",
-                               config=args.config)
+                               config=args.config, backend=args.backend)
     return 0
 
 
@@ -52,16 +55,17 @@ def cmd_output_error(args) -> int:
     runs = Path(args.out) / "runs.csv"
     if args.summarise_only and not runs.is_file():
         raise InputError(str(runs), "", "file not found (mmg output-error OUT writes it)")
+    check_backend_options(args)
     check_output_dir(args.out, "OUT")
     ekf_summary = args.ekf_summary
-    with StagedOutput(args.out) as stage:
+    with backend_client(args), StagedOutput(args.out) as stage:
         if args.summarise_only:          # the summary from a copy of runs.csv, moved in with it
             shutil.copy2(runs, stage.path("runs.csv"))
             summarise(stage.dir, tuple(args.trials), args.rudder, ekf_summary)
         else:
             output_error_monte_carlo(stage.dir, args.seeds, tuple(args.trials), n_jobs=args.jobs,
                                      first_seed=args.first_seed, rudder=args.rudder, ekf_summary=ekf_summary,
-                                     config=args.config)
+                                     config=args.config, backend=args.backend)
     return 0
 
 
@@ -73,6 +77,11 @@ def add_parser(sub) -> None:
         p.add_argument("--first-seed", type=_seed, default=1000, help="noise seed of the first run of each trial")
         p.add_argument("--jobs", type=_positive_int, default=2, help="workers (default 2)")
         p.add_argument("--config", default=None, help=f"estimation YAML for the {what}")
+        p.add_argument("--backend", choices=("serial", "loky", "dask"), default="loky",
+                       help="where the seeds run: serial, loky (local processes, default) or dask (--scheduler's "
+                            "cluster, or a local one of --jobs workers; optional extra mmg-toolkit[dask])")
+        p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                       help="with --backend dask: a running dask scheduler (tcp://host:8786)")
 
     p = sub.add_parser("montecarlo", help="Monte Carlo of the paper EKF over noise seeds (ST35, ZZ10, ZZ20, S-type 120)")
     mc_common(p, "EKF")

@@ -4,7 +4,7 @@ the joint output-error fit.
 ``mmg montecarlo OUT --seeds 20``, ``mmg log-filter OUT --seeds 20`` and ``mmg output-error OUT
 --seeds 20`` run them.  Each run simulates the trial with a new noise seed (in memory),
 recovers the measurements and runs the estimator; runs go through
-:func:`trials.runs.sweep.run_sweep` (both cores, a progress line per run).  A run whose filter
+:func:`trials.files.sweep.run_sweep` (both cores, a progress line per run).  A run whose filter
 diverges is counted and left out of the statistics.
 """
 from __future__ import annotations
@@ -27,7 +27,7 @@ from mmg.rudder import REBUILT_KINDS, reversal_timing_errors
 
 from .estimation import data_from_trial
 from .rhee_kim import PAPER, TRIALS
-from ..runs.sweep import run_sweep
+from ..files.sweep import run_sweep
 from ..runs.trial import load_trial
 
 PAPER_TRIALS = tuple(TRIALS)

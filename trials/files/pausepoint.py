@@ -18,7 +18,7 @@ The points:
     :meth:`trials.files.output.StagedOutput.path` once the staging folder holds a file (the command has
     written at least one of its outputs);
 ``sweep-task``
-    a worker of :func:`trials.runs.sweep.run_sweep` starting its first task (in each worker process).
+    a worker of :func:`trials.files.sweep.run_sweep` starting its first task (in each worker process).
 """
 from __future__ import annotations
 

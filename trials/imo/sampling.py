@@ -9,7 +9,7 @@ water: it changes nothing) and the others keep their joint distribution (the mar
 
 Where the samples run is an *executor*: a function ``executor(func, tasks) -> list`` returning
 ``[func(t) for t in tasks]`` in order (``func`` and the tasks are picklable).  The default,
-:func:`local_executor`, is :func:`trials.runs.sweep.run_sweep` on this machine's cores (joblib's
+:func:`local_executor`, is :func:`trials.files.sweep.run_sweep` on this machine's cores (joblib's
 process pool); a distributed one (Dask, a cluster) plugs in the same way.
 
 Summaries (:func:`summarise`): the median, the 90 % interval (5th to 95th percentile) and the
@@ -142,11 +142,11 @@ def sample_tasks(p: Plan, names, samples: np.ndarray, chunks: int) -> list:
 
 
 def local_executor(jobs: int | None = None, progress: bool = False, backend: str = "loky", client=None):
-    """The default executor: :func:`trials.runs.sweep.run_sweep` on ``jobs`` local processes (default
+    """The default executor: :func:`trials.files.sweep.run_sweep` on ``jobs`` local processes (default
     every usable core), one progress line per finished chunk when ``progress``; ``backend="dask"``
     sends the chunks to the workers of ``client`` (default: the current ``distributed.Client``),
     ``"serial"`` runs them here, the same numbers either way."""
-    from ..runs.sweep import run_sweep
+    from ..files.sweep import run_sweep
 
     def run(func, tasks):
         return run_sweep(func, tasks, backend=backend, n_jobs=jobs, progress=progress, client=client,
@@ -174,7 +174,7 @@ def run_samples(p: Plan, names, samples: np.ndarray, executor=None, chunks: int 
         Per sample, in order: ``values`` (criterion name -> value or None) and ``error`` (None, or why
         the sample's runs failed).
     """
-    from ..runs.sweep import default_jobs
+    from ..files.sweep import default_jobs
 
     executor = executor or local_executor()
     tasks = sample_tasks(p, names, samples, chunks or 8 * default_jobs())

@@ -727,7 +727,7 @@ def _diagnose_one(task) -> "Diagnosis":
 
 def diagnose_each(ship: Ship, items, options: DiagnoseOptions | None = None, progress: bool = False) -> list:
     """Each record diagnosed alone, in record order, spread by ``options.backend`` (serial, this
-    machine's cores, or a dask cluster: :func:`trials.runs.sweep.run_sweep`, one progress line per
+    machine's cores, or a dask cluster: :func:`trials.files.sweep.run_sweep`, one progress line per
     record).  Every diagnosis is deterministic, so the backend does not change a number.
 
     Parameters
@@ -743,7 +743,7 @@ def diagnose_each(ship: Ship, items, options: DiagnoseOptions | None = None, pro
     -------
     list of Diagnosis
     """
-    from ..runs.sweep import run_sweep
+    from ..files.sweep import run_sweep
 
     o = options or DiagnoseOptions()
     recs = prepare(ship, items, wind=o.wind, segment_s=o.segment_s)

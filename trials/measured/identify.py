@@ -465,33 +465,49 @@ def same_run_groups(runs: list[MeasuredRun]) -> list[int]:
     return out
 
 
+def _fold(task) -> list[dict]:
+    """One cross-validation fold: identify on its training records, replay its kept-out ones."""
+    ship, ref, train, tests, k, kw = task
+    ident = identify(ship, train, **kw)
+    return [{"name": r.name, "fold": k, "initial": replay_record(ref, r).scores(),
+             "identified": ident.replay(r).scores(), "ship": ident.ship} for r in tests]
+
+
 def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress=None, initial: Ship | None = None,
-                   folds_by: str = "order", **kw) -> list[dict]:
+                   folds_by: str = "order", backend: str = "serial", client=None, n_jobs: int | None = None,
+                   **kw) -> list[dict]:
     """k-fold cross-validation: each record kept out once; per record the open-loop heading RMS [deg]
     (and the other scores) of the initial model (``initial``, the prior ``ship`` when omitted) and of
     the model identified from ``ship`` without it (``kw``: :func:`identify`'s options); ``folds_by``:
     how records are dealt into folds (:func:`fold_of`).  Each record's dict also holds ``"ship"``,
-    the model identified without it (for further replays of the kept-out record)."""
+    the model identified without it (for further replays of the kept-out record).
+
+    The folds are independent: ``backend`` ``"serial"`` (default: one after the other, ``progress(k,
+    folds)`` after each), ``"loky"`` (``n_jobs`` local processes) or ``"dask"`` (the workers of
+    ``client``) run them through :func:`trials.files.sweep.run_sweep`, one progress line per fold, the
+    same numbers either way."""
     ref = ship if initial is None else initial
     if initial is not None:
         from ..files.shipcheck import check_same_ship
 
         check_same_ship(ship, initial)
-    out = []
     idx = np.arange(len(runs))
     folds = cv_folds(runs, folds)
     fold = fold_of(runs, folds, folds_by)
-    for k in range(folds):
-        test = idx[fold == k]
-        train = [runs[i] for i in idx if i not in set(test)]
-        ident = identify(ship, train, **kw)
-        for i in test:
-            a = replay_record(ref, runs[i]).scores()
-            b = ident.replay(runs[i]).scores()
-            out.append({"name": runs[i].name, "fold": k, "initial": a, "identified": b, "ship": ident.ship})
-        if progress:
-            progress(k + 1, folds)
-    return out
+    tasks = [(ship, ref, [runs[i] for i in idx if fold[i] != k], [runs[i] for i in idx if fold[i] == k], k, kw)
+             for k in range(folds)]
+    if backend == "serial":
+        out = []
+        for k, t in enumerate(tasks):
+            out += _fold(t)
+            if progress:
+                progress(k + 1, folds)
+        return out
+    from ..files.sweep import run_sweep
+
+    parts = run_sweep(_fold, tasks, backend=backend, client=client, n_jobs=n_jobs,
+                      labels=[f"cross-validation fold {k + 1}/{folds}" for k in range(folds)])
+    return [r for part in parts for r in part]
 
 
 PARAMETER_UNITS = {"rudder_offset": "rad", "m_x": "kg", "m_y": "kg", "J_z": "kg m^2"}

@@ -17,7 +17,7 @@ trial and dominates the mean) are reported beside it.  Both are computed twice: 
 ``mean_rel_crb_nonlinear_pct`` ...) and, as the log has no rudder channel, with the timing of
 every rudder movement a nuisance (prior std ``rudder_timing``, 0.15 s; columns prefixed
 ``timing_``; :func:`trials.planning.fisher.fisher`).  A trial with many short rudder movements loses
-more to the second.  Every point is one task of :func:`trials.runs.sweep.run_sweep`.
+more to the second.  Every point is one task of :func:`trials.files.sweep.run_sweep`.
 """
 from __future__ import annotations
 
@@ -82,9 +82,9 @@ def search(base, grid: dict | None = None, references=(), noise: str = "log", ru
 
     noise: noise model of :func:`trials.planning.fisher.fisher`; rudder_timing: prior std [s] of the
     per-movement timing nuisances of the ``timing_`` criteria (None: rudder-known criteria only);
-    sweep_kw: :func:`trials.runs.sweep.run_sweep` options (backend, n_jobs, progress).
+    sweep_kw: :func:`trials.files.sweep.run_sweep` options (backend, n_jobs, progress).
     """
-    from ..runs.sweep import run_sweep
+    from ..files.sweep import run_sweep
 
     grid = DEFAULT_GRID if grid is None else grid
     tasks = [(base, fam, v, noise, rudder_timing) for fam, vals in grid.items() for v in vals]

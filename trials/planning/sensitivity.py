@@ -20,7 +20,7 @@ that does not).
 A trial whose perturbed run stops early (speed collapse) is compared over the common
 length.  The simulations are the compiled MMG loop (:func:`mmg.integrate.integrate`) with
 the derivative written into the packed ship's coefficient slot; one trial's 13 runs are
-one task of :func:`trials.runs.sweep.run_sweep`.
+one task of :func:`trials.files.sweep.run_sweep`.
 """
 from __future__ import annotations
 
@@ -91,7 +91,7 @@ def _task(trial):
 def sensitivity(trials, *, backend: str = "loky", n_jobs: int | None = None, progress: bool = True,
                 client=None) -> pd.DataFrame:
     """Sensitivities (eqs. 21-22, %) of the 12 derivatives in each trial, normalised over ``trials``."""
-    from ..runs.sweep import run_sweep
+    from ..files.sweep import run_sweep
 
     trials = list(trials)
     diffs = run_sweep(_task, trials, backend=backend, n_jobs=n_jobs, labels=[t.name for t in trials],
@@ -101,7 +101,7 @@ def sensitivity(trials, *, backend: str = "loky", n_jobs: int | None = None, pro
 
 def group_differences(trials, **kw) -> list[TrialDifferences]:
     """The raw per-trial tables, for renormalising over several groups without re-simulating."""
-    from ..runs.sweep import run_sweep
+    from ..files.sweep import run_sweep
 
     trials = list(trials)
     return run_sweep(_task, trials, labels=[t.name for t in trials], **kw)

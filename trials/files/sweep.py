@@ -88,7 +88,7 @@ def run_sweep(func: Callable, tasks: Sequence, *, backend: str = "loky", n_jobs:
     else:
         ctx = parallel_backend("loky", n_jobs=jobs)
     out: list = [None] * n
-    from ..files.output import children_ignore_sigint
+    from .output import children_ignore_sigint
 
     with ctx, children_ignore_sigint():      # workers leave Ctrl-C to the main process (it cleans up)
         gen = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=batch_size)(
@@ -100,7 +100,7 @@ def run_sweep(func: Callable, tasks: Sequence, *, backend: str = "loky", n_jobs:
 
 
 def _indexed(func, i, task):
-    from ..files.pausepoint import pause
+    from .pausepoint import pause
 
     pause("sweep-task")                 # a test hook (trials.files.pausepoint); no-op otherwise
     return i, func(task)
