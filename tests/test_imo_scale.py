@@ -116,6 +116,11 @@ def test_scaled_samples_and_interval_widths(ships):
     assert sum(w["width"] >= w["width_identified"] for w in ws) >= 9
     doc = json.loads(res.to_json())
     assert list(doc) == ["ship", "criteria"] and all(len(c) == 7 for c in doc["criteria"])
+    from trials.imo.report import report_lines
+
+    md = "\n".join(report_lines(res))
+    assert "the model's 2 parameters (N_r, Y_beta)" in md and "4 scale-effect corrections" in md
+    assert "| tactical diameter, port |" in md and "from the scaling" in md
 
 
 def test_cli_scale_to_writes_the_schema(tmp_path, capsys):

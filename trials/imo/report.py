@@ -105,8 +105,13 @@ def report_lines(res) -> list[str]:
              f"execute (heading changed by 10 deg with 10 deg rudder).", ""]
     if sampled:
         pn = res.parameters
-        lines += [f"Uncertainty: {res.n_samples} samples of {len(pn['names'])} parameters "
-                  f"({', '.join(pn['names'])}) from their covariance (correlations kept; seed {pn['seed']}), every "
+        src = pn.get("model", pn)
+        what = (f"{len(src['names'])} parameters ({', '.join(src['names']) or 'none'}) from their covariance"
+                if src["names"] else "no parameters (no covariance)")
+        if "model" in pn:
+            what = (f"the model's {what} and the {len(pn['scale_effects'][0])} scale-effect corrections (below), "
+                    f"written into the full-scale ship as {len(pn['names'])} parameters")
+        lines += [f"Uncertainty: {res.n_samples} samples of {what} (correlations kept; seed {pn['seed']}), every "
                   f"manoeuvre run per sample.  Value: the median of the samples ('own parameters': the ship's own "
                   f"values); interval: 5th to 95th percentile; probability: the share of samples meeting the limit "
                   f"(a sample whose manoeuvre does not give the figure counts as not meeting it).  Verdict: pass "
