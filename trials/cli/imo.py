@@ -21,11 +21,20 @@ def cmd_imo(args) -> int:
     check_output_dir(args.out)
     ship = load_ship(args.ship)
     try:
+        target = ship if args.scale_to is None else load_ship(args.scale_to)
+    except InputError as e:
+        raise InputError("--scale-to", args.scale_to, e.message) from None
+    try:
         if args.speed is not None:
-            plan(ship, args.speed)                 # a bad speed: one line before any run
+            plan(target, args.speed)               # a bad speed: one line before any run
         else:
-            approach_speed(ship)                   # no speed known: the same
-        if args.samples:
+            approach_speed(target)                 # no speed known: the same
+        if args.scale_to is not None:
+            from ..imo.scaling import scaling
+            from ..imo.standard import _parse_speed
+
+            scaling(ship, target, _parse_speed(args.speed or approach_speed(target)[0]))   # another hull form
+        if args.samples and (args.scale_to is None or ship.covariance is not None):
             covariance_of(ship)                    # no covariance, a bad one: the same
     except InputError as e:
         if e.source not in ("speed", "samples"):
@@ -36,7 +45,8 @@ def cmd_imo(args) -> int:
               file=sys.stderr, flush=True)
     with backend_client(args) as client:
         ex = local_executor(args.jobs, progress=bool(args.samples), backend=args.backend, client=client)
-        res = imo(ship, speed=args.speed, samples=args.samples, seed=args.seed, executor=ex)
+        res = imo(ship, speed=args.speed, samples=args.samples, seed=args.seed, executor=ex, scale_to=target
+                  if args.scale_to is not None else None)
     with StagedOutput(args.out) as stage:
         names = write_report(res, stage.dir)
     print(f"{res.ship} at {res.speed} (L/V = {res.L_over_V:.3g} s): wrote {', '.join(names)} to {args.out}")
@@ -47,6 +57,13 @@ def cmd_imo(args) -> int:
             lo, hi = ("-" if x is None else f"{x:.3g}" for x in r["interval"])
             extra = f"  90 % [{lo}, {hi}]  P = {r['probability']:.3f}"
         print(f"  {r['name']:40s} {val:>10s}  limit {r['limit']:.3g} {r['unit']}{extra}  {r['verdict']}")
+    widths = res.interval_widths()
+    if widths:
+        print("90 % interval widths, all uncertainty / identified covariance only (scale effects fixed):")
+        for w in widths:
+            a, b = ("-" if x is None else f"{x:.3g}" for x in (w["width"], w["width_identified"]))
+            share = "-" if w["scaling_share"] is None else f"{100 * w['scaling_share']:.0f} %"
+            print(f"  {w['name']:40s} {a:>8s} / {b:<8s} {w['unit']:3s}  from the scaling: {share}")
     return 0
 
 
@@ -61,6 +78,10 @@ def add_parser(sub) -> None:
                    help="approach speed with its unit, e.g. '10 kn' (default: the ship's bundled trials')")
     p.add_argument("--samples", type=_whole(0, "--samples"), default=0, metavar="N",
                    help="parameter samples from the ship's covariance (default 0: its own parameters only)")
+    p.add_argument("--scale-to", default=None, metavar="SHIP",
+                   help="the full-scale ship (bundled name or YAML, same hull form) to Froude-scale this model to, "
+                        "with the scale effects (friction line, wake, rudder inflow) and their uncertainty "
+                        "(docs/imo.md)")
     p.add_argument("--seed", type=_seed, default=0, help="seed of the parameter samples (default 0)")
     p.add_argument("--jobs", type=_positive_int, default=None, help="worker processes (default: all usable cores)")
     p.add_argument("--backend", choices=("serial", "loky", "dask"), default="loky",

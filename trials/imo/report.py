@@ -57,6 +57,40 @@ def _convergence(res) -> list[str]:
     return lines
 
 
+_EFFECT_SOURCES = {
+    "friction": "(1 + k)(C_FM - C_FS) S/(L T) added to the resistance coefficient (ITTC-1957 line; ITTC 7.5-02-03-01.4 "
+                "2.4.1); std on the correction",
+    "wake": "w_S = (t + 0.04) + (w_M - t - 0.04)((1 + k) C_FS + dC_F)/((1 + k) C_FM) (ITTC 7.5-02-03-01.4 2.4.3); std "
+            "on the correction",
+    "epsilon": "(1 - w_R)/(1 - w_P) with the rudder's wake scaled by the same formula; std on the value",
+    "kappa": "transferred; the loading itself is the full-scale propeller's and engine's; std on the value"}
+
+
+def _scaling(res) -> list[str]:
+    sc = res.scaling
+    lines = ["## From the model to the ship", "",
+             f"Froude-scaled from {sc['model']} to {sc['ship']} (trials.imo.scaling): lambda = {sc['lambda']:.4g}, model "
+             f"speed {sc['u_model']:.4g} m/s (the ship's {sc['u_ship']:.4g} m/s / sqrt(lambda)).  From the model: the "
+             f"primed hull coefficients, w_P0, epsilon, kappa, gamma_R, l_R', the primed added masses; from the ship's "
+             f"config: geometry, mass, propeller, engine, steering, rudder geometry.  Re {sc['re_model']:.3g} (model) "
+             f"and {sc['re_ship']:.3g} (ship), ITTC-1957 C_F {sc['cf_model']:.5f} and {sc['cf_ship']:.5f}, "
+             f"1 + k = {sc['form_factor']:g}, dC_F = {sc['delta_CF']:g}, t = {sc['t_model']:.3f}.", "",
+             "| scale effect | quantity | model | ship | relative std | formula |", "|---|---|---|---|---|---|"]
+    for k, (q, m, s) in sc["corrections"].items():
+        lines.append(f"| {k} | {q} | {m:.4g} | {s:.4g} | {sc['rel_std'][k]:g} | {_EFFECT_SOURCES[k]} |")
+    widths = res.interval_widths()
+    if widths:
+        lines += ["", "The 90 % intervals' widths with all the uncertainty and with the identified covariance only "
+                  "(the same model draws, the scale-effect corrections fixed at their nominal values): the share the "
+                  "scaling assumptions add.", "",
+                  "| criterion | width | width, identified only | from the scaling |", "|---|---|---|---|"]
+        for w in widths:
+            share = "-" if w["scaling_share"] is None else f"{100 * w['scaling_share']:.0f} %"
+            lines.append(f"| {w['name']} | {_num(w['width'])} {w['unit']} | {_num(w['width_identified'])} {w['unit']} "
+                         f"| {share} |")
+    return lines + [""]
+
+
 def report_lines(res) -> list[str]:
     """The lines of ``imo.md``: the criteria table, the rules, the notes, the convergence and the figures."""
     sampled = res.samples is not None
@@ -69,8 +103,13 @@ def report_lines(res) -> list[str]:
              f"execute (heading changed by 10 deg with 10 deg rudder).", ""]
     if sampled:
         pn = res.parameters
-        lines += [f"Uncertainty: {res.n_samples} samples of {len(pn['names'])} parameters "
-                  f"({', '.join(pn['names'])}) from their covariance (correlations kept; seed {pn['seed']}), every "
+        src = pn.get("model", pn)
+        what = (f"{len(src['names'])} parameters ({', '.join(src['names']) or 'none'}) from their covariance"
+                if src["names"] else "no parameters (no covariance)")
+        if "model" in pn:
+            what = (f"the model's {what} and the {len(pn['scale_effects'][0])} scale-effect corrections (below), "
+                    f"written into the full-scale ship as {len(pn['names'])} parameters")
+        lines += [f"Uncertainty: {res.n_samples} samples of {what} (correlations kept; seed {pn['seed']}), every "
                   f"manoeuvre run per sample.  Value: the median of the samples ('own parameters': the ship's own "
                   f"values); interval: 5th to 95th percentile; probability: the share of samples meeting the limit "
                   f"(a sample whose manoeuvre does not give the figure counts as not meeting it).  Verdict: pass "
@@ -80,6 +119,8 @@ def report_lines(res) -> list[str]:
         lines += ["No uncertainty (the ship's own parameters: `mmg imo --samples N` samples them from the "
                   "ship's covariance): value against limit, no interval or probability.", ""]
     stop = [n[len(STOPPING) + 2:] for n in res.notes if n.startswith(f"{STOPPING}: ")]
+    if res.scaling is not None:
+        lines += _scaling(res)
     lines += ["## Criteria", "", *_table(res), "", "Full-astern stopping test: " + " ".join(stop) + ".", ""]
     other = [n for n in res.notes if not n.startswith(STOPPING)]
     if other:

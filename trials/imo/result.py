@@ -71,6 +71,13 @@ class ImoResult:
     sample_runs: dict = field(default_factory=dict, repr=False, compare=False)
     """With samples: the turning circles of the samples with the smallest, the median and the largest
     tactical diameter on each side, ``"turning circle, starboard: median sample"`` -> (TrialRun, metrics)."""
+    scaling: dict | None = None
+    """Scaled from a model (``scale_to``): ``model``, ``lambda``, ``u_model``, ``re_model``, ``re_ship``,
+    ``cf_model``, ``cf_ship``, ``form_factor``, ``corrections`` (name -> (quantity, model value, ship
+    value)), ``rel_std`` (:data:`trials.imo.scaling.EFFECTS` -> relative std); None otherwise."""
+    samples_without_scaling: dict | None = None
+    """Scaled with samples: the same model draws with the scale-effect uncertainties off (criterion name ->
+    values), so :meth:`interval_widths` can say how much of each interval the scaling assumptions make."""
 
     @property
     def n_samples(self) -> int:
@@ -125,6 +132,23 @@ class ImoResult:
         c = next(c for c in self.criteria if c.name == name)
         return S.convergence(self.samples[name], c.limit)
 
+    def interval_widths(self) -> list[dict]:
+        """Scaled with samples: per criterion the 90 % interval's width with all the uncertainty
+        (``width``), with the identified covariance only (``width_identified``: scale effects fixed at
+        their nominal corrections) and the share of the width the scaling assumptions add
+        (``scaling_share`` = 1 - width_identified / width).  Empty otherwise."""
+        if self.samples is None or self.samples_without_scaling is None:
+            return []
+        out = []
+        for c in self.criteria:
+            a = S.summarise(self.samples[c.name], c.limit)["interval"]
+            b = S.summarise(self.samples_without_scaling[c.name], c.limit)["interval"]
+            w = None if None in a else a[1] - a[0]
+            w0 = None if None in b else b[1] - b[0]
+            share = None if (w is None or w0 is None or w <= 0) else 1.0 - w0 / w
+            out.append({"name": c.name, "unit": c.unit, "width": w, "width_identified": w0, "scaling_share": share})
+        return out
+
     def plot(self, kind: str = "tracks", ax=None, pyplot: bool = True):
         """A figure: ``"tracks"`` (the turning circles with ship outlines), ``"zigzags"`` (heading and rudder
         histories), ``"stopping"`` (the full-astern stopping track with ship outlines and its speed and
@@ -152,7 +176,8 @@ def _ship(ship) -> Ship:
     return load_ship(ship)
 
 
-def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | None = 0, executor=None):
+def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | None = 0, executor=None,
+        scale_to=None):
     """Check the IMO manoeuvring standards on ``ship``, with their uncertainty when ``samples`` > 0.
 
     Criteria of IMO Resolution MSC.137(76) (2002), Annex 5.3, with the explanatory notes MSC/Circ.1053:
@@ -169,7 +194,8 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
         A Ship, a bundled ship name (``"esso_osaka"``) or a ship YAML path (``mmg identify``'s
         ``DIR/ship.yaml``, with its ``covariance:`` section).
     speed : str, optional
-        Approach speed with its unit (``"10 kn"``); default the one of the ship's bundled trials.
+        Approach speed with its unit (``"10 kn"``); default the one of the ship's bundled trials (with
+        ``scale_to``: the full-scale ship's speed and trials).
     samples : int, default 0
         Parameter samples; 0: the ship's own parameters only (no interval, no probability).
     cov : ParameterCovariance, mapping or DataFrame, optional
@@ -179,6 +205,14 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
     executor : callable, optional
         ``executor(func, tasks) -> list`` that runs the samples (:mod:`trials.imo.sampling`); default
         this machine's cores.
+    scale_to : Ship, str or os.PathLike, optional
+        The full-scale ship (same hull form) ``ship``, a model, is Froude-scaled to
+        (:mod:`trials.imo.scaling`): the model's primed hull coefficients and flow constants (identified
+        or its config's) with the scale-effect corrections (friction line, wake, rudder inflow), the
+        full-scale ship's geometry, mass, propeller, engine and steering.  With samples the corrections'
+        uncertainties (:class:`~trials.imo.scaling.ScaleEffects`) are sampled with the model's
+        covariance, and the same model draws are run again with the corrections fixed
+        (:meth:`ImoResult.interval_widths`: how much of each interval the scaling makes; twice the runs).
 
     Returns
     -------
@@ -191,42 +225,95 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
     Raises
     ------
     mmg.errors.InputError
-        An unknown ship, a bad speed (or none known), a negative sample count, a bad covariance.
+        An unknown ship, a bad speed (or none known), a negative sample count, a bad covariance, a
+        ``scale_to`` of another hull form or not larger than the model.
     """
     sh = _ship(ship)
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 0:
         raise InputError("samples", repr(samples), "expected a whole number of samples, 0 or more")
+    target = sh if scale_to is None else _ship(scale_to)
     notes = []
     if speed is None:
-        speed, files = approach_speed(sh)
+        speed, files = approach_speed(target)
         notes.append(f"approach speed {speed} from the bundled trials {', '.join(files)}")
-    p = plan(sh, speed)
-    notes += list(p.notes)
-    params = draws = None
-    if samples:
-        names, mean, mat, more = S.covariance_of(p.ship, cov)
-        notes += more
-        draws = S.draw(mean, mat, samples, seed)
-        params = {"names": names, "mean": mean, "cov": mat, "draws": draws, "seed": seed}
+    sc, scaled = _scale(sh, target, speed) if scale_to is not None else (None, None)
+    p = plan(sh if sc is None else sc.ship(sh), speed)
+    notes += ([] if sc is None else [_scale_note(sc)]) + list(p.notes)
     runs = run_manoeuvres(p)
     nominal = criterion_values(p, runs)
     crit = tuple(criteria(p.L_over_V))
     notes += [f"{c.name}: the manoeuvre does not give it (no 180 deg of turn, no overshoot, no stop) within "
               f"{MAX_RUN_LENGTHS_L:g} L/V: it fails" for c in crit if nominal[c.name] is None]
-    sampled = None
+    sampled = without = params = None
     if samples:
-        out = S.run_samples(p, params["names"], draws, executor)
-        sampled = {c.name: [o["values"][c.name] for o in out] for c in crit}
-        bad = [o["error"] for o in out if o["error"]]
-        if bad:
-            notes.append(f"{len(bad)} of {samples} samples failed to run (counted as not meeting any criterion), "
-                         f"e.g. {bad[0]}")
+        sampled, without, params = _sampled(p, sh, sc, (samples, cov, seed), executor, notes)
     notes.append(stopping_note(runs[STOPPING_RUN]))
     pa = p.ship.particulars
     extremes = _extreme_turns(p, params, sampled) if samples else {}
-    return ImoResult(ship=sh.name, speed=str(speed), u0=p.u0, L_over_V=p.L_over_V, L=pa.L, B=pa.B, criteria=crit,
-                     nominal=nominal, samples=sampled, parameters=params, notes=tuple(notes), runs=runs,
-                     sample_runs=extremes)
+    return ImoResult(ship=sh.name if sc is None else sc.base.name, speed=str(speed), u0=p.u0,
+                     L_over_V=p.L_over_V, L=pa.L, B=pa.B, criteria=crit, nominal=nominal, samples=sampled,
+                     parameters=params, notes=tuple(notes), runs=runs, sample_runs=extremes, scaling=scaled,
+                     samples_without_scaling=without)
+
+
+def _scale(model: Ship, full: Ship, speed: str):
+    """(:class:`~trials.imo.scaling.Scaling`, its summary for :attr:`ImoResult.scaling`)."""
+    from . import scaling as SC
+    from .standard import _parse_speed
+
+    sc = SC.scaling(model, full, _parse_speed(speed))
+    e = sc.effects
+    return sc, {"model": model.name, "ship": full.name, "lambda": sc.lam, "u_model": sc.u_model, "u_ship": sc.u_ship,
+                "re_model": sc.re_model, "re_ship": sc.re_ship, "cf_model": sc.cf_model, "cf_ship": sc.cf_ship,
+                "form_factor": e.form_factor, "delta_CF": e.delta_CF, "t_model": sc.t_model,
+                "corrections": sc.corrections(model), "rel_std": dict(zip(SC.EFFECTS, e.stds().tolist()))}
+
+
+def _scale_note(sc) -> str:
+    return (f"Froude-scaled from {sc.model_name} (lambda = {sc.lam:.4g}, model speed {sc.u_model:.4g} m/s): the "
+            f"model's primed hull coefficients and flow constants with the scale-effect corrections, the ship's "
+            f"geometry, mass, propeller, engine and steering (trials.imo.scaling)")
+
+
+def _run(p, names, rows, executor, notes: list) -> dict:
+    """Criterion name -> one value per row of ``rows`` (:func:`trials.imo.sampling.run_samples`); a note on failures."""
+    out = S.run_samples(p, names, rows, executor)
+    bad = [o["error"] for o in out if o["error"]]
+    if bad:
+        notes.append(f"{len(bad)} of {len(out)} samples failed to run (counted as not meeting any criterion), "
+                     f"e.g. {bad[0]}")
+    return {c.name: [o["values"][c.name] for o in out] for c in criteria(p.L_over_V)}
+
+
+def _sampled(p, sh: Ship, sc, how: tuple, executor, notes: list):
+    """(samples, samples with the scale effects fixed or None, parameters) of :func:`imo`; ``how`` =
+    (number of samples, covariance or None, seed)."""
+    from .scaling import EFFECTS, full_scale_draws
+
+    n, cov, seed = how
+    if sc is None or cov is not None or sh.covariance is not None:
+        names, mean, mat, more = S.covariance_of(p.ship if sc is None else sh, cov)
+        notes += more
+        draws = S.draw(mean, mat, n, seed)
+    else:
+        names, mean, mat, draws = [], np.zeros(0), np.zeros((0, 0)), np.zeros((n, 0))
+        notes.append(f"{sh.name} has no covariance: only the scale-effect corrections are sampled")
+    params = {"names": names, "mean": mean, "cov": mat, "draws": draws, "seed": seed}
+    if sc is None:
+        return _run(p, names, draws, executor, notes), None, params
+    rng = np.random.default_rng(None if seed is None else [int(seed), 28])
+    xi = rng.standard_normal((n, len(EFFECTS))) * sc.effects.stds()
+    fnames, rows = full_scale_draws(sc, sh, names, draws, xi)
+    nominal = sc.values(sh)
+    full = {"names": fnames, "mean": np.array([nominal[k] for k in fnames]),
+            "cov": np.cov(rows.T) if n > 1 else np.zeros((len(fnames),) * 2), "draws": rows, "seed": seed,
+            "model": params, "scale_effects": xi}
+    sampled = _run(p, fnames, rows, executor, notes)
+    without = None
+    if names:
+        _, rows0 = full_scale_draws(sc, sh, names, draws, np.zeros_like(xi))
+        without = _run(p, fnames, rows0, executor, [])
+    return sampled, without, full
 
 
 def stopping_note(run_metrics) -> str:
