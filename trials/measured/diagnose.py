@@ -605,11 +605,12 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
     current, named, rounds, remaining = base, [], [], list(cand)
     while remaining:
         taus, inflate = _taus(current, o.stride)
-        results = []
+        results, parts = [], []
         for cls in remaining:
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
             dbic, _, _, _, vals, _, z, mag, _ = results[-1]
-            pt = _parts(fitter, cls.name, vals).get("parts")
+            parts.append(_parts(fitter, cls.name, vals))
+            pt = parts[-1].get("parts")
             size = (", ".join(f"{k} {fmt3(abs(a))} (floor {fmt3(f)})" for k, (a, f) in pt.items()) if pt else
                     f"{fmt3(mag)} (floor {fmt3(floor(cls.name, fitter.kind))})")
             say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}, size {size} "
@@ -619,10 +620,9 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
                        "kind": fitter.kind, "heading_deg": round(math.degrees(fitter.heading), 2),
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
                                        "magnitude": float(f"{g:.4g}"), "floor": floor(c.name, fitter.kind),
-                                       **_parts(fitter, c.name, v),
-                                       "R": round(rr, 4) if math.isfinite(rr) else None,
+                                       **pa, "R": round(rr, 4) if math.isfinite(rr) else None,
                                        "clears_threshold": bool(ok), "parameters": v, "standard_errors": s}
-                                      for d, ok, c, m, v, s, z, g, rr in results]})
+                                      for (d, ok, c, m, v, s, z, g, rr), pa in zip(results, parts)]})
         ok = [r for r in results if r[1]]
         if not ok:
             break
