@@ -272,6 +272,8 @@ def predict_logged(packed: PackedShip, rec: Segmented, effects=None, free=(), th
     ext = es.external(rec.context, base=rec.inputs.ext)
     inputs = replace(rec.inputs, ext=ext) if ext is not None else rec.inputs
     mm = es.to_model(rec.restart)
+    if rec.speed_only:     # no logged sway: the start has none through the water, whatever the effects
+        mm[:, 1] = 0.0     # make of the stand-in zero (a current would turn it into a sway of -its cross part)
     pred = replay_states(pk, inputs, mm[0], meas=mm, reset=rec.reset)
     return es.to_logged(pred)
 
