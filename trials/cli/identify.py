@@ -113,6 +113,8 @@ def cmd_identify(args) -> int:
         if st["status"] == 0:
             print(f"note: {st['description'].split(':')[0]} stopped at its evaluation limit ({st['max_nfev']}) before "
                   f"converging; --max-nfev raises it", file=sys.stderr)
+    for w in ident.physical_check().warnings():
+        print(f"warning: {w}", file=sys.stderr)
     warn = ident.fit.warnings()
     if warn:
         print(f"warning: {len(warn)} finding(s) on where the identified values should not be read as the ship's "

@@ -140,6 +140,13 @@ class Identification:
         records when omitted) with the identified or the initial model."""
         return [{"name": r.name, **self.replay(r, model).scores()} for r in (runs or self.runs)]
 
+    def physical_check(self):
+        """:func:`trials.measured.physical.physical_check` of the identified model against its prior
+        over the training records: the energy balance unpowered, and every record's replay."""
+        from .physical import physical_check
+
+        return physical_check(self.ship, self.prior or self.initial, self.runs, [self.replay(r) for r in self.runs])
+
     def replay(self, run: MeasuredRun, model: str = "identified"):
         """:func:`trials.measured.predict.replay_record` of ``run`` with the identified (its wind scale too) or initial model."""
         if model == "identified":
@@ -624,6 +631,19 @@ def _report_fit(ident: Identification) -> list:
     return lines
 
 
+def _report_physical(chk) -> list:
+    """The report's physical checks (:mod:`trials.measured.physical`)."""
+    lines = ["", "## Physical checks", "",
+             "Energy: with the propeller stopped and the rudder amidships the ship must lose energy at every "
+             "state (dT/dt <= 0, mmg.dissipation), checked at the states the training records log and over "
+             "the box of their ranges; replays: every training record replayed open loop.", ""]
+    for what, c in (("identified, logged states", chk.logged), ("identified, range box", chk.box),
+                    ("prior, logged states", chk.prior_logged), ("prior, range box", chk.prior_box)):
+        lines.append(f"- {what}: {c.describe()}")
+    lines.append(f"- replays: {len(chk.divergences)} diverged" + "".join(f"\n  - {d.describe()}" for d in chk.divergences))
+    return lines
+
+
 def _report_training(ident: Identification) -> list:
     """The report's training fits (heading and speed RMS) and manoeuvre metrics, measured and replayed."""
     a = ident.scores(model="initial")
@@ -703,7 +723,7 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     cov = fit_covariance(fit, "Gauss-Newton covariance of mmg identify's fit scaled by the residual variance "
                               "(optimistic: the 10 Hz residuals are correlated)")
     (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov))
-    lines = _report_fit(ident) + _report_training(ident)
+    lines = _report_fit(ident) + _report_physical(ident.physical_check()) + _report_training(ident)
     if test_runs:
         lines += _report_test(ident, test_runs)
     if cv:
