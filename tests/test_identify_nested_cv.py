@@ -3,6 +3,7 @@ the hull form is chosen by held-out prediction, a non-finite replay is a diverge
 state, and ``mmg identify --hull`` refuses what it cannot do in one line."""
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -181,3 +182,88 @@ def test_hull_candidates_name_both_forms_and_refuse_a_ship_without_one():
     with pytest.raises(InputError, match="--hull"):
         N.hull_candidates("kvlcc2_l7")
     assert list(N.hull_candidates("kvlcc2_l7", ("kijima",))) == ["kijima"]
+
+
+# ----------------------------------------------------------------------------- mmg identify --hull
+from .conftest import FRT, needs_frt  # noqa: E402
+
+
+def _slice(src, dst, seconds):
+    lines = src.read_text().splitlines()
+    keep = [lines[0]] + [ln for ln in lines[1:] if ln.strip() and float(ln.split(",")[0]) <= seconds]
+    dst.write_text("\n".join(keep) + "\n")
+    return dst
+
+
+def _one_error(capsys):
+    err = capsys.readouterr().err
+    return [ln for ln in err.strip().splitlines() if ln.startswith("error")], err
+
+
+@needs_frt()
+@pytest.mark.parametrize("extra, words", [
+    (["--hull", "auto", "--ship", "kvlcc2_l7"], ["--hull", "crossflow", "kvlcc2_l7_crossflow"]),
+    (["--ship", "esso_osaka_3m", "--inner-folds", "3"], ["--inner-folds", "needs --hull auto"]),
+    (["--ship", "esso_osaka_3m", "--hull", "kijima", "--inner-folds", "2"], ["--inner-folds", "nothing to choose"]),
+])
+def test_hull_option_refusals_are_one_line_before_any_record_is_read(tmp_path, capsys, extra, words):
+    from trials.cli import main
+
+    out = tmp_path / "out"
+    rc = main(["identify", "--train", str(FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv"), "--out", str(out), *extra])
+    errs, err = _one_error(capsys)
+    assert rc == 2 and not out.exists() and len(errs) == 1, err
+    assert all(w in errs[0] for w in words), errs[0]
+    assert "training on" not in err                   # refused before the records were read
+
+
+def test_hull_option_parsing():
+    import argparse
+
+    from trials.cli.identify import add_parser
+
+    ap = argparse.ArgumentParser()
+    add_parser(ap.add_subparsers())
+    base = ["identify", "--ship", "esso_osaka_3m", "--train", "a.csv", "--out", "o"]
+    a = ap.parse_args(base + ["--hull", "auto", "--inner-folds", "2"])
+    assert (a.hull, a.inner_folds) == ("auto", 2)
+    assert ap.parse_args(base).hull is None and ap.parse_args(base).inner_folds is None
+    for bad in (["--hull", "polynomial"], ["--hull", "auto", "--inner-folds", "1"]):
+        with pytest.raises(SystemExit) as e:
+            ap.parse_args(base + bad)
+        assert e.value.code == 2
+
+
+@needs_frt()
+def test_hull_auto_reports_the_choice_and_with_cv_each_folds(tmp_path, capsys, monkeypatch):
+    """--hull auto --cv 2 over three 30 s slices: the inner fits replaced by the prior itself (the choice
+    then rests on the two forms' own predictions), the final fit real but short; stdout names the form
+    and each fold's choice, nested_cv.json holds them, the report the kept-out records."""
+    import json
+
+    from trials.cli import main
+
+    monkeypatch.setattr(N, "fit_model", _Watch())
+    src = [FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv", FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv",
+           FRT / "turning" / "turn_14-Sep-2020_13_51_45.csv"]
+    logs = [_slice(p, tmp_path / f"{k}.csv", 30.0) for k, p in enumerate(src)]
+    out = tmp_path / "out"
+    args = ["identify", "--ship", "esso_osaka_3m", "--out", str(out), "--hull", "auto", "--cv", "2", "--inner-folds", "2",
+            "--max-nfev", "1", "--backend", "serial", "--train"]
+    assert main(args + [str(x) for x in logs[:3]]) == 2 and not out.exists()     # a training set of one: no choice
+    errs, err = _one_error(capsys)
+    assert errs == ["error: --hull: auto: no choice can be made on outer fold 0's training set: the inner cross-validation "
+                    "needs 2 or more independent records, got 1 (a record and its cut copies count once)"], err
+    assert "iteration" not in err and "[1/" not in err
+    logs.append(_slice(FRT / "turning" / "turn_14-Oct-2020_14_08_51.csv", tmp_path / "3.csv", 30.0))
+    rc = main(args + [str(x) for x in logs])
+    cap = capsys.readouterr()
+    assert rc == 0, cap.err
+    form = [ln for ln in cap.out.splitlines() if ln.startswith("hull form: ")]
+    assert len(form) == 1 and form[0].split()[2] in ("kijima", "crossflow")
+    res = json.loads((out / "nested_cv.json").read_text())
+    assert [f["fold"] for f in res["folds"]] == [0, 1] and {r["name"] for r in res["records"]} == {"0", "1", "2", "3"}
+    for f in res["folds"]:
+        assert re.search(rf"^fold {f['fold']}: chose {f['choice']} \(kijima [\d.]+ deg, \d diverged; crossflow", cap.out, re.M)
+        assert not set(f["test"]) & set(f["train"])
+    assert "## Cross-validation (2 folds" in (out / "report.md").read_text()

@@ -45,6 +45,17 @@ def _auto_hull(args, cands, runs, initial, folds, wind, kw, t0):
     common = dict(kw, wind=wind)
     args.inner_folds = args.inner_folds or 3
     say = (lambda m: print(m, file=sys.stderr, flush=True))
+    from ..measured.nested import _inner_tasks
+
+    try:                                       # a training set too small to choose on: refused before any fit
+        _inner_tasks(None, cands, runs, args.inner_folds, args.folds_by, None, {})
+        if folds:
+            from ..measured.nested import _split
+
+            for k, (tr, _) in enumerate(_split(runs, folds, args.folds_by)[1]):
+                _inner_tasks(k, cands, tr, args.inner_folds, args.folds_by, None, {})
+    except ValueError as e:
+        raise InputError("--hull", "auto", f"{e} (a record and its cut copies count once)") from None
     with backend_client(args) as client:
         if folds:
             say(f"nested cross-validation: {folds} outer folds, the hull form chosen in each by "

@@ -162,7 +162,11 @@ def _split(runs, folds: int, folds_by: str):
 
 
 def _inner_tasks(outer, candidates, train, inner_folds, folds_by, initial, kw):
-    _, splits = _split(train, inner_folds, folds_by)
+    try:
+        _, splits = _split(train, inner_folds, folds_by)
+    except ValueError as e:
+        where = "the records" if outer is None else f"outer fold {outer}'s training set"
+        raise ValueError(f"no choice can be made on {where}: the inner {e}") from None
     return [(outer, j, c, tr, te, initial, kw) for j, (tr, te) in enumerate(splits) for c in candidates.values()]
 
 
