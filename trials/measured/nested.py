@@ -131,9 +131,11 @@ def _outer_task(task) -> list[dict]:
     """One outer fit: the fold's choice fitted on the whole outer training set, the kept-out records scored."""
     outer, cand, train, tests, initial, kw, horizon_s = task
     ident = fit_model(cand.ship, train, initial=initial, **{**kw, **cand.options})
+    values = {k: float(v) for k, v in ident.fit.values().items()}
     return [{"name": r.name, "fold": outer, "choice": cand.name,
              "scaled": replay_scores(replay_record(initial, r), horizon_s),
-             "identified": replay_scores(ident.replay(r), horizon_s), "ship": ident.ship} for r in tests]
+             "identified": replay_scores(ident.replay(r), horizon_s), "ship": ident.ship, "values": values}
+            for r in tests]
 
 
 def choose(rows: list[dict], names) -> tuple[str, dict]:
@@ -278,7 +280,7 @@ class NestedCV:
     records : list of dict
         Per kept-out record: ``name``, ``fold``, ``choice`` (the candidate its fold chose), ``scaled``
         and ``identified`` (:func:`replay_scores` of the initial and the identified model), ``ship``
-        (the model identified without it).
+        (the model identified without it), ``values`` (its fitted values by name: the fold's fit).
     folds : list of dict
         Per outer fold: ``fold``, ``choice``, ``inner`` (:func:`choose`'s table), ``train``, ``test`` (names).
     inner : list of dict
