@@ -267,3 +267,32 @@ def test_hull_auto_reports_the_choice_and_with_cv_each_folds(tmp_path, capsys, m
         assert re.search(rf"^fold {f['fold']}: chose {f['choice']} \(kijima [\d.]+ deg, \d diverged; crossflow", cap.out, re.M)
         assert not set(f["test"]) & set(f["train"])
     assert "## Cross-validation (2 folds" in (out / "report.md").read_text()
+
+
+@needs_frt()
+@pytest.mark.slow
+def test_bench_prints_every_kept_out_record_the_choices_and_the_summary(tmp_path):
+    """bench/identify_cv.py end to end on the five berthing records (two outer folds, two inner, fits cut
+    short): one row per record, each fold's choice, the summary lines, the JSON with the same records."""
+    import json
+    import subprocess
+    import sys
+
+    from .conftest import REPO
+
+    js = tmp_path / "cv.json"
+    p = subprocess.run([sys.executable, str(REPO / "bench" / "identify_cv.py"), "--records", "berthing", "--folds", "2",
+                        "--inner-folds", "2", "--max-nfev", "2", "--backend", "serial", "--markdown", "--json", str(js)],
+                       capture_output=True, text=True, cwd=REPO, timeout=600)
+    assert p.returncode == 0, p.stderr
+    names = sorted(x.stem for x in (FRT / "berthing").glob("*.csv"))
+    rows = re.findall(r"^\| (berthing_\S+) \| ([01]) \| (kijima|crossflow) \|", p.stdout, re.M)
+    assert sorted(r[0] for r in rows) == names
+    for k in (0, 1):
+        assert re.search(rf"^- fold {k}: (kijima|crossflow) \(", p.stdout, re.M)
+    assert re.search(r"^- whole record: mean heading RMS scaled [\d.]+ deg, identified [\d.]+ deg, ratio", p.stdout, re.M)
+    assert re.search(r"^- first 60 s: mean heading RMS \[deg\]", p.stdout, re.M)
+    assert re.search(r"^- divergences: \d+", p.stdout, re.M)
+    res = json.loads(js.read_text())
+    assert sorted(r["name"] for r in res["records"]) == names
+    assert {(r["name"], str(r["fold"]), r["choice"]) for r in res["records"]} == set(rows)
