@@ -14,7 +14,7 @@ from mmg.model import pack
 from mmg.replay import ReplayInputs, replay
 from trials.measured import nested as N
 from trials.measured.identify import Identification
-from trials.measured.predict import MeasuredRun, Replayed, replay_record
+from trials.measured.predict import MeasuredRun, replay_record
 
 
 def _runs(ship, n=8, seconds=20.0):

@@ -45,15 +45,10 @@ def _auto_hull(args, cands, runs, initial, folds, wind, kw, t0):
     common = dict(kw, wind=wind)
     args.inner_folds = args.inner_folds or 3
     say = (lambda m: print(m, file=sys.stderr, flush=True))
-    from ..measured.nested import _inner_tasks
+    from ..measured.nested import check_choosable
 
     try:                                       # a training set too small to choose on: refused before any fit
-        _inner_tasks(None, cands, runs, args.inner_folds, args.folds_by, None, {})
-        if folds:
-            from ..measured.nested import _split
-
-            for k, (tr, _) in enumerate(_split(runs, folds, args.folds_by)[1]):
-                _inner_tasks(k, cands, tr, args.inner_folds, args.folds_by, None, {})
+        check_choosable(cands, runs, args.inner_folds, folds, args.folds_by)
     except ValueError as e:
         raise InputError("--hull", "auto", f"{e} (a record and its cut copies count once)") from None
     with backend_client(args) as client:
@@ -88,7 +83,7 @@ def _nested_as_cv(nested) -> list:
 
 def _print_nested(nested, out: Path) -> None:
     """--hull auto: the choices (each fold's with --cv) and the nested summary, on stdout."""
-    res, sel = nested
+    res, _ = nested
     if res is None:
         return
     for f in res.folds:

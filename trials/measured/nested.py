@@ -31,7 +31,7 @@ from mmg.ship import Ship
 from .predict import MeasuredRun, replay_record
 
 __all__ = ["Candidate", "NestedCV", "Selection", "nested_cross_validate", "select_candidate", "choose",
-           "replay_scores", "fit_model", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES"]
+           "replay_scores", "fit_model", "check_choosable", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES"]
 
 HULL_FORMS = {"kijima": "", "crossflow": "_crossflow"}
 """The hull forms ``mmg identify --hull`` knows, by the suffix of their bundled config's name after the
@@ -172,6 +172,17 @@ def _inner_tasks(outer, candidates, train, inner_folds, folds_by, initial, kw):
     return [(outer, j, c, tr, te, initial, kw) for j, (tr, te) in enumerate(splits) for c in candidates.values()]
 
 
+def check_choosable(candidates: dict, runs: list[MeasuredRun], inner_folds: int, folds: int | None = None,
+                    folds_by: str = "order") -> None:
+    """Raise ValueError, before any fit, where a choice among ``candidates`` cannot be made: on ``runs``
+    (:func:`select_candidate`) and, with ``folds``, on each outer training set (:func:`nested_cross_validate`),
+    an inner cross-validation needs 2 or more independent records."""
+    _inner_tasks(None, candidates, runs, inner_folds, folds_by, None, {})
+    if folds:
+        for k, (tr, _) in enumerate(_split(runs, folds, folds_by)[1]):
+            _inner_tasks(k, candidates, tr, inner_folds, folds_by, None, {})
+
+
 def _sweep(func, tasks, labels, backend, client, n_jobs):
     from ..files.sweep import run_sweep
 
@@ -224,7 +235,7 @@ def _initial(candidates: dict, initial: Ship | None) -> Ship:
 
 def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int = 4, inner_folds: int = 3,
                           initial: Ship | None = None, folds_by: str = "order", backend: str = "serial",
-                          client=None, n_jobs=None, horizon_s: float = HORIZON_S, **kw) -> "NestedCV":
+                          client=None, n_jobs=None, horizon_s: float = HORIZON_S, **kw) -> NestedCV:
     """Nested cross-validation (module docstring) of the procedure "choose among ``candidates`` by an
     inner ``inner_folds``-fold cross-validation, then fit the choice".
 
