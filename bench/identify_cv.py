@@ -1,18 +1,32 @@
-"""Cross-validation of ``mmg identify`` on the shared FRT-DS-ESSO turning and zigzag records
-(issue 11, acceptance 1): four folds, each record kept out once, with and without wind; per
-record the open-loop heading RMS of the initial (Froude-scaled) 3 m model and of the model
-identified without it.  The fit starts from that ship (``esso_osaka_3m``, the Kijima hull form,
-``--ship``; stop 19: it predicts the kept-out records better than the cross-flow form
-``esso_osaka_3m_crossflow``, the default before) and is scored against it (``--initial``).
-Run: ``python bench/identify_cv.py [--wind on|off|both] [--ship S] [--initial S] [--free ...]``.
+"""Nested cross-validation of ``mmg identify`` on the shared FRT-DS-ESSO records (issue 27, "Honest
+evaluation"): one command, every figure held out.
+
+The records (default: all of ``turning/``, ``zigzag/``, ``random/`` and ``berthing/``; a record and its
+cut copies count once and share a fold) are dealt into ``--folds`` outer folds, each kept out once.
+Inside each outer training set an inner ``--inner-folds`` cross-validation on the training records only
+chooses the hull form (``--hull auto``: Kijima ``esso_osaka_3m`` or cross-flow
+``esso_osaka_3m_crossflow``, by the lower inner held-out mean heading RMS, fewer divergences first;
+:func:`trials.measured.nested.nested_cross_validate`); the choice is fitted on the whole outer training
+set and the kept-out records are replayed open loop with it and with the initial Froude-scaled
+``esso_osaka_3m``.  The kept-out records never reach a fit or a choice of their fold.
+
+Printed per kept-out record: the scaled and the identified model's heading RMS, yaw-rate RMS, speed RMS
+and final position error in L, over the whole record and over its first minute (``--horizon``); a
+diverged replay (its time and last finite state); each fold's choice with the inner figures behind it;
+the summary (mean heading RMS scaled / identified, better on N of M, divergences).  ``--markdown``
+prints the tables as Markdown (docs/benchmark_frt.md), ``--json FILE`` writes
+:meth:`~trials.measured.nested.NestedCV.to_json`.
+
+Run: ``python bench/identify_cv.py [--hull auto|kijima|crossflow] [--folds 4] [--inner-folds 2]
+[--records turning zigzag random berthing] [--jobs 2] [--markdown] [--json out.json]``.
 
 ``--offset-spread DEG`` also replays every kept-out record, with both models, under rudder offsets
-from -DEG to +DEG (the ``rudder_offset`` effect: the blade DEG from what the indicator logs) and prints
-the range of heading RMS each model spans and the offset each prefers: how much of a record's score a
-small, record-specific asymmetry (a rudder zero, a steady gust, a pond current) decides."""
+from -DEG to +DEG (the ``rudder_offset`` effect) and prints the range of heading RMS each model spans.
+"""
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -22,81 +36,174 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import mmg  # noqa: E402
-from trials.measured.identify import cross_validate, load_runs  # noqa: E402
+from trials.measured.identify import load_runs  # noqa: E402
+from trials.measured.nested import HULL_FORMS, SCORE_NAMES, hull_candidates, nested_cross_validate  # noqa: E402
 from trials.papers.reproduce import frt_data_dir  # noqa: E402
 
-
 SHIP = "esso_osaka_3m"
-"""The prior: the Froude-scaled 3 m ship in the Kijima hull form (``esso_osaka_3m_crossflow``: the same
-ship in the low-speed cross-flow form, the default before stop 19; docs/identify_cv.md)."""
+"""The ship whose hull forms are candidates (:func:`trials.measured.nested.hull_candidates`)."""
 INITIAL = "esso_osaka_3m"
 """The honest initial model every kept-out record is scored with: the Froude-scaled full-scale ship."""
+SUBSETS = ("turning", "zigzag", "random", "berthing")
+SHORT = {"heading_rms_deg": "heading [deg]", "yaw_rate_rms_degps": "yaw rate [deg/s]",
+         "speed_rms_mps": "speed [m/s]", "final_position_error_L": "final pos. [L]"}
+FMT = {"heading_rms_deg": "{:.1f}", "yaw_rate_rms_degps": "{:.2f}", "speed_rms_mps": "{:.3f}",
+       "final_position_error_L": "{:.2f}"}
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--wind", choices=["on", "off", "both"], default="both")
-    ap.add_argument("--folds", type=int, default=4)
+def _args(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--hull", choices=("auto", *HULL_FORMS), default="auto",
+                    help="the hull form: chosen in each fold by the inner CV (auto, default) or fixed")
+    ap.add_argument("--folds", type=int, default=4, help="outer folds (default 4)")
+    ap.add_argument("--inner-folds", type=int, default=2, help="inner folds of the choice (default 2)")
+    ap.add_argument("--records", nargs="+", choices=SUBSETS, default=list(SUBSETS),
+                    help="which shared record folders to use (default all four)")
+    ap.add_argument("--wind", choices=["on", "off"], default="on")
     ap.add_argument("--free", nargs="+", default=None, help="free parameters (default: trials.measured.identify.DEFAULT_FREE)")
     ap.add_argument("--prior", type=float, default=0.5, help="prior std relative to the config value")
-    ap.add_argument("--ship", default=SHIP, help=f"prior ship: the form identified and its starting values (default {SHIP})")
-    ap.add_argument("--initial", default=INITIAL, help=f"the model the identified one is compared with (default {INITIAL})")
     ap.add_argument("--weighting", choices=["samples", "equal", "relative"], default=None,
                     help="record weighting in the fit (default: trials.measured.identify.DEFAULT_WEIGHTING)")
-    ap.add_argument("--loss", default="linear", help="least_squares loss of the whole-record stage")
-    ap.add_argument("--f-scale", type=float, default=1.0, help="the robust loss's residual scale")
-    ap.add_argument("--nuisance", nargs="+", default=(), metavar="EFFECT",
-                    help="effects fitted once per training record as nuisances (e.g. current)")
     ap.add_argument("--folds-by", choices=["order", "revolutions"], default="order",
-                    help="deal the records into folds in file order or stratified by propeller revolutions")
+                    help="deal the records into folds (outer and inner) in file order or stratified by revolutions")
     ap.add_argument("--max-nfev", type=int, default=None,
                     help="evaluation limit of each fit stage (default: trials.measured.identify.DEFAULT_MAX_NFEV)")
     ap.add_argument("--velocity-weight", type=float, default=1.0,
                     help="weight of the u, v, r residuals beside the heading's (identify(velocity_weight=))")
+    ap.add_argument("--nuisance", nargs="+", default=(), metavar="EFFECT",
+                    help="effects fitted once per training record as nuisances (e.g. current)")
+    ap.add_argument("--horizon", type=float, default=60.0, help="the short-horizon window [s] (default 60)")
+    ap.add_argument("--backend", choices=("serial", "loky"), default="loky")
+    ap.add_argument("--jobs", type=int, default=2, help="local workers of the loky backend (default 2)")
+    ap.add_argument("--markdown", action="store_true", help="print the tables as Markdown")
+    ap.add_argument("--json", default=None, metavar="FILE", help="also write the result as JSON")
     ap.add_argument("--offset-spread", type=float, default=0.0, metavar="DEG",
                     help="also score each kept-out record under rudder offsets within +-DEG (both models)")
-    a = ap.parse_args()
+    return ap.parse_args(argv)
+
+
+def _options(a) -> dict:
+    extra = {"wind": a.wind == "on", "prior_rel_std": a.prior}
+    if a.free:
+        extra["free"] = a.free
+    if a.weighting:
+        extra["record_weighting"] = a.weighting
+    if a.nuisance:
+        extra["record_nuisance"] = tuple(a.nuisance)
+    if a.velocity_weight != 1.0:
+        extra["velocity_weight"] = a.velocity_weight
+    if a.max_nfev:
+        extra["max_nfev"] = a.max_nfev
+    return extra
+
+
+def _cell(s: dict, key: str) -> str:
+    v = s[key]
+    return "div." if v is None or not np.isfinite(v) else FMT[key.replace(_cell.tag, "")].format(v)
+
+
+_cell.tag = "_60s"
+
+
+def _divergence_text(d) -> str:
+    if d is None:
+        return ""
+    st = d["last_state"]
+    where = "at the start" if st is None else (
+        f"last finite at {d['last_t_s']:.1f} s: u {st['u']:.3g} m/s, v {st['v']:.3g} m/s, r {np.degrees(st['r']):.3g} deg/s, "
+        f"x {st['x']:.4g} m, y {st['y']:.4g} m, psi {np.degrees(st['psi']):.4g} deg")
+    return f"non-finite at t = {d['t_s']:.1f} s ({where})"
+
+
+def record_table(res, markdown: bool) -> list[str]:
+    """Per kept-out record: scaled / identified scores over the whole record and over the first window."""
+    tag = f"_{res.horizon_s:g}s"
+    _cell.tag = tag
+    keys = list(SCORE_NAMES) + [k + tag for k in SCORE_NAMES]
+    head = (["record", "fold", "form"] + [f"{SHORT[k]} s / i" for k in SCORE_NAMES]
+            + [f"first {res.horizon_s:g} s: {SHORT[k]} s / i" for k in SCORE_NAMES] + ["diverged"])
+    rows = []
+    for r in res.records:
+        a, b = r["scaled"], r["identified"]
+        div = "; ".join(f"{who} at {s['divergence']['t_s']:.1f} s" for who, s in (("scaled", a), ("identified", b))
+                        if s["divergence"] is not None) or "no"
+        rows.append([r["name"], str(r["fold"]), r["choice"]] + [f"{_cell(a, k)} / {_cell(b, k)}" for k in keys] + [div])
+    return _table(head, rows, markdown)
+
+
+def _table(head, rows, markdown: bool) -> list[str]:
+    if markdown:
+        return ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)] + ["| " + " | ".join(r) + " |" for r in rows]
+    w = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)] if rows else [len(h) for h in head]
+    return ["  ".join(h.ljust(x) for h, x in zip(head, w))] + ["  ".join(c.ljust(x) for c, x in zip(r, w)) for r in rows]
+
+
+def summary_lines(res) -> list[str]:
+    """The summary: mean heading RMS over the whole record and the first window, better on N of M, divergences."""
+    s = res.summary()
+    tag = f"_{res.horizon_s:g}s"
+    fin = [r for r in res.records if r["scaled"]["divergence"] is None and r["identified"]["divergence"] is None]
+    out = [f"whole record: mean heading RMS scaled {s['mean_scaled']:.2f} deg, identified {s['mean_identified']:.2f} deg, "
+           f"ratio scaled/identified {s['ratio']:.2f} (over the {s['n_both_finite']} records both replays kept finite); "
+           f"identified better on {s['better']} of {s['n']}"]
+    for key, words in (("heading_rms_deg", "heading RMS [deg]"), ("yaw_rate_rms_degps", "yaw-rate RMS [deg/s]"),
+                       ("speed_rms_mps", "speed RMS [m/s]"), ("final_position_error_L", "final position error [L]")):
+        for k, span in ((key, "whole record"), (key + tag, f"first {res.horizon_s:g} s")):
+            x = [r["scaled"][k] for r in fin if np.isfinite(r["scaled"][k]) and np.isfinite(r["identified"][k])]
+            y = [r["identified"][k] for r in fin if np.isfinite(r["scaled"][k]) and np.isfinite(r["identified"][k])]
+            nb = sum(q < p for p, q in zip(x, y))
+            if x:
+                out.append(f"{span}: mean {words} scaled {np.mean(x):.4g}, identified {np.mean(y):.4g}, ratio "
+                           f"{np.mean(x) / np.mean(y):.2f}; identified lower on {nb} of {len(x)}")
+    out.append(f"divergences: {len(s['diverged'])}" + ("" if not s["diverged"] else ": " + "; ".join(
+        f"{n} ({who}) {_divergence_text(d)}" for n, who, d in s["diverged"])))
+    return out
+
+
+def choice_lines(res) -> list[str]:
+    """Each outer fold's choice and the inner figures it was made on."""
+    out = []
+    for f in res.folds:
+        inner = "; ".join(f"{c}: {t['mean_heading_rms_deg']:.2f} deg over {t['n'] - t['diverged']} inner kept-out "
+                          f"records, {t['diverged']} diverged" for c, t in f["inner"].items()) or "fixed (no choice)"
+        out.append(f"fold {f['fold']}: {f['choice']} ({len(f['train'])} training, {len(f['test'])} kept-out records; {inner})")
+        for r in res.inner:
+            if r["outer"] == f["fold"] and r["divergence"] is not None:
+                out.append(f"  fold {f['fold']}, inner fold {r['inner']}, {r['candidate']}: {r['name']} diverged, "
+                           f"{_divergence_text(r['divergence'])}")
+    return out
+
+
+def main(argv=None) -> None:
+    a = _args(argv)
     d = frt_data_dir()
     if d is None:
         sys.exit("FRT-DS-ESSO data not found (set MMG_FRT_DATA)")
-    files = sorted((d / "turning").glob("*.csv")) + sorted((d / "zigzag").glob("*.csv"))
-    ship, initial = mmg.load_ship(a.ship), mmg.load_ship(a.initial)
-    print(f"prior {ship.name}; initial {initial.name}; free {a.free or 'default'}; weighting "
-          f"{a.weighting or 'default'}; loss {a.loss} (f_scale {a.f_scale:g}); folds by {a.folds_by}; "
-          f"per-record nuisance {list(a.nuisance) or 'none'}; velocity weight {a.velocity_weight:g}", flush=True)
-    for wind in ([True, False] if a.wind == "both" else [a.wind == "on"]):
-        runs = load_runs(ship, files, wind=wind)
-        t0 = time.perf_counter()
-        extra = {"free": a.free} if a.free else {}
-        if a.weighting:
-            extra["record_weighting"] = a.weighting
-        if a.nuisance:
-            extra["record_nuisance"] = tuple(a.nuisance)
-        if a.loss != "linear":
-            extra.update(loss=a.loss, f_scale=a.f_scale)
-        if a.velocity_weight != 1.0:
-            extra["velocity_weight"] = a.velocity_weight
-        if a.max_nfev:
-            extra["max_nfev"] = a.max_nfev
-        cv = cross_validate(ship, runs, folds=a.folds, wind=wind, prior_rel_std=a.prior, initial=initial,
-                            folds_by=a.folds_by, **extra,
-                            progress=lambda k, n: print(f"  fold {k}/{n} done, {time.perf_counter() - t0:.0f} s", flush=True))
-        print(f"\nwind {'on' if wind else 'off'}: {len(runs)} records, {a.folds} folds, {time.perf_counter() - t0:.0f} s")
-        print(f"{'record':32s} {'initial':>8s} {'identified':>10s} {'ratio':>6s}  (heading RMS, deg)")
-        for c in cv:
-            x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
-            print(f"{c['name']:32s} {x:8.2f} {y:10.2f} {x / y:6.2f}")
-        ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
-        xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
-        xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
-        nb = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
-        print(f"{'mean':32s} {xa:8.2f} {xb:10.2f} {xa / xb:6.2f}   better on {nb} of {len(cv)} kept-out records")
-        diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
-        if diverged:
-            print(f"the identified model's replay diverged on {', '.join(diverged)} (counted as not better; "
-                  f"left out of both means)")
-        if a.offset_spread > 0:
-            offset_spread(cv, runs, initial, a.offset_spread)
+    files = [p for s in a.records for p in sorted((d / s).glob("*.csv"))]
+    forms = tuple(HULL_FORMS) if a.hull == "auto" else (a.hull,)
+    cands = hull_candidates(SHIP, forms)
+    initial = mmg.load_ship(INITIAL)
+    opts = _options(a)
+    runs = load_runs(initial, files, wind=opts["wind"])
+    print(f"nested cross-validation: {len(runs)} records ({', '.join(a.records)}), {a.folds} outer folds, "
+          f"hull {a.hull} ({' / '.join(c.ship.name for c in cands.values())}), inner folds {a.inner_folds}, "
+          f"scored against {initial.name}; wind {a.wind}; free {a.free or 'default'}; prior {a.prior:g}; "
+          f"weighting {a.weighting or 'default'}; folds by {a.folds_by}; backend {a.backend} ({a.jobs} jobs)", flush=True)
+    t0 = time.perf_counter()
+    res = nested_cross_validate(cands, runs, folds=a.folds, inner_folds=a.inner_folds, initial=initial,
+                                folds_by=a.folds_by, backend=a.backend, n_jobs=a.jobs, horizon_s=a.horizon, **opts)
+    print(f"\n{time.perf_counter() - t0:.0f} s wall\n")
+    print("Per kept-out record (s: scaled esso_osaka_3m, i: identified without it; 'div.': the replay diverged):\n")
+    print("\n".join(record_table(res, a.markdown)))
+    print("\nChoices of each fold (inner held-out mean heading RMS):\n")
+    print("\n".join(("- " if a.markdown else "") + ln for ln in choice_lines(res)))
+    print("\nSummary:\n")
+    print("\n".join(("- " if a.markdown else "") + ln for ln in summary_lines(res)))
+    if a.json:
+        Path(a.json).write_text(json.dumps(res.to_json(), indent=1) + "\n")
+        print(f"\nwrote {a.json}")
+    if a.offset_spread > 0:
+        offset_spread(res.records, runs, initial, a.offset_spread)
 
 
 def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> None:
@@ -118,7 +225,6 @@ def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> None:
 
     print(f"\nrudder offsets {offs[0]:+.2f} .. {offs[-1]:+.2f} deg ({n} values): heading RMS range [deg] and "
           f"preferred offset [deg] of each model")
-    print(f"{'record':32s} {'initial range':>15s} {'at':>6s} {'identified range':>17s} {'at':>6s}")
     best_a, best_b = [], []
     for c in cv:
         run = by_name[c["name"]]

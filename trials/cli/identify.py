@@ -22,6 +22,85 @@ def _check_free(ship, names) -> None:
                                           f"hull, hull-except-constants, {', '.join(SHIP_CONSTANTS)}")
 
 
+def _hull_choice(args):
+    """The candidate hull forms of ``--hull`` (None without it); refusals in one line, exit 2."""
+    if args.hull is None:
+        if args.inner_folds is not None:
+            raise InputError("--inner-folds", str(args.inner_folds), "needs --hull auto")
+        return None
+    from ..measured.nested import HULL_FORMS, hull_candidates
+
+    if args.hull != "auto" and args.inner_folds is not None:
+        raise InputError("--inner-folds", str(args.inner_folds), "needs --hull auto (nothing to choose)")
+    forms = tuple(HULL_FORMS) if args.hull == "auto" else (args.hull,)
+    return hull_candidates(args.ship, forms)
+
+
+def _auto_hull(args, cands, runs, initial, folds, wind, kw, t0):
+    """--hull auto: (ship, its config path, the nested cross-validation or None).  Without --cv the choice
+    is an inner cross-validation on all the training records; with --cv K the K-fold cross-validation is
+    nested (each fold's choice made on its training records) and the final form is chosen as without."""
+    from ..measured.nested import nested_cross_validate, select_candidate
+
+    common = dict(kw, wind=wind)
+    args.inner_folds = args.inner_folds or 3
+    say = (lambda m: print(m, file=sys.stderr, flush=True))
+    from ..measured.nested import check_choosable
+
+    try:                                       # a training set too small to choose on: refused before any fit
+        check_choosable(cands, runs, args.inner_folds, folds, args.folds_by)
+    except ValueError as e:
+        raise InputError("--hull", "auto", f"{e} (a record and its cut copies count once)") from None
+    with backend_client(args) as client:
+        if folds:
+            say(f"nested cross-validation: {folds} outer folds, the hull form chosen in each by "
+                f"{args.inner_folds} inner folds ({time.perf_counter() - t0:.0f} s)")
+            nested = nested_cross_validate(cands, runs, folds=folds, inner_folds=args.inner_folds, initial=initial,
+                                           folds_by=args.folds_by, backend=args.backend, client=client,
+                                           n_jobs=args.jobs, **common)
+        else:
+            nested = None
+        say(f"choosing the hull form by a {args.inner_folds}-fold cross-validation on the {len(runs)} training "
+            f"records ({time.perf_counter() - t0:.0f} s)")
+        sel = select_candidate(cands, runs, folds=args.inner_folds, initial=initial, folds_by=args.folds_by,
+                               backend=args.backend, client=client, n_jobs=args.jobs, **common)
+    for ln in sel.lines():
+        say(f"  {ln}")
+    print(f"hull form: {sel.choice} (inner {sel.folds}-fold cross-validation on the training records)")
+    chosen = cands[sel.choice].ship
+    return chosen, cands[sel.choice].path, (nested, sel)
+
+
+def _nested_as_cv(nested) -> list:
+    """The nested cross-validation's kept-out records in :func:`trials.measured.identify.cross_validate`'s
+    form (the report's cross-validation table)."""
+    res, _ = nested
+    if res is None:
+        return None
+    return [{"name": r["name"], "fold": r["fold"], "initial": r["scaled"], "identified": r["identified"],
+             "ship": r["ship"]} for r in res.records]
+
+
+def _print_nested(nested, out: Path) -> None:
+    """--hull auto: the choices (each fold's with --cv) and the nested summary, on stdout."""
+    res, _ = nested
+    if res is None:
+        return
+    for f in res.folds:
+        print(f"fold {f['fold']}: chose {f['choice']} ("
+              + "; ".join(f"{c} {t['mean_heading_rms_deg']:.2f} deg, {t['diverged']} diverged"
+                          for c, t in f["inner"].items()) + ")")
+    s = res.summary()
+    print(f"nested cross-validation: mean heading RMS {s['mean_scaled']:.2f} deg (initial) -> "
+          f"{s['mean_identified']:.2f} deg (identified), ratio {s['ratio']:.2f}, better on {s['better']} of {s['n']}; "
+          f"{len(s['diverged'])} diverged replay(s)")
+    for name, who, d in s["diverged"]:
+        print(f"  diverged: {name} ({who}) at t = {d['t_s']:.1f} s, last finite state "
+              + ("none" if d["last_state"] is None else
+                 ", ".join(f"{k} {v:.3g}" for k, v in d["last_state"].items())))
+    print(f"wrote {out / 'nested_cv.json'} (per kept-out record, the scores of both models and each fold's choice)")
+
+
 def cmd_identify(args) -> int:
     import numpy as np
 
@@ -38,9 +117,17 @@ def cmd_identify(args) -> int:
             raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
     src = ship_path(args.ship)
     ship = load_ship(src)
+    cands = _hull_choice(args)                     # refused before any record is read
+    if cands is not None and len(cands) == 1:      # --hull kijima|crossflow: that form is the prior
+        (only,) = cands.values()
+        src, ship = only.path, only.ship
     if args.free:
         _check_free(ship, args.free)
+        for c in (cands or {}).values():
+            _check_free(c.ship, args.free)
     initial = load_ship(ship_path(args.initial)) if args.initial else None
+    if initial is None and cands is not None and ship.name != load_ship(ship_path(args.ship)).name:
+        initial = load_ship(ship_path(args.ship))  # scored against the --ship given, whatever form is fitted
     if initial is not None:                # the same ship's particulars, before any record is read
         from ..files.shipcheck import check_same_ship
 
@@ -93,9 +180,16 @@ def cmd_identify(args) -> int:
         kw["velocity_weight"] = args.velocity_weight
     if args.free:
         kw["free"] = tuple(args.free)
+    nested = None
+    if cands is not None and len(cands) > 1:          # --hull auto: the form chosen by an inner CV
+        ship, src, nested = _auto_hull(args, cands, runs, initial, folds if args.cv else None, wind, kw, t0)
+        if initial is None:
+            initial = load_ship(ship_path(args.ship))
     ident = identify(ship, runs, wind=wind, progress=progress, initial=initial, **kw)
     cv = None
-    if args.cv:
+    if nested is not None:
+        cv = _nested_as_cv(nested)
+    elif args.cv:
         with backend_client(args) as client:
             cv = cross_validate(ship, runs, folds=folds, wind=wind, initial=initial, folds_by=args.folds_by, **kw,
                                 backend=args.backend, client=client, n_jobs=args.jobs,
@@ -104,11 +198,17 @@ def cmd_identify(args) -> int:
                                                             file=sys.stderr, flush=True))
     with StagedOutput(args.out) as stage:
         write_identification(ident, src, stage.dir, cv, tests)
+        if nested is not None and nested[0] is not None:
+            import json
+
+            (stage.dir / "nested_cv.json").write_text(json.dumps(nested[0].to_json(), indent=1) + "\n")
     a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
     b = np.mean([x["heading_rms_deg"] for x in ident.scores()])
     print(f"identified {len(ident.fit.free)} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
           f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
     print(f"wrote {Path(args.out) / 'ship.yaml'} and {Path(args.out) / 'report.md'}")
+    if nested is not None:
+        _print_nested(nested, Path(args.out))
     for st in ident.stages:
         if st["status"] == 0:
             print(f"note: {st['description'].split(':')[0]} stopped at its evaluation limit ({st['max_nfev']}) before "
@@ -158,5 +258,12 @@ def add_parser(sub) -> None:
     p.add_argument("--folds-by", choices=("order", "revolutions"), default="order",
                    help="with --cv: deal the records into folds in the order given or stratified by their propeller "
                         "revolutions (a record and its cut copies always share a fold)")
-    add_backend_options(p, "the cross-validation folds (--cv)")
+    p.add_argument("--hull", choices=("auto", "kijima", "crossflow"), default=None,
+                   help="the hull form fitted: kijima (--ship's bundled Kijima config) or crossflow (its "
+                        "'_crossflow' config); auto: chosen by an inner cross-validation on the --train records "
+                        "(lowest held-out mean heading RMS; --inner-folds), reported; with --cv the cross-validation "
+                        "is nested (the choice made inside each training set; default: --ship as given)")
+    p.add_argument("--inner-folds", type=_whole(2, "--inner-folds"), default=None, metavar="FOLDS",
+                   help="with --hull auto: folds of the inner cross-validation that chooses the form (default 3)")
+    add_backend_options(p, "the cross-validation folds (--cv) and the --hull auto choice")
     p.set_defaults(func=cmd_identify)

@@ -201,12 +201,33 @@ class Replayed:
         bad = ~np.isfinite(self.pred).all(axis=1)
         return float(self.run.t[np.argmax(bad)]) if bad.any() else None
 
-    def scores(self) -> dict:
+    @cached_property
+    def divergence(self) -> dict | None:
+        """Where the replay diverged, as a finding: ``{"t_s": time [s] of the first non-finite predicted
+        sample, "last_t_s": the last finite sample's time [s] (None when the first is not finite),
+        "last_state": that sample's predicted u, v [m/s], r [rad/s], x, y [m], psi [rad] by name
+        (:data:`mmg.replay.STATE`), "measured_state": the measured state there}``; None when the whole
+        record replayed.  :meth:`scores` are NaN over a window the divergence falls in: read this too."""
+        if self.diverged_at is None:
+            return None
+        i = int(np.argmax(~np.isfinite(self.pred).all(axis=1)))
+        j = i - 1 if i > 0 else None
+        state = (lambda row: {c: float(x) for c, x in zip(STATE, row)})   # noqa: E731
+        return {"t_s": float(self.run.t[i]), "last_t_s": None if j is None else float(self.run.t[j]),
+                "last_state": None if j is None else state(self.pred[j]),
+                "measured_state": state(self.run.meas[i])}
+
+    def scores(self, until_s: float | None = None) -> dict:
         """RMS over the record of heading [deg], yaw rate [deg/s], speed [m/s]; final position
-        error [m] and [L] (keys :data:`SCORE_KEYS`); NaN where the replay diverged."""
-        if self.diverged_at is not None:
-            return dict.fromkeys(SCORE_KEYS, float("nan"))
+        error [m] and [L] (keys :data:`SCORE_KEYS`); NaN where the replay diverged (within the window:
+        :attr:`divergence` says where).  ``until_s``: only the first ``until_s`` seconds from the
+        record's first sample (the final position error is then the one at the window's end)."""
         m, p = self.run.meas, self.pred
+        if until_s is not None:
+            keep = self.run.t <= self.run.t[0] + float(until_s) + 1e-9
+            m, p = m[keep], p[keep]
+        if not np.isfinite(p).all():
+            return dict.fromkeys(SCORE_KEYS, float("nan"))
         dpsi = np.degrees(p[:, 5] - m[:, 5])
         dr = np.degrees(p[:, 2] - m[:, 2])
         dU = np.hypot(p[:, 0], p[:, 1]) - np.hypot(m[:, 0], m[:, 1])

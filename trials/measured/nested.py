@@ -1,0 +1,358 @@
+"""Nested cross-validation of ``mmg identify``: every choice made inside the training folds (issue 27).
+
+A plain k-fold cross-validation (:func:`trials.measured.identify.cross_validate`) scores one
+procedure.  When the procedure has a choice to make (the hull form, a free set, a prior width, a
+weighting), choosing it by that same cross-validation's figure fits the choice to the kept-out
+records, and the figure is no longer a held-out one.  :func:`nested_cross_validate` keeps the
+kept-out records out of the choice too:
+
+* outer folds: the records are dealt into ``folds`` folds (:func:`~trials.measured.identify.fold_of`:
+  a record and its cut copies share a fold), each kept out once;
+* inside each outer training set, an inner cross-validation over the training records only
+  (``inner_folds`` folds) fits every :class:`Candidate` on each inner training set and replays the
+  inner kept-out records; the candidate with the fewest diverged inner replays, then the lowest mean
+  inner held-out heading RMS, is the fold's choice (:func:`choose`);
+* the choice is then fitted on the whole outer training set and the outer kept-out records are
+  replayed open loop with it and with the initial (Froude-scaled) model.
+
+Every fit goes through :func:`fit_model` (one place a test can watch).  A replay that goes
+non-finite is reported as a divergence with its time and state (:func:`replay_scores`), never as a
+bare NaN.  :func:`select_candidate` is the inner step alone, on all the given records: what
+``mmg identify --hull auto`` uses to choose the form it then fits.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mmg.ship import Ship
+
+from .predict import MeasuredRun, replay_record
+
+__all__ = ["Candidate", "NestedCV", "Selection", "nested_cross_validate", "select_candidate", "choose",
+           "replay_scores", "fit_model", "check_choosable", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES"]
+
+HULL_FORMS = {"kijima": "", "crossflow": "_crossflow"}
+"""The hull forms ``mmg identify --hull`` knows, by the suffix of their bundled config's name after the
+Kijima one's (``esso_osaka_3m`` and ``esso_osaka_3m_crossflow``: the same ship, the hull rewritten in
+the low-speed cross-flow form of :mod:`mmg.terms`)."""
+HORIZON_S = 60.0
+"""The short-horizon window [s] of the scores (the first minute: what a berthing pilot looks at)."""
+SCORE_NAMES = ("heading_rms_deg", "yaw_rate_rms_degps", "speed_rms_mps", "final_position_error_L")
+"""The scores reported per record, over the whole record and over the first :data:`HORIZON_S`."""
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One procedure among which a nested cross-validation chooses.
+
+    Attributes
+    ----------
+    name : str
+        Its label in the choices reported.
+    ship : Ship
+        The prior the fit starts from (its hull form is the model form).
+    options : dict
+        :func:`trials.measured.identify.identify` keyword arguments of this candidate on top of the
+        common ones (a free set ``free``, ``prior_rel_std``, ``record_weighting``, ...).
+    path : str, optional
+        The ship's config file (where ``mmg identify`` reads the YAML it writes the fitted values into).
+    """
+
+    name: str
+    ship: Ship
+    options: dict = field(default_factory=dict)
+    path: object = None
+
+
+def hull_candidates(ship_name: str, forms=("kijima", "crossflow")) -> dict[str, Candidate]:
+    """The candidates of ``mmg identify --hull``: the bundled configs of ``ship_name``'s hull forms
+    (:data:`HULL_FORMS`; ``ship_name`` may name either form).  Raises :class:`mmg.errors.InputError`
+    naming ``--hull`` for a form whose config is not bundled."""
+    from mmg.errors import InputError
+    from mmg.resources import ship_path
+    from mmg.ship import load_ship
+
+    base = str(ship_name)
+    for suffix in HULL_FORMS.values():
+        if suffix and base.endswith(suffix):
+            base = base[: -len(suffix)]
+    out = {}
+    for f in forms:
+        if f not in HULL_FORMS:
+            raise InputError("--hull", f, f"one of auto, {', '.join(HULL_FORMS)}")
+        name = base + HULL_FORMS[f]
+        try:
+            path = ship_path(name)
+            out[f] = Candidate(f, load_ship(path), path=path)
+        except InputError:
+            raise InputError("--hull", f, f"no bundled ship config {name!r} for the {f} hull form of "
+                                          f"{ship_name!r} (--hull needs --ship to name a bundled ship "
+                                          f"whose forms are {', '.join(base + s for s in HULL_FORMS.values())})"
+                             ) from None
+    return out
+
+
+def fit_model(ship: Ship, runs: list[MeasuredRun], **kw):
+    """Every fit of the nested cross-validation: :func:`trials.measured.identify.identify` (quiet)."""
+    from .identify import identify
+
+    kw.setdefault("say", lambda m: None)
+    return identify(ship, runs, **kw)
+
+
+def replay_scores(rep, horizon_s: float = HORIZON_S) -> dict:
+    """Scores of one replay (:class:`trials.measured.predict.Replayed`): :data:`SCORE_NAMES` over the whole
+    record, the same with the suffix ``_60s`` (``horizon_s``) over its first minute, and ``divergence``
+    (:attr:`~trials.measured.predict.Replayed.divergence`: time and state, None when it stayed finite).
+    A window the divergence falls in has NaN scores and the divergence says why."""
+    whole, first = rep.scores(), rep.scores(until_s=horizon_s)
+    tag = f"_{horizon_s:g}s"
+    out = {k: whole[k] for k in SCORE_NAMES}
+    out.update({k + tag: first[k] for k in SCORE_NAMES})
+    out["divergence"] = rep.divergence
+    return out
+
+
+def _inner_task(task) -> list[dict]:
+    """One inner fit: candidate fitted on an inner training set, its inner kept-out records replayed."""
+    outer, inner, cand, train, tests, initial, kw = task
+    ident = fit_model(cand.ship, train, initial=initial, **{**kw, **cand.options})
+    out = []
+    for r in tests:
+        rep = ident.replay(r)
+        out.append({"outer": outer, "inner": inner, "candidate": cand.name, "name": r.name,
+                    "heading_rms_deg": rep.scores()["heading_rms_deg"], "divergence": rep.divergence})
+    return out
+
+
+def _outer_task(task) -> list[dict]:
+    """One outer fit: the fold's choice fitted on the whole outer training set, the kept-out records scored."""
+    outer, cand, train, tests, initial, kw, horizon_s = task
+    ident = fit_model(cand.ship, train, initial=initial, **{**kw, **cand.options})
+    values = {k: float(v) for k, v in ident.fit.values().items()}
+    return [{"name": r.name, "fold": outer, "choice": cand.name,
+             "scaled": replay_scores(replay_record(initial, r), horizon_s),
+             "identified": replay_scores(ident.replay(r), horizon_s), "ship": ident.ship, "values": values}
+            for r in tests]
+
+
+def choose(rows: list[dict], names) -> tuple[str, dict]:
+    """The candidate an inner cross-validation chooses and each candidate's inner figures.
+
+    ``rows``: one per inner kept-out record and candidate (``candidate``, ``heading_rms_deg``,
+    ``divergence``).  Per candidate: ``n`` records, ``diverged`` replays, ``mean_heading_rms_deg``
+    over the finite ones.  Chosen: fewest divergences (a model that diverges on records like its
+    training set is not the better predictor), then the lowest mean, then the order of ``names``."""
+    table = {}
+    for c in names:
+        mine = [r for r in rows if r["candidate"] == c]
+        h = [r["heading_rms_deg"] for r in mine if r["divergence"] is None and np.isfinite(r["heading_rms_deg"])]
+        table[c] = {"n": len(mine), "diverged": len(mine) - len(h),
+                    "mean_heading_rms_deg": float(np.mean(h)) if h else float("inf")}
+    best = min(names, key=lambda c: (table[c]["diverged"], table[c]["mean_heading_rms_deg"], list(names).index(c)))
+    return best, table
+
+
+def _split(runs, folds: int, folds_by: str):
+    from .identify import cv_folds, fold_of
+
+    k = cv_folds(runs, folds)
+    f = fold_of(runs, k, folds_by)
+    return k, [([r for r, g in zip(runs, f) if g != j], [r for r, g in zip(runs, f) if g == j]) for j in range(k)]
+
+
+def _inner_tasks(outer, candidates, train, inner_folds, folds_by, initial, kw):
+    try:
+        _, splits = _split(train, inner_folds, folds_by)
+    except ValueError as e:
+        where = "the records" if outer is None else f"outer fold {outer}'s training set"
+        raise ValueError(f"no choice can be made on {where}: the inner {e}") from None
+    return [(outer, j, c, tr, te, initial, kw) for j, (tr, te) in enumerate(splits) for c in candidates.values()]
+
+
+def check_choosable(candidates: dict, runs: list[MeasuredRun], inner_folds: int, folds: int | None = None,
+                    folds_by: str = "order") -> None:
+    """Raise ValueError, before any fit, where a choice among ``candidates`` cannot be made: on ``runs``
+    (:func:`select_candidate`) and, with ``folds``, on each outer training set (:func:`nested_cross_validate`),
+    an inner cross-validation needs 2 or more independent records."""
+    _inner_tasks(None, candidates, runs, inner_folds, folds_by, None, {})
+    if folds:
+        for k, (tr, _) in enumerate(_split(runs, folds, folds_by)[1]):
+            _inner_tasks(k, candidates, tr, inner_folds, folds_by, None, {})
+
+
+def _sweep(func, tasks, labels, backend, client, n_jobs):
+    from ..files.sweep import run_sweep
+
+    return run_sweep(func, tasks, backend=backend, client=client, n_jobs=n_jobs, labels=labels)
+
+
+@dataclass(frozen=True)
+class Selection:
+    """:func:`select_candidate`'s result: ``choice`` and per candidate its inner figures (``table``)."""
+
+    choice: str
+    table: dict
+    folds: int
+    rows: list
+
+    def lines(self) -> list[str]:
+        """One line per candidate: its inner held-out mean heading RMS and divergences, the choice marked."""
+        return [f"{c}: mean held-out heading RMS {t['mean_heading_rms_deg']:.2f} deg over {t['n'] - t['diverged']} "
+                f"records, {t['diverged']} diverged{' (chosen)' if c == self.choice else ''}"
+                for c, t in self.table.items()]
+
+
+def select_candidate(candidates: dict, runs: list[MeasuredRun], folds: int = 3, initial: Ship | None = None,
+                     folds_by: str = "order", backend: str = "serial", client=None, n_jobs=None, **kw) -> Selection:
+    """Choose among ``candidates`` (:class:`Candidate` by name) by a ``folds``-fold cross-validation on
+    ``runs`` (:func:`choose`); ``kw``: :func:`~trials.measured.identify.identify`'s common options."""
+    initial = _initial(candidates, initial)
+    if len(candidates) == 1:
+        (name,) = candidates
+        return Selection(name, {name: {"n": 0, "diverged": 0, "mean_heading_rms_deg": float("nan")}}, 0, [])
+    tasks = _inner_tasks(None, candidates, runs, folds, folds_by, initial, kw)
+    parts = _sweep(_inner_task, tasks, [f"choice: inner fold {t[1] + 1}, {t[2].name}" for t in tasks],
+                   backend, client, n_jobs)
+    rows = [r for p in parts for r in p]
+    choice, table = choose(rows, list(candidates))
+    return Selection(choice, table, len({t[1] for t in tasks}), rows)
+
+
+def _initial(candidates: dict, initial: Ship | None) -> Ship:
+    from ..files.shipcheck import check_same_ship
+
+    if not candidates:
+        raise ValueError("no candidate to fit")
+    first = next(iter(candidates.values())).ship
+    ref = first if initial is None else initial
+    for c in candidates.values():
+        check_same_ship(ref, c.ship, option="--hull")
+    return ref
+
+
+def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int = 4, inner_folds: int = 3,
+                          initial: Ship | None = None, folds_by: str = "order", backend: str = "serial",
+                          client=None, n_jobs=None, horizon_s: float = HORIZON_S, **kw) -> NestedCV:
+    """Nested cross-validation (module docstring) of the procedure "choose among ``candidates`` by an
+    inner ``inner_folds``-fold cross-validation, then fit the choice".
+
+    Parameters
+    ----------
+    candidates : dict of str to Candidate
+        The procedures to choose among (one: no inner cross-validation, a plain one).
+    runs : list of MeasuredRun
+        Every record (a record and its cut copies count once: they share a fold).
+    folds, inner_folds : int
+        Outer and inner fold counts (fewer when there are fewer independent records).
+    initial : Ship, optional
+        The model every kept-out record is also replayed with ("scaled"); the first candidate's prior
+        when omitted.
+    folds_by : str
+        How records are dealt into folds, outer and inner (:func:`~trials.measured.identify.fold_of`).
+    backend, client, n_jobs
+        Where the fits run (:func:`trials.files.sweep.run_sweep`): the inner fits of every outer fold
+        in one sweep, then the outer fits in another; the same numbers on every backend.
+    horizon_s : float
+        The short-horizon window [s] of the scores.
+    **kw
+        :func:`~trials.measured.identify.identify`'s options common to every candidate.
+    """
+    initial = _initial(candidates, initial)
+    n_out, splits = _split(runs, folds, folds_by)
+    choices, tables, inner_rows = {}, {}, []
+    if len(candidates) > 1:
+        tasks = [t for k, (tr, _) in enumerate(splits)
+                 for t in _inner_tasks(k, candidates, tr, inner_folds, folds_by, initial, kw)]
+        parts = _sweep(_inner_task, tasks, [f"outer fold {t[0] + 1}/{n_out}: inner fold {t[1] + 1}, {t[2].name}"
+                                            for t in tasks], backend, client, n_jobs)
+        inner_rows = [r for p in parts for r in p]
+        for k in range(n_out):
+            choices[k], tables[k] = choose([r for r in inner_rows if r["outer"] == k], list(candidates))
+    else:
+        choices = dict.fromkeys(range(n_out), next(iter(candidates)))
+    tasks = [(k, candidates[choices[k]], tr, te, initial, kw, horizon_s) for k, (tr, te) in enumerate(splits)]
+    parts = _sweep(_outer_task, tasks, [f"outer fold {k + 1}/{n_out}: fit {choices[k]} on {len(t[2])} records"
+                                        for k, t in enumerate(tasks)], backend, client, n_jobs)
+    folds_info = [{"fold": k, "choice": choices[k], "inner": tables.get(k, {}),
+                   "train": [r.name for r in tr], "test": [r.name for r in te]} for k, (tr, te) in enumerate(splits)]
+    return NestedCV(records=[r for p in parts for r in p], folds=folds_info, inner=inner_rows,
+                    candidates=list(candidates), horizon_s=horizon_s)
+
+
+@dataclass(frozen=True)
+class NestedCV:
+    """:func:`nested_cross_validate`'s result.
+
+    Attributes
+    ----------
+    records : list of dict
+        Per kept-out record: ``name``, ``fold``, ``choice`` (the candidate its fold chose), ``scaled``
+        and ``identified`` (:func:`replay_scores` of the initial and the identified model), ``ship``
+        (the model identified without it), ``values`` (its fitted values by name: the fold's fit).
+    folds : list of dict
+        Per outer fold: ``fold``, ``choice``, ``inner`` (:func:`choose`'s table), ``train``, ``test`` (names).
+    inner : list of dict
+        Every inner kept-out replay (``outer``, ``inner``, ``candidate``, ``name``, ``heading_rms_deg``,
+        ``divergence``).
+    candidates : list of str
+    horizon_s : float
+    """
+
+    records: list
+    folds: list
+    inner: list
+    candidates: list
+    horizon_s: float = HORIZON_S
+
+    def summary(self) -> dict:
+        """``mean_scaled``, ``mean_identified`` heading RMS [deg] over the records both replays kept finite,
+        their ``ratio``, ``better`` (identified finite and lower, or the scaled one diverged and it did not)
+        of ``n``; ``diverged``: ``[(record, "scaled" | "identified", divergence)]``."""
+        both, better, div = [], 0, []
+        for r in self.records:
+            a, b = r["scaled"], r["identified"]
+            for who, s in (("scaled", a), ("identified", b)):
+                if s["divergence"] is not None:
+                    div.append((r["name"], who, s["divergence"]))
+            fa, fb = a["divergence"] is None, b["divergence"] is None
+            if fa and fb:
+                both.append((a["heading_rms_deg"], b["heading_rms_deg"]))
+            better += int(fb and (not fa or b["heading_rms_deg"] < a["heading_rms_deg"]))
+        x = float(np.mean([p[0] for p in both])) if both else float("nan")
+        y = float(np.mean([p[1] for p in both])) if both else float("nan")
+        return {"mean_scaled": x, "mean_identified": y, "ratio": x / y if both else float("nan"),
+                "better": better, "n": len(self.records), "n_both_finite": len(both), "diverged": div}
+
+    def to_pandas(self):
+        """One row per kept-out record: ``fold``, ``choice``, ``scaled_<score>`` and ``identified_<score>``
+        (:data:`SCORE_NAMES` and their first-minute ``_60s`` versions), ``<model>_diverged_at_s``."""
+        import pandas as pd
+
+        rows = []
+        for r in self.records:
+            row = {"name": r["name"], "fold": r["fold"], "choice": r["choice"]}
+            for who in ("scaled", "identified"):
+                s = r[who]
+                row.update({f"{who}_{k}": v for k, v in s.items() if k != "divergence"})
+                row[f"{who}_diverged_at_s"] = None if s["divergence"] is None else s["divergence"]["t_s"]
+            rows.append(row)
+        return pd.DataFrame(rows).set_index("name")
+
+    def to_json(self) -> dict:
+        """Everything but the identified ships, JSON-ready (NaN as None)."""
+        def clean(v):
+            if isinstance(v, dict):
+                return {k: clean(x) for k, x in v.items() if k != "ship"}
+            if isinstance(v, (list, tuple)):
+                return [clean(x) for x in v]
+            if isinstance(v, (float, np.floating)):
+                return float(v) if np.isfinite(v) else None
+            if isinstance(v, np.integer):
+                return int(v)
+            return v
+
+        return clean({"candidates": self.candidates, "horizon_s": self.horizon_s, "folds": self.folds,
+                      "records": self.records, "inner": self.inner, "summary": self.summary()})
