@@ -62,10 +62,9 @@ def divergence_of(rep) -> Divergence | None:
     Its time is the first non-finite sample's; its state and inputs are those where the replay first
     left twice the record's own range (speed over ground, yaw rate), where it began to run away
     (the last finite state is astronomically large)."""
-    if rep.diverged_at is None:
+    if rep.divergence is None:                 # (its first non-finite sample: Replayed.divergence)
         return None
     t, m, p = rep.run.t, rep.run.meas, rep.pred
-    bad = int(np.argmax(~np.isfinite(p).all(axis=1)))
     with np.errstate(invalid="ignore"):
         out = ((np.hypot(p[:, 0], p[:, 1]) > 2.0 * np.nanmax(np.hypot(m[:, 0], m[:, 1])))
                | (np.abs(p[:, 2]) > 2.0 * np.nanmax(np.abs(m[:, 2]))) | ~np.isfinite(p).all(axis=1))
@@ -74,7 +73,7 @@ def divergence_of(rep) -> Divergence | None:
     state = {"t_s": t[k] - t[0], "u_mps": last[0], "v_mps": last[1], "r_degps": np.degrees(last[2]),
              "x_m": last[3], "y_m": last[4], "psi_deg": np.degrees(last[5])}
     inputs = {"rudder_deg": np.degrees(rep.run.inputs.delta[k]), "n_rps": rep.run.inputs.n[k]}
-    return Divergence(rep.run.name, float(t[bad] - t[0]), {k_: float(v) for k_, v in state.items()},
+    return Divergence(rep.run.name, float(rep.divergence["t_s"] - t[0]), {k_: float(v) for k_, v in state.items()},
                       {k_: float(v) for k_, v in inputs.items()})
 
 
