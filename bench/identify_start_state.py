@@ -52,9 +52,11 @@ def main(argv=None) -> int:
     ap.add_argument("--data", default=str(REPO.parent / "shared" / "data" / "frt-ds-esso"))
     ap.add_argument("--wind", choices=("on", "off"), default=None)
     ap.add_argument("--out", default=None)
+    ap.add_argument("--sample-from", default=None, help="the 'sample' fit's figures from an earlier --out JSON "
+                                                        "(that fit does not depend on the start-state options)")
     a = ap.parse_args(argv)
-    res = []
-    for st in ("sample", "fit"):
+    res = [json.loads(Path(a.sample_from).read_text())[0]] if a.sample_from else []
+    for st in ("sample", "fit")[len(res):]:
         r = run(Path(a.data), a.wind, st)
         res.append(r)
         print(f"initial_state={st}: {r['seconds']:.0f} s, evaluations {r['evaluations']}, tau {r['tau']:.2f}, "

@@ -92,3 +92,15 @@ def test_the_written_covariance_keeps_the_prior_at_its_stated_std():
     assert np.isclose(got4[0, 0], 1.0 / (4.0 * N / (4.0 * sd2) + 1.0 / 0.25), rtol=1e-9)
     assert np.isclose(np.sqrt(got4[1, 1]), 0.5, rtol=1e-9)
     assert "(inflated)" in identification_covariance(tau)["source"] and "not inflated" in c["source"]
+
+
+def test_a_channel_without_noise_gets_no_start_offset():
+    """Smoothed channels (no noise in their second difference: the FRT records' u, v, r) leave the start as
+    logged: an offset whose prior std (twice the noise) is under 1 % of its residual scale is not fitted."""
+    ship = mmg.load_ship(SHIP)
+    clean, runs = _records(ship, n_rec=1, duration=20.0)
+    m = runs[0].meas.copy()
+    m[:, :3] = clean[0][:, :3]                          # u, v, r without noise; the heading noisy
+    run = MeasuredRun(name="smooth", source="smooth", meas=m, inputs=runs[0].inputs)
+    ident = identify(ship, [run], free=["kappa"], segment_s=(np.inf,), say=lambda m: None, max_nfev=2)
+    assert [f.name for f in ident.fit.free if f.kind == "start"] == ["start.psi[smooth]"]

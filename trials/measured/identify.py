@@ -39,7 +39,8 @@ starts from its first sample, and that one sample's noise (on the 3 m model r is
 are correlated over the record (tau ~ 20 samples on synthetic records; docs/imo.md).  So the offsets
 of u, v, r and the heading of each record's first sample are fitted as per-record nuisance parameters
 (:func:`ekf.identify.start_parameters`), prior 0 with a std of twice the record's noise level
-(:func:`start_noise`: the first sample's error has the noise's std; twice it lets the data decide).
+(:func:`start_noise`: the first sample's error has the noise's std; twice it lets the data decide), an
+offset whose std is below 1 % of its residual scale left out (:data:`START_MIN_SCALE`: smoothed channels).
 Fitted rather than smoothed: a local polynomial over the first seconds estimates the state at the
 window's *end* point, whose variance a low-degree fit barely reduces (a quadratic's end-point
 variance is 9/N of the noise's: 10 samples gain nothing) and whose bias is largest where a
@@ -377,7 +378,7 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
     if o.initial_state == "fit":
         from ekf.identify import start_parameters
 
-        fp = fp + start_parameters(np.array([start_noise(r) for r in runs]) * 2.0, names=[r.name for r in runs])
+        fp = fp + start_parameters(_start_sigmas(ship, runs, o), names=[r.name for r in runs])
     if not o.record_nuisance:
         return fp, None
     import mmg.effects as E
@@ -402,6 +403,22 @@ def start_noise(run: MeasuredRun) -> np.ndarray:
     if run.speed_only:
         out[1] = np.nan
     return out
+
+
+START_MIN_SCALE = 0.01
+"""A start offset whose prior std is below this share of its residual scale (:func:`_scales`) is not fitted:
+it could not move the fit, and its finite-difference step (1e-6 of the std) would be at round-off."""
+
+
+def _start_sigmas(ship: Ship, runs, o: IdentifyOptions) -> np.ndarray:
+    """Prior std (n_records, 6) of each record's start offsets: twice its noise level (:func:`start_noise`);
+    NaN (not fitted) where below :data:`START_MIN_SCALE` of the residual scale (smoothed channels, whose
+    second difference shows no noise) and for x, y (not in the residuals)."""
+    sc = _scales(runs, ship.particulars.L, o.velocity_weight)
+    floor = START_MIN_SCALE * np.array([sc.u, sc.v, sc.r, np.nan, np.nan, sc.psi])
+    sig = np.array([start_noise(r) for r in runs]) * 2.0
+    with np.errstate(invalid="ignore"):
+        return np.where(sig >= floor, sig, np.nan)
 
 
 def _segmented(runs, seg: float):
