@@ -13,10 +13,16 @@ criterion's 90 % interval holds the true value.
 
 Variants (the same seeds and draws' seed; no factor is tuned on them):
 
-* ``gauss-newton``: the covariance as ``mmg identify`` writes it;
+* ``written``: what ``mmg identify`` writes into ship.yaml since each record's start state is fitted
+  as a nuisance (:func:`trials.measured.identify.identification_covariance`: the linearised posterior
+  with the prior at its stated std and the data's information divided by the fit's residuals'
+  correlation time tau);
+* ``gauss-newton``: the fit's own Gauss-Newton covariance (:func:`~trials.measured.identify.fit_covariance`:
+  what ``mmg identify`` wrote before);
 * ``tau``: that covariance times the residuals' integrated autocorrelation time tau (samples, the mean
-  over u, v, r, psi of each channel's median over the records of the identified model's open-loop
-  residuals), i.e. the standard errors times sqrt(tau), as ``mmg diagnose`` inflates its own
+  over u, v, r, psi of each channel's median over the records; since the start-state fit, of the fit's own
+  residuals at its stride, :attr:`~trials.measured.identify.Identification.tau`; before, of the identified
+  model's open-loop residuals from the first sample at the full rate), i.e. the standard errors times sqrt(tau), as ``mmg diagnose`` inflates its own
   (:func:`trials.measured.diagnose._tau`): N residuals carry about N / tau independent ones;
 * ``prior-stated``: the linearised posterior with the prior at its stated std.  :func:`ekf.identify._result`
   scales the whole inverse J^T J by the residual variance s^2, prior rows included, so a good fit
@@ -32,7 +38,11 @@ Variants (the same seeds and draws' seed; no factor is tuned on them):
   open-loop replay's sensitivity of record k's channel j (u, v, r, psi) to the fitted parameters (forward
   differences at the identified values).
 
-Usage: ``python bench/imo_coverage.py --seeds 24 --samples 64 [--out bench_imo_coverage.json]``.
+Every variant's covariance is the shared parameters' block (each record's start-state offsets, fitted as
+nuisance parameters, marginalised out).  ``--initial-state sample`` identifies as before the start-state fit
+(each replay from the raw first sample).
+
+Usage: ``python bench/imo_coverage.py --seeds 24 --seed0 500 --samples 64 [--out bench_imo_coverage.json]``.
 """
 from __future__ import annotations
 
@@ -57,7 +67,7 @@ NOISE = (0.02 / math.sqrt(LAMBDA), 0.02 / math.sqrt(LAMBDA), 0.0002 * math.sqrt(
 RECORDS = (("turning", 35.0, 60.0), ("turning", -35.0, 60.0), ("zigzag", 20.0, 70.0), ("zigzag", -10.0, 70.0))
 """(kind, rudder [deg], duration [s]) of each seed's records: short (60-70 s, about 110-130 sqrt(L/g))."""
 PERTURB = 0.15
-VARIANTS = ("gauss-newton", "tau", "prior-stated", "prior-stated-tau", "per-channel")
+VARIANTS = ("written", "gauss-newton", "tau", "prior-stated", "prior-stated-tau", "per-channel")
 
 
 def silent(*_a, **_k):
@@ -103,11 +113,18 @@ def records(prior, truth, seed: int, dt: float = 0.2):
     return out
 
 
+INITIAL_STATE = "fit"
+"""``--initial-state``: :func:`trials.measured.identify.identify`'s ``initial_state``."""
+
+
 def residual_tau(ident) -> float:
-    """Mean over u, v, r, psi of the median over the records of the open-loop residuals' integrated
-    autocorrelation time [samples]."""
+    """The fit's residuals' correlation time (:attr:`~trials.measured.identify.Identification.tau`); with
+    ``--initial-state sample``, as before: the mean over u, v, r, psi of the median over the records of the
+    open-loop residuals' (from the first sample, full rate) integrated autocorrelation time [samples]."""
     from trials.measured.diagnose import _tau
 
+    if ident.initial_state == "fit":
+        return float(ident.tau)
     taus = []
     for j in (0, 1, 2, 5):
         per = []
@@ -138,8 +155,9 @@ def covariances(fit, tau: float) -> dict:
     sd2 = (2.0 * fit.cost_final - prior_ss) / max(N - 2 * n, 1)  # the data rows' own (N - n of them)
     P = np.diag(1.0 / sig ** 2)
     Ad = np.linalg.inv(cov) * s2 - P
-    return {"gauss-newton": cov, "tau": cov * tau, "prior-stated": _psd(np.linalg.inv(Ad / sd2 + P)),
-            "prior-stated-tau": _psd(np.linalg.inv(Ad / (sd2 * tau) + P)), "s2": s2, "sd2": sd2}
+    k = np.ix_(*(2 * [[i for i, f in enumerate(fit.free) if getattr(f, "record", None) is None]]))   # the shared block
+    return {"gauss-newton": cov[k], "tau": cov[k] * tau, "prior-stated": _psd(np.linalg.inv(Ad / sd2 + P)[k]),
+            "prior-stated-tau": _psd(np.linalg.inv(Ad / (sd2 * tau) + P)[k]), "s2": s2, "sd2": sd2}
 
 
 def per_channel_covariance(ident) -> np.ndarray:
@@ -148,9 +166,10 @@ def per_channel_covariance(ident) -> np.ndarray:
     from trials.measured.identify import ship_with_values
 
     fit = ident.fit
-    names = [f.name for f in fit.free]
-    theta = np.asarray(fit.theta, float)
-    sig = np.array([f.sigma for f in fit.free], float)
+    shared = [f for f in fit.free if f.record is None]
+    names = [f.name for f in shared]
+    theta = np.array([v for f, v in zip(fit.free, fit.theta) if f.record is None], float)
+    sig = np.array([f.sigma for f in shared], float)
 
     def preds(th):
         ship = ship_with_values(ident.initial, dict(zip(names, th)))
@@ -190,26 +209,27 @@ def one_seed(seed: int, samples: int) -> dict:
     """Identify one seed's records and count which intervals hold the truth, per variant."""
     import mmg
     from trials.imo import result as R
-    from trials.measured.identify import fit_covariance, identify
+    from trials.measured.identify import fit_covariance, identification_covariance, identify
 
     t0 = time.perf_counter()
     prior = mmg.load_ship(SHIP)
     truth = true_ship(prior, seed)
     runs = records(prior, truth, seed)
-    ident = identify(prior, runs, say=silent)
+    ident = identify(prior, runs, say=silent, initial_state=INITIAL_STATE)
     t_fit = time.perf_counter() - t0
     U = float(np.median(np.concatenate([np.hypot(r.meas[:, 0], r.meas[:, 1]) for r in runs[:1]])[:10]))
     speed = f"{0.09 * math.sqrt(9.80665 * prior.particulars.L):.6g} m/s"
     want = R.imo(truth, speed=speed, executor=serial).nominal
     cov = fit_covariance(ident.fit)
     tau = residual_tau(ident)
-    out = {"seed": seed, "tau": tau, "fit_s": t_fit, "approach_U": U, "stages": [s["status"] for s in ident.stages],
+    out = {"seed": seed, "tau": tau, "initial_state": ident.initial_state, "fit_s": t_fit, "approach_U": U, "stages": [s["status"] for s in ident.stages],
            "truth": want, "variants": {}}
     if cov is None:
         out["error"] = "singular covariance"
         return out
     covs = covariances(ident.fit, tau)
     covs["per-channel"] = per_channel_covariance(ident)
+    covs["written"] = np.asarray(identification_covariance(ident)["matrix"], float)
     out["s2"], out["sd2"] = covs["s2"], covs["sd2"]
     for v in VARIANTS:
         c = {**cov, "matrix": covs[v]}
@@ -244,9 +264,11 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=None, help="JSON of every seed's figures")
     ap.add_argument("--exact-start", action="store_true",
                     help="each record's first sample without its noise (an oracle experiment on the cause)")
+    ap.add_argument("--initial-state", default="fit", choices=("fit", "sample"),
+                    help="identify's initial_state: each record's start state fitted (default) or its raw first sample")
     a = ap.parse_args(argv)
-    global EXACT_START
-    EXACT_START = a.exact_start
+    global EXACT_START, INITIAL_STATE
+    EXACT_START, INITIAL_STATE = a.exact_start, a.initial_state
     results = []
     t0 = time.perf_counter()
     for s in range(a.seed0, a.seed0 + a.seeds):

@@ -26,6 +26,13 @@ effects in it, their external loads (from the record's logged channels, ``Segmen
 starts and restarts from the model states of the logged ones and is compared in logged states
 (:class:`mmg.effects.EffectSet`).  ``Scales.pos`` [m] adds the position residuals (x, y) to the
 fit; without effects and ``pos`` the fit is the one above, bit for bit.
+
+Start states (:func:`start_parameters`): a free parameter of kind ``"start"`` is an offset on one
+logged state (``sub``: u, v, r, x, y, psi) of one record's first sample (``record``), the state its
+replay starts from; the residuals stay against the measured samples.  Fitted as a per-record
+nuisance beside the ship's parameters, so the noise of one sample does not drift a whole open-loop
+replay (and is not absorbed by the shared parameters).  :attr:`IdentifyResult.info_data` keeps the
+data rows' J^T J apart from the prior's, so a caller can weigh the two differently.
 """
 from __future__ import annotations
 
@@ -42,7 +49,7 @@ __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_param
            "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
            "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled",
            "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "logged_residual", "record_effect_parameters", "effect_set_of",
-           "predict_logged"]
+           "predict_logged", "start_parameters", "record_residuals"]
 
 RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
                     "l_R_prime": (P_LR, -2.0, 0.0)}
@@ -208,8 +215,8 @@ def apply_parameters(packed: PackedShip, free: list[FreeParameter], theta) -> Pa
             coef[f.index] = v
         elif f.kind == "w_P0":
             poly[POLY_WP0][0] = v
-        elif f.kind in ("effect", "wind_scale"):
-            continue                                  # applied by effect_set_of / to the records' loads
+        elif f.kind in ("effect", "wind_scale", "start"):
+            continue                                  # applied by effect_set_of / to the records' loads / starts
         else:
             p[f.index] = v
     return replace(packed, p=p, poly=poly, hull_coef=coef)
@@ -238,6 +245,33 @@ def record_effect_parameters(effects, n_records: int, first_index: int = 0, name
                 out.append(replace(effect_prior(e, q.name, f"{e.name}.{q.name}[{tag}]", index=first_index + i),
                                    record=k))
     return out
+
+
+def start_parameters(sigmas, names=None, channels=(0, 1, 2, 5)) -> list[FreeParameter]:
+    """Nuisance offsets of each record's start state (kind ``"start"``, prior 0): ``sigmas`` (n_records, 6)
+    the prior std of each logged state's offset (u, v [m/s], r [rad/s], x, y [m], psi [rad]) per record;
+    one parameter per record and channel of ``channels`` whose std is positive and finite, named
+    ``"start.<state>[<record>]"`` (the record's name from ``names`` or its index)."""
+    from mmg.replay import STATE
+
+    out = []
+    for k, sig in enumerate(np.asarray(sigmas, float)):
+        tag = names[k] if names is not None else k
+        for j in channels:
+            if np.isfinite(sig[j]) and sig[j] > 0:
+                out.append(FreeParameter(f"start.{STATE[j]}[{tag}]", "start", j, 0.0, float(sig[j]), sub=j, record=k))
+    return out
+
+
+def _started(rec: Segmented, free, theta, record) -> Segmented:
+    """``rec`` with its first restart state moved by record ``record``'s start offsets (kind ``"start"``)."""
+    off = [(f.sub, float(v)) for f, v in zip(free, theta) if f.kind == "start" and f.record == record]
+    if not off:
+        return rec
+    st = np.array(rec.restart, float, copy=True)
+    for j, v in off:
+        st[0, j] += v
+    return replace(rec, start=st)
 
 
 def effect_set_of(effects, free: list[FreeParameter], theta, record: int | None = None):
@@ -315,7 +349,7 @@ def logged_residual(pred: np.ndarray, rec: Segmented) -> np.ndarray:
 
 def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=None, free=(), theta=(),
                   ship=None, pos=None, record: int | None = None) -> np.ndarray:
-    rec = _wind_scaled(rec, free, theta)
+    rec = _started(_wind_scaled(rec, free, theta), free, theta, record)
     if effects or rec.fixed is not None:
         pred = predict_logged(packed, rec, effects, free, theta, ship, record)
     else:
@@ -343,6 +377,11 @@ class IdentifyResult:
     message: str
     status: int = 1
     """scipy's ``least_squares`` status: 0 the evaluation limit stopped it, > 0 converged."""
+    info_data: np.ndarray | None = None
+    """J_d^T J_d of the data rows alone (the residuals of the records, without the prior's rows) at the
+    solution, unscaled; None where not computed."""
+    ss_data: float | None = None
+    """Sum of squares of the data rows' residuals at the solution (twice the cost without the prior's part)."""
 
     def warnings(self) -> list[str]:
         """What a reader of the values should not miss, one sentence each: a parameter on one of its
@@ -363,8 +402,9 @@ class IdentifyResult:
         return out
 
     def values(self) -> dict:
-        """Fitted value of each free parameter, by name."""
-        return {f.name: float(v) for f, v in zip(self.free, self.theta)}
+        """Fitted value of each free parameter, by name (a record's start-state offsets, kind ``"start"``,
+        left out: they move one replay's start, not the model)."""
+        return {f.name: float(v) for f, v in zip(self.free, self.theta) if f.kind != "start"}
 
     def to_pandas(self):
         """One row per parameter: prior, estimate, standard error, change from the prior [%]."""
@@ -410,6 +450,16 @@ def record_residual_rms(packed: PackedShip, records: list[Segmented], free: list
     pk = apply_parameters(packed, free, theta)
     return np.array([float(np.sqrt(np.mean(_residual_one(pk, rec, scales.array(), stride, effects, free, theta,
                                                           ship, scales.pos, k) ** 2))) for k, rec in enumerate(records)])
+
+
+def record_residuals(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], theta,
+                     scales: Scales, stride: int = 2, effects=None, ship=None) -> list[np.ndarray]:
+    """Each record's scaled, unweighted residuals (n_k, 4: u, v, r, heading; 6 with ``scales.pos``) at
+    ``theta``, every ``stride``-th sample, as the fit sees them (start offsets and nuisance included)."""
+    pk = apply_parameters(packed, free, theta)
+    nch = 4 if scales.pos is None else 6
+    return [_residual_one(pk, rec, scales.array(), stride, effects, free, theta, ship, scales.pos, k).reshape(-1, nch)
+            for k, rec in enumerate(records)]
 
 
 @dataclass(frozen=True)
@@ -538,9 +588,11 @@ def _result(free, sol, cost_initial: float) -> IdentifyResult:
     std = np.sqrt(np.abs(np.diag(cov)))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(std, std)
+    Jd, fd = np.asarray(J)[:-n], sol.fun[:-n]                # the prior's rows are the last n
     return IdentifyResult(free=free, theta=sol.x, std=std, corr=corr, cost_initial=cost_initial,
                           cost_final=float(sol.cost), n_residuals=len(sol.fun), iterations=int(sol.nfev),
-                          message=str(sol.message), status=int(sol.status))
+                          message=str(sol.message), status=int(sol.status), info_data=Jd.T @ Jd,
+                          ss_data=float(fd @ fd))
 
 
 def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,

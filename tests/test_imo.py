@@ -231,8 +231,9 @@ def test_samples_are_written_into_the_ship():
 
 
 def test_identify_writes_the_covariance_imo_samples(tmp_path):
-    """mmg identify's ship.yaml carries the fit's covariance (names, units, values, corr * std std^T),
-    and imo samples that ship from it."""
+    """mmg identify's ship.yaml carries the fit's covariance (names, units, values and the linearised
+    posterior: the data's information over its residual variance and correlation time, the prior at its
+    stated std, the start-state nuisances marginalised out), and imo samples that ship from it."""
     from tests.test_identify import SHIP, _synthetic_runs
     from trials.measured.identify import identify, write_identification
 
@@ -245,10 +246,14 @@ def test_identify_writes_the_covariance_imo_samples(tmp_path):
     c = back.covariance
     f = ident.fit
     assert list(c.names) == free and list(c.units) == ["1", "1", "1", "kg"]
-    assert np.allclose(c.values, f.theta, rtol=1e-8)
-    want = np.asarray(f.corr) * np.outer(f.std, f.std)
-    assert np.allclose(np.asarray(c.matrix), want, rtol=1e-8, atol=0)
-    assert np.allclose(c.std(), f.std, rtol=1e-8)
+    shared = [i for i, p in enumerate(f.free) if p.name in free]
+    assert len(f.free) > len(free)                              # the start-state offsets were fitted too
+    assert np.allclose(c.values, np.asarray(f.theta)[shared], rtol=1e-8)
+    n = len(f.free)
+    sd2 = f.ss_data / (f.n_residuals - n - n)                   # data rows N - n, less the n fitted
+    sig = np.array([p.sigma for p in f.free])
+    want = np.linalg.inv(f.info_data / (sd2 * max(ident.tau, 1.0)) + np.diag(sig ** -2.0))[np.ix_(shared, shared)]
+    assert np.allclose(np.asarray(c.matrix), want, rtol=1e-6, atol=0)
     res = mmg.imo(path, speed="0.5 m/s", samples=4, executor=serial, seed=3)
     assert res.parameters["names"] == free and res.n_samples == 4
     for r in res.rows():

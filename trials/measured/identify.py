@@ -32,6 +32,29 @@ The hull form is the prior's: ``esso_osaka_3m`` (Kijima polynomials in beta) or
 values stay physical (w_P0 0.61 as the Osaka identification's 0.614, N_r within 10 % of its prior)
 where the Kijima ones do not (Y_bb changes sign, N_r falls to a fifth); ``initial=`` scores the
 fit against another model (the Kijima ship the cross-flow prior was converted from).
+
+Each record's start state (:data:`DEFAULT_INITIAL_STATE` ``"fit"``): the open-loop replay of a record
+starts from its first sample, and that one sample's noise (on the 3 m model r is logged to about
++-0.002 rad/s) drifts the whole replay; the shared parameters then absorb the drift and the residuals
+are correlated over the record (tau ~ 20 samples on synthetic records; docs/imo.md).  So the offsets
+of u, v, r and the heading of each record's first sample are fitted as per-record nuisance parameters
+(:func:`ekf.identify.start_parameters`), prior 0 with a std of twice the record's noise level
+(:func:`start_noise`: the first sample's error has the noise's std; twice it lets the data decide), an
+offset whose std is below 1 % of its residual scale left out (:data:`START_MIN_SCALE`: smoothed channels).
+Fitted rather than smoothed: a local polynomial over the first seconds estimates the state at the
+window's *end* point, whose variance a low-degree fit barely reduces (a quadratic's end-point
+variance is 9/N of the noise's: 10 samples gain nothing) and whose bias is largest where a
+record starts with the rudder going over (a zigzag); the fit uses the whole record through the
+model, and its covariance accounts for the offsets (the shared parameters' block of the joint
+inverse is their marginal).  ``initial_state="sample"`` replays from the raw first sample as before.
+
+The covariance written into ship.yaml (:func:`identification_covariance`): the linearised posterior
+cov = (J_d^T J_d / (s_d^2 tau) + diag(1 / sigma_prior^2))^-1, the data rows' information scaled by
+their own residual variance s_d^2 and the prior's kept at its stated std (:func:`ekf.identify._result`
+scales the whole inverse, prior rows included, by s^2, so a good fit shrank the prior's std too),
+inflated by the fit's residuals' integrated autocorrelation time tau where it is above 1 (N
+correlated residuals carry about N / tau independent ones; tau as ``mmg diagnose`` takes it: the
+mean over u, v, r, heading of the median over the records).
 """
 from __future__ import annotations
 
@@ -51,11 +74,17 @@ __all__ = ["identify", "IdentifyOptions",
            "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
            "fit_covariance", "ship_with_values", "PARAMETER_UNITS",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
-           "stage_description"]
+           "stage_description", "identification_covariance", "start_noise", "DEFAULT_INITIAL_STATE",
+           "INITIAL_STATES"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale")
 DEFAULT_MAX_NFEV = 30
 """Default limit of the residual evaluations of each fit stage (:func:`identify`'s ``max_nfev``)."""
+DEFAULT_INITIAL_STATE = "fit"
+"""Default start state of each record's replay in the fit (:func:`identify`'s ``initial_state``)."""
+INITIAL_STATES = ("fit", "sample")
+"""``"fit"``: each record's start state offsets fitted as nuisance parameters (module docstring);
+``"sample"``: the raw first sample."""
 DEFAULT_WEIGHTING = "equal"
 """Default weighting of the training records in the fit (:func:`ekf.identify.record_weights`)."""
 DEFAULT_SEGMENTS_L = (52.0, np.inf)
@@ -130,6 +159,10 @@ class Identification:
     """How the training records counted (:func:`ekf.identify.record_weights`)."""
     velocity_weight: float = 1.0
     """How much the u, v, r residuals counted beside the heading's (:func:`identify`)."""
+    tau: float = 1.0
+    """The fit's residuals' integrated autocorrelation time [samples at the fit's stride] (module docstring)."""
+    initial_state: str = DEFAULT_INITIAL_STATE
+    """How each record's start state was taken (:data:`INITIAL_STATES`)."""
     stages: tuple = ()
     """One dict per fit stage, in order: ``segment_s`` (segment length [s]; ``inf``: the whole record,
     no cut), ``description`` (:func:`stage_description`), ``evaluations`` (residual evaluations used),
@@ -300,6 +333,10 @@ class IdentifyOptions:
         median speed, the heading's 2 deg; 0.1: their squares weigh a hundredth in the cost, so the
         fit follows the heading, the score a replay is judged by).  docs/identify_cv.md: 0.1
         predicts the kept-out records better without wind and worse with it.
+    initial_state : str
+        ``"fit"`` (default): each record's start state (u, v, r, heading of its first sample) moved by
+        offsets fitted as per-record nuisance parameters; ``"sample"``: the raw first sample
+        (module docstring).
     """
 
     segment_s: object = None
@@ -314,6 +351,7 @@ class IdentifyOptions:
     f_scale: float = 1.0
     record_nuisance: tuple = ()
     velocity_weight: float = 1.0
+    initial_state: str = DEFAULT_INITIAL_STATE
 
 
 def _check_velocity_weight(velocity_weight) -> None:
@@ -344,6 +382,10 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
     if not any(r.inputs.ext is not None for r in runs):
         names = [n for n in names if n != "wind_scale"]       # no wind loads to scale
     fp = free_parameters(packed, ship.hull.names, names, o.prior_rel_std)
+    if o.initial_state == "fit":
+        from ekf.identify import start_parameters
+
+        fp = fp + start_parameters(_start_sigmas(ship, runs, o), names=[r.name for r in runs])
     if not o.record_nuisance:
         return fp, None
     import mmg.effects as E
@@ -353,15 +395,69 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
     return fp + record_effect_parameters(nuisance, len(runs), names=[r.name for r in runs]), nuisance
 
 
+def start_noise(run: MeasuredRun) -> np.ndarray:
+    """The noise level (std) of each logged state of ``run`` (u, v, r, x, y, psi; NaN where the record does
+    not log it: v of a speed-only record): the robust (MAD) std of the second difference over sqrt(6),
+    white noise on a smooth signal; where the MAD is 0 (a quantised channel) the plain std."""
+    m = np.asarray(run.meas, float).copy()
+    m[:, 5] = np.unwrap(m[:, 5])
+    d2 = np.diff(m, 2, axis=0)
+    d2 = d2[np.all(np.isfinite(d2), axis=1)]
+    if len(d2) < 3:
+        return np.full(6, np.nan)
+    mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0) * 1.4826
+    out = np.where(mad > 0, mad, np.std(d2, axis=0)) / np.sqrt(6.0)
+    if run.speed_only:
+        out[1] = np.nan
+    return out
+
+
+START_MIN_SCALE = 0.01
+"""A start offset whose prior std is below this share of its residual scale (:func:`_scales`) is not fitted:
+it could not move the fit, and its finite-difference step (1e-6 of the std) would be at round-off."""
+
+
+def _start_sigmas(ship: Ship, runs, o: IdentifyOptions) -> np.ndarray:
+    """Prior std (n_records, 6) of each record's start offsets: twice its noise level (:func:`start_noise`);
+    NaN (not fitted) where below :data:`START_MIN_SCALE` of the residual scale (smoothed channels, whose
+    second difference shows no noise) and for x, y (not in the residuals)."""
+    sc = _scales(runs, ship.particulars.L, o.velocity_weight)
+    floor = START_MIN_SCALE * np.array([sc.u, sc.v, sc.r, np.nan, np.nan, sc.psi])
+    sig = np.array([start_noise(r) for r in runs]) * 2.0
+    with np.errstate(invalid="ignore"):
+        return np.where(sig >= floor, sig, np.nan)
+
+
+def _segmented(runs, seg: float):
+    from ekf.identify import Segmented, segment_resets
+
+    return [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects, speed_only=r.speed_only)
+            for r in runs]
+
+
+def _residual_tau(problem: tuple, fit, o: IdentifyOptions, stride: int = 2) -> float:
+    """The integrated autocorrelation time [samples at ``stride``] of the last stage's residuals: each
+    channel's (u, v, r, heading) median over the records, the mean over the channels (as ``mmg diagnose``)."""
+    from ekf.identify import record_residuals
+
+    from .diagnose import _tau
+
+    ship, packed, runs, fp, nuisance = problem
+    res = record_residuals(packed, _segmented(runs, np.inf), fp, fit.theta,
+                           _scales(runs, ship.particulars.L, o.velocity_weight), stride=stride, effects=nuisance,
+                           ship=ship)
+    taus = [np.median([_tau(d[:, j]) for d in res]) for j in range(4)]
+    return float(np.mean(taus))
+
+
 def _fit_stage(problem: tuple, seg: float, label: str, last: bool, fit, o: IdentifyOptions):
     """One stage of :func:`identify`: every record cut into ``seg`` [s] segments, fitted from ``fit``'s values
     (the priors when None); problem = (ship, packed ship, runs, free parameters, nuisance effects or None)."""
-    from ekf.identify import Segmented, identify_segments, record_residual_rms, record_weights, segment_resets
+    from ekf.identify import identify_segments, record_residual_rms, record_weights
 
     ship, packed, runs, fp, nuisance = problem
     stage_progress = None if o.progress is None else (lambda i, c, _l=label: o.progress(i, c, _l))
-    segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, seg), fixed=r.effects, speed_only=r.speed_only)
-            for r in runs]
+    segs = _segmented(runs, seg)
     sc = _scales(runs, ship.particulars.L, o.velocity_weight)
     theta = np.array([f.prior for f in fp]) if fit is None else fit.theta
     rms = (record_residual_rms(packed, segs, fp, theta, sc, effects=nuisance, ship=ship)
@@ -393,6 +489,8 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, options: IdentifyOpti
     """
     o = IdentifyOptions(**kwargs) if options is None else replace(options, **kwargs)
     _check_velocity_weight(o.velocity_weight)                # before any record is read
+    if o.initial_state not in INITIAL_STATES:
+        raise ValueError(f"initial_state {o.initial_state!r}: one of {INITIAL_STATES}")
     if o.initial is not None:                                 # the same ship's, before any record is read
         from ..files.shipcheck import check_same_ship
 
@@ -411,10 +509,11 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, options: IdentifyOpti
         done.append({"segment_s": seg, "description": stage_description(seg), "evaluations": fit.iterations,
                      "max_nfev": int(o.max_nfev), "cost_initial": fit.cost_initial, "cost_final": fit.cost_final,
                      "status": fit.status, "message": fit.message})
+    tau = _residual_tau((ship, packed, runs, fp, nuisance), fit, o)
     return Identification(ship=_ship_with(ship, fit.values()), initial=ship if o.initial is None else o.initial,
                           fit=fit, runs=runs, segment_s=seg, prior=None if o.initial is None else ship,
                           record_weighting=o.record_weighting, velocity_weight=float(o.velocity_weight),
-                          stages=tuple(done))
+                          stages=tuple(done), tau=tau, initial_state=o.initial_state)
 
 
 FOLD_ASSIGNMENTS = ("order", "revolutions")
@@ -521,20 +620,61 @@ PARAMETER_UNITS = {"rudder_offset": "rad", "m_x": "kg", "m_y": "kg", "J_z": "kg 
 """The unit of a fitted parameter where it is not non-dimensional (``"1"``): the fit's own (SI)."""
 
 
-def fit_covariance(fit, note: str = "") -> dict | None:
-    """The ``covariance:`` section of a ship YAML from a fit (:class:`ekf.identify.IdentifyResult`):
-    its parameter names, units (:data:`PARAMETER_UNITS`), fitted values and the Gauss-Newton
-    covariance (``corr * std std^T``); None when the covariance is not finite (a singular fit)."""
-    std = np.asarray(fit.std, dtype=float)
-    cov = np.asarray(fit.corr, dtype=float) * np.outer(std, std)
+def _covariance_section(fit, cov: np.ndarray, note: str) -> dict | None:
+    """The ``covariance:`` section of the shared parameters (a record's own nuisance left out: the block
+    of the joint covariance is their marginal); None when it is not finite."""
+    keep = [i for i, f in enumerate(fit.free) if f.record is None]
+    cov = np.asarray(cov, float)[np.ix_(keep, keep)]
     if not np.all(np.isfinite(cov)):
         return None
     cov = 0.5 * (cov + cov.T)
-    names = [f.name for f in fit.free]
+    names = [fit.free[i].name for i in keep]
     return {"names": names, "units": [PARAMETER_UNITS.get(n, "1") for n in names],
-            "values": [float(f"{v:.10g}") for v in fit.theta],
-            "matrix": [[float(f"{x:.10g}") for x in row] for row in cov],
-            "source": note or "Gauss-Newton covariance of the fit scaled by the residual variance"}
+            "values": [float(f"{fit.theta[i]:.10g}") for i in keep],
+            "matrix": [[float(f"{x:.10g}") for x in row] for row in cov], "source": note}
+
+
+def fit_covariance(fit, note: str = "") -> dict | None:
+    """The ``covariance:`` section of a ship YAML from a fit (:class:`ekf.identify.IdentifyResult`) with
+    its own Gauss-Newton covariance (``corr * std std^T``: the whole inverse J^T J, prior rows included,
+    times the residual variance): its shared parameters' names, units (:data:`PARAMETER_UNITS`), fitted
+    values and covariance; None when it is not finite (a singular fit).  What ``mmg identify`` writes is
+    :func:`identification_covariance`'s."""
+    std = np.asarray(fit.std, dtype=float)
+    cov = np.asarray(fit.corr, dtype=float) * np.outer(std, std)
+    return _covariance_section(fit, cov, note or "Gauss-Newton covariance of the fit scaled by the residual variance")
+
+
+def posterior_covariance(fit, tau: float = 1.0) -> np.ndarray:
+    """(J_d^T J_d / (s_d^2 max(tau, 1)) + diag(1 / sigma_prior^2))^-1 over every free parameter of ``fit``:
+    the data rows' information (:attr:`ekf.identify.IdentifyResult.info_data`) scaled by their own
+    residual variance s_d^2 = ss_d / (N_d - n) and divided by their correlation time, the prior's at its
+    stated std; NaN where the fit has no data information or it is singular."""
+    n = len(fit.free)
+    if fit.info_data is None or fit.ss_data is None:
+        return np.full((n, n), np.nan)
+    n_data = int(fit.n_residuals) - n
+    sd2 = float(fit.ss_data) / max(n_data - n, 1)
+    sig = np.array([f.sigma for f in fit.free], float)
+    info = np.asarray(fit.info_data, float) / (sd2 * max(float(tau), 1.0)) + np.diag(1.0 / sig ** 2)
+    try:
+        return np.linalg.inv(info)
+    except np.linalg.LinAlgError:
+        return np.full((n, n), np.nan)
+
+
+def identification_covariance(ident: Identification) -> dict | None:
+    """The ``covariance:`` section ``mmg identify`` writes into ship.yaml: :func:`posterior_covariance`
+    with the fit's residual correlation time (:attr:`Identification.tau`), the shared parameters' block
+    (module docstring); None when it is not finite."""
+    tau = max(float(ident.tau), 1.0)
+    start = ("each record's start state fitted as a nuisance" if ident.initial_state == "fit"
+             else "each record replayed from its first sample")
+    note = (f"linearised posterior of mmg identify's fit ({start}): (J_d^T J_d / (s_d^2 tau) + "
+            f"diag(1 / sigma_prior^2))^-1, the prior at its stated std, the data's information divided by the "
+            f"residuals' integrated autocorrelation time tau = {tau:.3g} samples"
+            + (" (inflated)" if tau > 1.0 else " (not inflated: white residuals)"))
+    return _covariance_section(ident.fit, posterior_covariance(ident.fit, tau), note)
 
 
 def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None) -> str:
@@ -613,11 +753,22 @@ def _report_fit(ident: Identification) -> list:
              f"records weighted {ident.record_weighting!r}; velocity residuals weighted {ident.velocity_weight:g} "
              f"beside the heading's.", "", *_stage_lines(ident), "",
              "## Values and standard errors", "",
-             "Standard errors from the Gauss-Newton covariance scaled by the residual variance; the 10 Hz "
-             "residuals are correlated, so they are optimistic.", "",
+             "Standard errors from the covariance written into ship.yaml (the linearised posterior, the prior at "
+             f"its stated std, the data's information divided by the residuals' correlation time tau = "
+             f"{max(ident.tau, 1.0):.3g} samples; :func:`identification_covariance`); where it is singular, the "
+             "fit's own Gauss-Newton ones.", "",
              "| parameter | config | identified | std | change |", "|---|---|---|---|---|"]
+    cov = identification_covariance(ident)
+    std = dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"]))))) if cov else {}
+    starts = [f for f in fit.free if f.kind == "start"]
     for name, row in fit.to_pandas().iterrows():
-        lines.append(f"| {name} | {row.prior:.5g} | {row.estimate:.5g} | {row['std']:.2g} | {row.change_pct:+.0f} % |")
+        if name.startswith("start."):
+            continue
+        lines.append(f"| {name} | {row.prior:.5g} | {row.estimate:.5g} | {std.get(name, row['std']):.2g} | "
+                     f"{row.change_pct:+.0f} % |")
+    if starts:
+        lines += ["", f"Each record's start state (u, v, r, heading of its first sample) was fitted as a nuisance "
+                      f"({len(starts)} offsets, not listed; prior 0 with twice the record's noise level as std)."]
     warn = fit.warnings()
     if warn:
         lines += ["", "## Warnings", "",
@@ -720,8 +871,7 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     fit = ident.fit
     note = (f"segment-wise output error over {len(ident.runs)} records "
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
-    cov = fit_covariance(fit, "Gauss-Newton covariance of mmg identify's fit scaled by the residual variance "
-                              "(optimistic: the 10 Hz residuals are correlated)")
+    cov = identification_covariance(ident)
     (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov))
     lines = _report_fit(ident) + _report_physical(ident.physical_check()) + _report_training(ident)
     if test_runs:
