@@ -104,3 +104,18 @@ def test_a_channel_without_noise_gets_no_start_offset():
     run = MeasuredRun(name="smooth", source="smooth", meas=m, inputs=runs[0].inputs)
     ident = identify(ship, [run], free=["kappa"], segment_s=(np.inf,), say=lambda m: None, max_nfev=2)
     assert [f.name for f in ident.fit.free if f.kind == "start"] == ["start.psi[smooth]"]
+
+
+def test_cli_initial_state_choices_are_the_fits():
+    """``mmg identify --initial-state`` offers exactly what :func:`identify` accepts (the parser does not
+    import the fitting module, for the start-up time)."""
+    import argparse
+
+    from trials.cli.identify import add_parser
+    from trials.measured.identify import INITIAL_STATES
+
+    ap = argparse.ArgumentParser()
+    add_parser(ap.add_subparsers())
+    sub = next(a for a in ap._subparsers._group_actions[0].choices.values())
+    act = next(a for a in sub._actions if a.dest == "initial_state")
+    assert set(act.choices) == set(INITIAL_STATES)

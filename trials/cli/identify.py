@@ -180,6 +180,8 @@ def cmd_identify(args) -> int:
         kw["velocity_weight"] = args.velocity_weight
     if args.free:
         kw["free"] = tuple(args.free)
+    if args.initial_state:
+        kw["initial_state"] = args.initial_state
     nested = None
     if cands is not None and len(cands) > 1:          # --hull auto: the form chosen by an inner CV
         ship, src, nested = _auto_hull(args, cands, runs, initial, folds if args.cv else None, wind, kw, t0)
@@ -204,7 +206,7 @@ def cmd_identify(args) -> int:
             (stage.dir / "nested_cv.json").write_text(json.dumps(nested[0].to_json(), indent=1) + "\n")
     a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
     b = np.mean([x["heading_rms_deg"] for x in ident.scores()])
-    print(f"identified {len(ident.fit.free)} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
+    print(f"identified {len(ident.fit.values())} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
           f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
     print(f"wrote {Path(args.out) / 'ship.yaml'} and {Path(args.out) / 'report.md'}")
     if nested is not None:
@@ -251,6 +253,11 @@ def add_parser(sub) -> None:
     p.add_argument("--velocity-weight", type=_finite_positive, default=None, metavar="W",
                    help="factor on the u, v, r residuals beside the heading's (default 1; 0.1: their squares weigh a "
                         "hundredth, so the fit follows the heading; docs/identify_cv.md)")
+    p.add_argument("--initial-state", choices=("fit", "sample"), default=None,     # identify.INITIAL_STATES (test)
+                   help="where each record's replay starts in the fit: 'fit' (default: offsets on the first sample's "
+                        "u, v, r and heading fitted as the record's own nuisance, so one noisy sample does not drift a "
+                        "whole replay; the written covariance then covers the truth: docs/imo.md) or 'sample' (the "
+                        "first sample as logged, the fit before stop 32)")
     p.add_argument("--max-nfev", type=_positive_int, default=None, metavar="N",
                    help="most evaluations of the residuals in each fit stage (segment-wise, then whole-record; "
                         "default trials.measured.identify.DEFAULT_MAX_NFEV); a stage that reaches it stops unconverged, "
