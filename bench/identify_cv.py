@@ -72,6 +72,9 @@ def _args(argv=None):
                     help="weight of the u, v, r residuals beside the heading's (identify(velocity_weight=))")
     ap.add_argument("--nuisance", nargs="+", default=(), metavar="EFFECT",
                     help="effects fitted once per training record as nuisances (e.g. current)")
+    ap.add_argument("--initial-state", choices=("fit", "sample"), default=None,
+                    help="each record's start state in the fits (mmg identify --initial-state; default its default, "
+                         "'fit'; docs/benchmark_frt.md's figures: 'sample')")
     ap.add_argument("--horizon", type=float, default=60.0, help="the short-horizon window [s] (default 60)")
     ap.add_argument("--backend", choices=("serial", "loky"), default="loky")
     ap.add_argument("--jobs", type=int, default=2, help="local workers of the loky backend (default 2)")
@@ -94,6 +97,8 @@ def _options(a) -> dict:
         extra["velocity_weight"] = a.velocity_weight
     if a.max_nfev:
         extra["max_nfev"] = a.max_nfev
+    if a.initial_state:
+        extra["initial_state"] = a.initial_state
     return extra
 
 
