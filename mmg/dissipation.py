@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import (DELTA_, N_, P_IZ, P_JZ, P_L, P_M, P_MX, P_MY, P_RHO, P_T, P_XG, R_, U_, V_, hull_regressors,
-                    pack, rhs)
+from .model import (DELTA_, N_, P_IZ, P_JZ, P_L, P_M, P_MX, P_MY, P_RHO, P_T, P_ULOW, P_XG, R_, U_, V_,
+                    hull_regressors, pack, rhs)
 
 __all__ = ["PowerCheck", "unpowered_power", "hull_term_power", "power_check", "power_scale", "state_box"]
 
@@ -135,11 +135,14 @@ class PowerCheck:
 
 def power_check(ship, u, v, r, tol: float = POWER_TOLERANCE) -> PowerCheck:
     """:class:`PowerCheck` of ``ship`` at the states u, v [m/s], r [rad/s] (arrays broadcast
-    together; states with U_t = 0 skipped)."""
+    together).  States whose U_t (:func:`power_scale`) is below the hull's low-speed floor
+    (:data:`mmg.model.LOW_SPEED_FROUDE` sqrt(g L)) are skipped: there the forces are a few
+    microwatts' worth, and a term such as Y_0 (a propeller-induced side force the model keeps at any
+    speed) outweighs a vanishing scale without feeding any motion."""
     uu, vv, rr, _ = _states(u, v, r)
     pk = pack(ship)
     sc = power_scale(pk, uu, vv, rr)
-    ok = sc > 0
+    ok = sc > power_scale(pk, pk.p[P_ULOW], 0.0, 0.0)
     uu, vv, rr, sc = uu[ok], vv[ok], rr[ok], sc[ok]
     rel = unpowered_power(pk, uu, vv, rr) / sc
     i = int(np.argmax(rel))
