@@ -101,20 +101,12 @@ def _print_nested(nested, out: Path) -> None:
     print(f"wrote {out / 'nested_cv.json'} (per kept-out record, the scores of both models and each fold's choice)")
 
 
-def cmd_identify(args) -> int:
-    import numpy as np
-
+def _ships(args):
+    """(the prior's YAML path, the prior, the --hull candidates or None, the ship scored against or None),
+    every refusal before any record is read."""
     from mmg.resources import ship_path
     from mmg.ship import load_ship
 
-    from ..measured.identify import DEFAULT_MAX_NFEV, cross_validate, cv_folds, identify, load_runs, write_identification
-    from ..files.output import StagedOutput, check_output_dir, record_labels
-
-    check_backend_options(args)
-    check_output_dir(args.out)
-    for log in args.train + (args.test or []):
-        if not Path(log).is_file():
-            raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
     src = ship_path(args.ship)
     ship = load_ship(src)
     cands = _hull_choice(args)                     # refused before any record is read
@@ -132,11 +124,54 @@ def cmd_identify(args) -> int:
         from ..files.shipcheck import check_same_ship
 
         check_same_ship(ship, initial)
-    wind = None if args.wind is None else args.wind == "on"
-    t0 = time.perf_counter()
-    names = record_labels(args.train + (args.test or []))   # training and test records told apart together
+    return src, ship, cands, initial
+
+
+def _fit_options(args, default_max_nfev: int) -> dict:
+    """:func:`~trials.measured.identify.identify`'s keywords from the command line."""
+    kw = {"record_weighting": args.weighting} if args.weighting else {}
+    kw["max_nfev"] = args.max_nfev or default_max_nfev
+    if args.velocity_weight is not None:
+        kw["velocity_weight"] = args.velocity_weight
+    if args.free:
+        kw["free"] = tuple(args.free)
+    if args.initial_state:
+        kw["initial_state"] = args.initial_state
+    return kw
+
+
+def _print_outcome(ident, runs, out: Path, nested, t0: float) -> None:
+    """The closing lines: the fit's figures, what was written, notes and warnings."""
+    import numpy as np
+
+    a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
+    b = np.mean([x["heading_rms_deg"] for x in ident.scores()])
+    print(f"identified {len(ident.fit.values())} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
+          f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
+    print(f"wrote {out / 'ship.yaml'} and {out / 'report.md'}")
+    if nested is not None:
+        _print_nested(nested, out)
+    for st in ident.stages:
+        if st["status"] == 0:
+            print(f"note: {st['description'].split(':')[0]} stopped at its evaluation limit ({st['max_nfev']}) before "
+                  f"converging; --max-nfev raises it", file=sys.stderr)
+    for w in ident.physical_check().warnings():
+        print(f"warning: {w}", file=sys.stderr)
+    warn = ident.fit.warnings()
+    if warn:
+        print(f"warning: {len(warn)} finding(s) on where the identified values should not be read as the ship's "
+              f"physics (sign changes, bounds, no convergence): {out / 'report.md'}, 'Warnings'", file=sys.stderr)
+
+
+def _records(args, ship, wind):
+    """(the training records, the test records or None): an unusable record is skipped with one line;
+    an option none of whose records is usable is refused, saying why."""
     import logging
 
+    from ..files.output import record_labels
+    from ..measured.identify import load_runs
+
+    names = record_labels(args.train + (args.test or []))   # training and test records told apart together
     skipped: list = []
 
     def note(msg):                          # held until every record is read (a refusal: one line)
@@ -154,6 +189,25 @@ def cmd_identify(args) -> int:
              if args.test else None)
     if args.test and not tests:
         raise InputError("--test", "", why(first_test))
+    return runs, tests
+
+
+def cmd_identify(args) -> int:
+    from mmg.resources import ship_path
+    from mmg.ship import load_ship
+
+    from ..measured.identify import DEFAULT_MAX_NFEV, cross_validate, cv_folds, identify, write_identification
+    from ..files.output import StagedOutput, check_output_dir
+
+    check_backend_options(args)
+    check_output_dir(args.out)
+    for log in args.train + (args.test or []):
+        if not Path(log).is_file():
+            raise InputError(log, "", "file not found" if not Path(log).exists() else "is not a regular file")
+    src, ship, cands, initial = _ships(args)
+    wind = None if args.wind is None else args.wind == "on"
+    t0 = time.perf_counter()
+    runs, tests = _records(args, ship, wind)
     release_notes()
     print(f"training on {len(runs)} record{'' if len(runs) == 1 else 's'}", file=sys.stderr, flush=True)
     if args.cv:                                          # refused or narrowed before any fit
@@ -174,14 +228,7 @@ def cmd_identify(args) -> int:
         print(f"  {stage.split(':')[0]}, iteration {k}: cost {cost:.5g} ({time.perf_counter() - t0:.0f} s)",
               file=sys.stderr, flush=True)
 
-    kw = {"record_weighting": args.weighting} if args.weighting else {}
-    kw["max_nfev"] = args.max_nfev or DEFAULT_MAX_NFEV
-    if args.velocity_weight is not None:
-        kw["velocity_weight"] = args.velocity_weight
-    if args.free:
-        kw["free"] = tuple(args.free)
-    if args.initial_state:
-        kw["initial_state"] = args.initial_state
+    kw = _fit_options(args, DEFAULT_MAX_NFEV)
     nested = None
     if cands is not None and len(cands) > 1:          # --hull auto: the form chosen by an inner CV
         ship, src, nested = _auto_hull(args, cands, runs, initial, folds if args.cv else None, wind, kw, t0)
@@ -204,24 +251,7 @@ def cmd_identify(args) -> int:
             import json
 
             (stage.dir / "nested_cv.json").write_text(json.dumps(nested[0].to_json(), indent=1) + "\n")
-    a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
-    b = np.mean([x["heading_rms_deg"] for x in ident.scores()])
-    print(f"identified {len(ident.fit.values())} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
-          f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
-    print(f"wrote {Path(args.out) / 'ship.yaml'} and {Path(args.out) / 'report.md'}")
-    if nested is not None:
-        _print_nested(nested, Path(args.out))
-    for st in ident.stages:
-        if st["status"] == 0:
-            print(f"note: {st['description'].split(':')[0]} stopped at its evaluation limit ({st['max_nfev']}) before "
-                  f"converging; --max-nfev raises it", file=sys.stderr)
-    for w in ident.physical_check().warnings():
-        print(f"warning: {w}", file=sys.stderr)
-    warn = ident.fit.warnings()
-    if warn:
-        print(f"warning: {len(warn)} finding(s) on where the identified values should not be read as the ship's "
-              f"physics (sign changes, bounds, no convergence): {Path(args.out) / 'report.md'}, 'Warnings'",
-              file=sys.stderr)
+    _print_outcome(ident, runs, Path(args.out), nested, t0)
     return 0
 
 

@@ -60,6 +60,7 @@ from __future__ import annotations
 
 import sys
 from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -175,7 +176,12 @@ class Identification:
 
     def physical_check(self):
         """:func:`trials.measured.physical.physical_check` of the identified model against its prior
-        over the training records: the energy balance unpowered, and every record's replay."""
+        over the training records: the energy balance unpowered, and every record's replay (made once,
+        then kept: the report and the console both read it)."""
+        return self._physical
+
+    @cached_property
+    def _physical(self):
         from .physical import physical_check
 
         return physical_check(self.ship, self.prior or self.initial, self.runs, [self.replay(r) for r in self.runs])
