@@ -49,7 +49,7 @@ __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_param
            "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
            "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled",
            "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "logged_residual", "record_effect_parameters", "effect_set_of",
-           "predict_logged", "start_parameters", "record_residuals"]
+           "predict_logged", "start_parameters", "record_residuals", "model_states"]
 
 RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
                     "l_R_prime": (P_LR, -2.0, 0.0)}
@@ -291,6 +291,17 @@ def effect_set_of(effects, free: list[FreeParameter], theta, record: int | None 
     return EffectSet(tuple(items))
 
 
+def model_states(es, logged: np.ndarray, speed_only: bool = False) -> np.ndarray:
+    """The model's states (through the water, true heading) of logged ones (N, 6) under the effects
+    ``es`` (:meth:`mmg.effects.EffectSet.to_model`): what a replay starts and restarts from.  A record
+    that logs no sway (``speed_only``: v a stand-in zero) starts with none through the water, whatever
+    the effects make of the stand-in (a current would turn it into a sway of minus its cross part)."""
+    mm = es.to_model(logged)
+    if speed_only:
+        mm[:, 1] = 0.0
+    return mm
+
+
 def predict_logged(packed: PackedShip, rec: Segmented, effects=None, free=(), theta=(), ship=None,
                    record: int | None = None) -> np.ndarray:
     """The replayed states of ``rec`` (segments as in ``rec.reset``) as the record logs them:
@@ -305,9 +316,7 @@ def predict_logged(packed: PackedShip, rec: Segmented, effects=None, free=(), th
     pk = es.pack(pk, ship)
     ext = es.external(rec.context, base=rec.inputs.ext)
     inputs = replace(rec.inputs, ext=ext) if ext is not None else rec.inputs
-    mm = es.to_model(rec.restart)
-    if rec.speed_only:     # no logged sway: the start has none through the water, whatever the effects
-        mm[:, 1] = 0.0     # make of the stand-in zero (a current would turn it into a sway of -its cross part)
+    mm = model_states(es, rec.restart, rec.speed_only)
     pred = replay_states(pk, inputs, mm[0], meas=mm, reset=rec.reset)
     return es.to_logged(pred)
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import (DELTA_, N_, P_IZ, P_JZ, P_L, P_M, P_MX, P_MY, P_RHO, P_T, P_ULOW, P_XG, R_, U_, V_,
+from .model import (P_IZ, P_JZ, P_L, P_M, P_MX, P_MY, P_RHO, P_T, P_ULOW, P_XG, R_, U_, V_,
                     hull_regressors, pack, rhs)
 
 __all__ = ["PowerCheck", "unpowered_power", "hull_term_power", "power_check", "power_scale", "state_box"]
@@ -57,15 +57,14 @@ def unpowered_power(ship_or_packed, u, v, r) -> np.ndarray:
     r [rad/s] (arrays broadcast together): nu^T M dnu/dt of :func:`mmg.model.rhs`."""
     pk = _packed(ship_or_packed)
     uu, vv, rr, shape = _states(u, v, r)
-    M = mass_matrix(pk.p)
     x, out = np.zeros(8), np.zeros(8)
-    P = np.empty(uu.size)
-    for i in range(uu.size):
-        x[:] = 0.0
-        x[U_], x[V_], x[R_], x[DELTA_], x[N_] = uu[i], vv[i], rr[i], 0.0, 0.0
+    acc = np.empty((uu.size, 3))
+    for i in range(uu.size):             # propeller stopped, rudder amidships: x[DELTA_] = x[N_] = 0
+        x[U_], x[V_], x[R_] = uu[i], vv[i], rr[i]
         rhs(x, 0.0, *pk.args(), out)
-        nu = np.array([uu[i], vv[i], rr[i]])
-        P[i] = nu @ M @ out[:3]
+        acc[i] = out[:3]
+    nu = np.column_stack([uu, vv, rr])
+    P = np.einsum("ij,jk,ik->i", nu, mass_matrix(pk.p), acc)
     return P.reshape(shape)
 
 
@@ -77,10 +76,11 @@ def power_scale(ship_or_packed, u, v, r) -> np.ndarray:
     return 0.5 * p[P_RHO] * p[P_L] * p[P_T] * ut2 ** 1.5
 
 
-def hull_term_power(ship, u: float, v: float, r: float) -> dict:
+def hull_term_power(ship, u: float, v: float, r: float, packed=None) -> dict:
     """{hull coefficient name: its share of dT/dt [W]} at one state: the coefficient's value times
-    its regressor's power u dX + v dY + r dN (:func:`mmg.model.hull_regressors`)."""
-    pk = pack(ship)
+    its regressor's power u dX + v dY + r dN (:func:`mmg.model.hull_regressors`); ``packed``: the
+    ship already packed (:func:`mmg.model.pack`)."""
+    pk = packed or pack(ship)
     names = list(ship.hull.names)
     idx = np.arange(len(names), dtype=np.int64)
     x = np.zeros(8)
@@ -149,7 +149,7 @@ def power_check(ship, u, v, r, tol: float = POWER_TOLERANCE) -> PowerCheck:
     bad = int(np.sum(rel > tol))
     feeding = {}
     if bad:
-        share = hull_term_power(ship, uu[i], vv[i], rr[i])
+        share = hull_term_power(ship, uu[i], vv[i], rr[i], pk)
         feeding = dict(sorted(((k, w) for k, w in share.items() if w > 0), key=lambda kv: -kv[1]))
     return PowerCheck(bad == 0, float(rel[i]), (float(uu[i]), float(vv[i]), float(rr[i])), int(rel.size), bad, feeding)
 

@@ -278,7 +278,10 @@ def replay_record(ship: Ship, rec: TrialRecord | MeasuredRun, start: float | Non
     if es is None:
         pred = replay_states(packed, run.inputs, run.meas[0])
     else:
-        pred = es.to_logged(replay_states(es.pack(packed, ship), run.inputs, es.to_model(run.meas[:1])[0]))
+        from ekf.identify import model_states
+
+        start = model_states(es, run.meas[:1], run.speed_only)[0]
+        pred = es.to_logged(replay_states(es.pack(packed, ship), run.inputs, start))
     return Replayed(run=run, pred=pred, L=ship.particulars.L, B=ship.particulars.B)
 
 
