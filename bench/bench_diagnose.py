@@ -15,6 +15,7 @@ each record diagnosed alone with the bundled config; false alarms over ``--clean
 records, detection per effect and size split zigzag / turn (``bench/diagnose_mismatch.py``):
 
     python bench/bench_diagnose.py --mismatch [--clean 40] [--seeds 5] [--seed0 0] [--jobs 2] [--effects ...]
+        [--only ID ...] [--candidate-start config|current]
         [--quick] [--tag _cal]
 
 writes bench/out/diagnose_mismatch<tag>.json (every record's factors, truth, named effects and
@@ -92,6 +93,10 @@ def main(argv=None):
                     help="full-scale trials of the mismatch family, one record per diagnose (bench/diagnose_mismatch.py)")
     ap.add_argument("--seed0", type=int, default=0, help="--mismatch: the family's and the noise seeds' offset")
     ap.add_argument("--jobs", type=int, default=2, help="--mismatch: parallel processes")
+    ap.add_argument("--only", nargs="+", default=None, metavar="ID",
+                    help="--mismatch: only these records (ids as printed, e.g. wind_10_0 clean_20) of the full draw")
+    ap.add_argument("--candidate-start", choices=("config", "current"), default="config",
+                    help="--mismatch: where candidates' fits start the ship (DiagnoseOptions.candidate_start)")
     ap.add_argument("--trials", nargs="*", default=None,
                     help="--mismatch: the trials to draw from (default all: turn35 turn35p zz10 zz15 zz20)")
     a = ap.parse_args(argv)

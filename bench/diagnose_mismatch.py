@@ -87,7 +87,7 @@ def run_one(job: dict, seed0: int) -> dict:
     rec = trial_records(config, member, job["trial"], job["spec"], seed=job["seed"], true_wind=job["true_wind"],
                         name=job["id"])
     t0 = time.perf_counter()
-    d = diagnose(config, [rec])
+    d = diagnose(config, [rec], candidate_start=job.get("candidate_start", "config"))
     js = d.to_json()
     truth = {k: dict(v) for k, v in job["spec"].items()}
     if "wind" in truth:
@@ -210,12 +210,16 @@ def main_mismatch(a) -> None:
     out = REPO / "bench" / "out"
     out.mkdir(exist_ok=True)
     todo = jobs(nclean, seeds, effects, a.seed0, a.trials)
+    if a.only:                                   # the same records as a full run of these options, by id
+        todo = [j for j in todo if j["id"] in set(a.only)]
+    todo = [{**j, "candidate_start": a.candidate_start} for j in todo]
     path = out / f"diagnose_mismatch{a.tag}.json"
     head = {"family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds, "effects": effects,
             "sizes": {e: SIZES[e] for e in effects}}
     save = lambda rows: path.write_text(json.dumps({**head, "records": rows}, indent=1, default=float))  # noqa: E731
     t0 = time.perf_counter()
-    print(f"mismatch bench: {len(todo)} records ({nclean} clean, {len(todo) - nclean} with an effect), family seed "
+    nc = sum(j["effect"] is None for j in todo)
+    print(f"mismatch bench: {len(todo)} records ({nc} clean, {len(todo) - nc} with an effect), family seed "
           f"{a.seed0}, {a.jobs} job(s)", flush=True)
     rows = _execute(todo, a.seed0, a.jobs, save)
     table = summarise(rows)
