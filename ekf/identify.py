@@ -110,6 +110,22 @@ class Segmented:
     def restart(self) -> np.ndarray:
         return self.meas if self.start is None else self.start
 
+    def first_segment(self) -> "Segmented":
+        """The record up to its second segment start (the whole record when it has one segment): what
+        an offset of its start state moves, every later segment restarting from its own state."""
+        later = np.flatnonzero(np.asarray(self.reset, bool)[1:])
+        n = len(self.meas) if len(later) == 0 else int(later[0]) + 1
+        if n == len(self.meas):
+            return self
+        cut = lambda a: None if a is None else a[:n]  # noqa: E731
+        ctx = self.context
+        if ctx is not None:
+            ctx = replace(ctx, t=ctx.t[:n], delta=ctx.delta[:n], n=ctx.n[:n],
+                          channels={k: np.asarray(v)[:n] for k, v in ctx.channels.items()})
+        inp = self.inputs
+        return replace(self, meas=self.meas[:n], reset=self.reset[:n], start=cut(self.start), context=ctx,
+                       inputs=replace(inp, t=inp.t[:n], delta=inp.delta[:n], n=inp.n[:n], ext=cut(inp.ext)))
+
 
 @dataclass(frozen=True)
 class Scales:
@@ -528,6 +544,7 @@ class _SegmentFit:
         self.own = [f.record for f in free]                   # a record's own (nuisance) parameter, or None
         nch = 4 if self.pos is None else 6
         self.start = np.cumsum([0] + [len(r.meas[::opts.stride]) * nch for r in records])   # each record's block
+        self.heads = {k: records[k].first_segment() for k in set(self.own) - {None}}   # what a start offset moves
         self.count = 0
 
     def block(self, theta, k, pk=None):
@@ -558,10 +575,18 @@ class _SegmentFit:
         return h, steps
 
     def _own_column(self, j, step, h, r0):
-        """A record's own parameter moves only its record's block (and its prior residual): that record alone."""
+        """A record's own parameter moves only its record's block (and its prior residual): that record
+        alone; an offset of its start state (kind ``"start"``) only its first segment, which alone is replayed."""
         col = np.zeros_like(r0)
         k, s = self.own[j], self.start
-        col[s[k]:s[k + 1]] = (self.block(step, k) - r0[s[k]:s[k + 1]]) / h
+        if self.free[j].kind == "start":
+            o = self.opts
+            pk = apply_parameters(self.packed, self.free, step)
+            b = self.wts[k] * _residual_one(pk, self.heads[k], self.sc, o.stride, o.effects, self.free, step, o.ship,
+                                            self.pos, k)
+            col[s[k]:s[k] + len(b)] = (b - r0[s[k]:s[k] + len(b)]) / h
+        else:
+            col[s[k]:s[k + 1]] = (self.block(step, k) - r0[s[k]:s[k + 1]]) / h
         col[s[-1] + j] = 1.0 / self.sig0[j]
         return col
 
