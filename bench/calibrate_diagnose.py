@@ -22,7 +22,16 @@ and never below the largest passing magnitude seen.  A parametric tail, not the 
 alone: 20 records per kind cannot place a 1 % quantile by themselves.  The floors are checked
 afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the records that set them.
 
-    python bench/calibrate_diagnose.py bench/out/diagnose_mismatch_cal.json [--alpha 0.05] [--write]
+    python bench/calibrate_diagnose.py bench/out/diagnose_mismatch_cal.json[:KIND] ... [--alpha 0.05] [--write]
+
+``PATH:KIND`` takes only the records of one kind of a run (``turn``, ``zigzag``): a run made while
+the diagnosis of the other kind was another (the rudder's inflow freed on zigzags too, variant 6
+in ``docs/diagnose.md``) still calibrates this one.
+
+Effects whose floor on a kind of record exceeds the size worth detecting are never named there
+(:func:`hidden_effects`: a rudder offset or heading bias on one turning circle); the records that
+have them lend the other candidates sizes that count as clean samples (:func:`clean_magnitudes`),
+so the floors are set twice: once from the clean records, once with those.
 """
 from __future__ import annotations
 
@@ -39,7 +48,7 @@ sys.path.insert(0, str(REPO))
 OUT = REPO / "configs" / "calibration" / "diagnose.yaml"
 
 
-def clean_magnitudes(records, L: float) -> tuple:
+def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
     """({effect: {kind: [clean magnitude]}}, the same of whether dBIC and z cleared, the same of
     the magnitudes whether or not they cleared).
 
@@ -48,7 +57,13 @@ def clean_magnitudes(records, L: float) -> tuple:
     round of a record with effects right after its true effects were named (a wind named, what does
     the ship's mismatch lend a shallow-water candidate on top of it).  Before the true effects are
     in, the other candidates soak up theirs (a current takes a heading bias on a zigzag): that is
-    the confusion :mod:`trials.measured.identifiability` reports, not the ship's mismatch."""
+    the confusion :mod:`trials.measured.identifiability` reports, not the ship's mismatch.
+
+    ``hidden`` ({kind: set of effects}, :func:`hidden_effects`): effects that cannot be named on that
+    kind of record (a rudder offset on one turning circle).  A record's true effects among them are
+    never in the model, so its rounds count as clean for the other candidates once its other true
+    effects are in: what such an effect lends a current or shallow water on a turn is a nuisance
+    of the same kind as the ship's own mismatch, and a name given for it is a wrong name."""
     import math
 
     from trials.measured.decision import BIC_THRESHOLD, COMPONENT_FLOORS, Z_THRESHOLD, current_components, magnitude
@@ -59,9 +74,9 @@ def clean_magnitudes(records, L: float) -> tuple:
     for rec in records:
         truth = set(rec.get("truth") or {})
         for rd in rec.get("rounds") or []:
-            if set(rd.get("model", [])) != truth:
-                continue       # before the true effects are in, a candidate soaks up theirs: not a clean sample
             kind = rd.get("kind") or ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
+            if set(rd.get("model", [])) != truth - set((hidden or {}).get(kind, ())):
+                continue       # before the true effects are in, a candidate soaks up theirs: not a clean sample
             for c in rd["candidates"]:
                 if c["effect"] in truth:
                     continue
@@ -107,6 +122,32 @@ def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
     return out
 
 
+def record_kind_of(rec: dict) -> str:
+    """The kind of record set a bench record was diagnosed as (its first round's, else by its trial)."""
+    return (rec.get("rounds") or [{}])[0].get("kind") or \
+        ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
+
+
+def only_kind(rec: dict, kind: str):
+    """``rec`` when it is of ``kind`` (:func:`record_kind_of`), else None: a run's records of one kind,
+    where the diagnosis of the other kind has changed since the run."""
+    return rec if record_kind_of(rec) == kind else None
+
+
+def hidden_effects(fl: dict, L: float) -> dict:
+    """{kind: effects} whose floor on that kind of record exceeds the size worth detecting
+    (:data:`trials.measured.identifiability.DETECTION_SIZE`): they are never named there, only
+    reported ``not_identifiable``."""
+    from trials.measured.identifiability import detection_size
+
+    out: dict = {}
+    for e, kinds in fl.items():
+        for k, f in kinds.items():
+            if f > detection_size(e, L):
+                out.setdefault(k, set()).add(e)
+    return out
+
+
 MIN_PASSING = 3
 """Fewer passing sizes than this: the floor's scale is taken from every size the candidate took."""
 
@@ -127,8 +168,7 @@ def residual_floors(records) -> dict:
     for rec in records:
         if rec.get("truth") or "rms_after" not in rec:
             continue
-        kind = (rec.get("rounds") or [{}])[0].get("kind") or \
-            ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
+        kind = record_kind_of(rec)
         ra, U, L = rec["rms_after"], rec["speed_mps"], rec["L_m"]
         v = vals.setdefault(kind, {"u": [], "v": [], "r": [], "heading": []})
         v["u"].append(ra["u"] / U)
@@ -141,7 +181,8 @@ def residual_floors(records) -> dict:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("bench_json", nargs="+", help="the calibration runs' JSON (clean, and with effects)")
+    ap.add_argument("bench_json", nargs="+", help="the calibration runs' JSON (clean, and with effects); "
+                    "PATH:KIND takes only that run's records of one kind (turn, zigzag)")
     ap.add_argument("--alpha", type=float, default=0.05)
     ap.add_argument("--write", action="store_true", help=f"write {OUT.relative_to(REPO)}")
     a = ap.parse_args(argv)
@@ -151,10 +192,16 @@ def main(argv=None):
 
     records = []
     for p in a.bench_json:
+        p, _, kind = p.partition(":")
         data = json.loads(Path(p).read_text())
-        records += data["records"] if isinstance(data, dict) else data
+        records += [only_kind(r, kind) for r in (data["records"] if isinstance(data, dict) else data)] if kind else \
+            (data["records"] if isinstance(data, dict) else data)
+    records = [r for r in records if r is not None]
     L = mmg.load_ship("esso_osaka").particulars.L
     clean, passes, raw = clean_magnitudes(records, L)
+    hidden = hidden_effects(floors(clean, a.alpha, raw), L)      # pass 1: what a kind of record cannot name
+    print("never named (floor above the size to detect):", {k: sorted(v) for k, v in hidden.items()})
+    clean, passes, raw = clean_magnitudes(records, L, hidden)   # pass 2: their records lend the others
     fl = floors(clean, a.alpha, raw)
     n = sum(1 for r in records if not r.get("truth"))
     n_eff = len(records) - n

@@ -72,13 +72,16 @@ either way).  Floors: 0.01 for a hull coefficient, 0.05 for a rudder constant; `
 absolute.  Effect parameters carry their own prior (:class:`mmg.effects.Parameter`)."""
 
 DIAGNOSIS_PRIOR_REL_STD = {**PRIOR_REL_STD, "mass": 0.2, "hull": 0.15, "hull_nonlinear": 0.30, "resistance": 0.10,
-                           "w_P0": 0.20, "hull_floor": 0.002}
+                           "w_P0": 0.20, "epsilon": 0.10, "hull_floor": 0.002}
 """The diagnosis's policy (:func:`trials.measured.diagnose.diagnose`), beside :data:`PRIOR_REL_STD` in
 the one table of prior widths: what is known of a config's source, not identification's factor of
 2.  Linear sway/yaw derivatives (``hull``: the terms in beta, r, v) from captive tests or
 Kijima-type regressions are good to 10-15 %, their nonlinear terms (``hull_nonlinear``: r|r|) to
 about 30 %, the resistance (``resistance``: cos(beta)^2, u^2) to 10 %, the wake fraction w_P0
-(``w_P0``, relative here) to 20 %; ``hull_floor`` is the smallest std of a primed hull coefficient.
+(``w_P0``, relative here) to 20 %; the rudder's inflow ratio epsilon = (1 - w_R) / (1 - w_P) to 10 %
+(``epsilon``: the rudder normal force goes as epsilon^2, so its force to about 20 %, the spread of
+the rudder-wake regressions and of the rudder lift slope a config takes from Fujii's formula);
+``hull_floor`` is the smallest std of a primed hull coefficient.
 The added masses at 20 %: the diagnosis frees them with every candidate effect, and an added mass
 a few % off leaves a residual (surge speed loss in the turn, sway and yaw lag) an effect would
 otherwise take; a wider prior would let them take an effect's residual instead.  Which term is in

@@ -43,7 +43,7 @@ def test_coefficient_prior_widths_are_one_table(ship):
 
     pk = pack(ship)
     ident = {f.name: f for f in free_parameters(pk, ship.hull.names, ["N_r", *MASS_FREE])}
-    diag = {f.name: f for f in _ship_free(ship, pk)}
+    diag = {f.name: f for f in _ship_free(ship, pk, kind="turn")}
     for nm in MASS_FREE:
         assert ident[nm].sigma == pytest.approx(PRIOR_REL_STD["mass"] * ident[nm].prior)
         assert diag[nm].sigma == pytest.approx(DIAGNOSIS_PRIOR_REL_STD["mass"] * diag[nm].prior)
@@ -53,6 +53,9 @@ def test_coefficient_prior_widths_are_one_table(ship):
     assert diag["N_rr"].sigma == pytest.approx(max(P["hull_nonlinear"] * abs(diag["N_rr"].prior), P["hull_floor"]))
     assert diag["X_uu"].sigma == pytest.approx(max(P["resistance"] * abs(diag["X_uu"].prior), P["hull_floor"]))
     assert diag["w_P0"].sigma == pytest.approx(P["w_P0"] * diag["w_P0"].prior)
+    assert diag["epsilon"].prior == pytest.approx(ship.rudder.epsilon)     # the rudder's inflow ratio, 10 %
+    assert diag["epsilon"].sigma == pytest.approx(0.10 * ship.rudder.epsilon)
+    assert "epsilon" not in {f.name for f in _ship_free(ship, pk, kind="zigzag")}   # on turns only
     assert diag["N_r"].upper == 0.0 and diag["Y_beta"].lower == 0.0        # the signs that define the ship
 
 
@@ -108,3 +111,33 @@ def test_one_record_generator(ship, monkeypatch):
     log = run.record()
     assert calls == ["syn", run.trial.name]
     assert len(rec.t) > 10 and len(log.t) > 10
+
+
+def _load_cov(theta, load_var):
+    """The covariance of (scale, sway_factor, yaw_factor) when the fit knows the three loads (surge
+    scale, sway scale*sway_factor, yaw scale*yaw_factor) independently with variances ``load_var``:
+    the loads' Jacobian inverted by hand."""
+    s, a, b = theta
+    Ginv = np.array([[1.0, 0.0, 0.0], [-a / s, 1.0 / s, 0.0], [-b / s, 0.0, 1.0 / s]])
+    return Ginv @ np.diag(load_var) @ Ginv.T
+
+
+def test_wind_presence_is_judged_on_its_three_loads():
+    """A wind whose surge load the fit cannot tell from the resistance (sd 2) but whose sway and yaw
+    loads it knows to 0.1: present at many standard errors, though its scale alone is 0.5 sd from 0;
+    loads of 0.1, 0.05, 0.05 with the same sds: not shown."""
+    from scipy.stats import chi2, norm
+
+    from mmg.effects import get
+    from mmg.effects.base import Effect
+
+    W = get("wind")
+    var = np.array([4.0, 0.01, 0.01])
+    th = np.array([1.0, 1.0, 1.0])
+    cov = _load_cov(th, var)
+    x = 1.0 / 4.0 + 1.0 / 0.01 + 1.0 / 0.01                       # the loads' Wald statistic, 3 dof
+    assert W.presence_z(th, cov) == pytest.approx(norm.isf(0.5 * chi2.sf(x, 3)), rel=1e-6)
+    assert W.presence_z(th, cov) > 10.0
+    assert Effect.presence_z.__func__(W, th, cov) == pytest.approx(0.5, rel=1e-6)   # the scale alone
+    small = np.array([0.1, 0.5, 0.5])                              # loads 0.1, 0.05, 0.05
+    assert W.presence_z(small, _load_cov(small, var)) < 3.0

@@ -106,7 +106,7 @@ def test_single_turn_rudder_offset_not_identifiable(full):
     ent = {e["effect"]: e for e in j["not_identifiable"]}
     assert "rudder_offset" in ent, j["not_identifiable"]
     e = ent["rudder_offset"]
-    hull = set(full[0].hull.names) | {"w_P0", "m_x", "m_y", "J_z"}
+    hull = set(full[0].hull.names) | {"w_P0", "epsilon", "m_x", "m_y", "J_z"}
     assert e["confused_with"] and set(e["confused_with"]) <= hull
     assert e["correlation"] >= 0.9
     assert 3.0 * e["std"] > 1.0                    # could not have been named at 1 deg
@@ -154,7 +154,7 @@ def test_dev_single_turn_offset_reported(stem):
     if "rudder_offset" not in d.named:
         ent = {e["effect"]: e for e in d.to_json()["not_identifiable"]}
         assert "rudder_offset" in ent
-        assert set(ent["rudder_offset"]["confused_with"]) <= set(ship.hull.names) | {"w_P0", "m_x", "m_y", "J_z"}
+        assert set(ent["rudder_offset"]["confused_with"]) <= set(ship.hull.names) | {"w_P0", "epsilon", "m_x", "m_y", "J_z"}
 
 
 def test_trial_advice_with_a_named_wind_in_the_model(monkeypatch):

@@ -136,6 +136,20 @@ class Effect(abc.ABC):
         return tuple(p.name for p in cls.fit_parameters())
 
     @classmethod
+    def presence_z(cls, theta, cov) -> float:
+        """How far the fit says the effect is from absent, in standard errors: the root sum of squares
+        of the :meth:`presence_parameters`' departures from their neutral values over their standard
+        errors (default).  ``theta``, ``cov``: the effect's fitted parameters (in :meth:`fit_parameters`
+        order) and their covariance."""
+        th = np.asarray(theta, float)
+        std = np.sqrt(np.clip(np.diag(np.asarray(cov, float)), 0.0, None))
+        pres = cls.presence_parameters()
+        on = np.array([q.name in pres for q in cls.fit_parameters()])
+        neutral = np.array([q.default for q in cls.fit_parameters()])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return float(np.sqrt(np.sum(((th - neutral)[on] / np.where(std > 0, std, np.inf)[on]) ** 2)))
+
+    @classmethod
     def from_fit(cls, theta) -> dict:
         """Named values from fitted ones (identity by default)."""
         return {p.name: float(v) for p, v in zip(cls.fit_parameters(), theta)}

@@ -15,7 +15,8 @@ measured-wind loads and the simulator's steady wind alike).  The effect stands f
 not for one regression's numbers: a real ship's side force and, above all, its yaw moment (the arm
 of the lateral load, a small difference of large terms) stray from any regression, so one scale
 cannot stand for them and the misfit would be named as other effects.  Only ``scale`` says whether
-the wind is there (:meth:`Wind.presence_parameters`): with it at 0 the factors do nothing.
+the wind is there (:meth:`Wind.presence_parameters`): with it at 0 the factors do nothing; the test
+that it is there is on the three loads together (:meth:`Wind.presence_z`).
 
 The factors' prior (:data:`SHAPE_SIGMA` = 0.35 about 1, bounds 0.2-3): how far a real ship's
 coefficients stray from a regression's.  Owens & Palo (1982), *Wind-induced steady loads on ships*,
@@ -95,6 +96,30 @@ class Wind(Effect):
     def presence_parameters(cls):
         """Only the scale: at 0 there is no wind whatever the shape factors say."""
         return ("scale",)
+
+    @classmethod
+    def presence_z(cls, theta, cov):
+        """The Wald test that the three loads, surge ``scale``, sway ``scale * sway_factor`` and yaw
+        ``scale * yaw_factor`` (delta-method covariance), are all zero, as the normal deviate of the
+        same two-sided tail probability (chi-square with the covariance's rank as its degrees of
+        freedom).  The scale alone (the surge load) can trade with the ship's resistance and thrust,
+        which the diagnosis fits too, while the sway and yaw loads, which turn with the relative wind,
+        show the wind plainly: on a 10/10 zigzag in a 10 m/s quartering wind (family seed 7000) the
+        scale stood 1.6 standard errors from 0 at dBIC 246."""
+        from scipy.stats import chi2, norm
+
+        s, a, b = (float(x) for x in np.asarray(theta, float)[:3])
+        G = np.array([[1.0, 0.0, 0.0], [a, s, 0.0], [b, 0.0, s]])
+        C = G @ np.asarray(cov, float)[:3, :3] @ G.T
+        g = np.array([s, s * a, s * b])
+        if not (np.all(np.isfinite(C)) and np.all(np.isfinite(g))):
+            return super().presence_z(theta, cov)
+        w, V = np.linalg.eigh(0.5 * (C + C.T))
+        keep = w > 1e-12 * max(float(w.max()), 1e-300)
+        if not np.any(keep):
+            return super().presence_z(theta, cov)
+        x = float(np.sum((V[:, keep].T @ g) ** 2 / w[keep]))
+        return float(norm.isf(0.5 * chi2.sf(x, int(np.sum(keep)))))
 
     @classmethod
     def amplitudes(cls, values, particulars):

@@ -11,7 +11,8 @@ checking the scale) and the ship config:
    config as it is.
 2. **Baseline**: fit the ship coefficients the records inform (:data:`SHIP_FREE_TERMS`: the
    resistance, the linear sway/yaw derivatives and the yaw damping r|r| term, the wake
-   w_P0 and the added masses and moment, :data:`MASS_FREE`; :func:`ekf.identify.identify_segments`
+   w_P0, :data:`CONSTANTS_FREE`, on turns the rudder's inflow ratio epsilon,
+   :data:`TURN_CONSTANTS_FREE`, and the added masses and moment, :data:`MASS_FREE`; :func:`ekf.identify.identify_segments`
    with its prior) with no effect: constants of the
    config that are merely a bit off (added mass, wake, hull) are absorbed here, so they do not
    pass for an effect.  ``rms_before`` is this model's residual.
@@ -71,7 +72,8 @@ __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
-"""Hull terms whose coefficients the diagnosis fits with every model (plus ``w_P0``)."""
+"""Hull terms whose coefficients the diagnosis fits with every model (plus :data:`CONSTANTS_FREE`,
+:data:`TURN_CONSTANTS_FREE` on turns, :data:`MASS_FREE`)."""
 SCREEN_NFEV = 6
 """Evaluation budget of a candidate's first (screening) fit; see :func:`diagnose`."""
 UNEXPLAINED_FACTOR = 5.0
@@ -150,6 +152,19 @@ class _Model:
         return self.fit.theta
 
 
+CONSTANTS_FREE = ("w_P0",)
+"""Propeller constants the diagnosis fits with every model: the wake w_P0 (the thrust)."""
+TURN_CONSTANTS_FREE = ("epsilon",)
+"""Rudder constants it fits as well on turns (:func:`~trials.measured.decision.record_kind` ``turn`` or
+``turn_pair``): the rudder's inflow ratio epsilon (the rudder force, as epsilon^2).  In a 35 deg turn the
+rudder's drag, (1 - t_R) F_N sin(delta), sets much of the speed lost; a rudder force 10-15 % off its
+config leaves a residual in that speed loss and the drift that the resistance (u^2) and the wake cannot
+take, and a candidate effect took it instead: on family member 31 of seed 5000 (rudder constants 9-14 %
+off) a 10 m/s wind on a port turn was fitted at dBIC 19.5 and z 1.9 without epsilon, at dBIC 141 and z 7
+(scale 1.08 for 1.10) with it.  On a zigzag the rudder force is what drives the response, and its size
+trades with the freed linear hull terms (a Nomoto gain is their ratio): freeing it there too (variant 6
+in ``docs/diagnose.md``) made a following 18 m/s wind on a 20/20 zigzag of the development set
+not identifiable (correlation 0.997 with m_x, m_y, epsilon)."""
 MASS_FREE = ("m_x", "m_y", "J_z")
 """Added masses and the added moment of inertia the diagnosis fits with every model (prior: the
 config value, relative std from :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`, the diagnosis's policy
@@ -199,11 +214,15 @@ def _baseline_prior(f, term):
     return f
 
 
-def _ship_free(ship: Ship, packed, names=None):
+def _ship_free(ship: Ship, packed, names=None, kind: str = "zigzag"):
+    """The ship's own parameters the diagnosis fits (``names``, or by default :data:`SHIP_FREE_TERMS`,
+    :data:`CONSTANTS_FREE`, on a ``kind`` of record set other than ``"zigzag"`` :data:`TURN_CONSTANTS_FREE`,
+    and :data:`MASS_FREE`) with the diagnosis's priors."""
     from ekf.identify import DIAGNOSIS_PRIOR_REL_STD, free_parameters
 
     if names is None:
-        names = [n for n, t in zip(ship.hull.names, ship.hull.terms) if t in SHIP_FREE_TERMS] + ["w_P0"]
+        names = [n for n, t in zip(ship.hull.names, ship.hull.terms) if t in SHIP_FREE_TERMS] + list(CONSTANTS_FREE)
+        names += list(TURN_CONSTANTS_FREE) if kind != "zigzag" else []
         mass = list(MASS_FREE)
     else:
         mass = [n for n in names if n in MASS_FREE]
@@ -295,11 +314,7 @@ def _effect_report(model: _Model, effect, inflate: float):
     np.fill_diagonal(corr, 1.0)
     cov = corr * np.outer(std, std)
     vals, se = effect.report(th, cov)
-    neutral = np.array([q.default for q in effect.fit_parameters()])
-    on = np.array([q.name in effect.presence_parameters() for q in effect.fit_parameters()])  # z: presence only
-    with np.errstate(divide="ignore", invalid="ignore"):
-        z = float(np.sqrt(np.sum(((th - neutral)[on] / np.where(std > 0, std, np.inf)[on]) ** 2)))
-    return vals, se, z
+    return vals, se, effect.presence_z(th, cov)
 
 
 # --------------------------------------------------------------------------- description of what is left
@@ -709,10 +724,11 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     U = max(U, 0.05 * math.sqrt(9.80665 * L))
     noise = np.median(np.vstack([_noise(r.seg.meas) for r in recs]), axis=0)
     cand, cand_log = _candidates(recs, list(o.candidates) if o.candidates is not None else E.names(), say)
-    sfree = _ship_free(ship, packed, o.ship_free)
+    kind = record_kind([r.seg.inputs.delta for r in recs])
+    sfree = _ship_free(ship, packed, o.ship_free, kind)
     sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
     fitter = _Fitter(ship, packed, recs, sc0, o.stride, o.max_nfev, sfree)
-    fitter.kind = record_kind([r.seg.inputs.delta for r in recs])
+    fitter.kind = kind
     fitter.heading = mean_heading([r.seg.meas[:, 5] for r in recs])
     d_config, base, kept = _baseline(fitter, noise, say)
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)

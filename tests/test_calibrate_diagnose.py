@@ -1,0 +1,72 @@
+"""The calibration of mmg diagnose's floors (bench/calibrate_diagnose.py): which candidate fits count as
+clean samples, the effects a kind of record can never name, and the floor's rule on hand-made records."""
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+L = 325.0
+
+
+@pytest.fixture(scope="module")
+def cal():
+    path = Path(__file__).resolve().parents[1] / "bench" / "calibrate_diagnose.py"
+    spec = importlib.util.spec_from_file_location("calibrate_diagnose", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _cand(effect, dbic, z, **params):
+    return {"effect": effect, "delta_bic": dbic, "z": z, "parameters": params}
+
+
+def _turn_with_offset():
+    """A single turn with a true rudder offset, never named: its first round tries a current that
+    clears dBIC and z at 0.06 m/s."""
+    return {"trial": "turn35", "truth": {"rudder_offset": {"offset_deg": 1.0}},
+            "rounds": [{"round": 1, "model": [], "kind": "turn", "heading_deg": 0.0,
+                        "candidates": [_cand("current", 40.0, 6.0, speed_mps=0.06, direction_deg=90.0),
+                                       _cand("rudder_offset", -5.0, 0.5, offset_deg=2.0)]}]}
+
+
+def test_a_hidden_effects_record_lends_clean_samples_to_the_others(cal):
+    rec = _turn_with_offset()
+    clean, passes, _ = cal.clean_magnitudes([rec], L)
+    assert "current" not in clean                       # the offset is not in the model: not a clean round
+    clean, passes, _ = cal.clean_magnitudes([rec], L, hidden={"turn": {"rudder_offset"}})
+    assert clean["current"]["turn"] == [pytest.approx(0.06 / np.sqrt(9.80665 * L))]
+    assert passes["current"]["turn"] == [True]
+    assert "rudder_offset" not in clean                 # the record's own effect is no sample of itself
+    clean, _, _ = cal.clean_magnitudes([rec], L, hidden={"zigzag": {"rudder_offset"}})
+    assert "current" not in clean                       # hidden on zigzags only: this turn is not clean
+
+
+def test_hidden_effects_are_those_whose_floor_exceeds_the_size_to_detect(cal):
+    from trials.measured.identifiability import detection_size
+
+    fl = {"rudder_offset": {"turn": 4.9, "zigzag": 0.66}, "heading_bias": {"turn": 0.9},
+          "current": {"turn": 0.5 * detection_size("current", L)}}
+    assert cal.hidden_effects(fl, L) == {"turn": {"rudder_offset"}}
+
+
+def test_only_kind_keeps_the_records_of_one_kind(cal):
+    rec = _turn_with_offset()
+    assert cal.only_kind(rec, "turn") is rec
+    assert cal.only_kind(rec, "zigzag") is None
+    assert cal.record_kind_of({"trial": "zz20", "rounds": []}) == "zigzag"
+
+
+def test_floor_is_the_half_normal_tail_at_the_passing_share(cal):
+    """20 clean samples, 5 passing with sizes 1..5: the floor is RMS * Q(1 - alpha / (m p_up)), p_up
+    the Clopper-Pearson upper 95 % bound of 5/20, computed here from scipy's beta and half-normal."""
+    from scipy.stats import beta, halfnorm
+
+    sizes = [1.0, 2.0, 3.0, 4.0, 5.0] + [0.0] * 15
+    out = cal.floors({"rudder_offset": {"zigzag": sizes}}, 0.05)
+    p_up = beta.ppf(0.95, 6, 15)
+    want = np.sqrt(np.mean(np.square([1, 2, 3, 4, 5]))) * halfnorm.ppf(1 - 0.05 / p_up)
+    assert out["rudder_offset"]["zigzag"] == pytest.approx(max(want, 5.0), rel=1e-3)
