@@ -206,17 +206,3 @@ def test_floor_parts_and_the_reason_given(monkeypatch):
             "parts": {k: list(v) for k, v in parts.items()}, "clears_threshold": False}
     (entry,) = within_mismatch([{"candidates": [cand]}], L)
     assert "along" in entry["reason"] and "across" in entry["reason"]
-
-
-def test_an_effect_whose_floor_exceeds_the_size_to_detect_is_never_named(monkeypatch):
-    """A rudder offset on one turn whose calibrated floor (4 deg) is above the 1 deg worth detecting is
-    never named, however large its fit: a value over that floor is what the ship's mismatch lends it now
-    and then.  The same offset on a zigzag, floor 0.6 deg, is judged by its floor."""
-    import trials.measured.decision as D
-
-    monkeypatch.setattr(D, "calibration", lambda: {"floors": {"rudder_offset": {"turn": 4.0, "zigzag": 0.6}}})
-    assert D.never_named("rudder_offset", "turn", 325.0)
-    assert not D.clears_floor("rudder_offset", {"offset_deg": 9.0}, 325.0, "turn")
-    assert not D.never_named("rudder_offset", "zigzag", 325.0)
-    assert D.clears_floor("rudder_offset", {"offset_deg": 0.7}, 325.0, "zigzag")
-    assert not D.clears_floor("rudder_offset", {"offset_deg": 0.5}, 325.0, "zigzag")

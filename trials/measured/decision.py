@@ -36,7 +36,7 @@ import numpy as np
 
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
-           "clears_floor", "floor_parts", "COMPONENT_FLOORS", "never_named"]
+           "clears_floor", "floor_parts", "COMPONENT_FLOORS"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -141,26 +141,10 @@ def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float 
     heading : float, optional
         The records' mean heading [rad] (:func:`mean_heading`).
     """
-    if never_named(effect, kind, L):
-        return False
     parts = floor_parts(effect, values, L, kind, heading)
     if parts:
         return any(abs(x) > f for x, f in parts.values())
     return not magnitude(effect, values, L) <= floor(effect, kind)
-
-
-def never_named(effect: str, kind: str, L: float) -> bool:
-    """Whether ``effect`` is never named on a record set of ``kind``: its calibrated floor there
-    exceeds the size worth detecting (:data:`trials.measured.identifiability.DETECTION_SIZE`), so a
-    value above the floor is one the ship's own mismatch lends it now and then, not a finding (a
-    rudder offset or a heading bias on one turning circle: reported ``not_identifiable``).  The
-    calibration counts the records with such an effect as clean samples for the others
-    (``bench/calibrate_diagnose.py``, ``hidden_effects``): the one rule on both sides."""
-    from .identifiability import detection_size
-
-    if effect == "current" and kind in COMPONENT_FLOORS:
-        return False                                   # judged by its parts, each against its own floor
-    return floor(effect, kind) > detection_size(effect, L)
 
 
 def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float | None = None) -> dict:
