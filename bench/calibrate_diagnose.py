@@ -28,10 +28,11 @@ afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the record
 the diagnosis of the other kind was another (the rudder's inflow freed on zigzags too, variant 6
 in ``docs/diagnose.md``) still calibrates this one.
 
-Effects whose floor on a kind of record exceeds the size worth detecting are never named there
-(:func:`hidden_effects`: a rudder offset or heading bias on one turning circle); the records that
-have them lend the other candidates sizes that count as clean samples (:func:`clean_magnitudes`),
-so the floors are set twice: once from the clean records, once with those.
+Effects whose floor on a kind of record exceeds the size worth detecting cannot be shown there at
+that size (:func:`hidden_effects`: a rudder offset or heading bias on one turning circle, reported
+``not_identifiable``); the records that have them at such sizes lend the other candidates sizes that
+count as clean samples (:func:`clean_magnitudes`), so the floors are set twice: once from the clean
+records, once with those.
 """
 from __future__ import annotations
 
@@ -136,8 +137,8 @@ def only_kind(rec: dict, kind: str):
 
 def hidden_effects(fl: dict, L: float) -> dict:
     """{kind: effects} whose floor on that kind of record exceeds the size worth detecting
-    (:data:`trials.measured.identifiability.DETECTION_SIZE`): they are never named there, only
-    reported ``not_identifiable``."""
+    (:data:`trials.measured.identifiability.DETECTION_SIZE`): at the sizes worth detecting they are
+    not named there, only reported ``not_identifiable``."""
     from trials.measured.identifiability import detection_size
 
     out: dict = {}
@@ -200,7 +201,7 @@ def main(argv=None):
     L = mmg.load_ship("esso_osaka").particulars.L
     clean, passes, raw = clean_magnitudes(records, L)
     hidden = hidden_effects(floors(clean, a.alpha, raw), L)      # pass 1: what a kind of record cannot name
-    print("never named (floor above the size to detect):", {k: sorted(v) for k, v in hidden.items()})
+    print("not named at the size to detect (floor above it):", {k: sorted(v) for k, v in hidden.items()})
     clean, passes, raw = clean_magnitudes(records, L, hidden)   # pass 2: their records lend the others
     fl = floors(clean, a.alpha, raw)
     n = sum(1 for r in records if not r.get("truth"))

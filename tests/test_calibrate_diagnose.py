@@ -1,5 +1,5 @@
 """The calibration of mmg diagnose's floors (bench/calibrate_diagnose.py): which candidate fits count as
-clean samples, the effects a kind of record can never name, and the floor's rule on hand-made records."""
+clean samples, the effects a kind of record cannot show at the size worth detecting, and the floor's rule on hand-made records."""
 from __future__ import annotations
 
 import importlib.util
@@ -25,7 +25,7 @@ def _cand(effect, dbic, z, **params):
 
 
 def _turn_with_offset():
-    """A single turn with a true rudder offset, never named: its first round tries a current that
+    """A single turn with a true 1 deg rudder offset, not named: its first round tries a current that
     clears dBIC and z at 0.06 m/s."""
     return {"trial": "turn35", "truth": {"rudder_offset": {"offset_deg": 1.0}},
             "rounds": [{"round": 1, "model": [], "kind": "turn", "heading_deg": 0.0,

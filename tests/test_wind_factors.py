@@ -170,15 +170,18 @@ def _report(effect, theta, std):
     return _effect_report(SimpleNamespace(free=free, fit=fit), effect, 1.0)
 
 
-def test_presence_of_the_wind_is_its_scale_alone():
+def test_presence_of_the_wind_needs_its_scale():
+    """At scale 0 there is no wind whatever the shape factors say (z 0); a wind of 0.8 the published
+    loads, each load known to about 0.1: present at more standard errors than the threshold (the test
+    is on the three loads together, tests/test_effect_definitions.py checks its value)."""
     from trials.measured.diagnose import Z_THRESHOLD
 
     assert E.Wind.presence_parameters() == ("scale",)
     assert E.Current.presence_parameters() == tuple(q.name for q in E.Current.fit_parameters())
     _, _, z = _report(E.Wind, [0.0, 1.3, 1.3], [0.1, 0.1, 0.1])       # no wind, shape factors off 1
-    assert z == pytest.approx(0.0, abs=1e-12) and z < Z_THRESHOLD
+    assert z == pytest.approx(0.0, abs=1e-9) and z < Z_THRESHOLD
     vals, _, z = _report(E.Wind, [0.8, 1.0, 1.0], [0.1, 0.05, 0.05])  # a wind of 0.8 the published
-    assert z == pytest.approx(8.0) and vals["scale"] == 0.8
+    assert z > 2 * Z_THRESHOLD and vals["scale"] == 0.8
 
 
 # ----------------------------------------------------------------------------- the fit
