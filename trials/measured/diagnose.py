@@ -160,7 +160,7 @@ TURN_CONSTANTS_FREE = ("epsilon",)
 rudder's drag, (1 - t_R) F_N sin(delta), sets much of the speed lost; a rudder force 10-15 % off its
 config leaves a residual in that speed loss and the drift that the resistance (u^2) and the wake cannot
 take, and a candidate effect took it instead: on family member 31 of seed 5000 (rudder constants 9-14 %
-off) a 10 m/s wind on a port turn was fitted at dBIC 19.5 and z 1.9 without epsilon, at dBIC 141 and z 7
+off) a 10 m/s wind on a port turn was fitted at dBIC 19.5 and z 1.9 without epsilon, at dBIC 140 (z 10.5 on its loads)
 (scale 1.08 for 1.10) with it.  On a zigzag the rudder force is what drives the response, and its size
 trades with the freed linear hull terms (a Nomoto gain is their ratio): freeing it there too (variant 6
 in ``docs/diagnose.md``) made a following 18 m/s wind on a 20/20 zigzag of the development set
