@@ -195,9 +195,8 @@ def main(argv=None):
     for p in a.bench_json:
         p, _, kind = p.partition(":")
         data = json.loads(Path(p).read_text())
-        records += [only_kind(r, kind) for r in (data["records"] if isinstance(data, dict) else data)] if kind else \
-            (data["records"] if isinstance(data, dict) else data)
-    records = [r for r in records if r is not None]
+        recs = data["records"] if isinstance(data, dict) else data
+        records += [r for r in recs if not kind or only_kind(r, kind) is not None]
     L = mmg.load_ship("esso_osaka").particulars.L
     clean, passes, raw = clean_magnitudes(records, L)
     hidden = hidden_effects(floors(clean, a.alpha, raw), L)      # pass 1: what a kind of record cannot name

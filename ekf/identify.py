@@ -550,12 +550,12 @@ class _SegmentFit:
         self.heads = {k: records[k].first_segment() for k in set(self.own) - {None}}   # what a start offset moves
         self.count = 0
 
-    def block(self, theta, k, pk=None):
-        """Record k's weighted residuals."""
+    def block(self, theta, k, pk=None, rec=None):
+        """Record k's weighted residuals (of ``rec``, a part of it such as its first segment, when given)."""
         o = self.opts
         pk = apply_parameters(self.packed, self.free, theta) if pk is None else pk
-        return self.wts[k] * _residual_one(pk, self.records[k], self.sc, o.stride, o.effects, self.free, theta, o.ship,
-                                           self.pos, k)
+        rec = self.records[k] if rec is None else rec
+        return self.wts[k] * _residual_one(pk, rec, self.sc, o.stride, o.effects, self.free, theta, o.ship, self.pos, k)
 
     def resid(self, theta, parallel=True):
         """Every record's residuals, then the prior's."""
@@ -582,14 +582,8 @@ class _SegmentFit:
         alone; an offset of its start state (kind ``"start"``) only its first segment, which alone is replayed."""
         col = np.zeros_like(r0)
         k, s = self.own[j], self.start
-        if self.free[j].kind == "start":
-            o = self.opts
-            pk = apply_parameters(self.packed, self.free, step)
-            b = self.wts[k] * _residual_one(pk, self.heads[k], self.sc, o.stride, o.effects, self.free, step, o.ship,
-                                            self.pos, k)
-            col[s[k]:s[k] + len(b)] = (b - r0[s[k]:s[k] + len(b)]) / h
-        else:
-            col[s[k]:s[k + 1]] = (self.block(step, k) - r0[s[k]:s[k + 1]]) / h
+        b = self.block(step, k, rec=self.heads[k] if self.free[j].kind == "start" else None)
+        col[s[k]:s[k] + len(b)] = (b - r0[s[k]:s[k] + len(b)]) / h
         col[s[-1] + j] = 1.0 / self.sig0[j]
         return col
 
