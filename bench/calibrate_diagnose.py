@@ -29,7 +29,7 @@ the diagnosis of the other kind was another (the rudder's inflow freed on zigzag
 in ``docs/diagnose.md``) still calibrates this one.
 
 Effects whose floor on a kind of record exceeds the size worth detecting cannot be shown there at
-that size (:func:`hidden_effects`: a rudder offset or heading bias on one turning circle, reported
+that size (:func:`hidden_effects`: a rudder offset on one turning circle, reported
 ``not_identifiable``); the records that have them at such sizes lend the other candidates sizes that
 count as clean samples (:func:`clean_magnitudes`), so the floors are set twice: once from the clean
 records, once with those.
