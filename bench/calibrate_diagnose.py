@@ -1,25 +1,10 @@
 """Calibrate the naming floors of ``mmg diagnose`` (:mod:`trials.measured.decision`) on the clean
-records of the mismatch family, and write them to the packaged ``configs/calibration/diagnose.yaml``.
+records of the mismatch family, and write them to the packaged ``configs/calibration/diagnose.yaml``:
+the command over :func:`trials.measured.calibration.calibrate` (its module docstring gives the rule).
 
 Input: the JSON of ``python bench/bench_diagnose.py --mismatch --tag _cal --seed0 1000 --effects none``
 (clean records of ships that differ from the config as real ships do, diagnosed as a user would,
-with no floor: the packaged calibration moved aside).  For every clean record the first search
-round tries each candidate on top of the fitted ship; its *clean magnitude* is the candidate's
-:func:`~trials.measured.decision.magnitude` where its dBIC and z clear their thresholds (it would
-be named but for the floor), else 0.  Where they do not clear, the magnitude says nothing: a
-rudder offset on a turning circle wanders to its 10 deg bound at z 1.
-
-A candidate is named on a clean record when it clears dBIC and z (probability p, the share that
-did) *and* its magnitude exceeds the floor.  Per effect and kind of record (turn, zigzag) the floor
-holds that chance to alpha / m (m candidates, alpha 0.05: the acceptance's false-alarm rate per
-record), the passing magnitudes taken as half-normal (the law of |x| for a zero-mean normal x: a
-size the ship's own mismatch lends an effect, with no preferred sign or direction) with their RMS
-as the scale:
-
-    floor = RMS(passing) * Q_half-normal(1 - alpha / (m p)),   0 where p <= alpha / m
-
-and never below the largest passing magnitude seen.  A parametric tail, not the sample maximum
-alone: 20 records per kind cannot place a 1 % quantile by themselves.  The floors are checked
+with no floor: ``MMG_DIAGNOSE_CALIBRATION=none``), and runs with effects.  The floors are checked
 afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the records that set them.
 
     python bench/calibrate_diagnose.py bench/out/diagnose_mismatch_cal.json[:KIND] ... [--alpha 0.05] [--write]
@@ -27,12 +12,6 @@ afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the record
 ``PATH:KIND`` takes only the records of one kind of a run (``turn``, ``zigzag``): a run made while
 the diagnosis of the other kind was another (the rudder's inflow freed on zigzags too, variant 6
 in ``docs/diagnose.md``) still calibrates this one.
-
-Effects whose floor on a kind of record exceeds the size worth detecting cannot be shown there at
-that size (:func:`hidden_effects`: a rudder offset on one turning circle, reported
-``not_identifiable``); the records that have them at such sizes lend the other candidates sizes that
-count as clean samples (:func:`clean_magnitudes`), so the floors are set twice: once from the clean
-records, once with those.
 """
 from __future__ import annotations
 
@@ -48,136 +27,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 OUT = REPO / "configs" / "calibration" / "diagnose.yaml"
 
-
-def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
-    """({effect: {kind: [clean magnitude]}}, the same of whether dBIC and z cleared, the same of
-    the magnitudes whether or not they cleared).
-
-    A candidate's sample is *clean* where the record does not have that effect and the model it is
-    tried on holds exactly the effects the record has: every first round of a clean record, and the
-    round of a record with effects right after its true effects were named (a wind named, what does
-    the ship's mismatch lend a shallow-water candidate on top of it).  Before the true effects are
-    in, the other candidates soak up theirs (a current takes a heading bias on a zigzag): that is
-    the confusion :mod:`trials.measured.identifiability` reports, not the ship's mismatch.
-
-    ``hidden`` ({kind: set of effects}, :func:`hidden_effects`): effects that cannot be named on that
-    kind of record (a rudder offset on one turning circle).  A record's true effects among them are
-    never in the model, so its rounds count as clean for the other candidates once its other true
-    effects are in: what such an effect lends a current or shallow water on a turn is a nuisance
-    of the same kind as the ship's own mismatch, and a name given for it is a wrong name."""
-    import math
-
-    from trials.measured.decision import BIC_THRESHOLD, COMPONENT_FLOORS, Z_THRESHOLD, current_components, magnitude
-
-    out: dict = {}
-    passes: dict = {}
-    raw: dict = {}
-    for rec in records:
-        truth = set(rec.get("truth") or {})
-        for rd in rec.get("rounds") or []:
-            kind = rd.get("kind") or ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
-            if set(rd.get("model", [])) != truth - set((hidden or {}).get(kind, ())):
-                continue       # before the true effects are in, a candidate soaks up theirs: not a clean sample
-            for c in rd["candidates"]:
-                if c["effect"] in truth:
-                    continue
-                ok = bool(c["delta_bic"] > BIC_THRESHOLD and c["z"] > Z_THRESHOLD)
-                sizes = [(c["effect"], magnitude(c["effect"], c["parameters"], L))]
-                if c["effect"] == "current" and kind in COMPONENT_FLOORS:
-                    # bench runs of the family sail at heading 0 (trials.measured.mismatch.trial_records)
-                    parts = current_components(c["parameters"], L, math.radians(rd.get("heading_deg", 0.0)))
-                    sizes += [(k, abs(x)) for k, x in zip(COMPONENT_FLOORS[kind], parts)]
-                for e, m in sizes:
-                    out.setdefault(e, {}).setdefault(kind, []).append(float(m) if ok else 0.0)
-                    passes.setdefault(e, {}).setdefault(kind, []).append(ok)
-                    raw.setdefault(e, {}).setdefault(kind, []).append(float(m))
-    return out, passes, raw
-
-
-def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
-    """{effect: {kind: floor}} (module docstring): the passing share p taken at its upper 95 %
-    (Clopper-Pearson) bound, not its estimate (0 of 23 is not a bound of 0); the scale the RMS of
-    the passing sizes, or, with fewer than :data:`MIN_PASSING` of them, of every size the candidate
-    took (``raw``), passing or not (a conservative stand-in)."""
-    from scipy.stats import beta, halfnorm
-
-    from trials.measured.decision import COMPONENT_FLOORS
-
-    comps = {c for cs in COMPONENT_FLOORS.values() for c in cs}
-    m0 = max(len([e for e in clean if e not in comps]), 1)
-    out = {}
-    for e, kinds in clean.items():
-        out[e] = {}
-        m = m0 * (2 if e in comps else 1)       # a current named when either component clears: alpha split
-        for k, v in kinds.items():
-            v = np.asarray(v, float)
-            on = v[v > 0]
-            n, kk = len(v), len(on)
-            p_up = float(beta.ppf(0.95, kk + 1, max(n - kk, 1))) if n else 1.0
-            f = 0.0
-            if p_up > alpha / m:
-                pool = on if kk >= MIN_PASSING else np.asarray((raw or {}).get(e, {}).get(k, v), float)
-                scale = float(np.sqrt(np.mean(pool * pool))) if len(pool) else 0.0
-                f = max(scale * float(halfnorm.ppf(1.0 - alpha / (m * p_up))), float(on.max()) if kk else 0.0)
-            out[e][k] = float(f"{f:.4g}")
-    return out
-
-
-def record_kind_of(rec: dict) -> str:
-    """The kind of record set a bench record was diagnosed as (its first round's, else by its trial)."""
-    return (rec.get("rounds") or [{}])[0].get("kind") or \
-        ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
-
-
-def only_kind(rec: dict, kind: str):
-    """``rec`` when it is of ``kind`` (:func:`record_kind_of`), else None: a run's records of one kind,
-    where the diagnosis of the other kind has changed since the run."""
-    return rec if record_kind_of(rec) == kind else None
-
-
-def hidden_effects(fl: dict, L: float) -> dict:
-    """{kind: effects} whose floor on that kind of record exceeds the size worth detecting
-    (:data:`trials.measured.identifiability.DETECTION_SIZE`): at the sizes worth detecting they are
-    not named there, only reported ``not_identifiable``."""
-    from trials.measured.identifiability import detection_size
-
-    out: dict = {}
-    for e, kinds in fl.items():
-        for k, f in kinds.items():
-            if f > detection_size(e, L):
-                out.setdefault(k, set()).add(e)
-    return out
-
-
-MIN_PASSING = 3
-"""Fewer passing sizes than this: the floor's scale is taken from every size the candidate took."""
-
-
-RESIDUAL_QUANTILE = 95.0
-"""The residual floors are this percentile of the clean records' residuals after the fit: a record
-is unexplained when its residual is worse than 95 % of the records of ships that differ from the
-config as real ships do (a few members of the family, cross-flow hulls that lose 85 % of their speed
-in a 35 deg turn, are fitted far worse than the rest: the maximum would be theirs)."""
-
-
-def residual_floors(records) -> dict:
-    """{kind: {channel: floor}} of the residual RMS after the fit on the clean records: u, v over the
-    speed, r as r L / U, heading [deg] (:func:`trials.measured.decision.residual_floor`)."""
-    import math
-
-    vals: dict = {}
-    for rec in records:
-        if rec.get("truth") or "rms_after" not in rec:
-            continue
-        kind = record_kind_of(rec)
-        ra, U, L = rec["rms_after"], rec["speed_mps"], rec["L_m"]
-        v = vals.setdefault(kind, {"u": [], "v": [], "r": [], "heading": []})
-        v["u"].append(ra["u"] / U)
-        v["v"].append(ra["v"] / U)
-        v["r"].append(math.radians(ra["r"]) * L / U)
-        v["heading"].append(ra["heading"])
-    return {k: {c: float(f"{np.percentile(x, RESIDUAL_QUANTILE):.4g}") for c, x in v.items() if x}
-            for k, v in vals.items()}
+from trials.measured.calibration import calibrate, only_kind
 
 
 def main(argv=None):
@@ -197,30 +47,16 @@ def main(argv=None):
         data = json.loads(Path(p).read_text())
         recs = data["records"] if isinstance(data, dict) else data
         records += [r for r in recs if not kind or only_kind(r, kind) is not None]
-    L = mmg.load_ship("esso_osaka").particulars.L
-    clean, passes, raw = clean_magnitudes(records, L)
-    hidden = hidden_effects(floors(clean, a.alpha, raw), L)      # pass 1: what a kind of record cannot name
-    print("not named at the size to detect (floor above it):", {k: sorted(v) for k, v in hidden.items()})
-    clean, passes, raw = clean_magnitudes(records, L, hidden)   # pass 2: their records lend the others
-    fl = floors(clean, a.alpha, raw)
-    n = sum(1 for r in records if not r.get("truth"))
-    n_eff = len(records) - n
-    for e, kinds in clean.items():
-        for k, v in kinds.items():
-            v = np.asarray(v)
-            print(f"{e:14s} {k:7s} n {len(v):3d}  passing dBIC,z {sum(passes[e][k]):3d}  max {v.max():.4g}  "
-                  f"rms of passing {np.sqrt(np.mean(v[v > 0] ** 2)) if np.any(v > 0) else 0.0:.4g}  floor {fl[e][k]:.4g}")
+    cal = calibrate(records, mmg.load_ship("esso_osaka").particulars.L, a.alpha)
+    print("not named at the size to detect (floor above it):", {k: sorted(v) for k, v in cal.hidden.items()})
+    for row in cal.to_pandas().itertuples():
+        v = np.asarray(cal.clean[row.effect][row.kind])
+        print(f"{row.effect:14s} {row.kind:7s} n {row.samples:3d}  passing dBIC,z {row.passing:3d}  max {row.max_passing:.4g}  "
+              f"rms of passing {np.sqrt(np.mean(v[v > 0] ** 2)) if np.any(v > 0) else 0.0:.4g}  floor {row.floor:.4g}")
     doc = {"source": f"python bench/calibrate_diagnose.py {' '.join(Path(p).name for p in a.bench_json)} --alpha {a.alpha} "
-                     f"({n} clean records and {n_eff} with effects of the mismatch family, seeds of those bench runs; "
-                     f"{datetime.date.today().isoformat()})",
-           "alpha": a.alpha, "units": {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg",
-                                       "wind": "1", "shallow_water": "T/H",
-                                       "current_along": "sqrt(gL)", "current_across": "sqrt(gL)"},
-           "floors": fl, "residual_floors": residual_floors(records),
-           "residual_floor_units": {"u": "fraction of U", "v": "fraction of U", "r": "r L / U", "heading": "deg"},
-           "clean": {e: {k: [float(f"{x:.4g}") for x in v] for k, v in kinds.items()}
-                                   for e, kinds in clean.items()}}
-    print("residual floors (u, v / U, r L / U, heading deg):", residual_floors(records))
+                     f"({cal.n_clean} clean records and {cal.n_effects} with effects of the mismatch family, seeds of "
+                     f"those bench runs; {datetime.date.today().isoformat()})", **cal.to_json()}
+    print("residual floors (u, v / U, r L / U, heading deg):", cal.residual_floors)
     if a.write:
         OUT.parent.mkdir(parents=True, exist_ok=True)
         OUT.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "

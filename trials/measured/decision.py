@@ -17,8 +17,9 @@ An effect is named when three tests hold:
    are large.  The floors bound the sizes the candidates took on clean records of a family of
    ships that differ from the config as real ships do (:mod:`trials.measured.mismatch`; hull
    linear terms +-10 %, nonlinear +-25 %, rudder and propeller constants +-15 %, other wind-load
-   factors, another hull form): ``bench/calibrate_diagnose.py`` (its docstring gives the rule)
-   writes them, with their sources and the clean samples, to the packaged
+   factors, another hull form): :func:`trials.measured.calibration.calibrate` (its module docstring
+   gives the rule) sets them and ``bench/calibrate_diagnose.py`` writes them, with their sources
+   and the clean samples, to the packaged
    ``configs/calibration/diagnose.yaml``.  On a zigzag a current is judged by its components along
    and across the records' mean heading, each against its own floor (:func:`clears_floor`): the
    ship's own speed mismatch lends a current along the heading, hardly any across it.

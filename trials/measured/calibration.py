@@ -1,0 +1,266 @@
+"""Calibration of the naming floors of ``mmg diagnose`` (:mod:`trials.measured.decision`) from the
+diagnoses of clean records, and of records with effects, of ships that differ from the config as
+real ships do (:mod:`trials.measured.mismatch`; the records of ``bench/bench_diagnose.py --mismatch``,
+each with its ``truth`` and every search round's candidate statistics).
+
+For every clean record the first search round tries each candidate on top of the fitted ship; its
+*clean magnitude* is the candidate's :func:`~trials.measured.decision.magnitude` where its dBIC and
+z clear their thresholds (it would be named but for the floor), else 0.  Where they do not clear,
+the magnitude says nothing: a rudder offset on a turning circle wanders to its 10 deg bound at z 1.
+
+A candidate is named on a clean record when it clears dBIC and z (probability p, the share that
+did) *and* its magnitude exceeds the floor.  Per effect and kind of record (turn, zigzag) the floor
+holds that chance to alpha / m (m candidates, alpha 0.05: the acceptance's false-alarm rate per
+record), the passing magnitudes taken as half-normal (the law of |x| for a zero-mean normal x: a
+size the ship's own mismatch lends an effect, with no preferred sign or direction) with their RMS
+as the scale:
+
+    floor = RMS(passing) * Q_half-normal(1 - alpha / (m p)),   0 where p <= alpha / m
+
+and never below the largest passing magnitude seen.  A parametric tail, not the sample maximum
+alone: 20 records per kind cannot place a 1 % quantile by themselves.
+
+Effects whose floor on a kind of record exceeds the size worth detecting cannot be shown there at
+that size (:func:`hidden_effects`: a rudder offset on one turning circle, reported
+``not_identifiable``); the records that have them at such sizes lend the other candidates sizes that
+count as clean samples (:func:`clean_magnitudes`), so :func:`calibrate` sets the floors twice: once
+from the clean records, once with those.
+
+``bench/calibrate_diagnose.py`` is the command over this module: it reads the bench's JSON and
+writes the packaged ``configs/calibration/diagnose.yaml``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = [
+    "MIN_PASSING",
+    "RESIDUAL_QUANTILE",
+    "RESIDUAL_UNITS",
+    "UNITS",
+    "Calibration",
+    "calibrate",
+    "clean_magnitudes",
+    "floors",
+    "hidden_effects",
+    "only_kind",
+    "record_kind_of",
+    "residual_floors",
+]
+
+UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1", "shallow_water": "T/H",
+         "current_along": "sqrt(gL)", "current_across": "sqrt(gL)"}
+"""Units of the floors and clean magnitudes, per effect (and per part of a current on zigzags)."""
+RESIDUAL_UNITS = {"u": "fraction of U", "v": "fraction of U", "r": "r L / U", "heading": "deg"}
+"""Units of the residual floors, per channel."""
+
+
+def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
+    """({effect: {kind: [clean magnitude]}}, the same of whether dBIC and z cleared, the same of
+    the magnitudes whether or not they cleared).
+
+    A candidate's sample is *clean* where the record does not have that effect and the model it is
+    tried on holds exactly the effects the record has: every first round of a clean record, and the
+    round of a record with effects right after its true effects were named (a wind named, what does
+    the ship's mismatch lend a shallow-water candidate on top of it).  Before the true effects are
+    in, the other candidates soak up theirs (a current takes a heading bias on a zigzag): that is
+    the confusion :mod:`trials.measured.identifiability` reports, not the ship's mismatch.
+
+    ``hidden`` ({kind: set of effects}, :func:`hidden_effects`): effects that cannot be named on that
+    kind of record (a rudder offset on one turning circle).  A record's true effects among them are
+    never in the model, so its rounds count as clean for the other candidates once its other true
+    effects are in: what such an effect lends a current or shallow water on a turn is a nuisance
+    of the same kind as the ship's own mismatch, and a name given for it is a wrong name."""
+    import math
+
+    from .decision import (
+        BIC_THRESHOLD,
+        COMPONENT_FLOORS,
+        Z_THRESHOLD,
+        current_components,
+        magnitude,
+    )
+
+    out: dict = {}
+    passes: dict = {}
+    raw: dict = {}
+    for rec in records:
+        truth = set(rec.get("truth") or {})
+        for rd in rec.get("rounds") or []:
+            kind = rd.get("kind") or ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
+            if set(rd.get("model", [])) != truth - set((hidden or {}).get(kind, ())):
+                continue       # before the true effects are in, a candidate soaks up theirs: not a clean sample
+            for c in rd["candidates"]:
+                if c["effect"] in truth:
+                    continue
+                ok = bool(c["delta_bic"] > BIC_THRESHOLD and c["z"] > Z_THRESHOLD)
+                sizes = [(c["effect"], magnitude(c["effect"], c["parameters"], L))]
+                if c["effect"] == "current" and kind in COMPONENT_FLOORS:
+                    # bench runs of the family sail at heading 0 (trials.measured.mismatch.trial_records)
+                    parts = current_components(c["parameters"], L, math.radians(rd.get("heading_deg", 0.0)))
+                    sizes += [(k, abs(x)) for k, x in zip(COMPONENT_FLOORS[kind], parts)]
+                for e, m in sizes:
+                    out.setdefault(e, {}).setdefault(kind, []).append(float(m) if ok else 0.0)
+                    passes.setdefault(e, {}).setdefault(kind, []).append(ok)
+                    raw.setdefault(e, {}).setdefault(kind, []).append(float(m))
+    return out, passes, raw
+
+
+def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
+    """{effect: {kind: floor}} (module docstring): the passing share p taken at its upper 95 %
+    (Clopper-Pearson) bound, not its estimate (0 of 23 is not a bound of 0); the scale the RMS of
+    the passing sizes, or, with fewer than :data:`MIN_PASSING` of them, of every size the candidate
+    took (``raw``), passing or not (a conservative stand-in)."""
+    from scipy.stats import beta, halfnorm
+
+    from .decision import COMPONENT_FLOORS
+
+    comps = {c for cs in COMPONENT_FLOORS.values() for c in cs}
+    m0 = max(len([e for e in clean if e not in comps]), 1)
+    out = {}
+    for e, kinds in clean.items():
+        out[e] = {}
+        m = m0 * (2 if e in comps else 1)       # a current named when either component clears: alpha split
+        for k, v in kinds.items():
+            v = np.asarray(v, float)
+            on = v[v > 0]
+            n, kk = len(v), len(on)
+            p_up = float(beta.ppf(0.95, kk + 1, max(n - kk, 1))) if n else 1.0
+            f = 0.0
+            if p_up > alpha / m:
+                pool = on if kk >= MIN_PASSING else np.asarray((raw or {}).get(e, {}).get(k, v), float)
+                scale = float(np.sqrt(np.mean(pool * pool))) if len(pool) else 0.0
+                f = max(scale * float(halfnorm.ppf(1.0 - alpha / (m * p_up))), float(on.max()) if kk else 0.0)
+            out[e][k] = float(f"{f:.4g}")
+    return out
+
+
+def record_kind_of(rec: dict) -> str:
+    """The kind of record set a bench record was diagnosed as (its first round's, else by its trial)."""
+    return (rec.get("rounds") or [{}])[0].get("kind") or \
+        ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
+
+
+def only_kind(rec: dict, kind: str):
+    """``rec`` when it is of ``kind`` (:func:`record_kind_of`), else None: a run's records of one kind,
+    where the diagnosis of the other kind has changed since the run."""
+    return rec if record_kind_of(rec) == kind else None
+
+
+def hidden_effects(fl: dict, L: float) -> dict:
+    """{kind: effects} whose floor on that kind of record exceeds the size worth detecting
+    (:data:`trials.measured.identifiability.DETECTION_SIZE`): at the sizes worth detecting they are
+    not named there, only reported ``not_identifiable``."""
+    from .identifiability import detection_size
+
+    out: dict = {}
+    for e, kinds in fl.items():
+        for k, f in kinds.items():
+            if f > detection_size(e, L):
+                out.setdefault(k, set()).add(e)
+    return out
+
+
+MIN_PASSING = 3
+"""Fewer passing sizes than this: the floor's scale is taken from every size the candidate took."""
+
+
+RESIDUAL_QUANTILE = 95.0
+"""The residual floors are this percentile of the clean records' residuals after the fit: a record
+is unexplained when its residual is worse than 95 % of the records of ships that differ from the
+config as real ships do (a few members of the family, cross-flow hulls that lose 85 % of their speed
+in a 35 deg turn, are fitted far worse than the rest: the maximum would be theirs)."""
+
+
+def residual_floors(records) -> dict:
+    """{kind: {channel: floor}} of the residual RMS after the fit on the clean records: u, v over the
+    speed, r as r L / U, heading [deg] (:func:`trials.measured.decision.residual_floor`)."""
+    import math
+
+    vals: dict = {}
+    for rec in records:
+        if rec.get("truth") or "rms_after" not in rec:
+            continue
+        kind = record_kind_of(rec)
+        ra, U, L = rec["rms_after"], rec["speed_mps"], rec["L_m"]
+        v = vals.setdefault(kind, {"u": [], "v": [], "r": [], "heading": []})
+        v["u"].append(ra["u"] / U)
+        v["v"].append(ra["v"] / U)
+        v["r"].append(math.radians(ra["r"]) * L / U)
+        v["heading"].append(ra["heading"])
+    return {k: {c: float(f"{np.percentile(x, RESIDUAL_QUANTILE):.4g}") for c, x in v.items() if x}
+            for k, v in vals.items()}
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """The floors of :func:`calibrate` and what they rest on.
+
+    Attributes
+    ----------
+    floors : dict
+        {effect: {kind: floor}} in :data:`UNITS`.
+    residual_floors : dict
+        {kind: {channel: floor}} in :data:`RESIDUAL_UNITS`.
+    clean : dict
+        {effect: {kind: [clean magnitude]}} (0 where dBIC or z did not clear), the second pass's.
+    passes : dict
+        {effect: {kind: [whether dBIC and z cleared]}}, alike.
+    hidden : dict
+        {kind: set of effects} not named at the size worth detecting (the first pass's floors).
+    n_clean, n_effects : int
+        Records without and with effects.
+    alpha : float
+        The false-alarm rate per record the floors hold.
+    """
+    floors: dict
+    residual_floors: dict
+    clean: dict
+    passes: dict
+    hidden: dict
+    n_clean: int
+    n_effects: int
+    alpha: float = 0.05
+    units: dict = field(default_factory=lambda: dict(UNITS))
+
+    def to_json(self) -> dict:
+        """The document ``configs/calibration/diagnose.yaml`` holds (without its ``source``)."""
+        return {"alpha": self.alpha, "units": self.units, "floors": self.floors,
+                "residual_floors": self.residual_floors, "residual_floor_units": dict(RESIDUAL_UNITS),
+                "clean": {e: {k: [float(f"{x:.4g}") for x in v] for k, v in kinds.items()}
+                          for e, kinds in self.clean.items()}}
+
+    def to_pandas(self):
+        """One row per effect and kind: samples, passing dBIC and z, largest passing size, floor."""
+        import pandas as pd
+
+        rows = [{"effect": e, "kind": k, "samples": len(v), "passing": int(sum(self.passes[e][k])),
+                 "max_passing": float(np.max(v)) if len(v) else 0.0, "floor": self.floors[e][k],
+                 "unit": self.units.get(e, "")}
+                for e, kinds in self.clean.items() for k, v in kinds.items()]
+        return pd.DataFrame(rows)
+
+
+def calibrate(records, L: float, alpha: float = 0.05) -> Calibration:
+    """The naming floors from bench records (module docstring): a first pass over the clean
+    records, then a second in which the records of effects a kind of record cannot show
+    (:func:`hidden_effects`) count as clean samples for the other candidates.
+
+    Parameters
+    ----------
+    records : list of dict
+        Records of ``bench/bench_diagnose.py --mismatch`` (``truth``, ``rounds``, ``rms_after``, ...).
+    L : float
+        Length of the config's ship [m] (the current's sqrt(g L) unit).
+    alpha : float
+        False-alarm rate per clean record.
+    """
+    records = list(records)
+    clean, passes, raw = clean_magnitudes(records, L)
+    hidden = hidden_effects(floors(clean, alpha, raw), L)
+    clean, passes, raw = clean_magnitudes(records, L, hidden)
+    n = sum(1 for r in records if not r.get("truth"))
+    return Calibration(floors=floors(clean, alpha, raw), residual_floors=residual_floors(records), clean=clean,
+                       passes=passes, hidden=hidden, n_clean=n, n_effects=len(records) - n, alpha=alpha)
