@@ -98,7 +98,8 @@ def main(argv=None):
     ap.add_argument("--candidate-start", choices=("config", "current"), default="config",
                     help="--mismatch: where candidates' fits start the ship (DiagnoseOptions.candidate_start)")
     ap.add_argument("--trials", nargs="*", default=None,
-                    help="--mismatch: the trials to draw from (default all: turn35 turn35p zz10 zz15 zz20)")
+                    help="--mismatch: the trials to draw from (default all: turn35 turn35p zz10 zz15 zz20; "
+                         "turn_pair: both 35 deg turns of one member diagnosed together)")
     a = ap.parse_args(argv)
     if a.mismatch:
         sys.path.insert(0, str(REPO / "bench"))

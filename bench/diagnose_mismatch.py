@@ -28,6 +28,11 @@ if str(REPO) not in sys.path:
 
 KINDS = ("turn35", "turn35p", "zz10", "zz15", "zz20")
 
+PAIRS = {"turn_pair": ("turn35", "turn35p")}
+"""Trials of several records diagnosed together (``--trials turn_pair``): a 35 deg turn to each
+side by the same member, with one shared effect (the IMO set of turning circles; record kind
+``turn_pair`` of :func:`trials.measured.decision.record_kind`).  Not among the default trials."""
+
 SIZES = {
     "current": ("speed_mps", "m/s", [0.05, 0.1, 0.15, 0.25]),
     "wind": ("speed_mps", "m/s", [6.0, 10.0, 15.0]),
@@ -84,10 +89,12 @@ def run_one(job: dict, seed0: int) -> dict:
 
     config = mmg.load_ship(mmg.ship_path("esso_osaka"))
     member, factors = _family(seed0)[job["member"]]
-    rec = trial_records(config, member, job["trial"], job["spec"], seed=job["seed"], true_wind=job["true_wind"],
-                        name=job["id"])
+    recs = [trial_records(config, member, t, job["spec"], seed=job["seed"] + 1000003 * k, true_wind=job["true_wind"],
+                          name=f"{job['id']}_{t}" if k else job["id"])
+            for k, t in enumerate(PAIRS.get(job["trial"], (job["trial"],)))]
+    rec = recs[0]
     t0 = time.perf_counter()
-    d = diagnose(config, [rec], candidate_start=job.get("candidate_start", "config"))
+    d = diagnose(config, recs, candidate_start=job.get("candidate_start", "config"))
     js = d.to_json()
     truth = {k: dict(v) for k, v in job["spec"].items()}
     if "wind" in truth:
@@ -96,7 +103,7 @@ def run_one(job: dict, seed0: int) -> dict:
     return {**{k: job[k] for k in ("id", "seed", "member", "trial", "effect", "size")},
             "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
             "parameters": d.parameters, "not_identifiable": [n["effect"] for n in d.not_identifiable],
-            "unexplained": bool(d.unexplained), "rounds": js["rounds"], "duration_s": float(rec.t[-1]),
+            "unexplained": bool(d.unexplained), "rounds": js["rounds"], "duration_s": float(sum(r.t[-1] for r in recs)),
             "rms_after": js["rms_after"], "rms_before": js["rms_before"], "rms_config": js["rms_config"],
             "speed_mps": float(np.median(np.hypot(rec.u, rec.v))), "L_m": float(config.particulars.L),
             "seconds": round(time.perf_counter() - t0, 1)}
@@ -209,6 +216,9 @@ def main_mismatch(a) -> None:
         raise SystemExit(f"--mismatch: unknown effects {sorted(unknown)}; have {list(SIZES)}")
     out = REPO / "bench" / "out"
     out.mkdir(exist_ok=True)
+    bad = set(a.trials or ()) - set(KINDS) - set(PAIRS)
+    if bad:
+        raise SystemExit(f"--mismatch: unknown trials {sorted(bad)}; have {list(KINDS) + list(PAIRS)}")
     todo = jobs(nclean, seeds, effects, a.seed0, a.trials)
     if a.only:                                   # the same records as a full run of these options, by id
         todo = [j for j in todo if j["id"] in set(a.only)]
