@@ -42,11 +42,16 @@ def test_a_hidden_effects_record_lends_clean_samples_to_the_others(cal):
 
 
 def test_hidden_effects_are_those_whose_floor_exceeds_the_size_to_detect(cal):
-    from trials.measured.identifiability import detection_size
-
+    """Floors are in the unit of decision.magnitude (a current's speed over sqrt(g L)); the size worth
+    detecting a current is 0.0027 sqrt(g L), 0.152 m/s at 325 m (issue 26: 0.15 m/s)."""
+    g = np.sqrt(9.80665 * L)
     fl = {"rudder_offset": {"turn": 4.9, "zigzag": 0.66}, "heading_bias": {"turn": 0.9},
-          "current": {"turn": 0.5 * detection_size("current", L)}}
-    assert cal.hidden_effects(fl, L) == {"turn": {"rudder_offset"}}
+          "current": {"turn": 0.5 * 0.0027, "turn_pair": 0.16 / g, "zigzag": 0.19 / g}}
+    assert cal.hidden_effects(fl, L) == {"turn": {"rudder_offset": 4.9}, "turn_pair": {"current": 0.16 / g},
+                                         "zigzag": {"current": 0.19 / g}}
+    # on zigzags a current is judged by its parts: 0.19 m/s along, 0.017 across -> one across the heading shows
+    fl.update({"current_along": {"zigzag": 0.19 / g}, "current_across": {"zigzag": 0.017 / g}})
+    assert cal.hidden_effects(fl, L) == {"turn": {"rudder_offset": 4.9}, "turn_pair": {"current": 0.16 / g}}
 
 
 def test_only_kind_keeps_the_records_of_one_kind(cal):
@@ -89,7 +94,7 @@ def test_calibrate_sets_the_floors_twice(cal):
     recs = [_clean_turn(0.01 * (1 + i % 5)) for i in range(20)] + [offset_turn]
     c = cal.calibrate(recs, L)
     g = np.sqrt(9.80665 * L)
-    assert c.hidden == {"turn": {"rudder_offset"}}
+    assert set(c.hidden) == {"turn"} and set(c.hidden["turn"]) == {"rudder_offset"}
     assert c.floors["rudder_offset"]["turn"] > detection_size("rudder_offset", L)
     assert c.n_clean == 20 and c.n_effects == 1
     assert len(c.clean["current"]["turn"]) == 21                 # 20 clean rounds + the offset turn's
@@ -101,3 +106,13 @@ def test_calibrate_sets_the_floors_twice(cal):
     assert row.samples == 21 and row.passing == 21 and row.unit == "sqrt(gL)"
     doc = c.to_json()
     assert doc["floors"] == c.floors and doc["alpha"] == 0.05
+
+
+def test_a_hidden_effect_larger_than_its_floor_lends_no_clean_sample(cal):
+    """A turn with a true 1 deg offset counts as clean for the current where the offset's floor on turns
+    (5 deg) could lend it; with a floor of 0.8 deg a 1 deg offset could have been named, and it does not."""
+    rec = _turn_with_offset()
+    clean, _, _ = cal.clean_magnitudes([rec], L, hidden={"turn": {"rudder_offset": 5.0}})
+    assert len(clean["current"]["turn"]) == 1
+    clean, _, _ = cal.clean_magnitudes([rec], L, hidden={"turn": {"rudder_offset": 0.8}})
+    assert "current" not in clean

@@ -68,11 +68,12 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
     in, the other candidates soak up theirs (a current takes a heading bias on a zigzag): that is
     the confusion :mod:`trials.measured.identifiability` reports, not the ship's mismatch.
 
-    ``hidden`` ({kind: set of effects}, :func:`hidden_effects`): effects that cannot be named on that
-    kind of record (a rudder offset on one turning circle).  A record's true effects among them are
-    never in the model, so its rounds count as clean for the other candidates once its other true
-    effects are in: what such an effect lends a current or shallow water on a turn is a nuisance
-    of the same kind as the ship's own mismatch, and a name given for it is a wrong name."""
+    ``hidden`` ({kind: {effect: floor}}, :func:`hidden_effects`, or {kind: set of effects}): effects
+    that cannot be named on that kind of record (a rudder offset on one turning circle).  A record's
+    true effects among them, at a size within their floor (:func:`_hidden_here`), are never in the
+    model, so its rounds count as clean for the other candidates once its other true effects are
+    in: what such an effect lends a current or shallow water on a turn is a nuisance of the same
+    kind as the ship's own mismatch, and a name given for it is a wrong name."""
     import math
 
     from .decision import (
@@ -90,7 +91,7 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
         truth = set(rec.get("truth") or {})
         for rd in rec.get("rounds") or []:
             kind = rd.get("kind") or ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
-            if set(rd.get("model", [])) != truth - set((hidden or {}).get(kind, ())):
+            if set(rd.get("model", [])) != truth - _hidden_here(rec, (hidden or {}).get(kind, ()), L):
                 continue       # before the true effects are in, a candidate soaks up theirs: not a clean sample
             for c in rd["candidates"]:
                 if c["effect"] in truth:
@@ -106,6 +107,18 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
                     passes.setdefault(e, {}).setdefault(kind, []).append(ok)
                     raw.setdefault(e, {}).setdefault(kind, []).append(float(m))
     return out, passes, raw
+
+
+def _hidden_here(rec: dict, hidden, L: float) -> set:
+    """The record's true effects among ``hidden`` (a set, or {effect: floor} from
+    :func:`hidden_effects`) at a size its floor could lend: a larger one could have been named.  The
+    bench's truth holds the fit values (``speed_mps``, ``offset_deg``, ``bias_deg``)."""
+    from .decision import magnitude
+
+    truth = rec.get("truth") or {}
+    if not isinstance(hidden, dict):
+        return set(hidden) & set(truth)
+    return {e for e, fl in hidden.items() if e in truth and not magnitude(e, truth[e], L) > fl}
 
 
 def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
@@ -150,16 +163,20 @@ def only_kind(rec: dict, kind: str):
 
 
 def hidden_effects(fl: dict, L: float) -> dict:
-    """{kind: effects} whose floor on that kind of record exceeds the size worth detecting
+    """{kind: {effect: floor}} of the effects whose floor on that kind of record exceeds the size worth detecting
     (:data:`trials.measured.identifiability.DETECTION_SIZE`): at the sizes worth detecting they are
-    not named there, only reported ``not_identifiable``."""
-    from .identifiability import detection_size
+    not named there, only reported ``not_identifiable``.  A current judged by its parts along and
+    across the heading (on zigzags) is hidden only where the smaller part's floor exceeds it
+    (:func:`~trials.measured.decision.least_floor`)."""
+    from .decision import least_floor
+    from .identifiability import detection_size, floor_in_fit_unit
 
     out: dict = {}
     for e, kinds in fl.items():
-        for k, f in kinds.items():
-            if f > detection_size(e, L):
-                out.setdefault(k, set()).add(e)
+        for k in kinds:
+            least = least_floor(e, k, fl)
+            if floor_in_fit_unit(e, least, L) > detection_size(e, L):
+                out.setdefault(k, {})[e] = least
     return out
 
 
@@ -209,7 +226,7 @@ class Calibration:
     passes : dict
         {effect: {kind: [whether dBIC and z cleared]}}, alike.
     hidden : dict
-        {kind: set of effects} not named at the size worth detecting (the first pass's floors).
+        {kind: {effect: floor}} not named at the size worth detecting (the first pass's floors).
     n_clean, n_effects : int
         Records without and with effects.
     alpha : float

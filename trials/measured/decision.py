@@ -37,7 +37,7 @@ import numpy as np
 
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
-           "clears_floor", "floor_parts", "COMPONENT_FLOORS"]
+           "clears_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -159,11 +159,23 @@ def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float |
     return {c.split("_")[-1]: (float(f"{x:.4g}"), floor(c, kind)) for x, c in zip(parts, comp)}
 
 
+def least_floor(effect: str, kind: str, floors: dict | None = None) -> float:
+    """The least size of ``effect`` that can clear its floor on a record set of ``kind``, in the unit
+    of :func:`magnitude`: its floor, or, for a current judged by its parts there
+    (:data:`COMPONENT_FLOORS`, :func:`clears_floor`), the smaller part's floor (a current that size
+    across the heading clears it).  ``floors`` ({effect: {kind: floor}}): the calibration's by default."""
+    floors = (calibration().get("floors") or {}) if floors is None else floors
+    comp = COMPONENT_FLOORS.get(kind) if effect == "current" else None
+    if comp and all(kind in (floors.get(c) or {}) for c in comp):
+        return float(min(floors[c][kind] for c in comp))
+    return float((floors.get(effect) or {}).get(kind, 0.0))
+
+
 def record_kind(rudders) -> str:
     """The kind of a set of records, which the floors are calibrated for: ``"zigzag"`` when any
     record's rudder changes side (a zigzag among turns pins an offset or a bias as a zigzag alone
-    does), else ``"turn_pair"`` for turns to both sides (their symmetric mismatch cancels in a shared
-    offset: not calibrated, no floor), else ``"turn"``.
+    does), else ``"turn_pair"`` for turns to both sides, diagnosed together (calibrated on pairs of
+    35 deg turns: ``bench/bench_diagnose.py --mismatch --trials turn_pair``), else ``"turn"``.
 
     A record's rudder is on one side when at least 90 % of its samples beyond 2 deg have one sign.
 

@@ -41,7 +41,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-__all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "block_confounding",
+__all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "floor_in_fit_unit", "block_confounding",
            "assess", "not_identifiable_lines"]
 
 DETECTION_SIZE = {"rudder_offset": (1.0, "deg"), "heading_bias": (1.0, "deg"), "current": (0.0027, "sqrt(gL)"),
@@ -68,6 +68,14 @@ def detection_size(effect: str, L: float) -> float:
     (inf for an effect not in the table)."""
     v, unit = DETECTION_SIZE.get(effect, (math.inf, "1"))
     return v * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else v
+
+
+def floor_in_fit_unit(effect: str, fl: float, L: float) -> float:
+    """A calibrated floor (:func:`trials.measured.decision.floor`, in the unit of
+    :func:`~trials.measured.decision.magnitude`: a current's speed over sqrt(g L)) in the unit of
+    :func:`detection_size` (the effect's fit parameters: m/s for a current), for a ship of length ``L`` [m]."""
+    _, unit = DETECTION_SIZE.get(effect, (math.inf, "1"))
+    return fl * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else fl
 
 
 def block_confounding(cov: np.ndarray, idx) -> dict:
@@ -279,7 +287,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         leans on the ship's coefficients or another effect, a check on it).
     """
     from .decision import Z_THRESHOLD as z_name
-    from .decision import floor
+    from .decision import least_floor
 
     say = say or (lambda m: None)
     L = fitter.ship.particulars.L
@@ -308,7 +316,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         table.append(row)
         say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
             f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
-        fl = floor(cls.name, getattr(fitter, "kind", ""))
+        fl = floor_in_fit_unit(cls.name, least_floor(cls.name, getattr(fitter, "kind", "")), L)
         statistical = bool(max(2.0, z_name) * b["sd"] > det
                            and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED))
         row["confounded"] = statistical or fl > det
