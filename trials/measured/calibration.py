@@ -90,7 +90,7 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
     for rec in records:
         truth = set(rec.get("truth") or {})
         for rd in rec.get("rounds") or []:
-            kind = rd.get("kind") or ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
+            kind = rd.get("kind") or _trial_kind(rec)
             if set(rd.get("model", [])) != truth - _hidden_here(rec, (hidden or {}).get(kind, ()), L):
                 continue       # before the true effects are in, a candidate soaks up theirs: not a clean sample
             for c in rd["candidates"]:
@@ -152,8 +152,12 @@ def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
 
 def record_kind_of(rec: dict) -> str:
     """The kind of record set a bench record was diagnosed as (its first round's, else by its trial)."""
-    return (rec.get("rounds") or [{}])[0].get("kind") or \
-        ("turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag")
+    return (rec.get("rounds") or [{}])[0].get("kind") or _trial_kind(rec)
+
+
+def _trial_kind(rec: dict) -> str:
+    """A bench record's kind by its trial's name, for records whose rounds do not say it."""
+    return "turn" if str(rec.get("trial", "")).startswith("turn") else "zigzag"
 
 
 def only_kind(rec: dict, kind: str):

@@ -151,9 +151,8 @@ def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float 
 def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float | None = None) -> dict:
     """``{part: (size, floor)}`` of a current judged by its parts (:func:`clears_floor`): ``along`` and
     ``across`` over sqrt(gL); empty where the effect is judged by its :func:`magnitude` alone."""
-    comp = COMPONENT_FLOORS.get(kind) if effect == "current" else None
-    floors = (calibration().get("floors") or {})
-    if not comp or heading is None or not all(kind in (floors.get(c) or {}) for c in comp):
+    comp = _component_floors(effect, kind, calibration().get("floors") or {})
+    if not comp or heading is None:
         return {}
     parts = current_components(values, L, heading)
     return {c.split("_")[-1]: (float(f"{x:.4g}"), floor(c, kind)) for x, c in zip(parts, comp)}
@@ -165,10 +164,17 @@ def least_floor(effect: str, kind: str, floors: dict | None = None) -> float:
     (:data:`COMPONENT_FLOORS`, :func:`clears_floor`), the smaller part's floor (a current that size
     across the heading clears it).  ``floors`` ({effect: {kind: floor}}): the calibration's by default."""
     floors = (calibration().get("floors") or {}) if floors is None else floors
-    comp = COMPONENT_FLOORS.get(kind) if effect == "current" else None
-    if comp and all(kind in (floors.get(c) or {}) for c in comp):
+    comp = _component_floors(effect, kind, floors)
+    if comp:
         return float(min(floors[c][kind] for c in comp))
     return float((floors.get(effect) or {}).get(kind, 0.0))
+
+
+def _component_floors(effect: str, kind: str, floors: dict) -> tuple:
+    """The names of the part floors ``effect`` is judged by on ``kind`` (:data:`COMPONENT_FLOORS`),
+    where ``floors`` holds them all; else ()."""
+    comp = COMPONENT_FLOORS.get(kind, ()) if effect == "current" else ()
+    return comp if comp and all(kind in (floors.get(c) or {}) for c in comp) else ()
 
 
 def record_kind(rudders) -> str:
