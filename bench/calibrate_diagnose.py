@@ -27,7 +27,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 OUT = REPO / "configs" / "calibration" / "diagnose.yaml"
 
-from trials.measured.calibration import calibrate, only_kind
+from trials.measured.calibration import calibrate, only_kind, short_of_name
 
 
 def main(argv=None):
@@ -57,6 +57,8 @@ def main(argv=None):
                      f"({cal.n_clean} clean records and {cal.n_effects} with effects of the mismatch family, seeds of "
                      f"those bench runs; {datetime.date.today().isoformat()})", **cal.to_json()}
     print("residual floors (u, v / U, r L / U, heading deg):", cal.residual_floors)
+    k, n = short_of_name(records, mmg.load_ship("esso_osaka").particulars.L)
+    print(f"clean records with a candidate short of a name (reported not_identifiable; packaged floors): {k} of {n}")
     if a.write:
         OUT.parent.mkdir(parents=True, exist_ok=True)
         OUT.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "

@@ -206,3 +206,59 @@ def test_floor_parts_and_the_reason_given(monkeypatch):
             "parts": {k: list(v) for k, v in parts.items()}, "clears_threshold": False}
     (entry,) = within_mismatch([{"candidates": [cand]}], L)
     assert "along" in entry["reason"] and "across" in entry["reason"]
+
+
+def _cand(effect="heading_bias", dbic=9.6, z=4.6, mag=0.77, fl=0.39, ok=False, **kw):
+    return {"effect": effect, "delta_bic": dbic, "z": z, "magnitude": mag, "floor": fl, "clears_threshold": ok, **kw}
+
+
+def test_evidence_short_of_a_name_is_reported_not_dropped():
+    """A candidate whose precision and size pass but whose dBIC is between Kass & Raftery's 'positive'
+    (2) and the naming threshold is reported (weak_evidence), with the figures that decided; one with
+    no evidence, an imprecise one, one within its floor and one that was named are not."""
+    import trials.measured.decision as D
+    from trials.measured.diagnose import weak_evidence
+
+    assert D.WEAK_BIC == 2.0 and D.BIC_THRESHOLD == 20.0
+    got = weak_evidence([{"candidates": [_cand()]}])
+    assert list(got) == ["heading_bias"]
+    assert "dBIC 9.6" in got["heading_bias"] and "z 4.6" in got["heading_bias"]
+    for c in (_cand(dbic=1.9), _cand(dbic=20.5), _cand(z=2.9), _cand(mag=0.3), _cand(ok=True)):
+        assert weak_evidence([{"candidates": [c]}]) == {}, c
+    assert weak_evidence([{"candidates": [_cand(dbic=2.1)]}]) and weak_evidence([{"candidates": [_cand(dbic=20.0)]}])
+    assert weak_evidence([]) == {}
+    # a current judged by its parts: over the floor when either part is
+    parts_in = {"along": [0.001, 0.003], "across": [0.0001, 0.0003]}
+    parts_out = {"along": [0.001, 0.003], "across": [0.0005, 0.0003]}
+    assert weak_evidence([{"candidates": [_cand("current", mag=0.01, fl=0.001, parts=parts_in)]}]) == {}
+    assert list(weak_evidence([{"candidates": [_cand("current", mag=0.0, fl=0.001, parts=parts_out)]}])) == ["current"]
+    # only the last round counts: a candidate of an earlier round that a later one dropped is not reported
+    assert weak_evidence([{"candidates": [_cand()]}, {"candidates": [_cand(dbic=-5.0)]}]) == {}
+
+
+def test_console_line_of_an_evidence_entry_gives_its_reason():
+    """The console line of an entry reported for its evidence says why, not that its std 'could not
+    have shown' the size to detect (which is false for a precise candidate)."""
+    from trials.measured.identifiability import not_identifiable_lines
+
+    e = {"effect": "heading_bias", "confused_with": ["N_r"], "correlation": 0.998, "what_would_separate": "a zigzag",
+         "reason": "at dBIC 9.6 (a name needs 20), z 4.6", "std": 0.17, "detection_size": 1.0, "unit": "deg"}
+    (line,) = not_identifiable_lines([e])
+    assert "dBIC 9.6" in line and "could not have shown" not in line
+    e["reason"] = "its standard error and correlation"
+    (line,) = not_identifiable_lines([e])
+    assert "could not have shown 1 deg" in line
+
+
+def test_short_of_name_counts_clean_first_rounds(monkeypatch):
+    """The calibration's count of clean records that would carry an evidence entry: records with
+    effects are not counted, a clean record counts once, the floor is the packaged one."""
+    import trials.measured.decision as D
+    from trials.measured.calibration import short_of_name
+
+    monkeypatch.setattr(D, "calibration", lambda: {"floors": {"heading_bias": {"turn": 0.5}}})
+    def rec(truth, *cands):
+        return {"trial": "turn35", "truth": truth, "rounds": [{"kind": "turn", "heading_deg": 0.0, "candidates": list(cands)}]}
+    c = lambda b, dbic=9.0: {"effect": "heading_bias", "delta_bic": dbic, "z": 5.0, "parameters": {"bias_deg": b}}
+    recs = [rec({}, c(0.8), c(0.9)), rec({}, c(0.4)), rec({}, c(0.8, dbic=1.0)), rec({"heading_bias": 1.0}, c(0.8))]
+    assert short_of_name(recs, 325.0) == (1, 3)

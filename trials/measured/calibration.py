@@ -48,6 +48,7 @@ __all__ = [
     "only_kind",
     "record_kind_of",
     "residual_floors",
+    "short_of_name",
 ]
 
 UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1", "shallow_water": "T/H",
@@ -262,6 +263,26 @@ class Calibration:
                  "unit": self.units.get(e, "")}
                 for e, kinds in self.clean.items() for k, v in kinds.items()]
         return pd.DataFrame(rows)
+
+
+def short_of_name(records, L: float) -> tuple[int, int]:
+    """(clean records whose first round has a candidate with evidence short of a name, clean records):
+    :func:`~trials.measured.decision.evidence_short` with its size over the packaged floor, which
+    ``mmg diagnose`` reports ``not_identifiable`` (:func:`trials.measured.diagnose.weak_evidence`)."""
+    import math
+
+    from .decision import clears_floor, evidence_short
+
+    n = k = 0
+    for r in records:
+        if r.get("truth"):
+            continue
+        n += 1
+        first = (r.get("rounds") or [{}])[0]
+        kind, head = record_kind_of(r), math.radians(first.get("heading_deg") or 0.0)
+        k += any(evidence_short(c["delta_bic"], c["z"]) and clears_floor(c["effect"], c["parameters"], L, kind, head)
+                 for c in first.get("candidates", []))
+    return k, n
 
 
 def calibrate(records, L: float, alpha: float = 0.05) -> Calibration:

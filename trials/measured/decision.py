@@ -35,7 +35,7 @@ from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "KINDS", "magnitude", "record_kind", "floor",
+__all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS"]
 
@@ -46,11 +46,21 @@ perturbed record pairs (bench/bench_diagnose.py, seeds 0-19) was 15.4, 10.9, 9.5
 above 10), so the threshold is set at 20 and the false-alarm rate checked on fresh seeds."""
 Z_THRESHOLD = 3.0
 """|parameter - neutral| / standard error an effect's fit must exceed to be named."""
+WEAK_BIC = 2.0
+"""dBIC above which a candidate short of :data:`BIC_THRESHOLD`, but precise (z) and over its floor,
+is reported ``not_identifiable`` rather than dropped (:func:`evidence_short`): Kass & Raftery
+(1995) call 2-6 "positive" evidence and below 2 "not worth more than a bare mention"."""
 KINDS = ("turn", "zigzag", "turn_pair")
 """Kinds of record set (:func:`record_kind`); the floors are calibrated for the first two."""
 MAGNITUDE_UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1",
                    "shallow_water": "T/H"}
 """The unit of each effect's :func:`magnitude`."""
+
+
+def evidence_short(delta_bic: float, z: float) -> bool:
+    """Whether a candidate's evidence is some but short of a name (:data:`WEAK_BIC` < dBIC <=
+    :data:`BIC_THRESHOLD`) while its precision would pass (z > :data:`Z_THRESHOLD`)."""
+    return bool(WEAK_BIC < delta_bic <= BIC_THRESHOLD and z > Z_THRESHOLD)
 
 
 def magnitude(effect: str, values: dict, L: float) -> float:

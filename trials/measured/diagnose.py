@@ -61,9 +61,8 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, clears_floor, floor, floor_parts,
-                       magnitude, mean_heading, record_kind,
-                       residual_floor)
+from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, clears_floor, evidence_short, floor,
+                       floor_parts, magnitude, mean_heading, record_kind, residual_floor)
 from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
 
@@ -778,14 +777,46 @@ def diagnose_each(ship: Ship, items, options: DiagnoseOptions | None = None, pro
 
 def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()):
     """(not_identifiable entries, every candidate's figures): :func:`trials.measured.identifiability.assess`,
-    and a candidate of the last round whose dBIC and z cleared but whose size did not clear its
-    calibrated floor (:func:`within_mismatch`)."""
+    a candidate of the last round whose dBIC and z cleared but whose size did not clear its
+    calibrated floor (:func:`within_mismatch`), and one with evidence short of a name
+    (:func:`weak_evidence`)."""
     from .identifiability import assess
 
     _, inflate = _taus(current, o.stride)
-    entries, table = assess(fitter, current, named, cand, inflate, o.segment_s, o.say)
+    weak = weak_evidence(rounds)
+    entries, table = assess(fitter, current, named, cand, inflate, o.segment_s, o.say, weak=weak)
     have = {e["effect"] for e in entries}
-    return entries + [e for e in within_mismatch(rounds, fitter.ship.particulars.L) if e["effect"] not in have], table
+    extra = within_mismatch(rounds, fitter.ship.particulars.L) + [
+        {"effect": k, "confused_with": ["the ship's own coefficients"], "correlation": None,
+         "what_would_separate": "a longer record, or one where the effect is larger", "reason": why}
+        for k, why in weak.items()]                 # those assess could not assess (a singular information)
+    out = list(entries)
+    for e in extra:
+        if e["effect"] not in have:
+            out.append(e)
+            have.add(e["effect"])
+    return out, table
+
+
+def weak_evidence(rounds) -> dict:
+    """``{effect: reason}`` for the last round's candidates with some evidence that did not reach a
+    name (:func:`~trials.measured.decision.evidence_short`) with a size over the calibrated floor
+    (the size and precision tests a name needs pass; only the evidence falls short).  Such an effect
+    may be there; dropping it silently would report a clean record.  How often a clean record of the
+    calibration runs has one: ``bench/calibrate_diagnose.py`` prints it."""
+    out = {}
+    last = rounds[-1] if rounds else {"candidates": []}
+    for c in last["candidates"]:
+        if c.get("clears_threshold") or not evidence_short(c["delta_bic"], c["z"]):
+            continue
+        parts = c.get("parts")
+        over = (any(abs(v[0]) > v[1] for v in parts.values()) if parts else
+                not c["magnitude"] <= (c.get("floor") or 0.0))
+        if over:
+            out[c["effect"]] = (f"at dBIC {c['delta_bic']:.3g} (a name needs {BIC_THRESHOLD:.3g}), z {c['z']:.3g}, "
+                                f"size {c['magnitude']:.3g} {MAGNITUDE_UNITS.get(c['effect'], '')} over its floor: "
+                                "the record holds too little evidence to tell it from the ship's own mismatch")
+    return out
 
 
 def within_mismatch(rounds, L: float) -> list:

@@ -24,7 +24,10 @@ the naming z threshold (:data:`trials.measured.diagnose.Z_THRESHOLD`, 3; never l
 exceeds its :data:`DETECTION_SIZE` (the records could not have named it at a size that matters:
 an effect of that size would have been within the threshold's z of nothing), and confounding is the
 reason: R >= :data:`R_CONFOUNDED` or marginal / conditional std >= :data:`STD_RATIO_CONFOUNDED`.
-An effect skipped for lack of channels is not assessed.
+An effect skipped for lack of channels is not assessed.  Also reported, with its own reason: a
+candidate whose dBIC showed some evidence, short of a name, while its precision and size passed
+(:func:`trials.measured.diagnose.weak_evidence`), and one whose evidence and precision passed but
+whose size the calibrated floor stopped (:func:`trials.measured.diagnose.within_mismatch`).
 
 ``what_would_separate``: the information of candidate additional trials (the mirror of a turn,
 a 20/20 zigzag where the records have none, a 35 deg turn where they have none), simulated with the
@@ -59,6 +62,8 @@ R_CONFOUNDED = 0.9
 noise, is why the effect cannot be shown."""
 STD_RATIO_CONFOUNDED = 3.0
 """Marginal / conditional std above which the same holds (equivalent to R >= 0.943)."""
+_STATISTICAL = "its standard error and correlation"
+"""The ``reason`` of an entry the statistics report (the console line then gives the std)."""
 _CONFUSED_MIN = 0.5
 """|correlation| of another parameter with the effect's worst direction to be named as confused with it."""
 
@@ -257,7 +262,7 @@ def _fmt(x: float) -> str:
 # --------------------------------------------------------------------------- the assessment
 
 
-def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=None):
+def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=None, weak=None):
     """The identifiability of every candidate effect on the records of ``fitter``.
 
     Parameters
@@ -277,6 +282,10 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         The diagnosis's segment length (the candidate trials are cut alike).
     say : callable, optional
         Progress lines.
+    weak : dict, optional
+        ``{effect: reason}`` of candidates with some evidence short of a name
+        (:func:`trials.measured.diagnose.weak_evidence`): reported with that reason when the
+        statistics and floor would not report them.
 
     Returns
     -------
@@ -321,7 +330,8 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
                            and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED))
         row["confounded"] = statistical or fl > det
         row["floor"] = fl
-        if cls.name in named or not row["confounded"]:
+        weak_why = (weak or {}).get(cls.name)
+        if cls.name in named or not (row["confounded"] or weak_why):
             continue
         if trials is None:
             trials = _trial_segments(fitter, _trial_specs(fitter.recs, L), segment_s)
@@ -330,12 +340,20 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
                                                                            np.argsort(-np.abs(b["corr"]))
                                                                            if j not in idx][:1],
                         "correlation": round(b["R"], 3), "what_would_separate": text,
-                        "reason": ("its standard error and correlation" if statistical else
-                                   f"the ship's own mismatch lends it up to {fl:.3g} {_unit(cls)} on such a record "
-                                   f"(calibrated floor), more than the {det:.3g} {_unit(cls)} to detect"),
+                        "reason": _reason(statistical, row["confounded"], weak_why, fl, det, _unit(cls)),
                         "std": row["std"], "std_conditional": row["std_conditional"], "detection_size": row["detection_size"],
                         "unit": row["unit"], "trials": [{"trial": lb, "std": float(f"{sd:.3g}")} for lb, sd in res]})
     return entries, table
+
+
+def _reason(statistical: bool, confounded: bool, weak_why, fl: float, det: float, unit: str) -> str:
+    """Why an entry is reported: the statistics, the calibrated floor, or evidence short of a name."""
+    if statistical:
+        return _STATISTICAL
+    if confounded:
+        return (f"the ship's own mismatch lends it up to {fl:.3g} {unit} on such a record (calibrated floor), "
+                f"more than the {det:.3g} {unit} to detect")
+    return weak_why
 
 
 def _name(f) -> str:
@@ -348,7 +366,10 @@ def not_identifiable_lines(entries) -> list[str]:
     out = []
     for e in entries:
         unit = f" {e['unit']}" if e.get("unit") else ""
-        sd = f"sd {_fmt(e['std'])}{unit}: could not have shown {_fmt(e['detection_size'])}{unit}; " if "std" in e else ""
+        if "std" in e and e.get("reason", _STATISTICAL) == _STATISTICAL:
+            sd = f"sd {_fmt(e['std'])}{unit}: could not have shown {_fmt(e['detection_size'])}{unit}; "
+        else:
+            sd = f"{e['reason']}; " if e.get("reason") else ""
         out.append(f"not identifiable: {e['effect']} ({sd}correlation {e['correlation']:.2f} with "
                    f"{', '.join(e['confused_with'])}); would separate: {e['what_would_separate']}")
     return out
