@@ -147,7 +147,7 @@ def summarise(rows: list) -> dict:
     for r in clean:
         if r["named"]:
             print(f"  {r['id']} {r['trial']} ({r['factors']['hull_form']}): {r['named']} {r['parameters']}")
-    print(f"\n{'effect':14s} {'size':>9s} {'zigzag det':>12s} {'turn det':>12s} {'exact':>12s} {'not ident (turn)':>17s}")
+    print(f"\n{'effect':14s} {'size':>9s} {'zigzag det':>12s} {'turn det':>12s} {'exact':>12s} {'not ident (turn)':>17s} {'silent':>10s}")
     table = {"false_alarms": list(fa), "detection": {}}
     for eff, (par, unit, sizes) in SIZES.items():
         er = [r for r in rows if r["effect"] == eff]
@@ -162,9 +162,11 @@ def summarise(rows: list) -> dict:
             dz, dt = _rate(zz, hit), _rate(tu, hit)
             ex = _rate(sr, lambda r, e=eff: set(r["named"]) == {e})
             ni = _rate(tu, lambda r, e=eff: e not in r["named"] and e in r["not_identifiable"])
-            print(f"{eff:14s} {size:6g} {unit:3s} {_pct(*dz):>12s} {_pct(*dt):>12s} {_pct(*ex):>12s} {_pct(*ni):>17s}")
+            silent = _rate(sr, lambda r, e=eff: e not in r["named"] and e not in r["not_identifiable"])
+            print(f"{eff:14s} {size:6g} {unit:3s} {_pct(*dz):>12s} {_pct(*dt):>12s} {_pct(*ex):>12s} {_pct(*ni):>17s} "
+                  f"{_pct(*silent):>10s}")
             table["detection"][eff].append({"size": size, "zigzag": list(dz), "turn": list(dt), "exact": list(ex),
-                                            "turn_not_identifiable": list(ni)})
+                                            "turn_not_identifiable": list(ni), "silent": list(silent)})
     allr = _rate(rows, lambda r: set(r["named"]) == ({r["effect"]} if r["effect"] else set()))
     print(f"\nexact (named set == true set) over all records: {_pct(*allr)}")
     table["exact"] = list(allr)
