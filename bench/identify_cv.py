@@ -64,8 +64,9 @@ def _args(argv=None):
     ap.add_argument("--prior", type=float, default=0.5, help="prior std relative to the config value")
     ap.add_argument("--weighting", choices=["samples", "equal", "relative"], default=None,
                     help="record weighting in the fit (default: trials.measured.identify.DEFAULT_WEIGHTING)")
-    ap.add_argument("--folds-by", choices=["order", "revolutions"], default="order",
-                    help="deal the records into folds (outer and inner) in file order or stratified by revolutions")
+    ap.add_argument("--folds-by", choices=["order", "revolutions", "manoeuvre"], default="order",
+                    help="deal the records into folds (outer and inner) in file order, stratified by revolutions, "
+                         "or by manoeuvre (trials.measured.identify.manoeuvre_class)")
     ap.add_argument("--max-nfev", type=int, default=None,
                     help="evaluation limit of each fit stage (default: trials.measured.identify.DEFAULT_MAX_NFEV)")
     ap.add_argument("--velocity-weight", type=float, default=1.0,

@@ -262,3 +262,28 @@ def test_short_of_name_counts_clean_first_rounds(monkeypatch):
     c = lambda b, dbic=9.0: {"effect": "heading_bias", "delta_bic": dbic, "z": 5.0, "parameters": {"bias_deg": b}}
     recs = [rec({}, c(0.8), c(0.9)), rec({}, c(0.4)), rec({}, c(0.8, dbic=1.0)), rec({"heading_bias": 1.0}, c(0.8))]
     assert short_of_name(recs, 325.0) == (1, 3)
+
+
+def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(monkeypatch):
+    """End to end: a 1.5 deg heading bias on a zigzag, with the naming threshold raised out of reach, is
+    not named and not dropped: ``not_identifiable`` carries it with the figures that decided, and the
+    console line says so.  (With the threshold as shipped the same record names it: the control.)"""
+    import trials.measured.decision as D
+    import trials.measured.diagnose as G
+    from mmg.ship import load_ship
+    from trials.measured.diagnose import diagnose, synthetic_record
+    from trials.measured.identifiability import not_identifiable_lines
+
+    ship = load_ship("esso_osaka_3m")
+    rec = synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, rudder_deg=20.0, seed=4, name="z")
+    opts = dict(candidates=["heading_bias", "current"])
+    assert diagnose(ship, [rec], **opts).named == ["heading_bias"]
+    monkeypatch.setattr(D, "BIC_THRESHOLD", 1e7)
+    monkeypatch.setattr(G, "BIC_THRESHOLD", 1e7)
+    d = diagnose(ship, [rec], **opts)
+    assert d.named == []
+    ent = {e["effect"]: e for e in d.not_identifiable}
+    assert "heading_bias" in ent, d.not_identifiable
+    assert "a name needs 1e+07" in ent["heading_bias"]["reason"]
+    (line,) = [ln for ln in not_identifiable_lines(d.not_identifiable) if "heading_bias" in ln]
+    assert "a name needs" in line

@@ -207,6 +207,42 @@ def test_folds_by_revolutions_spread_every_revolution_band_over_the_folds():
         fold_of(runs, 4, "alphabet")
 
 
+def _manoeuvre_run(name, delta_deg, rps, seed):
+    from mmg.replay import ReplayInputs
+    from trials.measured.predict import MeasuredRun
+
+    d = np.radians(np.asarray(delta_deg, float))
+    t = np.arange(len(d)) * 1.0
+    n = np.broadcast_to(np.asarray(rps, float), d.shape).copy()
+    return MeasuredRun(name, name, np.random.default_rng(seed).normal(size=(len(d), 6)), ReplayInputs(t, d, n))
+
+
+def test_folds_by_manoeuvre_put_records_of_one_class_in_different_folds():
+    """Stratified by manoeuvre: the classes are told from the rudder and revolutions as a trial engineer
+    would (a turn holds one side, a zigzag changes side, astern revolutions make a record astern, small
+    rudder angles count for nothing), and two port turns that the file order puts in one fold go to two."""
+    from trials.measured.identify import fold_of, manoeuvre_class
+
+    hold = np.r_[np.zeros(10), np.full(90, 35.0)]
+    zig = np.r_[np.zeros(10), np.tile(np.r_[np.full(20, 20.0), np.full(20, -20.0)], 2), np.zeros(10)]
+    assert manoeuvre_class(_manoeuvre_run("s", hold, 10, 0)) == (0, 1, 10.0)
+    assert manoeuvre_class(_manoeuvre_run("p", -hold + 1.5 * (hold == 0), 8, 0)) == (0, -1, 8.0)  # 1.5 deg is not a side
+    assert manoeuvre_class(_manoeuvre_run("z", zig, 12, 0))[:2] == (1, 0)
+    astern = np.where(np.arange(100) > 60, -6.0, 10.0)
+    assert manoeuvre_class(_manoeuvre_run("a", hold, astern, 0))[:2] == (2, 0)
+    # file order: stbd, port, stbd, stbd, port, zig, zig, zig -> with 4 folds the two port turns (1, 5 in
+    # the order below) share fold 1
+    kinds = [hold, -hold, hold, hold, zig, -hold, zig, zig]
+    runs = [_manoeuvre_run(f"r{i}", k, 10, i) for i, k in enumerate(kinds)]
+    assert fold_of(runs, 4, "order")[1] == fold_of(runs, 4, "order")[5]
+    f = fold_of(runs, 4, "manoeuvre")
+    port = [f[i] for i, k in enumerate(kinds) if k is not hold and k is not zig]
+    stbd = [f[i] for i, k in enumerate(kinds) if k is hold]
+    zz = [f[i] for i, k in enumerate(kinds) if k is zig]
+    assert len(set(port)) == 2 and len(set(stbd)) == 3 and len(set(zz)) == 3
+    assert sorted(np.bincount(f, minlength=4)) == [2, 2, 2, 2]
+
+
 def test_a_rudder_offset_is_recovered_and_written_back_as_the_effect(tmp_path):
     """Records made with the blade 2 deg to starboard of the indicator: the freed ``rudder_offset``
     finds it, ship.yaml carries it as the ``rudder_offset`` effect, and that config replays the

@@ -292,9 +292,10 @@ def add_parser(sub) -> None:
                    help="most evaluations of the residuals in each fit stage (segment-wise, then whole-record; "
                         "default trials.measured.identify.DEFAULT_MAX_NFEV); a stage that reaches it stops unconverged, "
                         "and the report and a note say so")
-    p.add_argument("--folds-by", choices=("order", "revolutions"), default="order",
-                   help="with --cv: deal the records into folds in the order given or stratified by their propeller "
-                        "revolutions (a record and its cut copies always share a fold)")
+    p.add_argument("--folds-by", choices=("order", "revolutions", "manoeuvre"), default="order",
+                   help="with --cv: deal the records into folds in the order given, stratified by their propeller "
+                        "revolutions, or by manoeuvre (astern, zigzag, port or starboard turn, then revolutions); "
+                        "a record and its cut copies always share a fold")
     p.add_argument("--hull", choices=("auto", "kijima", "crossflow"), default=None,
                    help="the hull form fitted: kijima (--ship's bundled Kijima config) or crossflow (its "
                         "'_crossflow' config); auto: chosen by an inner cross-validation on the --train records "

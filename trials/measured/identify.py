@@ -76,7 +76,7 @@ __all__ = ["identify", "IdentifyOptions",
            "fit_covariance", "ship_with_values", "PARAMETER_UNITS",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description", "identification_covariance", "start_noise", "DEFAULT_INITIAL_STATE",
-           "INITIAL_STATES"]
+           "INITIAL_STATES", "fold_of", "manoeuvre_class", "FOLD_ASSIGNMENTS"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale")
 DEFAULT_MAX_NFEV = 30
@@ -522,7 +522,7 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, options: IdentifyOpti
                           stages=tuple(done), tau=tau, initial_state=o.initial_state)
 
 
-FOLD_ASSIGNMENTS = ("order", "revolutions")
+FOLD_ASSIGNMENTS = ("order", "revolutions", "manoeuvre")
 """How :func:`cross_validate` deals the records into folds (:func:`fold_of`)."""
 
 
@@ -545,18 +545,43 @@ def fold_of(runs: list[MeasuredRun], folds: int, by: str = "order") -> np.ndarra
     round-robin, so every fold's training set spans the revolutions of all the records and a kept-out
     record is not outside its training set's operating range by the luck of the file order (with
     "order" over the sorted FRT files, the 16.7 and 15 rps zigzags fell into one fold, whose training
-    set then held one zigzag above 12 rps)."""
+    set then held one zigzag above 12 rps).  ``"manoeuvre"``: stratified by :func:`manoeuvre_class`
+    (astern, zigzag, or a turn to one side, then the revolutions), dealt alike, so that records of
+    one class fall into different folds (with "order" the FRT set's only two 20 deg port turns at
+    10 rps shared fold 0, whose training set then had no port turn at that angle)."""
     if by not in FOLD_ASSIGNMENTS:
         raise ValueError(f"fold assignment {by!r}: one of {FOLD_ASSIGNMENTS}")
     group = same_run_groups(runs)
     firsts = sorted(set(group))                           # a group's first record stands for it
     if by == "order":
         key = {g: g for g in firsts}
+    elif by == "manoeuvre":
+        key = {g: (*manoeuvre_class(runs[g]), g) for g in firsts}
     else:
         rps = {g: float(np.nanmedian(np.abs(runs[g].inputs.n))) for g in firsts}
         key = {g: (rps[g], g) for g in firsts}
     deal = {g: k % folds for k, g in enumerate(sorted(firsts, key=lambda g: key[g]))}
     return np.array([deal[g] for g in group], dtype=int)
+
+
+def manoeuvre_class(run: MeasuredRun) -> tuple:
+    """(class, rudder side, median |revolutions| [rps]) of a record, for stratified folds: class 0 a
+    turn, 1 a zigzag, 2 a record with the propeller astern (n < 0 anywhere), whatever its rudder.
+
+    A turn holds one side: over the samples with the rudder beyond 2 deg, |sum delta| / sum |delta|
+    >= 0.5 (side +1 starboard, -1 port; the FRT turns, steered on the approach with up to 24 deg the
+    other way, give 0.7 or more; their zigzags, equal angles both ways, under 0.35).  Otherwise a
+    zigzag (side 0)."""
+    n = np.asarray(run.inputs.n, float)
+    rps = float(np.nanmedian(np.abs(n)))
+    if np.any(n < 0):
+        return (2, 0, rps)
+    d = np.asarray(run.inputs.delta, float)
+    big = d[np.abs(d) > np.radians(2.0)]
+    lean = float(np.sum(big) / np.sum(np.abs(big))) if len(big) else 1.0
+    if abs(lean) < 0.5:
+        return (1, 0, rps)
+    return (0, 1 if lean > 0 else -1, rps)
 
 
 def same_run_groups(runs: list[MeasuredRun]) -> list[int]:
