@@ -276,7 +276,7 @@ def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(monkeypatch):
 
     ship = load_ship("esso_osaka_3m")
     rec = synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, rudder_deg=20.0, seed=4, name="z")
-    opts = dict(candidates=["heading_bias", "current"])
+    opts = {"candidates": ["heading_bias", "current"]}
     assert diagnose(ship, [rec], **opts).named == ["heading_bias"]
     monkeypatch.setattr(D, "BIC_THRESHOLD", 1e7)
     monkeypatch.setattr(G, "BIC_THRESHOLD", 1e7)
