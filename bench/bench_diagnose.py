@@ -100,7 +100,17 @@ def main(argv=None):
     ap.add_argument("--trials", nargs="*", default=None,
                     help="--mismatch: the trials to draw from (default all: turn35 turn35p zz10 zz15 zz20; "
                          "turn_pair: both 35 deg turns of one member diagnosed together)")
+    ap.add_argument("--summarise", nargs="+", default=None, metavar="JSON",
+                    help="--mismatch: print the summary of runs already made (bench/out/diagnose_mismatch<tag>.json), "
+                         "pooled, their not_identifiable lists completed by the evidence rule of the code as it is "
+                         "(trials.measured.diagnose.weak_evidence over each record's stored rounds)")
     a = ap.parse_args(argv)
+    if a.mismatch and a.summarise:
+        sys.path.insert(0, str(REPO / "bench"))
+        from diagnose_mismatch import summarise_files
+
+        summarise_files(a.summarise)
+        return
     if a.mismatch:
         sys.path.insert(0, str(REPO / "bench"))
         from diagnose_mismatch import main_mismatch

@@ -173,6 +173,24 @@ def summarise(rows: list) -> dict:
     return table
 
 
+def summarise_files(paths) -> dict:
+    """:func:`summarise` of the records of runs already made, pooled; each record's ``not_identifiable``
+    completed by :func:`trials.measured.diagnose.weak_evidence` over its stored rounds (a run made
+    before that rule reported such candidates; the naming itself does not depend on it)."""
+    from trials.measured.diagnose import weak_evidence
+
+    rows = []
+    for p in paths:
+        for r in json.loads(Path(p).read_text())["records"]:
+            added = [e for e in weak_evidence(r["rounds"]) if e not in r["named"] and e not in r["not_identifiable"]]
+            rows.append({**r, "not_identifiable": list(r["not_identifiable"]) + added})
+    print(f"{len(rows)} records of {len(paths)} run(s): {', '.join(Path(p).name for p in paths)}")
+    clean = [r for r in rows if r["effect"] is None]
+    print(f"clean records with a not_identifiable entry added by the evidence rule: "
+          f"{sum(bool(weak_evidence(r['rounds'])) for r in clean)} of {len(clean)}")
+    return summarise(rows)
+
+
 def plot(table: dict, path: Path, title: str) -> None:
     """Detection rate against size per effect, zigzag and turn lines."""
     import matplotlib
