@@ -97,6 +97,9 @@ def main(argv=None):
                     help="--mismatch: only these records (ids as printed, e.g. wind_10_0 clean_20) of the full draw")
     ap.add_argument("--candidate-start", choices=("config", "current"), default="config",
                     help="--mismatch: where candidates' fits start the ship (DiagnoseOptions.candidate_start)")
+    ap.add_argument("--max-nfev", type=int, default=None,
+                    help="--mismatch: evaluations of each candidate's fit (DiagnoseOptions.max_nfev; default 12): "
+                         "whether a candidate stopped by its budget or by its physics")
     ap.add_argument("--trials", nargs="*", default=None,
                     help="--mismatch: the trials to draw from (default all: turn35 turn35p zz10 zz15 zz20; "
                          "turn_pair: both 35 deg turns of one member diagnosed together)")

@@ -94,7 +94,8 @@ def run_one(job: dict, seed0: int) -> dict:
             for k, t in enumerate(PAIRS.get(job["trial"], (job["trial"],)))]
     rec = recs[0]
     t0 = time.perf_counter()
-    d = diagnose(config, recs, candidate_start=job.get("candidate_start", "config"))
+    extra = {"max_nfev": job["max_nfev"]} if job.get("max_nfev") else {}
+    d = diagnose(config, recs, candidate_start=job.get("candidate_start", "config"), **extra)
     js = d.to_json()
     truth = {k: dict(v) for k, v in job["spec"].items()}
     if "wind" in truth:
@@ -242,7 +243,7 @@ def main_mismatch(a) -> None:
     todo = jobs(nclean, seeds, effects, a.seed0, a.trials)
     if a.only:                                   # the same records as a full run of these options, by id
         todo = [j for j in todo if j["id"] in set(a.only)]
-    todo = [{**j, "candidate_start": a.candidate_start} for j in todo]
+    todo = [{**j, "candidate_start": a.candidate_start, "max_nfev": a.max_nfev} for j in todo]
     path = out / f"diagnose_mismatch{a.tag}.json"
     head = {"family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds, "effects": effects,
             "sizes": {e: SIZES[e] for e in effects}}
