@@ -15,11 +15,17 @@ each record diagnosed alone with the bundled config; false alarms over ``--clean
 records, detection per effect and size split zigzag / turn (``bench/diagnose_mismatch.py``):
 
     python bench/bench_diagnose.py --mismatch [--clean 40] [--seeds 5] [--seed0 0] [--jobs 2] [--effects ...]
-        [--only ID ...] [--candidate-start config|current]
+        [--only ID ...] [--candidate-start config|current] [--max-nfev N] [--trials ...]
         [--quick] [--tag _cal]
 
 writes bench/out/diagnose_mismatch<tag>.json (every record's factors, truth, named effects and
-candidate rounds) and bench/out/diagnose_detection_mismatch<tag>.png.
+candidate rounds) and bench/out/diagnose_detection_mismatch<tag>.png; the summary gives, per effect
+and size, the records named, those reported ``not_identifiable`` and the silent ones.
+
+    python bench/bench_diagnose.py --mismatch --summarise bench/out/diagnose_mismatch<tag>.json ...
+
+summarises runs already made, pooled (their ``not_identifiable`` completed by the evidence rule of
+the code as it is, :func:`trials.measured.diagnose.weak_evidence`).
 """
 from __future__ import annotations
 
