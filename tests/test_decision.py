@@ -238,16 +238,34 @@ def test_evidence_short_of_a_name_is_reported_not_dropped():
 
 def test_console_line_of_an_evidence_entry_gives_its_reason():
     """The console line of an entry reported for its evidence says why, not that its std 'could not
-    have shown' the size to detect (which is false for a precise candidate)."""
-    from trials.measured.identifiability import not_identifiable_lines
+    have shown' the size to detect (which is false for a precise candidate); an entry without a
+    correlation (the floor's and the evidence's extras) is printed, not a TypeError."""
+    from trials.measured.diagnose_report import not_identifiable_line
 
     e = {"effect": "heading_bias", "confused_with": ["N_r"], "correlation": 0.998, "what_would_separate": "a zigzag",
          "reason": "at dBIC 9.6 (a name needs 20), z 4.6", "std": 0.17, "detection_size": 1.0, "unit": "deg"}
-    (line,) = not_identifiable_lines([e])
-    assert "dBIC 9.6" in line and "could not have shown" not in line
+    line = not_identifiable_line(e)
+    assert "dBIC 9.6" in line and "could not have shown" not in line and "0.998" in line
     e["reason"] = "its standard error and correlation"
-    (line,) = not_identifiable_lines([e])
-    assert "could not have shown 1 deg" in line
+    assert "could not have shown 1.00 deg" in not_identifiable_line(e)
+    e.update(correlation=None, reason="at dBIC 5, z 4, size 0.9 deg (floor 0.39 deg)")
+    line = not_identifiable_line(e)
+    assert "confused with N_r" in line and "floor 0.39 deg" in line and line.endswith("a zigzag")
+
+
+def test_weak_evidence_reason_gives_the_parts_that_cleared_their_floors():
+    """A current judged by its parts along and across the heading: the reason gives each part with its
+    floor, not the whole speed said to be "over its floor" when the whole is under the whole's floor;
+    with no part over its floor nothing is reported."""
+    from trials.measured.diagnose import weak_evidence
+
+    c = {"effect": "current", "delta_bic": 9.0, "z": 5.0, "clears_threshold": False, "magnitude": 0.002,
+         "floor": 0.01, "parts": {"along": [0.0005, 0.003], "across": [0.0019, 0.0003]}}
+    why = weak_evidence([{"candidates": [c]}])["current"]
+    assert "across 0.0019 (floor 0.0003)" in why and "along 0.0005 (floor 0.003)" in why
+    assert "size 0.002" not in why
+    c["parts"]["across"] = [0.0002, 0.0003]
+    assert weak_evidence([{"candidates": [c]}]) == {}
 
 
 def test_short_of_name_counts_clean_first_rounds(monkeypatch):
@@ -272,8 +290,6 @@ def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(monkeypatch):
     import trials.measured.diagnose as G
     from mmg.ship import load_ship
     from trials.measured.diagnose import diagnose, synthetic_record
-    from trials.measured.identifiability import not_identifiable_lines
-
     ship = load_ship("esso_osaka_3m")
     rec = synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, rudder_deg=20.0, seed=4, name="z")
     opts = {"candidates": ["heading_bias", "current"]}
@@ -285,5 +301,5 @@ def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(monkeypatch):
     ent = {e["effect"]: e for e in d.not_identifiable}
     assert "heading_bias" in ent, d.not_identifiable
     assert "a name needs 1e+07" in ent["heading_bias"]["reason"]
-    (line,) = [ln for ln in not_identifiable_lines(d.not_identifiable) if "heading_bias" in ln]
+    (line,) = [ln for ln in d.summary_lines() if ln.startswith("heading_bias: not identifiable")]
     assert "a name needs" in line

@@ -807,16 +807,31 @@ def weak_evidence(rounds) -> dict:
     out = {}
     last = rounds[-1] if rounds else {"candidates": []}
     for c in last["candidates"]:
-        if c.get("clears_threshold") or not evidence_short(c["delta_bic"], c["z"]):
+        if c.get("clears_threshold") or not evidence_short(c["delta_bic"], c["z"]) or not _over_floor(c):
             continue
-        parts = c.get("parts")
-        over = (any(abs(v[0]) > v[1] for v in parts.values()) if parts else
-                not c["magnitude"] <= (c.get("floor") or 0.0))
-        if over:
-            out[c["effect"]] = (f"at dBIC {c['delta_bic']:.3g} (a name needs {BIC_THRESHOLD:.3g}), z {c['z']:.3g}, "
-                                f"size {c['magnitude']:.3g} {MAGNITUDE_UNITS.get(c['effect'], '')} over its floor: "
-                                "the record holds too little evidence to tell it from the ship's own mismatch")
+        out[c["effect"]] = (f"at dBIC {c['delta_bic']:.3g} (a name needs {BIC_THRESHOLD:.3g}), z {c['z']:.3g}, "
+                            f"{_size_text(c, MAGNITUDE_UNITS.get(c['effect'], ''))}: the record holds too little "
+                            "evidence to tell it from the ship's own mismatch")
     return out
+
+
+def _over_floor(c: dict) -> bool:
+    """Whether a stored candidate's size cleared its floor: a part over its own floor where it was
+    judged by its parts (:func:`_parts`), else its size over its floor (the rule of
+    :func:`~trials.measured.decision.clears_floor`, on the figures the round kept)."""
+    parts = c.get("parts")
+    if parts:
+        return any(abs(v[0]) > v[1] for v in parts.values())
+    return not c["magnitude"] <= (c.get("floor") or 0.0)
+
+
+def _size_text(c: dict, unit: str) -> str:
+    """A stored candidate's size against its floor(s), in ``unit``: its parts along and across the
+    heading each with its floor where it was judged by them, else its size and floor."""
+    if c.get("parts"):
+        sizes = ", ".join(f"{k} {abs(v[0]):.3g} (floor {v[1]:.3g})" for k, v in c["parts"].items())
+        return f"its parts along and across the heading, {sizes} {unit}"
+    return f"size {c['magnitude']:.3g} {unit} (floor {c.get('floor') or 0.0:.3g} {unit})"
 
 
 def within_mismatch(rounds, L: float) -> list:
@@ -837,13 +852,8 @@ def within_mismatch(rounds, L: float) -> list:
 
 def _within_reason(c: dict, unit: str) -> str:
     """Why a candidate that cleared dBIC and z was not named: its size (or parts) and floor(s)."""
-    head = f"at dBIC {c['delta_bic']:.3g}, z {c['z']:.3g}, "
-    if c.get("parts"):
-        sizes = ", ".join(f"{k} {abs(v[0]):.3g} (floor {v[1]:.3g})" for k, v in c["parts"].items())
-        return head + f"its parts along and across the heading, {sizes} {unit}, within what the ship's own " \
-                      "mismatch lends them (calibrated)"
-    return head + f"size {c['magnitude']:.3g} {unit}, within the {c['floor']:.3g} {unit} the ship's own mismatch " \
-                  "lends it (calibrated)"
+    return (f"at dBIC {c['delta_bic']:.3g}, z {c['z']:.3g}, {_size_text(c, unit)}, within what the ship's own "
+            "mismatch lends it (calibrated)")
 
 
 def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int) -> Diagnosis:

@@ -22,7 +22,7 @@ import numpy as np
 from .decision import false_alarm_probability  # noqa: F401  (re-exported: the report's evidence)
 
 __all__ = ["Z95", "effect_estimate", "effect_intervals", "polar_interval", "effect_evidence",
-           "summary_lines", "fmt3", "format_rms", "format_values", "channel_text"]
+           "summary_lines", "not_identifiable_line", "fmt3", "format_rms", "format_values", "channel_text"]
 
 Z95 = 1.959963984540054
 """The two-sided 95 % point of the standard normal."""
@@ -253,6 +253,38 @@ def _plain(x) -> str:
     return str(x)
 
 
+def not_identifiable_line(ni: dict) -> str:
+    """The console line of one ``not_identifiable`` entry: the effect, what it is confused with (the
+    correlation where there is one), why it is reported (its standard error could not have shown the
+    size to detect, its calibrated floor, or its evidence short of a name) and what would separate it.
+
+    Parameters
+    ----------
+    ni : dict
+        An entry of :attr:`trials.measured.diagnose.Diagnosis.not_identifiable` (``effect``,
+        ``confused_with``, ``correlation`` or None, ``what_would_separate``; optionally ``reason``,
+        ``std``, ``detection_size``, ``unit``).
+
+    Returns
+    -------
+    str
+        One line, units with every figure.
+    """
+    from .identifiability import STATISTICAL_REASON
+
+    conf = ", ".join(map(str, ni.get("confused_with") or []))
+    corr = ni.get("correlation")
+    why = f"correlation {fmt3(corr)} with {conf}" if corr is not None else f"confused with {conf}"
+    reason = ni.get("reason")
+    if reason and reason != STATISTICAL_REASON:
+        why = f"{why}: {reason}"
+    elif ni.get("std") is not None and ni.get("detection_size") is not None:
+        unit = _unit(ni.get("unit") or "")
+        why = f"{why}; sd {fmt3(ni['std'])}{unit}: could not have shown {fmt3(ni['detection_size'])}{unit}"
+    return f"{ni.get('effect')}: not identifiable from these records ({why}): {ni.get('what_would_separate', '')}" \
+        .rstrip(": ")
+
+
 def summary_lines(diag) -> list[str]:
     """The console text of a :class:`trials.measured.diagnose.Diagnosis`: a line per named effect
     (:func:`effect_line`), the statistics' legend, a line per effect that cannot be told apart, the
@@ -268,17 +300,7 @@ def summary_lines(diag) -> list[str]:
     lines.append(f"  (dBIC: information gain with the effect, named above {BIC_THRESHOLD:g}; z: the fit's distance from "
                  f"no effect in standard errors, named above {Z_THRESHOLD:g}; false-alarm p: chance of naming it at "
                  "this dBIC on records without it, n/a: not calibrated)")
-    for ni in diag.not_identifiable or []:
-        conf = ni.get("confused_with") or []
-        corr = ni.get("correlation")
-        why = f"correlation {fmt3(corr)} with {', '.join(map(str, conf))}" if corr is not None else \
-            f"confused with {', '.join(map(str, conf))}"
-        if ni.get("reason") and corr is None:
-            why = f"{why}: {ni['reason']}"
-        elif ni.get("reason") and not ni["reason"].startswith("its standard error"):
-            why = ni["reason"]
-        lines.append(f"{ni.get('effect')}: not identifiable from these records ({why}): "
-                     f"{ni.get('what_would_separate', '')}".rstrip(": "))
+    lines += [not_identifiable_line(ni) for ni in diag.not_identifiable or []]
     for k, v in (diag.model_form_mismatch or {}).items():
         lines.append(f"model-form mismatch: {k} fitted {fmt3(v['fitted'])} against the config's {fmt3(v['config'])} "
                      f"({fmt3(v['z'])} prior std away): not written to --out-ship")

@@ -62,7 +62,9 @@ R_CONFOUNDED = 0.9
 noise, is why the effect cannot be shown."""
 STD_RATIO_CONFOUNDED = 3.0
 """Marginal / conditional std above which the same holds (equivalent to R >= 0.943)."""
-_STATISTICAL = "its standard error and correlation"
+STATISTICAL_REASON = "its standard error and correlation"
+"""The ``reason`` of an entry reported for its statistics (its standard error could not have shown the
+size to detect), as against its calibrated floor or its evidence."""
 """The ``reason`` of an entry the statistics report (the console line then gives the std)."""
 _CONFUSED_MIN = 0.5
 """|correlation| of another parameter with the effect's worst direction to be named as confused with it."""
@@ -349,7 +351,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
 def _reason(statistical: bool, confounded: bool, weak_why, fl: float, det: float, unit: str) -> str:
     """Why an entry is reported: the statistics, the calibrated floor, or evidence short of a name."""
     if statistical:
-        return _STATISTICAL
+        return STATISTICAL_REASON
     if confounded:
         return (f"the ship's own mismatch lends it up to {fl:.3g} {unit} on such a record (calibrated floor), "
                 f"more than the {det:.3g} {unit} to detect")
@@ -362,14 +364,8 @@ def _name(f) -> str:
 
 
 def not_identifiable_lines(entries) -> list[str]:
-    """One console line per ``not_identifiable`` entry."""
-    out = []
-    for e in entries:
-        unit = f" {e['unit']}" if e.get("unit") else ""
-        if "std" in e and e.get("reason", _STATISTICAL) == _STATISTICAL:
-            sd = f"sd {_fmt(e['std'])}{unit}: could not have shown {_fmt(e['detection_size'])}{unit}; "
-        else:
-            sd = f"{e['reason']}; " if e.get("reason") else ""
-        out.append(f"not identifiable: {e['effect']} ({sd}correlation {e['correlation']:.2f} with "
-                   f"{', '.join(e['confused_with'])}); would separate: {e['what_would_separate']}")
-    return out
+    """One console line per ``not_identifiable`` entry
+    (:func:`trials.measured.diagnose_report.not_identifiable_line`, the one the console prints)."""
+    from .diagnose_report import not_identifiable_line
+
+    return [not_identifiable_line(e) for e in entries]
