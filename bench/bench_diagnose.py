@@ -82,6 +82,18 @@ def timing():
     return dt
 
 
+def _refuse_bad_options(ap, a) -> None:
+    """Options that would be ignored or do the wrong thing silently are refused (exit 2, one line)."""
+    from trials.measured.diagnose import SCREEN_NFEV
+
+    if a.summarise and not a.mismatch:
+        ap.error("--summarise: summarises --mismatch runs; give --mismatch with it")
+    if a.summarise and (a.only or a.max_nfev is not None or a.trials is not None):
+        ap.error("--summarise: reads runs already made; --only, --max-nfev and --trials are not used with it")
+    if a.max_nfev is not None and a.max_nfev <= SCREEN_NFEV:
+        ap.error(f"--max-nfev: {a.max_nfev} is not more than the screening budget of {SCREEN_NFEV} evaluations")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--clean", type=int, default=None,
@@ -104,7 +116,8 @@ def main(argv=None):
     ap.add_argument("--candidate-start", choices=("config", "current"), default="config",
                     help="--mismatch: where candidates' fits start the ship (DiagnoseOptions.candidate_start)")
     ap.add_argument("--max-nfev", type=int, default=None,
-                    help="--mismatch: evaluations of each candidate's fit (DiagnoseOptions.max_nfev; default 12): "
+                    help="--mismatch: evaluations of each fit, the candidates' and the baseline's "
+                         "(DiagnoseOptions.max_nfev; default 12; more than the screening budget of 6): "
                          "whether a candidate stopped by its budget or by its physics")
     ap.add_argument("--trials", nargs="*", default=None,
                     help="--mismatch: the trials to draw from (default all: turn35 turn35p zz10 zz15 zz20; "
@@ -114,6 +127,7 @@ def main(argv=None):
                          "pooled, their not_identifiable lists completed by the evidence rule of the code as it is "
                          "(trials.measured.diagnose.weak_evidence over each record's stored rounds)")
     a = ap.parse_args(argv)
+    _refuse_bad_options(ap, a)
     if a.mismatch and a.summarise:
         sys.path.insert(0, str(REPO / "bench"))
         from diagnose_mismatch import summarise_files

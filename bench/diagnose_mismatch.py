@@ -94,7 +94,7 @@ def run_one(job: dict, seed0: int) -> dict:
             for k, t in enumerate(PAIRS.get(job["trial"], (job["trial"],)))]
     rec = recs[0]
     t0 = time.perf_counter()
-    extra = {"max_nfev": job["max_nfev"]} if job.get("max_nfev") else {}
+    extra = {"max_nfev": job["max_nfev"]} if job.get("max_nfev") is not None else {}
     d = diagnose(config, recs, candidate_start=job.get("candidate_start", "config"), **extra)
     js = d.to_json()
     truth = {k: dict(v) for k, v in job["spec"].items()}
@@ -180,15 +180,16 @@ def summarise_files(paths) -> dict:
     before that rule reported such candidates; the naming itself does not depend on it)."""
     from trials.measured.diagnose import weak_evidence
 
-    rows = []
+    rows, n_added = [], 0
     for p in paths:
         for r in json.loads(Path(p).read_text())["records"]:
             added = [e for e in weak_evidence(r["rounds"]) if e not in r["named"] and e not in r["not_identifiable"]]
             rows.append({**r, "not_identifiable": list(r["not_identifiable"]) + added})
+            n_added += bool(added) and r["effect"] is None
     print(f"{len(rows)} records of {len(paths)} run(s): {', '.join(Path(p).name for p in paths)}")
     clean = [r for r in rows if r["effect"] is None]
-    print(f"clean records with a not_identifiable entry added by the evidence rule: "
-          f"{sum(bool(weak_evidence(r['rounds'])) for r in clean)} of {len(clean)}")
+    print(f"clean records with a not_identifiable entry added here by the evidence rule (not in the run's own "
+          f"list): {n_added} of {len(clean)}")
     return summarise(rows)
 
 

@@ -268,7 +268,14 @@ class Calibration:
 def short_of_name(records, L: float) -> tuple[int, int]:
     """(clean records whose first round has a candidate with evidence short of a name, clean records):
     :func:`~trials.measured.decision.evidence_short` with its size over the packaged floor, which
-    ``mmg diagnose`` reports ``not_identifiable`` (:func:`trials.measured.diagnose.weak_evidence`)."""
+    ``mmg diagnose`` reports ``not_identifiable`` (:func:`trials.measured.diagnose.weak_evidence`).
+
+    The first round, where ``weak_evidence`` reads the last: the calibration runs are made without
+    floors (``MMG_DIAGNOSE_CALIBRATION=none``), so their later rounds follow names that the packaged
+    floors would not have made; on a clean record that names nothing, which is what the floors are
+    for, the last round of ``mmg diagnose`` is its first.  The floors are the packaged ones, not
+    those a ``bench/calibrate_diagnose.py`` run has just computed (the same when it reruns the runs
+    that made the packaged file)."""
     import math
 
     from .decision import clears_floor, evidence_short
