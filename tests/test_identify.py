@@ -230,6 +230,9 @@ def test_folds_by_manoeuvre_put_records_of_one_class_in_different_folds():
     assert manoeuvre_class(_manoeuvre_run("z", zig, 12, 0))[:2] == (1, 0)
     astern = np.where(np.arange(100) > 60, -6.0, 10.0)
     assert manoeuvre_class(_manoeuvre_run("a", hold, astern, 0))[:2] == (2, 0)
+    one_glitch = np.where(np.arange(100) == 50, -0.1, 10.0)        # one noisy sample is not an astern phase
+    assert manoeuvre_class(_manoeuvre_run("g", hold, one_glitch, 0))[:2] == (0, 1)
+    assert manoeuvre_class(_manoeuvre_run("c", np.full(100, 1.0), 10, 0))[:2] == (3, 0)   # straight: no side
     # file order: stbd, port, stbd, stbd, port, zig, zig, zig -> with 4 folds the two port turns (1, 5 in
     # the order below) share fold 1
     kinds = [hold, -hold, hold, hold, zig, -hold, zig, zig]

@@ -76,7 +76,7 @@ __all__ = ["identify", "IdentifyOptions",
            "fit_covariance", "ship_with_values", "PARAMETER_UNITS",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description", "identification_covariance", "start_noise", "DEFAULT_INITIAL_STATE",
-           "INITIAL_STATES", "fold_of", "manoeuvre_class", "FOLD_ASSIGNMENTS"]
+           "INITIAL_STATES", "fold_of", "manoeuvre_class", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale")
 DEFAULT_MAX_NFEV = 30
@@ -564,21 +564,41 @@ def fold_of(runs: list[MeasuredRun], folds: int, by: str = "order") -> np.ndarra
     return np.array([deal[g] for g in group], dtype=int)
 
 
+ASTERN_SHARE = 0.02
+"""Share of a record's samples with the propeller astern (n < 0) from which :func:`manoeuvre_class`
+calls it an astern record: a sustained astern phase, not one noisy sample (the FRT random and
+berthing records run astern for 12-36 % of their samples, its turns and zigzags for none)."""
+
+
 def manoeuvre_class(run: MeasuredRun) -> tuple:
-    """(class, rudder side, median |revolutions| [rps]) of a record, for stratified folds: class 0 a
-    turn, 1 a zigzag, 2 a record with the propeller astern (n < 0 anywhere), whatever its rudder.
+    """The manoeuvre of a record, for stratified folds (:func:`fold_of`).
 
     A turn holds one side: over the samples with the rudder beyond 2 deg, |sum delta| / sum |delta|
     >= 0.5 (side +1 starboard, -1 port; the FRT turns, steered on the approach with up to 24 deg the
     other way, give 0.7 or more; their zigzags, equal angles both ways, under 0.35).  Otherwise a
-    zigzag (side 0)."""
+    zigzag (side 0).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        The record (its logged revolutions and rudder angle).
+
+    Returns
+    -------
+    tuple
+        (class, rudder side, median |revolutions| [rps]): class 0 a turn, 1 a zigzag, 2 a record with
+        the propeller astern for at least :data:`ASTERN_SHARE` of its samples (whatever its rudder),
+        3 a straight run (no rudder beyond 2 deg); side 0 but for turns.
+    """
     n = np.asarray(run.inputs.n, float)
     rps = float(np.nanmedian(np.abs(n)))
-    if np.any(n < 0):
+    if np.mean(n < 0) >= ASTERN_SHARE:
         return (2, 0, rps)
     d = np.asarray(run.inputs.delta, float)
     big = d[np.abs(d) > np.radians(2.0)]
-    lean = float(np.sum(big) / np.sum(np.abs(big))) if len(big) else 1.0
+    if not len(big):
+        return (3, 0, rps)
+    lean = float(np.sum(big) / np.sum(np.abs(big)))
     if abs(lean) < 0.5:
         return (1, 0, rps)
     return (0, 1 if lean > 0 else -1, rps)
