@@ -69,6 +69,25 @@ def test_identify_improves_the_open_loop_replay_and_writes_a_usable_ship(tmp_pat
     assert "| N_r |" in rep and "Training fits" in rep
 
 
+def test_each_record_is_replayed_once_per_model(monkeypatch):
+    """The scores, the physical check and the report read the same replays: one per record and model
+    (the identified and the initial), and the identified replay is not the initial one."""
+    import trials.measured.identify as I
+
+    ship = mmg.load_ship(SHIP)
+    runs = _synthetic_runs(ship.with_hull({"N_r": ship.hull.value("N_r") * 1.3}), seeds=(0,), duration=40.0)
+    ident = identify(ship, runs, free=["N_r"], segment_s=(20.0,), say=lambda m: None)
+    calls = []
+    real = I.replay_record
+    monkeypatch.setattr(I, "replay_record", lambda s, r: calls.append(s) or real(s, r))
+    for _ in range(2):
+        ident.scores(model="initial"), ident.scores()
+    ident.physical_check()
+    assert len(calls) == 2 and calls[0] is ident.initial and calls[1] is ident.ship
+    assert ident.replay(runs[0]) is not ident.replay(runs[0], "initial")
+    assert ident.scores()[0] != ident.scores(model="initial")[0]
+
+
 def test_ship_yaml_changes_only_the_fitted_values(tmp_path):
     src = mmg.config_path("ships", f"{SHIP}.yaml")
     text = ship_yaml(src, {"N_r": -0.04, "w_P0": 0.5, "epsilon": 1.2}, "test")

@@ -187,10 +187,23 @@ class Identification:
         return physical_check(self.ship, self.prior or self.initial, self.runs, [self.replay(r) for r in self.runs])
 
     def replay(self, run: MeasuredRun, model: str = "identified"):
-        """:func:`trials.measured.predict.replay_record` of ``run`` with the identified (its wind scale too) or initial model."""
+        """:func:`trials.measured.predict.replay_record` of ``run`` with the identified (its wind scale too) or
+        initial model; made once per record and model, then kept (the scores, the physical check and the
+        report all read the same replays)."""
+        key = (id(run), model)
+        hit = self._replays.get(key)
+        if hit is not None and hit[0] is run:
+            return hit[1]
         if model == "identified":
-            return replay_record(self.ship, with_ship_effects(with_fitted_wind(run, self.fit.values()), self.ship))
-        return replay_record(self.initial, run)
+            rep = replay_record(self.ship, with_ship_effects(with_fitted_wind(run, self.fit.values()), self.ship))
+        else:
+            rep = replay_record(self.initial, run)
+        self._replays[key] = (run, rep)
+        return rep
+
+    @cached_property
+    def _replays(self) -> dict:
+        return {}
 
 
 METRIC_COLUMNS = (("advance_L", "advance [L]"), ("tactical_diameter_L", "tactical diameter [L]"),
