@@ -303,3 +303,16 @@ def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(monkeypatch):
     assert "a name needs 1e+07" in ent["heading_bias"]["reason"]
     (line,) = [ln for ln in d.summary_lines() if ln.startswith("heading_bias: not identifiable")]
     assert "a name needs" in line
+
+
+def test_an_entry_gives_the_first_reason_that_holds():
+    """The statistics come first (the record could not have shown the size to detect), then the
+    calibrated floor, and only then evidence short of a name: an effect reported for its floor is not
+    said to be short of evidence, and one with neither gets the evidence's reason."""
+    from trials.measured.identifiability import STATISTICAL_REASON, _reason
+
+    weak = "at dBIC 9.6 (a name needs 20)"
+    assert _reason(True, True, weak, 5.84, 1.0, "deg") == STATISTICAL_REASON
+    floor = _reason(False, True, weak, 5.84, 1.0, "deg")
+    assert "5.84 deg" in floor and "1 deg" in floor and "dBIC" not in floor
+    assert _reason(False, False, weak, 0.389, 1.0, "deg") == weak

@@ -307,11 +307,9 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
     entries, table, trials = [], [], None
     for cls in cand:
         setup = _setup(current, cls, ns, L)
-        effects, free, theta, s2 = setup
+        free = setup[1]
         try:
-            info_rec = info_fn.records(effects, free, theta, s2)
-            idx = [i for i, f in enumerate(free) if f.kind == "effect" and f.index == effects.index(cls)]
-            b = block_confounding(sym_inv(info_rec) * inflate ** 2, idx)
+            info_rec, idx, b = _block(info_fn, setup, cls, inflate)
         except (np.linalg.LinAlgError, ValueError) as e:
             say(f"identifiability of {cls.name}: not assessed ({e})")
             continue
@@ -346,6 +344,15 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
                         "std": row["std"], "std_conditional": row["std_conditional"], "detection_size": row["detection_size"],
                         "unit": row["unit"], "trials": [{"trial": lb, "std": float(f"{sd:.3g}")} for lb, sd in res]})
     return entries, table
+
+
+def _block(info_fn, setup, cls, inflate: float):
+    """(the records' information, the effect's indices among the free parameters, its
+    :func:`block_confounding` under the inflated covariance) of one candidate's ``setup``."""
+    effects, free, theta, s2 = setup
+    info_rec = info_fn.records(effects, free, theta, s2)
+    idx = [i for i, f in enumerate(free) if f.kind == "effect" and f.index == effects.index(cls)]
+    return info_rec, idx, block_confounding(sym_inv(info_rec) * inflate ** 2, idx)
 
 
 def _reason(statistical: bool, confounded: bool, weak_why, fl: float, det: float, unit: str) -> str:
