@@ -316,3 +316,16 @@ def test_an_entry_gives_the_first_reason_that_holds():
     floor = _reason(False, True, weak, 5.84, 1.0, "deg")
     assert "5.84 deg" in floor and "1 deg" in floor and "dBIC" not in floor
     assert _reason(False, False, weak, 0.389, 1.0, "deg") == weak
+
+
+def test_a_floor_reason_gives_each_effect_its_unit():
+    """The floor and the size to detect are said in the unit they are in: m/s for a current (the
+    detection size scales with the ship), T/H for shallow water (not its fit parameter's H/T, which has
+    no unit and left a double space), deg for the angles."""
+    import mmg.effects as E
+    from trials.measured.identifiability import _reason, _size_unit
+
+    units = {c.name: _size_unit(c) for c in (E.Current, E.RudderOffset, E.HeadingBias, E.ShallowWater)}
+    assert units == {"current": "m/s", "rudder_offset": "deg", "heading_bias": "deg", "shallow_water": "T/H"}
+    text = _reason(False, True, None, 0.574, 0.5, units["shallow_water"])
+    assert "0.574 T/H on" in text and "0.5 T/H to" in text and "  " not in text

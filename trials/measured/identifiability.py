@@ -246,7 +246,7 @@ def _separation(info_fn, trials, setup, info_rec, idx, inflate, cls):
                "the records already hold turns both ways and a zigzag")
         return f"{why}: a longer record, or one where the effect is larger", res
     label, sd = min(res, key=lambda t: t[1])
-    text = f"{label} with {'these' if len(info_fn.fitter.recs) > 1 else 'this one'}: sd {_fmt(sd0)} -> {_fmt(sd)} {unit}"
+    text = f"{label} with {'these' if len(info_fn.fitter.recs) > 1 else 'this one'}: sd {_fmt(sd0)} -> {_fmt(sd)}{_sp(unit)}"
     if sd > 0.7 * sd0:
         text = f"none of the trials tried separates it well (best: {text})"
     return text, res
@@ -255,6 +255,21 @@ def _separation(info_fn, trials, setup, info_rec, idx, inflate, cls):
 def _unit(cls) -> str:
     u = cls.fit_parameters()[0].unit
     return "" if u == "1" else u
+
+
+def _size_unit(cls) -> str:
+    """The unit of :func:`detection_size` and :func:`floor_in_fit_unit` of ``cls``: its fit parameter's
+    where :data:`DETECTION_SIZE` scales with the ship (a current: m/s), else its size's (deg, T/H)."""
+    from .decision import MAGNITUDE_UNITS
+
+    if DETECTION_SIZE.get(cls.name, (0.0, "1"))[1] == "sqrt(gL)":
+        return _unit(cls)
+    u = MAGNITUDE_UNITS.get(cls.name, "1")
+    return "" if u == "1" else u
+
+
+def _sp(unit: str) -> str:
+    return f" {unit}" if unit else ""
 
 
 def _fmt(x: float) -> str:
@@ -340,7 +355,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
                                                                            np.argsort(-np.abs(b["corr"]))
                                                                            if j not in idx][:1],
                         "correlation": round(b["R"], 3), "what_would_separate": text,
-                        "reason": _reason(statistical, row["confounded"], weak_why, fl, det, _unit(cls)),
+                        "reason": _reason(statistical, row["confounded"], weak_why, fl, det, _size_unit(cls)),
                         "std": row["std"], "std_conditional": row["std_conditional"], "detection_size": row["detection_size"],
                         "unit": row["unit"], "trials": [{"trial": lb, "std": float(f"{sd:.3g}")} for lb, sd in res]})
     return entries, table
@@ -360,8 +375,8 @@ def _reason(statistical: bool, confounded: bool, weak_why, fl: float, det: float
     if statistical:
         return STATISTICAL_REASON
     if confounded:
-        return (f"the ship's own mismatch lends it up to {fl:.3g} {unit} on such a record (calibrated floor), "
-                f"more than the {det:.3g} {unit} to detect")
+        return (f"the ship's own mismatch lends it up to {fl:.3g}{_sp(unit)} on such a record (calibrated floor), "
+                f"more than the {det:.3g}{_sp(unit)} to detect")
     return weak_why
 
 
