@@ -104,6 +104,7 @@ def run_one(job: dict, seed0: int) -> dict:
     return {**{k: job[k] for k in ("id", "seed", "member", "trial", "effect", "size")},
             "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
             "parameters": d.parameters, "not_identifiable": [n["effect"] for n in d.not_identifiable],
+            "not_identifiable_reasons": {n["effect"]: n.get("reason") for n in d.not_identifiable},
             "unexplained": bool(d.unexplained), "rounds": js["rounds"], "duration_s": float(sum(r.t[-1] for r in recs)),
             "rms_after": js["rms_after"], "rms_before": js["rms_before"], "rms_config": js["rms_config"],
             "speed_mps": float(np.median(np.hypot(rec.u, rec.v))), "L_m": float(config.particulars.L),
@@ -171,7 +172,34 @@ def summarise(rows: list) -> dict:
     allr = _rate(rows, lambda r: set(r["named"]) == ({r["effect"]} if r["effect"] else set()))
     print(f"\nexact (named set == true set) over all records: {_pct(*allr)}")
     table["exact"] = list(allr)
+    table["reasons"] = _reason_counts(rows)
     return table
+
+
+REASON_KINDS = (("statistics", "its standard error"), ("floor", "mismatch lends"), ("evidence", "(a name needs"),
+                ("information", "too little information"))
+"""The kinds of ``not_identifiable`` reasons (:func:`trials.measured.identifiability.verdict`,
+:func:`trials.measured.diagnose.within_mismatch`, :func:`trials.measured.diagnose.weak_evidence`)
+by a phrase of their text."""
+
+
+def _reason_kind(text) -> str:
+    return next((k for k, phrase in REASON_KINDS if phrase in str(text or "")), "other")
+
+
+def _reason_counts(rows) -> dict:
+    """Print and return the ``not_identifiable`` entries by kind of reason: on clean records, on records
+    with an effect for that effect, and for another effect (runs that stored the reasons only)."""
+    out = {w: {} for w in ("clean", "true effect", "other effect")}
+    for r in rows:
+        for eff, why in (r.get("not_identifiable_reasons") or {}).items():
+            w = "clean" if r["effect"] is None else "true effect" if eff == r["effect"] else "other effect"
+            k = _reason_kind(why)
+            out[w][k] = out[w].get(k, 0) + 1
+    if any(out.values()):
+        print("not_identifiable entries by reason: " + "; ".join(
+            f"{w} {', '.join(f'{k} {n}' for k, n in sorted(c.items())) or '-'}" for w, c in out.items()))
+    return out
 
 
 def summarise_files(paths) -> dict:

@@ -24,7 +24,11 @@ the naming z threshold (:data:`trials.measured.diagnose.Z_THRESHOLD`, 3; never l
 exceeds its :data:`DETECTION_SIZE` (the records could not have named it at a size that matters:
 an effect of that size would have been within the threshold's z of nothing), and confounding is the
 reason: R >= :data:`R_CONFOUNDED` or marginal / conditional std >= :data:`STD_RATIO_CONFOUNDED`.
-An effect skipped for lack of channels is not assessed.  Also reported, with its own reason: a
+An effect skipped for lack of channels is not assessed.  Also reported (since stop 35), with its
+own reason: one whose marginal std could not have shown its detection size though confounding is
+not why (the records hold too little information on it at all: a 1.5 deg heading bias on a single
+turn of a ship whose hull form is not the model's, sd 2.06 deg, R 0.899, was dropped silently);
+:func:`verdict` gives the reasons in order.  And a
 candidate whose dBIC showed some evidence, short of a name, while its precision and size passed
 (:func:`trials.measured.diagnose.weak_evidence`), and one whose evidence and precision passed but
 whose size the calibrated floor stopped (:func:`trials.measured.diagnose.within_mismatch`).
@@ -312,7 +316,6 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         ``confounded``: the rule's test without "not named", i.e. for a named effect that its value
         leans on the ship's coefficients or another effect, a check on it).
     """
-    from .decision import Z_THRESHOLD as z_name
     from .decision import least_floor
 
     say = say or (lambda m: None)
@@ -341,12 +344,9 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
             f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
         fl = floor_in_fit_unit(cls.name, least_floor(cls.name, getattr(fitter, "kind", "")), L)
-        statistical = bool(max(2.0, z_name) * b["sd"] > det
-                           and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED))
-        row["confounded"] = statistical or fl > det
+        row["confounded"], reason = verdict(b, det, fl, (weak or {}).get(cls.name), _unit(cls), _size_unit(cls))
         row["floor"] = fl
-        weak_why = (weak or {}).get(cls.name)
-        if cls.name in named or not (row["confounded"] or weak_why):
+        if cls.name in named or reason is None:
             continue
         if trials is None:
             trials = _trial_segments(fitter, _trial_specs(fitter.recs, L), segment_s)
@@ -355,7 +355,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
                                                                            np.argsort(-np.abs(b["corr"]))
                                                                            if j not in idx][:1],
                         "correlation": round(b["R"], 3), "what_would_separate": text,
-                        "reason": _reason(statistical, row["confounded"], weak_why, fl, det, _size_unit(cls)),
+                        "reason": reason,
                         "std": row["std"], "std_conditional": row["std_conditional"], "detection_size": row["detection_size"],
                         "unit": row["unit"], "trials": [{"trial": lb, "std": float(f"{sd:.3g}")} for lb, sd in res]})
     return entries, table
@@ -370,14 +370,44 @@ def _block(info_fn, setup, cls, inflate: float):
     return info_rec, idx, block_confounding(sym_inv(info_rec) * inflate ** 2, idx)
 
 
-def _reason(statistical: bool, confounded: bool, weak_why, fl: float, det: float, unit: str) -> str:
-    """Why an entry is reported: the statistics, the calibrated floor, or evidence short of a name."""
-    if statistical:
-        return STATISTICAL_REASON
-    if confounded:
-        return (f"the ship's own mismatch lends it up to {fl:.3g}{_sp(unit)} on such a record (calibrated floor), "
-                f"more than the {det:.3g}{_sp(unit)} to detect")
-    return weak_why
+def verdict(b: dict, det: float, fl: float, weak_why: str | None, unit: str, det_unit: str) -> tuple:
+    """Whether a candidate that was not named is reported ``not_identifiable``, and why (module
+    docstring, "Rule").
+
+    Parameters
+    ----------
+    b : dict
+        Its :func:`block_confounding` (``sd``, ``sd_conditional``, ``R``, ``ratio``).
+    det, fl : float
+        Its :func:`detection_size` and calibrated floor (:func:`floor_in_fit_unit`), in ``det_unit``.
+    weak_why : str or None
+        The reason of evidence short of a name (:func:`trials.measured.diagnose.weak_evidence`).
+    unit, det_unit : str
+        The units of its fit parameter (``sd``) and of ``det`` and ``fl`` ("" for none).
+
+    Returns
+    -------
+    (bool, str or None)
+        ``confounded`` (the records could not show it for its confounding or its floor) and the reason,
+        the first that holds: :data:`STATISTICAL_REASON` (its std could not have shown ``det`` and
+        confounding is why), the floor (the ship's own mismatch lends it more than ``det``), ``weak_why``,
+        too little information (its std could not have shown ``det``, confounded or not); None: not reported.
+    """
+    from .decision import Z_THRESHOLD
+
+    imprecise = bool(max(2.0, Z_THRESHOLD) * b["sd"] > det)
+    if imprecise and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED):
+        return True, STATISTICAL_REASON
+    if fl > det:
+        return True, (f"the ship's own mismatch lends it up to {fl:.3g}{_sp(det_unit)} on such a record (calibrated "
+                      f"floor), more than the {det:.3g}{_sp(det_unit)} to detect")
+    if weak_why:
+        return False, weak_why
+    if imprecise:
+        return False, (f"the records hold too little information on it: sd {_fmt(b['sd'])}{_sp(unit)} "
+                       f"({_fmt(b['sd_conditional'])}{_sp(unit)} with every other parameter fixed) could not have "
+                       f"shown {det:.3g}{_sp(det_unit)}")
+    return False, None
 
 
 def _name(f) -> str:
