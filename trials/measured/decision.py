@@ -37,7 +37,7 @@ import numpy as np
 
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
-           "clears_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS"]
+           "clears_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -52,6 +52,11 @@ is reported ``not_identifiable`` rather than dropped (:func:`evidence_short`): K
 (1995) call 2-6 "positive" evidence and below 2 "not worth more than a bare mention"."""
 KINDS = ("turn", "zigzag", "turn_pair")
 """Kinds of record set (:func:`record_kind`); the floors are calibrated for the first two."""
+STATISTICAL_REASON = "its standard error and correlation"
+"""The ``reason`` of a ``not_identifiable`` entry reported for its statistics (its standard error could
+not have shown the size to detect: :func:`trials.measured.identifiability.verdict`), as against its
+calibrated floor, its evidence or too little information."""
+
 MAGNITUDE_UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1",
                    "shallow_water": "T/H"}
 """The unit of each effect's :func:`magnitude`."""

@@ -270,7 +270,7 @@ def not_identifiable_line(ni: dict) -> str:
     str
         One line, units with every figure.
     """
-    from .identifiability import STATISTICAL_REASON
+    from .decision import STATISTICAL_REASON
 
     conf = ", ".join(map(str, ni.get("confused_with") or []))
     corr = ni.get("correlation")

@@ -48,8 +48,10 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .decision import STATISTICAL_REASON
+
 __all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "floor_in_fit_unit", "block_confounding",
-           "assess", "not_identifiable_lines"]
+           "assess", "verdict", "not_identifiable_lines", "STATISTICAL_REASON"]
 
 DETECTION_SIZE = {"rudder_offset": (1.0, "deg"), "heading_bias": (1.0, "deg"), "current": (0.0027, "sqrt(gL)"),
                   "wind": (0.5, "1"), "shallow_water": (0.5, "1")}
@@ -66,9 +68,7 @@ R_CONFOUNDED = 0.9
 noise, is why the effect cannot be shown."""
 STD_RATIO_CONFOUNDED = 3.0
 """Marginal / conditional std above which the same holds (equivalent to R >= 0.943)."""
-STATISTICAL_REASON = "its standard error and correlation"
-"""The ``reason`` of an entry reported for its statistics (its standard error could not have shown the
-size to detect), as against its calibrated floor or its evidence."""
+
 """The ``reason`` of an entry the statistics report (the console line then gives the std)."""
 _CONFUSED_MIN = 0.5
 """|correlation| of another parameter with the effect's worst direction to be named as confused with it."""
