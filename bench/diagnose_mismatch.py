@@ -105,6 +105,7 @@ def run_one(job: dict, seed0: int) -> dict:
             "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
             "parameters": d.parameters, "not_identifiable": [n["effect"] for n in d.not_identifiable],
             "not_identifiable_reasons": {n["effect"]: n.get("reason") for n in d.not_identifiable},
+            "not_identifiable_correlation": {n["effect"]: n.get("correlation") for n in d.not_identifiable},
             "unexplained": bool(d.unexplained), "rounds": js["rounds"], "duration_s": float(sum(r.t[-1] for r in recs)),
             "rms_after": js["rms_after"], "rms_before": js["rms_before"], "rms_config": js["rms_config"],
             "speed_mps": float(np.median(np.hypot(rec.u, rec.v))), "L_m": float(config.particulars.L),
