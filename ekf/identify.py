@@ -42,7 +42,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mmg.model import P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_RUDDER_OFFSET, POLY_WP0, PackedShip
+from mmg.model import (P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_RUDDER_OFFSET, P_YP_ASTERN, POLY_WP0,
+                       PackedShip)
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
@@ -59,11 +60,16 @@ inflow angle, positive and negative beta_R, and the effective lever l_R' of the 
 MASS_CONSTANTS = {"m_x": P_MX, "m_y": P_MY, "J_z": P_JZ}
 """Added masses [kg] and added moment of inertia [kg m^2] :func:`free_parameters` can free (the
 config's primed ``m_x_prime``, ``m_y_prime``, ``J_z_prime`` times the mass / inertia scale)."""
-SHIP_CONSTANTS = (("w_P0", "epsilon", "kappa", "wind_scale", "rudder_offset") + tuple(RUDDER_CONSTANTS)
+SHIP_CONSTANTS = (("w_P0", "epsilon", "kappa", "wind_scale", "rudder_offset", "Y_P_astern") + tuple(RUDDER_CONSTANTS)
                   + tuple(MASS_CONSTANTS))
 """Ship constants besides the hull coefficients that :func:`free_parameters` can free (``"wind_scale"``
 and ``"rudder_offset"`` are the ``wind`` and ``rudder_offset`` effects' parameters under their
 ``mmg identify --free`` names: their priors and bounds are the effects' own, :func:`effect_prior`)."""
+
+Y_P_ASTERN_PRIOR = (0.03, -0.3, 0.3)
+"""Prior std and bounds of the propeller's lateral force astern, Y_P / (rho n^2 D^4) (:func:`mmg.model.propeller_lateral`),
+absolute, about the config's value (0 unless given): a few per cent of the bollard thrust
+(K_T(0) about 0.3) is what single screws show; the bounds are the config's."""
 
 PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
 """Prior std of a freed ship coefficient relative to its config value, per family: the one table of
@@ -216,6 +222,9 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
         elif nm == "rudder_offset":      # the rudder_offset effect's offset [rad], prior at the config's
             out.append(effect_prior(E.RudderOffset, "offset_deg", nm, "rudder", P_RUDDER_OFFSET, np.pi / 180.0,
                                     float(packed.p[P_RUDDER_OFFSET])))
+        elif nm == "Y_P_astern":
+            sd, lo, hi = Y_P_ASTERN_PRIOR
+            out.append(FreeParameter(nm, "propeller", P_YP_ASTERN, float(packed.p[P_YP_ASTERN]), sd, lo, hi))
         elif nm in MASS_CONSTANTS:
             v = float(packed.p[MASS_CONSTANTS[nm]])
             out.append(FreeParameter(nm, "mass", MASS_CONSTANTS[nm], v, rel["mass"] * v, 0.0, 3.0 * v))

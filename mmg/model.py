@@ -60,7 +60,10 @@ P_FQ_BLEND = P_FQ_SCALE + 1
 """C_T* added at beta_p = :data:`BETA_ANCHOR`, faded out by 90 deg (:func:`thrust_coefficient`)."""
 P_FQ_A = P_FQ_BLEND + 1
 """Slots P_FQ_A .. + 2 N_HARMONICS - 1: the A_k then the B_k of the ship's B4-70 series (:mod:`mmg.fourquadrant`)."""
-N_PARAMS = P_FQ_A + 2 * N_HARMONICS
+P_YP_ASTERN = P_FQ_A + 2 * N_HARMONICS
+"""Lateral force coefficient of the propeller running astern, Y_P / (rho n^2 D^4) for n < 0
+(:func:`propeller_lateral`; the config's ``propeller.Y_P_astern``)."""
+N_PARAMS = P_YP_ASTERN + 1
 
 LOW_SPEED_FROUDE = 0.01
 """Froude number below which the hull's speed scale is floored (:func:`kinematics`): U_low =
@@ -137,7 +140,8 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: 
     p[P_POWER] = engine_power_W
     p[P_SHAFT_I] = en.shaft_inertia_coefficient * pr.D**5
     p[P_ULOW] = LOW_SPEED_FROUDE * np.sqrt(G * pa.L)
-    p[P_FQ_SCALE], p[P_FQ_BLEND], p[P_FQ_A:] = four_quadrant_slots(pr.K_T, pr.P_D)
+    p[P_FQ_SCALE], p[P_FQ_BLEND], p[P_FQ_A:P_YP_ASTERN] = four_quadrant_slots(pr.K_T, pr.P_D)
+    p[P_YP_ASTERN] = pr.Y_P_astern
     for k, v in (disturbance_slots or {}).items():
         p[k] = v
     poly = _poly_table([pr.K_T, pr.K_Q, pr.t_P, pr.w_P0])
@@ -312,6 +316,24 @@ def propeller(u, n, one_minus_wP, p, poly):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def propeller_lateral(n, p):
+    """Sway force [N] and yaw moment about midship [N m] of a propeller running astern (n < 0): the
+    transverse thrust ("propeller walk") of a single screw whose race, thrown forward, strikes the
+    stern quarters unevenly (a right-handed screw walks the stern to port: Y_P < 0, bow to starboard).
+
+    Y_P = Y_P* rho n^2 D^4 with Y_P* = ``p[P_YP_ASTERN]`` (the config's ``propeller.Y_P_astern``, 0 by
+    default: no force), acting at the propeller, N_P = x_P' L Y_P; 0 for n >= 0.  One constant, as the
+    Osaka group's low-speed MMG writes the reversing propeller's lateral force over n^2 D^4 (there a
+    function of the advance ratio from captive tests; none exists for this propeller, so the constant
+    is the identification's to fit).  Zero with zero slope at n = 0, so the forces stay continuous
+    (and smooth) as the propeller reverses."""
+    if n.real >= 0.0:
+        return 0.0 * n, 0.0 * n
+    Y = p[P_YP_ASTERN] * p[P_RHO] * n * n * p[P_D] ** 4
+    return Y, p[P_XP] * p[P_L] * Y
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def rudder_axial_speed(uP, TL, p):
     """Signed axial inflow speed at the rudder [m/s] (> 0: from the leading edge) for any signs of
     u_P and the slipstream loading TL [m^2/s^2] (:func:`propeller`).
@@ -432,9 +454,10 @@ def forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef):
     owp = one_minus_wake(u, beta, rp, p, poly)
     J, XP, TL = propeller(u, n, owp, p, poly)
     XR, YR, NR, FN = rudder(u, U, beta, rp, delta, n, owp, TL, p)
+    YP, NP = propeller_lateral(n, p)
     X = XHp * sX * surge_sign(u, p) + XP + XR + p[P_EXT_X]
-    Y = YHp * sY + YR + p[P_EXT_Y]
-    N = NHp * sN + NR + p[P_EXT_N]
+    Y = YHp * sY + YR + YP + p[P_EXT_Y]
+    N = NHp * sN + NR + NP + p[P_EXT_N]
     return X, Y, N, J
 
 

@@ -13,7 +13,8 @@ Symbols follow the MMG literature (Yasukawa & Yoshimura 2015; Rhee & Kim 1999):
 * ``m_prime, m_x_prime, m_y_prime`` mass and added masses (1/2 rho L^2 T).
 * ``I_zG_prime, J_z_prime`` yaw moment of inertia about G and added inertia (1/2 rho L^4 T).
 * Propeller: ``D`` diameter, ``K_T(J)``, ``K_Q(J)``, ``t_P`` thrust deduction,
-  ``w_P0`` wake fraction in straight run, ``x_P_prime`` propeller position.
+  ``w_P0`` wake fraction in straight run, ``x_P_prime`` propeller position, ``Y_P_astern``
+  (optional, 0) lateral force of the propeller running astern over rho n^2 D^4.
 * Rudder: ``A_R`` area, ``H_R`` span, ``f_alpha`` normal-force lift-gradient coefficient
   (Rhee & Kim's C_N), ``epsilon`` wake ratio (1-w_R)/(1-w_P), ``kappa`` propeller
   slipstream factor, ``eta`` = D/H_R, ``t_R, a_H, x_H_prime`` hull-rudder interaction,
@@ -131,6 +132,9 @@ class Propeller:
     C_2_neg: float = 1.0
     K_Q_scale: float = 1.0
     P_D: float | None = None
+    Y_P_astern: float = 0.0
+    """Lateral force of the propeller running astern over rho n^2 D^4 (+ to starboard; a right-handed
+    screw walks the stern to port: < 0): :func:`mmg.model.propeller_lateral`.  0: none."""
 
 
 @dataclass(frozen=True)
@@ -292,7 +296,7 @@ class Ship:
 #   hull         at least one X_, Y_ and N_ coefficient; |value| <= 20
 #   propeller    0 < D <= 1.5 T; 0 < P <= 3 D; K_T(0) in (0, 1); K_Q(0) in (0, 0.2] for a
 #                constant-power engine; t_P(0), w_P0(0) in [0, 1); polynomial coefficients
-#                |c| <= 10; |x_P'| <= 1; C_wake, C_1 0-50; C_2 0-10
+#                |c| <= 10; |x_P'| <= 1; C_wake, C_1 0-50; C_2 0-10; |Y_P_astern| <= 0.3
 #   rudder       A_R 0.002-0.1 L T; 0 < H_R <= 1.5 T; f_alpha 0-10; epsilon 0-3; kappa 0-2;
 #                eta 0-1.5; t_R in [0, 1); a_H 0-3; |x_H'|, |x_R'| <= 1; gamma_R 0-2; |l_R'| <= 3
 #   steering     0 < T_E <= 60 s; 0 < rate_max <= 60 deg/s; 0 < delta_max <= 90 deg
@@ -367,6 +371,7 @@ class _Propeller(_Strict):
     t_P: list[float] = Field(min_length=1, max_length=6)
     w_P0: list[float] = Field(min_length=1, max_length=6)
     wake: _Wake
+    Y_P_astern: float = 0.0
 
 
 class _Rudder(_Strict):
@@ -585,6 +590,9 @@ def _propeller(f: _ShipFile, src: str, pa: Particulars) -> Propeller:
         C_2_pos=_num(src, "propeller.wake.C_2_pos", wk.C_2_pos, 0.0, 10.0, lo_open=True),
         C_2_neg=_num(src, "propeller.wake.C_2_neg", wk.C_2_neg, 0.0, 10.0, lo_open=True),
         P_D=None if P is None else P / D,
+        Y_P_astern=_num(src, "propeller.Y_P_astern", pr.Y_P_astern, -0.3, 0.3,
+                        why="a transverse force of a propeller astern is at most of the order of its bollard "
+                            "thrust, K_T(0) < 0.5"),
     )
 
 

@@ -325,6 +325,7 @@ def test_wrong_unit_or_implausible_value_in_a_ship(case, tmp_path, capsys):
 @pytest.mark.parametrize("edit, field", [
     (ship_set("propeller", "D", "-1 m"), "propeller.D"),
     (ship_set("rudder", "t_R", 1.5), "rudder.t_R"),
+    (ship_set("propeller", "Y_P_astern", 0.8), "propeller.Y_P_astern"),
     (ship_set("engine", "mode", "diesel"), "engine.mode"),
     (lambda s: s.pop("steering"), "steering"),
     (ship_set("particulars", "colour", "red"), "particulars.colour"),

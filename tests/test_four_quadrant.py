@@ -265,3 +265,59 @@ def test_complex_step_derivative_in_other_quadrants():
             xm[k] -= e
             fd = (np.array(M.forces_of(*xp, *pk.args())[:3]) - np.array(M.forces_of(*xm, *pk.args())[:3])) / (2 * e)
             assert np.allclose(cs, fd, rtol=1e-4, atol=1e-6 * (1 + np.abs(fd).max()))
+
+
+# ----------------------------------------------------------------------------- propeller walk astern
+
+
+def _walking(c=-0.02):
+    """The 3 m model with a transverse force of its propeller astern, Y_P = c rho n^2 D^4."""
+    from dataclasses import replace
+
+    s = load_ship("esso_osaka_3m")
+    return s, M.pack(replace(s, propeller=replace(s.propeller, Y_P_astern=c)))
+
+
+def test_propeller_walk_is_the_stated_force_at_the_propeller():
+    """n < 0: Y = c rho n^2 D^4 at x_P (written out here from the ship's own particulars), N = x_P Y;
+    n >= 0: nothing (the forces of the ship without it, to the last bit)."""
+    s, pk = _walking(-0.02)
+    base = M.pack(s)
+    D, L, rho, xp = s.propeller.D, s.particulars.L, s.particulars.rho, s.propeller.x_P_prime
+    for u, n in ((0.3, -12.0), (-0.1, -5.0), (0.0, -20.0)):
+        f1 = np.array(M.forces_of(u, 0.01, 0.02, 0.1, n, *pk.args())[:3])
+        f0 = np.array(M.forces_of(u, 0.01, 0.02, 0.1, n, *base.args())[:3])
+        Y = -0.02 * rho * n * n * D ** 4
+        assert f1 - f0 == pytest.approx([0.0, Y, xp * L * Y], rel=1e-9, abs=1e-12)
+    for n in (0.0, 3.0, 12.0):
+        assert np.array_equal(M.forces_of(0.3, 0.01, 0.02, 0.1, n, *pk.args()),
+                              M.forces_of(0.3, 0.01, 0.02, 0.1, n, *base.args()))
+
+
+def test_a_right_handed_screw_astern_turns_the_bow_to_starboard():
+    """The seaman's rule: going astern, a right-handed screw walks the stern to port (Y_P < 0 with
+    the propeller aft, x_P < 0), so the bow swings to starboard: a positive yaw moment."""
+    s, pk = _walking(-0.02)
+    base = M.pack(s)
+    dN = M.forces_of(0.0, 0.0, 0.0, 0.0, -10.0, *pk.args())[2] - M.forces_of(0.0, 0.0, 0.0, 0.0, -10.0, *base.args())[2]
+    assert s.propeller.x_P_prime < 0 and dN > 0
+
+
+def test_propeller_walk_continuous_and_smooth_as_n_reverses():
+    """Zero with zero slope at n = 0: the forces' jump and their n-derivative's jump vanish there."""
+    _, pk = _walking(-0.05)
+    f = lambda n: np.array(M.propeller_lateral(n, pk.p))  # noqa: E731
+    assert np.all(np.abs(f(-1e-8) - f(1e-8)) < 1e-12)
+    h = 1e-7
+    slope = lambda n: (f(n + h) - f(n - h)) / (2 * h)  # noqa: E731
+    assert np.all(np.abs(slope(-1e-4)) < 1e-3 * np.abs(slope(-1.0)))
+
+
+def test_complex_step_derivative_in_n_with_propeller_walk():
+    _, pk = _walking(-0.05)
+    for n in (-8.0, -0.5):
+        cs = np.array(M.forces_of(0.2, 0.0, 0.0, 0.0, n + 1e-30j, *pk.args())[:3]).imag / 1e-30
+        e = 1e-6
+        fd = (np.array(M.forces_of(0.2, 0.0, 0.0, 0.0, n + e, *pk.args())[:3])
+              - np.array(M.forces_of(0.2, 0.0, 0.0, 0.0, n - e, *pk.args())[:3])) / (2 * e)
+        assert np.allclose(cs, fd, rtol=1e-5, atol=1e-9)

@@ -272,6 +272,8 @@ def ship_with_values(ship: Ship, values: dict) -> Ship:
         w = list(s.propeller.w_P0)
         w[0] = values["w_P0"]
         s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
+    if "Y_P_astern" in values:
+        s = replace(s, propeller=replace(s.propeller, Y_P_astern=float(values["Y_P_astern"])))
     from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
     from mmg.nondim import inertia_scale, mass_scale
 
@@ -758,6 +760,8 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
             data["hull"]["coefficients"][k]["value"] = float(f"{v:.6g}")
         elif k == "w_P0":
             data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
+        elif k == "Y_P_astern":
+            data["propeller"]["Y_P_astern"] = float(f"{v:.6g}")
         elif k in ("epsilon", "kappa", *RUDDER_CONSTANTS):
             data["rudder"][k] = float(f"{v:.6g}")
         elif k in MASS_CONSTANTS:
