@@ -392,3 +392,31 @@ def test_velocity_weight_sets_whether_the_fit_follows_the_heading_or_a_biased_ra
     for bad in (0.0, -1.0, float("nan"), "ten", None):
         with pytest.raises(ValueError, match="velocity_weight"):
             identify(ship, runs, free=list(true), say=lambda m: None, velocity_weight=bad)
+
+
+def test_propeller_walk_astern_is_recovered_written_back_and_sampled(tmp_path):
+    """Records with the screw going astern, made with a lateral force Y_P = -0.02 rho n^2 D^4 the
+    config does not have: the freed ``Y_P_astern`` finds it, ship.yaml carries it, and the IMO
+    sampling reads it from the written covariance (a round trip of the parameter's plumbing; the
+    force itself is checked against the written-out formula in tests/test_four_quadrant.py)."""
+    from dataclasses import replace
+
+    from trials.imo.sampling import _ship_values, covariance_of
+
+    ship = mmg.load_ship(SHIP)
+    true = replace(ship, propeller=replace(ship.propeller, Y_P_astern=-0.02))
+    runs = []
+    for k in (0, 1):
+        t = np.arange(0.0, 80.0 + 1e-9, 0.1)
+        n = np.where(np.sin(2 * np.pi * t / (40.0 + 10 * k)) > 0, 10.0, -12.0)    # ahead, then full astern
+        inp = ReplayInputs(t=t, delta=np.radians(5.0 * k) * np.ones_like(t), n=n)
+        runs.append(MeasuredRun(name=f"ast{k}", source=f"ast{k}",
+                                meas=replay(pack(true), inp, [0.3, 0, 0, 0, 0, 0]), inputs=inp))
+    ident = identify(ship, runs, free=["Y_P_astern"], segment_s=(20.0, np.inf), say=lambda m: None)
+    assert ident.fit.values()["Y_P_astern"] == pytest.approx(-0.02, abs=0.001)
+    out = write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)
+    back = mmg.load_ship(out["ship"])
+    assert back.propeller.Y_P_astern == pytest.approx(-0.02, abs=0.001)
+    names, mean, cov, _ = covariance_of(back)
+    assert "Y_P_astern" in names and mean[names.index("Y_P_astern")] == pytest.approx(back.propeller.Y_P_astern, rel=1e-5)
+    assert _ship_values(back, ["Y_P_astern"])[0] == back.propeller.Y_P_astern       # a covariance without values

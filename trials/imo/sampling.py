@@ -52,6 +52,8 @@ def _ship_values(ship: Ship, names) -> np.ndarray:
             out.append(ship.hull.value(n))
         elif n == "w_P0":
             out.append(ship.propeller.w_P0[0])
+        elif n == "Y_P_astern":
+            out.append(ship.propeller.Y_P_astern)
         elif n in ("m_x", "m_y"):
             out.append(getattr(ship.mass, f"{n}_prime") * mass_scale(pa.rho, pa.L, pa.T))
         elif n == "J_z":
@@ -66,7 +68,7 @@ def _ship_values(ship: Ship, names) -> np.ndarray:
         else:
             raise InputError("covariance", n, f"not a parameter of {ship.name} (a hull coefficient or one of "
                                               f"w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, "
-                                              f"rudder_offset, m_x, m_y, J_z)")
+                                              f"rudder_offset, Y_P_astern, m_x, m_y, J_z)")
     return np.asarray(out, dtype=float)
 
 
