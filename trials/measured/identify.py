@@ -17,8 +17,11 @@ fraction's constant term ``w_P0`` (the model-scale wake is the largest scale eff
 config), the rudder inflow ratio ``epsilon`` and the slipstream share ``kappa`` (at model scale
 the propeller runs heavily loaded, so how much of its slipstream reaches the rudder sets the
 rudder force: the Osaka set has kappa = 0.20 against the ship's 0.595), the rudder's flow
-straightening ``gamma_R_pos``, ``gamma_R_neg`` (the inflow angle at the rudder), and the wind-load
-scale.  The rudder's lever ``l_R_prime`` stays at its config value (it can be freed): fits that
+straightening ``gamma_R_pos``, ``gamma_R_neg`` (the inflow angle at the rudder), the wind-load
+scale, and the propeller's walk astern ``Y_P_astern`` (:func:`mmg.model.propeller_lateral`; no
+information and so its prior, 0, on records that never run the screw astern; with it the nested
+cross-validation over the 35 shared records went from 1.56x to 1.63x in heading and 1.02x to 1.33x in
+yaw rate, docs/benchmark_frt.md).  The rudder's lever ``l_R_prime`` stays at its config value (it can be freed): fits that
 freed it ran it to its bound (-2.0, twice the textbook 2 x_R'), and with folds that keep a run
 together keeping it fixed predicts the kept-out records as well or better in all four
 cross-validations (wind on / off, folds in file order / by revolutions; docs/identify_cv.md).  Each training record counts alike
@@ -78,7 +81,7 @@ __all__ = ["identify", "IdentifyOptions",
            "stage_description", "identification_covariance", "start_noise", "DEFAULT_INITIAL_STATE",
            "INITIAL_STATES", "fold_of", "manoeuvre_class", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
 
-DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale")
+DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale", "Y_P_astern")
 DEFAULT_MAX_NFEV = 30
 """Default limit of the residual evaluations of each fit stage (:func:`identify`'s ``max_nfev``)."""
 DEFAULT_INITIAL_STATE = "fit"
@@ -743,6 +746,12 @@ def identification_covariance(ident: Identification) -> dict | None:
     return _covariance_section(ident.fit, posterior_covariance(ident.fit, tau), note)
 
 
+def _change_text(pct: float) -> str:
+    """A fitted value's change from its config value, in per cent; "-" where the config value is 0
+    (a term the config does not have, e.g. ``Y_P_astern``: no relative change to give)."""
+    return "-" if not np.isfinite(pct) else f"{pct:+.0f} %"
+
+
 def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None) -> str:
     """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
     ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``; with
@@ -833,7 +842,7 @@ def _report_fit(ident: Identification) -> list:
         if name.startswith("start."):
             continue
         lines.append(f"| {name} | {row.prior:.5g} | {row.estimate:.5g} | {std.get(name, row['std']):.2g} | "
-                     f"{row.change_pct:+.0f} % |")
+                     f"{_change_text(row.change_pct)} |")
     if starts:
         lines += ["", f"Each record's start state (u, v, r, heading of its first sample) was fitted as a nuisance "
                       f"({len(starts)} offsets, not listed; prior 0 with twice the record's noise level as std)."]
