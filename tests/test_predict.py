@@ -410,3 +410,26 @@ def test_a_diverged_replay_says_where_and_scores_null(simulated, tmp_path, capsy
     assert not any(ln.startswith("mean over") for ln in lines)          # nothing finite to average
     doc = json.loads(js.read_text())
     assert all(run[k] is None for run in doc["runs"] for k in SCORE_KEYS)
+
+
+def test_cli_predict_horizon_gives_the_first_seconds(slices, tmp_path, ship3m, capsys):
+    """--horizon S: each run's JSON has "first", the RMS over the samples of its first S seconds
+    (computed here from the replay's own table), and the console line says it; a horizon longer than
+    the record gives the whole record's scores."""
+    import numpy as np
+
+    from trials.measured.predict import predict
+
+    js = tmp_path / "p.json"
+    rc, out, err = _run_cli(["predict", "--ship", "esso_osaka_3m", slices[0], "--json", js, "--horizon", "30"], capsys)
+    assert rc == 0, err
+    first = json.loads(js.read_text())["runs"][0]["first"]
+    df = predict(ship3m, slices[:1]).runs[0].to_pandas()
+    w = df[df.index <= df.index[0] + 30.0]
+    want = float(np.sqrt(np.mean(np.degrees(w["psi_pred"] - w["psi_meas"]) ** 2)))
+    assert first["horizon_s"] == 30.0 and first["heading_rms_deg"] == pytest.approx(want, rel=1e-12)
+    assert "first 30 s: heading" in out
+    whole = predict(ship3m, slices[:1]).to_json(horizon_s=1e6)["runs"][0]
+    assert whole["first"]["heading_rms_deg"] == whole["heading_rms_deg"]
+    _refused(["predict", "--ship", "esso_osaka_3m", slices[0], "--json", js.with_name("q.json"), "--horizon", "0"],
+             capsys, js.with_name("q.json"), contains=("--horizon",))

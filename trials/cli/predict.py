@@ -6,7 +6,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _output_path, release_notes
+from .common import _finite_positive, _output_path, release_notes
 
 
 def cmd_predict(args) -> int:
@@ -31,7 +31,7 @@ def cmd_predict(args) -> int:
         print(f"replayed {i}/{n}: {name}", file=sys.stderr, flush=True)
 
     pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)   # runs named after their files
-    text = dumps_json(pred.to_json())
+    text = dumps_json(pred.to_json(horizon_s=args.horizon))
     names = [f"{r.run.name}.png" for r in pred.runs]
     with StagedFile(args.json) as tmp:     # the files first (renamed last, after the plots), then the console
         with StagedOutput(args.plots) if args.plots is not None else nullcontext() as stage:
@@ -46,17 +46,29 @@ def cmd_predict(args) -> int:
             continue
         print(f"{r.run.name}: heading {s['heading_rms_deg']:.4g} deg RMS, yaw rate {s['yaw_rate_rms_degps']:.4g} deg/s RMS, "
               f"speed {s['speed_rms_mps']:.4g} m/s RMS, final position {s['final_position_error_m']:.4g} m "
-              f"({s['final_position_error_L']:.4g} L), wind {r.run.wind}")
+              f"({s['final_position_error_L']:.4g} L), wind {r.run.wind}" + _first_text(r, args.horizon))
     if len(pred.runs) > 1:                 # the figure a comparison of two configs quotes
         sc = [r.scores() for r in pred.runs if r.diverged_at is None]
         mean = lambda k: sum(x[k] for x in sc) / len(sc)  # noqa: E731
         left = len(pred.runs) - len(sc)
         if sc:
+            first = ""
+            if args.horizon is not None:
+                f = [r.scores(until_s=args.horizon)["heading_rms_deg"] for r in pred.runs if r.diverged_at is None]
+                first = f"; over the first {args.horizon:g} s: heading {sum(f) / len(f):.4g} deg RMS"
             print(f"mean over {len(sc)} runs{f' ({left} diverged, left out)' if left else ''}: heading "
-                  f"{mean('heading_rms_deg'):.4g} deg RMS, final position {mean('final_position_error_L'):.4g} L")
+                  f"{mean('heading_rms_deg'):.4g} deg RMS, final position {mean('final_position_error_L'):.4g} L{first}")
     print(f"wrote {args.json}" + (f" and {len(names)} plot{'s' if len(names) != 1 else ''} to {args.plots}"
                                   if args.plots is not None else ""))
     return 0
+
+
+def _first_text(r, horizon) -> str:
+    """The console's short-horizon part of a run's line ("" without ``--horizon``)."""
+    if horizon is None:
+        return ""
+    f = r.scores(until_s=horizon)
+    return f"; first {horizon:g} s: heading {f['heading_rms_deg']:.4g} deg RMS, yaw rate {f['yaw_rate_rms_degps']:.4g} deg/s RMS"
 
 
 def add_parser(sub) -> None:
@@ -73,4 +85,7 @@ def add_parser(sub) -> None:
                    help="start time [s] of every replay (default: each record's first sample)")
     p.add_argument("--wind", choices=("on", "off"), default=None,
                    help="wind loads from the measured relative wind (default: as the ship config says)")
+    p.add_argument("--horizon", type=_finite_positive, default=None, metavar="S",
+                   help="also the scores over the first S seconds of each replay (JSON key 'first'; the short-"
+                        "horizon figure of docs/benchmark_frt.md, 60 s there)")
     p.set_defaults(func=cmd_predict)

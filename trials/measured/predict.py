@@ -291,10 +291,18 @@ class Prediction:
 
     runs: list
 
-    def to_json(self) -> dict:
+    def to_json(self, horizon_s: float | None = None) -> dict:
         """``{"runs": [{"name": ..., "file": ..., "heading_rms_deg": ..., ...}, ...]}`` (``mmg predict --json``;
-        ``name``: the run's name, after its file, as printed and as its plot is named)."""
-        return {"runs": [{"name": r.run.name, "file": r.run.source, **r.scores()} for r in self.runs]}
+        ``name``: the run's name, after its file, as printed and as its plot is named).  With
+        ``horizon_s`` each run also has ``"first": {"horizon_s": ..., <the same scores over the first
+        horizon_s seconds>}`` (:meth:`Replayed.scores` ``until_s``: a short-horizon figure)."""
+        def row(r):
+            d = {"name": r.run.name, "file": r.run.source, **r.scores()}
+            if horizon_s is not None:
+                d["first"] = {"horizon_s": float(horizon_s), **r.scores(until_s=horizon_s)}
+            return d
+
+        return {"runs": [row(r) for r in self.runs]}
 
     def to_pandas(self):
         """One row of scores per run, indexed by the run's name (after its file: unique)."""
