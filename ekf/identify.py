@@ -48,7 +48,7 @@ from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
            "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
-           "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled",
+           "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled", "WIND_FACTORS",
            "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "logged_residual", "record_effect_parameters", "effect_set_of",
            "predict_logged", "start_parameters", "record_residuals", "model_states"]
 
@@ -60,8 +60,13 @@ inflow angle, positive and negative beta_R, and the effective lever l_R' of the 
 MASS_CONSTANTS = {"m_x": P_MX, "m_y": P_MY, "J_z": P_JZ}
 """Added masses [kg] and added moment of inertia [kg m^2] :func:`free_parameters` can free (the
 config's primed ``m_x_prime``, ``m_y_prime``, ``J_z_prime`` times the mass / inertia scale)."""
-SHIP_CONSTANTS = (("w_P0", "epsilon", "kappa", "wind_scale", "rudder_offset", "Y_P_astern") + tuple(RUDDER_CONSTANTS)
-                  + tuple(MASS_CONSTANTS))
+WIND_FACTORS = {"wind_sway_factor": ("sway_factor", 1), "wind_yaw_factor": ("yaw_factor", 2)}
+"""``mmg identify --free`` names of the wind effect's shape factors (:class:`mmg.effects.Wind`): the
+effect's parameter and the column of the records' external loads (X, Y, N) it multiplies, beside
+``wind_scale`` on all three.  Priors and bounds are the effect's (1, std
+:data:`mmg.effects.wind.SHAPE_SIGMA`, 0.2-3): a ship's wind loads are not the published regression's."""
+SHIP_CONSTANTS = (("w_P0", "epsilon", "kappa", "wind_scale", *WIND_FACTORS, "rudder_offset", "Y_P_astern")
+                  + tuple(RUDDER_CONSTANTS) + tuple(MASS_CONSTANTS))
 """Ship constants besides the hull coefficients that :func:`free_parameters` can free (``"wind_scale"``
 and ``"rudder_offset"`` are the ``wind`` and ``rudder_offset`` effects' parameters under their
 ``mmg identify --free`` names: their priors and bounds are the effects' own, :func:`effect_prior`)."""
@@ -230,6 +235,9 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
             out.append(FreeParameter(nm, "mass", MASS_CONSTANTS[nm], v, rel["mass"] * v, 0.0, 3.0 * v))
         elif nm == "wind_scale":         # the wind effect's scale on the records' external (wind) loads
             out.append(replace(effect_prior(E.Wind, "scale", nm, "wind_scale"), sub=0))
+        elif nm in WIND_FACTORS:         # its shape factors on the sway force / yaw moment (sub: the column)
+            par, col = WIND_FACTORS[nm]
+            out.append(replace(effect_prior(E.Wind, par, nm, "wind_scale"), sub=col))
         else:
             raise KeyError(f"unknown parameter {nm!r}: not a hull coefficient of the ship nor one of {SHIP_CONSTANTS}")
     return out
@@ -360,18 +368,27 @@ def segment_resets(t: np.ndarray, segment_s: float) -> np.ndarray:
     return reset
 
 
-def wind_scaled(inputs: ReplayInputs, scale: float) -> ReplayInputs:
-    """``inputs`` with their external (measured-wind) loads times a fitted ``wind_scale`` (the wind
-    effect's loads are linear in its scale, :meth:`mmg.effects.Wind.external`): the one place the
-    fitted scale is applied, in the fit and in the identified model's replays."""
-    return inputs if inputs.ext is None else replace(inputs, ext=inputs.ext * scale)
+def wind_scaled(inputs: ReplayInputs, scale: float, sway_factor: float = 1.0, yaw_factor: float = 1.0) -> ReplayInputs:
+    """``inputs`` with their external (measured-wind) loads (X, Y, N) times a fitted ``wind_scale``,
+    the sway force also times ``sway_factor`` and the yaw moment times ``yaw_factor`` (the wind
+    effect's loads are linear in its scale and in each shape factor, :meth:`mmg.effects.Wind.external`,
+    :func:`mmg.wind.amplitude_vector`): the one place the fitted values are applied, in the fit and in
+    the identified model's replays."""
+    if inputs.ext is None:
+        return inputs
+    return replace(inputs, ext=inputs.ext * (scale * np.array([1.0, sway_factor, yaw_factor])))
 
 
 def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
-    for f, v in zip(free, theta):
-        if f.kind == "wind_scale" and rec.inputs.ext is not None:
-            return replace(rec, inputs=wind_scaled(rec.inputs, v))
-    return rec
+    if rec.inputs.ext is None:
+        return rec
+    f = np.ones(3)                       # wind_scale (sub 0), sway and yaw factors (sub 1, 2)
+    hit = False
+    for p, v in zip(free, theta):
+        if p.kind == "wind_scale":
+            f[p.sub] = v
+            hit = True
+    return replace(rec, inputs=wind_scaled(rec.inputs, *f)) if hit else rec
 
 
 def logged_residual(pred: np.ndarray, rec: Segmented) -> np.ndarray:

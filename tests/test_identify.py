@@ -420,3 +420,40 @@ def test_propeller_walk_astern_is_recovered_written_back_and_sampled(tmp_path):
     names, mean, cov, _ = covariance_of(back)
     assert "Y_P_astern" in names and mean[names.index("Y_P_astern")] == pytest.approx(back.propeller.Y_P_astern, rel=1e-5)
     assert _ship_values(back, ["Y_P_astern"])[0] == back.propeller.Y_P_astern       # a covariance without values
+
+
+def test_wind_shape_factors_are_recovered_scale_the_loads_and_are_written_back(tmp_path):
+    """Records whose wind yaw moment is 1.8x and sway force 0.6x the loads the config computes from the
+    measured wind (given here as prescribed loads, Fujiwara's from a steady 4 m/s relative wind on the
+    bow quarter): the freed ``wind_sway_factor`` and ``wind_yaw_factor`` find them, ``with_fitted_wind``
+    scales a record's loads as the fit did (X unchanged), and ship.yaml's ``wind:`` section carries
+    the factors times the config's."""
+    from dataclasses import replace
+
+    import yaml
+
+    from mmg.wind import wind_forces
+    from trials.measured.identify import with_fitted_wind
+
+    ship = mmg.load_ship(SHIP)
+    runs = []
+    for k in (0, 1):
+        t = np.arange(0.0, 90.0 + 1e-9, 0.1)
+        inp = _zigzag_inputs(t, amp_deg=15.0 + 10 * k, period=30.0 + 10 * k, n=6.0)
+        X, Y, N = wind_forces(np.full_like(t, 4.0), np.full_like(t, np.radians(60.0 - 120.0 * k)), ship.wind.geometry)
+        ext = np.column_stack([X, Y, N])
+        truth = replace(inp, ext=ext * np.array([1.0, 0.6, 1.8]))
+        runs.append(MeasuredRun(name=f"w{k}", source=f"w{k}", meas=replay(pack(ship), truth, [0.2, 0, 0, 0, 0, 0]),
+                                inputs=replace(inp, ext=ext)))
+    ident = identify(ship, runs, free=["wind_sway_factor", "wind_yaw_factor"], segment_s=(30.0, np.inf),
+                     say=lambda m: None)
+    v = ident.fit.values()
+    assert v["wind_sway_factor"] == pytest.approx(0.6, abs=0.03) and v["wind_yaw_factor"] == pytest.approx(1.8, abs=0.03)
+    scaled = with_fitted_wind(runs[0], v).inputs.ext
+    assert np.allclose(scaled, runs[0].inputs.ext * [1.0, v["wind_sway_factor"], v["wind_yaw_factor"]])
+    out = write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path)
+    w = yaml.safe_load(open(out["ship"]))["wind"]
+    assert w["sway_factor"] == pytest.approx(ship.wind.sway_factor * v["wind_sway_factor"], rel=1e-5)
+    assert w["yaw_factor"] == pytest.approx(ship.wind.yaw_factor * v["wind_yaw_factor"], rel=1e-5)
+    back = mmg.load_ship(out["ship"])
+    assert back.wind.yaw_factor == pytest.approx(ident.ship.wind.yaw_factor, rel=1e-5)

@@ -278,7 +278,8 @@ def add_parser(sub) -> None:
                         "default trials.measured.identify.DEFAULT_WEIGHTING")
     p.add_argument("--free", nargs="+", default=None, metavar="NAME",
                    help="the parameters to fit: hull coefficient names, 'hull' (all of them), 'hull-except-constants', "
-                        "w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, rudder_offset, wind_scale, Y_P_astern, m_x, m_y, "
+                        "w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, rudder_offset, wind_scale, "
+                        "wind_sway_factor, wind_yaw_factor, Y_P_astern, m_x, m_y, "
                         "J_z (default trials.measured.identify.DEFAULT_FREE)")
     p.add_argument("--velocity-weight", type=_finite_positive, default=None, metavar="W",
                    help="factor on the u, v, r residuals beside the heading's (default 1; 0.1: their squares weigh a "

@@ -38,8 +38,9 @@ FAIL_PROBABILITY = 0.05
 """Verdict ``"fail"``: the probability of meeting the limit is at most this."""
 INTERVAL = (5.0, 95.0)
 """The percentiles bounding the reported 90 % interval."""
-NOT_SAMPLED = ("wind_scale",)
-"""Parameters of a covariance left out of the sampling: the wind-load scale does nothing in calm water."""
+NOT_SAMPLED = ("wind_scale", "wind_sway_factor", "wind_yaw_factor")
+"""Parameters of a covariance left out of the sampling: the wind-load scale and shape factors do nothing
+in calm water."""
 
 
 def _ship_values(ship: Ship, names) -> np.ndarray:
@@ -61,7 +62,7 @@ def _ship_values(ship: Ship, names) -> np.ndarray:
         elif n == "rudder_offset":
             off = ship.effect_set().get("rudder_offset")
             out.append(np.radians(off["offset_deg"]) if off else 0.0)
-        elif n == "wind_scale":
+        elif n in NOT_SAMPLED:           # factors on the records' wind loads: 1 is the ship as it is
             out.append(1.0)
         elif hasattr(ship.rudder, n):
             out.append(getattr(ship.rudder, n))

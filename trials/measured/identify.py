@@ -254,14 +254,16 @@ def with_ship_effects(run: MeasuredRun, ship: Ship) -> MeasuredRun:
 
 
 def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
-    """``run`` with its wind loads scaled by a fitted ``wind_scale`` (as the identified ship computes them)."""
+    """``run`` with its wind loads scaled by a fitted ``wind_scale`` and shape factors ``wind_sway_factor``,
+    ``wind_yaw_factor`` (as the identified ship computes them)."""
     from dataclasses import replace
 
     from ekf.identify import wind_scaled
 
-    if "wind_scale" not in values or run.inputs.ext is None:
+    if run.inputs.ext is None or not any(k in values for k in _WIND_KEYS):
         return run
-    return replace(run, inputs=wind_scaled(run.inputs, values["wind_scale"]))
+    return replace(run, inputs=wind_scaled(run.inputs, values.get("wind_scale", 1.0),
+                                           values.get("wind_sway_factor", 1.0), values.get("wind_yaw_factor", 1.0)))
 
 
 def ship_with_values(ship: Ship, values: dict) -> Ship:
@@ -293,15 +295,23 @@ def ship_with_values(ship: Ship, values: dict) -> Ship:
 
         s = replace(s, effects=s.effect_set().merged(
             E.effect_set({"rudder_offset": {"offset_deg": float(np.degrees(values["rudder_offset"]))}})))
-    if "wind_scale" in values and s.wind is not None:
-        scale = s.wind.scale * values["wind_scale"]
-        s = replace(s, wind=replace(s.wind, scale=scale))
+    wind = {k: values[name] for name, k in _WIND_KEYS.items() if name in values}
+    if wind and s.wind is not None:
+        new = {k: getattr(s.wind, k) * v for k, v in wind.items()}
+        s = replace(s, wind=replace(s.wind, **new))
         w = s.effect_set().get("wind")
         if w is not None:
             import mmg.effects as E
 
-            s = replace(s, effects=s.effect_set().merged(E.effect_set({"wind": {**w, "scale": scale}})))
+            new = {k: float(w.get(k, 1.0)) * v for k, v in wind.items()}
+            s = replace(s, effects=s.effect_set().merged(E.effect_set({"wind": {**w, **new}})))
     return s
+
+
+_WIND_KEYS = {"wind_scale": "scale", "wind_sway_factor": "sway_factor", "wind_yaw_factor": "yaw_factor"}
+"""``mmg identify --free`` name of a fitted wind value -> the key of the ship's ``wind:`` section (and of
+its ``wind`` effect) it multiplies: the records' loads were computed with the ship's values, so the
+fitted ones are factors on them."""
 
 
 _ship_with = ship_with_values
@@ -404,7 +414,7 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
 
     names = _free_names(ship, free)
     if not any(r.inputs.ext is not None for r in runs):
-        names = [n for n in names if n != "wind_scale"]       # no wind loads to scale
+        names = [n for n in names if n not in _WIND_KEYS]     # no wind loads to scale
     fp = free_parameters(packed, ship.hull.names, names, o.prior_rel_std)
     if o.initial_state == "fit":
         from ekf.identify import start_parameters
@@ -785,13 +795,14 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
             data.setdefault("effects", {})
             data["effects"] = dict(data["effects"] or {})
             data["effects"]["rudder_offset"] = {"offset_deg": float(f"{np.degrees(v):.6g}")}
-        elif k == "wind_scale" and "wind" in data:
+        elif k in _WIND_KEYS and "wind" in data:
+            key = _WIND_KEYS[k]
             eff = (data.get("effects") or {}).get("wind")
-            if isinstance(eff, dict) and "scale" in eff:           # the scale given in the effects section
-                eff["scale"] = float(f"{float(eff['scale']) * v:.6g}")
-                data["wind"].pop("scale", None)
+            if isinstance(eff, dict) and key in eff:               # the value given in the effects section
+                eff[key] = float(f"{float(eff[key]) * v:.6g}")
+                data["wind"].pop(key, None)
             else:
-                data["wind"]["scale"] = float(f"{float(data['wind'].get('scale', 1.0)) * v:.6g}")
+                data["wind"][key] = float(f"{float(data['wind'].get(key, 1.0)) * v:.6g}")
     data.pop("covariance", None)
     if covariance is not None:
         data["covariance"] = covariance
