@@ -339,3 +339,15 @@ def test_a_floor_reason_gives_each_effect_its_unit():
     assert units == {"current": "m/s", "rudder_offset": "deg", "heading_bias": "deg", "shallow_water": "T/H"}
     _, text = verdict(_block(0.01, 0.01, 0.1), 0.5, 0.574, None, "", units["shallow_water"])
     assert "0.574 T/H on" in text and "0.5 T/H to" in text and "  " not in text
+
+
+def test_over_floor_is_the_one_floor_rule_on_plain_figures():
+    """A size over its floor clears it, at or under it does not; a NaN size (an effect without a
+    magnitude) is not stopped by a floor; with parts, either
+    part over its own floor clears it whatever the whole size says (a current across the heading)."""
+    from trials.measured.decision import over_floor
+
+    assert over_floor(0.5, 0.4) and not over_floor(0.4, 0.4) and not over_floor(0.3, 0.4)
+    assert over_floor(float("nan"), 0.4)
+    assert over_floor(0.1, 0.4, {"along": (0.1, 0.2), "across": (-0.05, 0.01)})
+    assert not over_floor(0.9, 0.4, {"along": (0.1, 0.2), "across": (0.005, 0.01)})

@@ -37,7 +37,7 @@ import numpy as np
 
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
-           "clears_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON"]
+           "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -158,9 +158,17 @@ def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float 
         The records' mean heading [rad] (:func:`mean_heading`).
     """
     parts = floor_parts(effect, values, L, kind, heading)
+    return over_floor(magnitude(effect, values, L), floor(effect, kind), parts)
+
+
+def over_floor(size: float, fl: float, parts: dict | None = None) -> bool:
+    """The floor rule on plain figures, the one definition :func:`clears_floor` (on an effect's values)
+    and the diagnosis's stored candidates use: with ``parts`` ({part: (size, floor)}, a current judged
+    by its parts) either part over its own floor, else ``size`` over ``fl``; a NaN size (an effect
+    :func:`magnitude` does not know) is not stopped by a floor."""
     if parts:
         return any(abs(x) > f for x, f in parts.values())
-    return not magnitude(effect, values, L) <= floor(effect, kind)
+    return not size <= fl
 
 
 def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float | None = None) -> dict:

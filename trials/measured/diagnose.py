@@ -62,7 +62,7 @@ from mmg.model import pack
 from mmg.ship import Ship
 
 from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, clears_floor, evidence_short, floor,
-                       floor_parts, magnitude, mean_heading, record_kind, residual_floor)
+                       floor_parts, magnitude, mean_heading, over_floor, record_kind, residual_floor)
 from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
 
@@ -819,10 +819,7 @@ def _over_floor(c: dict) -> bool:
     """Whether a stored candidate's size cleared its floor: a part over its own floor where it was
     judged by its parts (:func:`_parts`), else its size over its floor (the rule of
     :func:`~trials.measured.decision.clears_floor`, on the figures the round kept)."""
-    parts = c.get("parts")
-    if parts:
-        return any(abs(v[0]) > v[1] for v in parts.values())
-    return not c["magnitude"] <= (c.get("floor") or 0.0)
+    return over_floor(c["magnitude"], c.get("floor") or 0.0, c.get("parts"))
 
 
 def _size_text(c: dict, unit: str) -> str:
