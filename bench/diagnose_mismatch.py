@@ -105,6 +105,7 @@ def run_one(job: dict, seed0: int) -> dict:
             "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
             "parameters": d.parameters, "not_identifiable": [n["effect"] for n in d.not_identifiable],
             "not_identifiable_reasons": {n["effect"]: n.get("reason") for n in d.not_identifiable},
+            "not_identifiable_kinds": {n["effect"]: n.get("reason_kind") for n in d.not_identifiable},
             "not_identifiable_correlation": {n["effect"]: n.get("correlation") for n in d.not_identifiable},
             "unexplained": bool(d.unexplained), "rounds": js["rounds"], "duration_s": float(sum(r.t[-1] for r in recs)),
             "rms_after": js["rms_after"], "rms_before": js["rms_before"], "rms_config": js["rms_config"],
@@ -177,15 +178,16 @@ def summarise(rows: list) -> dict:
     return table
 
 
-REASON_KINDS = (("statistics", "its standard error"), ("floor", "mismatch lends"), ("evidence", "(a name needs"),
-                ("information", "too little information"))
-"""The kinds of ``not_identifiable`` reasons (:func:`trials.measured.identifiability.verdict`,
-:func:`trials.measured.diagnose.within_mismatch`, :func:`trials.measured.diagnose.weak_evidence`)
-by a phrase of their text."""
+_OLD_RUN_PHRASES = (("statistics", "its standard error"), ("floor", "mismatch lends"), ("evidence", "(a name needs"),
+                    ("information", "too little information"))
+"""For runs stored before each entry kept its ``reason_kind``
+(:data:`trials.measured.decision.REASON_KINDS`): the kind by a phrase of the reason's text."""
 
 
-def _reason_kind(text) -> str:
-    return next((k for k, phrase in REASON_KINDS if phrase in str(text or "")), "other")
+def _reason_kind(r: dict, eff: str, text) -> str:
+    """The kind of record ``r``'s entry for ``eff``: as stored, else (an older run) by its text."""
+    kind = (r.get("not_identifiable_kinds") or {}).get(eff)
+    return kind or next((k for k, phrase in _OLD_RUN_PHRASES if phrase in str(text or "")), "other")
 
 
 def _reason_counts(rows) -> dict:
@@ -195,7 +197,7 @@ def _reason_counts(rows) -> dict:
     for r in rows:
         for eff, why in (r.get("not_identifiable_reasons") or {}).items():
             w = "clean" if r["effect"] is None else "true effect" if eff == r["effect"] else "other effect"
-            k = _reason_kind(why)
+            k = _reason_kind(r, eff, why)
             out[w][k] = out[w].get(k, 0) + 1
     if any(out.values()):
         print("not_identifiable entries by reason: " + "; ".join(

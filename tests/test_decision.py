@@ -300,7 +300,7 @@ def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(monkeypatch):
     assert d.named == []
     ent = {e["effect"]: e for e in d.not_identifiable}
     assert "heading_bias" in ent, d.not_identifiable
-    assert "a name needs 1e+07" in ent["heading_bias"]["reason"]
+    assert "a name needs 1e+07" in ent["heading_bias"]["reason"] and ent["heading_bias"]["reason_kind"] == "evidence"
     (line,) = [ln for ln in d.summary_lines() if ln.startswith("heading_bias: not identifiable")]
     assert "a name needs" in line
 
@@ -318,13 +318,14 @@ def test_an_entry_gives_the_first_reason_that_holds():
     from trials.measured.identifiability import STATISTICAL_REASON, verdict
 
     weak = "at dBIC 9.6 (a name needs 20)"
-    assert verdict(_block(0.5, 0.05, 0.995), 1.0, 5.84, weak, "deg", "deg") == (True, STATISTICAL_REASON)
-    conf, floor = verdict(_block(0.1, 0.05, 0.87), 1.0, 5.84, weak, "deg", "deg")
-    assert conf and "5.84 deg" in floor and "1 deg" in floor and "dBIC" not in floor
-    assert verdict(_block(0.5, 0.4, 0.6), 1.0, 0.389, weak, "deg", "deg") == (False, weak)
-    conf, lack = verdict(_block(2.06, 0.9, 0.899), 1.0, 0.389, None, "deg", "deg")
+    assert verdict(_block(0.5, 0.05, 0.995), 1.0, 5.84, weak, "deg", "deg") == (True, STATISTICAL_REASON, "statistics")
+    conf, floor, kind = verdict(_block(0.1, 0.05, 0.87), 1.0, 5.84, weak, "deg", "deg")
+    assert conf and "5.84 deg" in floor and "1 deg" in floor and "dBIC" not in floor and kind == "floor"
+    assert verdict(_block(0.5, 0.4, 0.6), 1.0, 0.389, weak, "deg", "deg") == (False, weak, "evidence")
+    conf, lack, kind = verdict(_block(2.06, 0.9, 0.899), 1.0, 0.389, None, "deg", "deg")
     assert not conf and "sd 2.06 deg" in lack and "0.9 deg with every other parameter fixed" in lack and "1 deg" in lack
-    assert verdict(_block(0.3, 0.29, 0.3), 1.0, 0.389, None, "deg", "deg") == (False, None)     # 3 x 0.3 < 1
+    assert kind == "information"
+    assert verdict(_block(0.3, 0.29, 0.3), 1.0, 0.389, None, "deg", "deg") == (False, None, None)     # 3 x 0.3 < 1
     assert verdict(_block(0.34, 0.33, 0.3), 1.0, 0.389, None, "deg", "deg")[1] is not None     # 3 x 0.34 > 1
 
 
@@ -337,7 +338,7 @@ def test_a_floor_reason_gives_each_effect_its_unit():
 
     units = {c.name: _size_unit(c) for c in (E.Current, E.RudderOffset, E.HeadingBias, E.ShallowWater)}
     assert units == {"current": "m/s", "rudder_offset": "deg", "heading_bias": "deg", "shallow_water": "T/H"}
-    _, text = verdict(_block(0.01, 0.01, 0.1), 0.5, 0.574, None, "", units["shallow_water"])
+    _, text, _ = verdict(_block(0.01, 0.01, 0.1), 0.5, 0.574, None, "", units["shallow_water"])
     assert "0.574 T/H on" in text and "0.5 T/H to" in text and "  " not in text
 
 

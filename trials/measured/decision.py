@@ -37,7 +37,8 @@ import numpy as np
 
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
-           "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON"]
+           "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
+           "REASON_KINDS"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -56,6 +57,12 @@ STATISTICAL_REASON = "its standard error and correlation"
 """The ``reason`` of a ``not_identifiable`` entry reported for its statistics (its standard error could
 not have shown the size to detect: :func:`trials.measured.identifiability.verdict`), as against its
 calibrated floor, its evidence or too little information."""
+
+REASON_KINDS = ("statistics", "floor", "evidence", "information")
+"""The kinds of ``not_identifiable`` reasons, each entry's ``reason_kind``: its standard error and
+confounding (:data:`STATISTICAL_REASON`), the calibrated floor (the ship's own mismatch lends it as much),
+evidence short of a name, too little information (:func:`trials.measured.identifiability.verdict`,
+:func:`trials.measured.diagnose.within_mismatch`, :func:`trials.measured.diagnose.weak_evidence`)."""
 
 MAGNITUDE_UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1",
                    "shallow_water": "T/H"}

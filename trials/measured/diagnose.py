@@ -788,7 +788,8 @@ def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()
     have = {e["effect"] for e in entries}
     extra = within_mismatch(rounds, fitter.ship.particulars.L) + [
         {"effect": k, "confused_with": ["the ship's own coefficients"], "correlation": None,
-         "what_would_separate": "a longer record, or one where the effect is larger", "reason": why}
+         "what_would_separate": "a longer record, or one where the effect is larger", "reason": why,
+         "reason_kind": "evidence"}
         for k, why in weak.items()]                 # those assess could not assess (a singular information)
     out = list(entries)
     for e in extra:
@@ -843,7 +844,7 @@ def within_mismatch(rounds, L: float) -> list:
             out.append({"effect": c["effect"], "confused_with": ["the ship's own coefficients"], "correlation": None,
                         "what_would_separate": "a ship model closer to this ship (e.g. identified on other "
                                                "records) or a larger effect",
-                        "reason": _within_reason(c, unit)})
+                        "reason": _within_reason(c, unit), "reason_kind": "floor"})
     return out
 
 

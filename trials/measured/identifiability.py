@@ -31,7 +31,9 @@ turn of a ship whose hull form is not the model's, sd 2.06 deg, R 0.899, was dro
 :func:`verdict` gives the reasons in order.  And a
 candidate whose dBIC showed some evidence, short of a name, while its precision and size passed
 (:func:`trials.measured.diagnose.weak_evidence`), and one whose evidence and precision passed but
-whose size the calibrated floor stopped (:func:`trials.measured.diagnose.within_mismatch`).
+whose size the calibrated floor stopped (:func:`trials.measured.diagnose.within_mismatch`).  Each
+entry's ``reason`` says why in words and figures, its ``reason_kind`` which rule it was
+(:data:`trials.measured.decision.REASON_KINDS`: statistics, floor, evidence, information).
 
 ``what_would_separate``: the information of candidate additional trials (the mirror of a turn,
 a 20/20 zigzag where the records have none, a 35 deg turn where they have none), simulated with the
@@ -344,7 +346,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
             f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
         fl = floor_in_fit_unit(cls.name, least_floor(cls.name, getattr(fitter, "kind", "")), L)
-        row["confounded"], reason = verdict(b, det, fl, (weak or {}).get(cls.name), _unit(cls), _size_unit(cls))
+        row["confounded"], reason, kind = verdict(b, det, fl, (weak or {}).get(cls.name), _unit(cls), _size_unit(cls))
         row["floor"] = fl
         if cls.name in named or reason is None:
             continue
@@ -355,7 +357,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
                                                                            np.argsort(-np.abs(b["corr"]))
                                                                            if j not in idx][:1],
                         "correlation": round(b["R"], 3), "what_would_separate": text,
-                        "reason": reason,
+                        "reason": reason, "reason_kind": kind,
                         "std": row["std"], "std_conditional": row["std_conditional"], "detection_size": row["detection_size"],
                         "unit": row["unit"], "trials": [{"trial": lb, "std": float(f"{sd:.3g}")} for lb, sd in res]})
     return entries, table
@@ -387,27 +389,29 @@ def verdict(b: dict, det: float, fl: float, weak_why: str | None, unit: str, det
 
     Returns
     -------
-    (bool, str or None)
-        ``confounded`` (the records could not show it for its confounding or its floor) and the reason,
+    (bool, str or None, str or None)
+        ``confounded`` (the records could not show it for its confounding or its floor), the reason,
         the first that holds: :data:`STATISTICAL_REASON` (its std could not have shown ``det`` and
         confounding is why), the floor (the ship's own mismatch lends it more than ``det``), ``weak_why``,
-        too little information (its std could not have shown ``det``, confounded or not); None: not reported.
+        too little information (its std could not have shown ``det``, confounded or not); None: not
+        reported; and that reason's kind (:data:`~trials.measured.decision.REASON_KINDS`: "statistics",
+        "floor", "evidence", "information"; None with it).
     """
     from .decision import Z_THRESHOLD
 
     imprecise = bool(max(2.0, Z_THRESHOLD) * b["sd"] > det)
     if imprecise and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED):
-        return True, STATISTICAL_REASON
+        return True, STATISTICAL_REASON, "statistics"
     if fl > det:
         return True, (f"the ship's own mismatch lends it up to {fl:.3g}{_sp(det_unit)} on such a record (calibrated "
-                      f"floor), more than the {det:.3g}{_sp(det_unit)} to detect")
+                      f"floor), more than the {det:.3g}{_sp(det_unit)} to detect"), "floor"
     if weak_why:
-        return False, weak_why
+        return False, weak_why, "evidence"
     if imprecise:
         return False, (f"the records hold too little information on it: sd {_fmt(b['sd'])}{_sp(unit)} "
                        f"({_fmt(b['sd_conditional'])}{_sp(unit)} with every other parameter fixed) could not have "
-                       f"shown {det:.3g}{_sp(det_unit)}")
-    return False, None
+                       f"shown {det:.3g}{_sp(det_unit)}"), "information"
+    return False, None, None
 
 
 def _name(f) -> str:
