@@ -457,3 +457,34 @@ def test_wind_shape_factors_are_recovered_scale_the_loads_and_are_written_back(t
     assert w["yaw_factor"] == pytest.approx(ship.wind.yaw_factor * v["wind_yaw_factor"], rel=1e-5)
     back = mmg.load_ship(out["ship"])
     assert back.wind.yaw_factor == pytest.approx(ident.ship.wind.yaw_factor, rel=1e-5)
+
+
+def test_propeller_walk_is_not_fitted_on_records_that_never_go_astern():
+    """With no record astern the term has no information: it is left out of the fit (and so out of the
+    covariance the IMO sampling draws from), and the run says so."""
+    ship = mmg.load_ship(SHIP)
+    runs = _synthetic_runs(ship, seeds=(0,), duration=30.0)
+    said = []
+    ident = identify(ship, runs, free=["Y_P_astern", "w_P0"], segment_s=(15.0,), say=said.append, max_nfev=2)
+    assert [f.name for f in ident.fit.free if f.kind != "start"] == ["w_P0"]
+    assert any("Y_P_astern not fitted" in m for m in said)
+
+
+def test_fitted_wind_factors_multiply_the_configs_and_stay_within_its_range(tmp_path):
+    """A config whose wind yaw factor is 1.4: a fitted factor f is a factor on the loads it computes, so
+    ship.yaml writes 1.4 f, and the fit's bound is 3 / 1.4 so that what is written loads."""
+    import yaml
+
+    from ekf.identify import free_parameters
+    from trials.measured.identify import _bounded_wind
+
+    data = yaml.safe_load(open(mmg.config_path("ships", f"{SHIP}.yaml")))
+    data["wind"]["yaw_factor"] = 1.4
+    path = tmp_path / "ship.yaml"
+    path.write_text(yaml.safe_dump(data))
+    ship = mmg.load_ship(path)
+    (f,) = _bounded_wind(ship, free_parameters(pack(ship), ship.hull.names, ["wind_yaw_factor"]))
+    assert f.upper == pytest.approx(3.0 / 1.4) and f.lower == pytest.approx(0.2 / 1.4)
+    out = tmp_path / "out.yaml"
+    out.write_text(ship_yaml(path, {"wind_yaw_factor": f.upper}, "test"))
+    assert mmg.load_ship(out).wind.yaw_factor == pytest.approx(3.0, rel=1e-5)

@@ -12,8 +12,11 @@ form, its terms and values; the resistance coefficient corrected by the friction
 straight-run wake ``w_P0`` (scaled by the ITTC-1978 wake formula below), the rudder inflow ratio
 ``epsilon`` (corrected for the wake scaling), the slipstream share ``kappa``, the flow-straightening
 ``gamma_R_pos``, ``gamma_R_neg`` and lever ``l_R_prime``, and the added masses ``m_x_prime``,
-``m_y_prime``, ``J_z_prime`` (primed).  A fitted ``rudder_offset`` (the model rudder's zero error) and
-the wind scale are not transferred.
+``m_y_prime``, ``J_z_prime`` (primed).  A fitted ``rudder_offset`` (the model rudder's zero error), the
+wind scale and shape factors (the model's superstructure and the pond's wind, not the ship's), and the
+propeller walk astern ``Y_P_astern`` (a property of the model's own screw, its handedness and its stern
+run; the full-scale config's value, 0 unless given, stands) are not transferred: sampled values of them
+are dropped.
 
 *From the full-scale config*: particulars (L, B, T, S, x_G, rho), mass and inertia (m', I_zG'),
 propeller (D, P, K_T, K_Q, the thrust deduction t_P(u), the speed dependence of w_P0(u)), engine,

@@ -263,7 +263,7 @@ def not_identifiable_line(ni: dict) -> str:
     ni : dict
         An entry of :attr:`trials.measured.diagnose.Diagnosis.not_identifiable` (``effect``,
         ``confused_with``, ``correlation`` or None, ``what_would_separate``; optionally ``reason``,
-        ``std``, ``detection_size``, ``unit``).
+        ``reason_kind`` (not printed: the reason says it), ``std``, ``detection_size``, ``unit``).
 
     Returns
     -------

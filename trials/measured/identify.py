@@ -408,6 +408,22 @@ def _training_runs(ship: Ship, paths_or_runs, o: IdentifyOptions) -> list[Measur
     return runs
 
 
+def _bounded_wind(ship: Ship, fp: list) -> list:
+    """``fp`` with the bounds of the fitted wind values divided by the config's own (the fitted ones are
+    factors on the records' loads, which carry the config's; ship.yaml writes their product, which must
+    stay within the config's range: scale 0-10, shape factors 0.2-3)."""
+    from dataclasses import replace
+
+    if ship.wind is None:
+        return fp
+    out = []
+    for f in fp:
+        key = _WIND_KEYS.get(f.name) if f.kind == "wind_scale" else None
+        c = float(getattr(ship.wind, key)) if key else 1.0
+        out.append(replace(f, lower=f.lower / c, upper=f.upper / c) if key and c > 0 and c != 1.0 else f)
+    return out
+
+
 def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
     """(free parameters, the per-record nuisance effects or None)."""
     from ekf.identify import free_parameters
@@ -415,7 +431,10 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
     names = _free_names(ship, free)
     if not any(r.inputs.ext is not None for r in runs):
         names = [n for n in names if n not in _WIND_KEYS]     # no wind loads to scale
-    fp = free_parameters(packed, ship.hull.names, names, o.prior_rel_std)
+    if "Y_P_astern" in names and not any(np.mean(np.asarray(r.inputs.n) < 0) >= ASTERN_SHARE for r in runs):
+        names = [n for n in names if n != "Y_P_astern"]       # nothing to fit it on: it stays the config's
+        o.say(f"Y_P_astern not fitted: no record runs its propeller astern on {ASTERN_SHARE:.0%} of its samples")
+    fp = _bounded_wind(ship, free_parameters(packed, ship.hull.names, names, o.prior_rel_std))
     if o.initial_state == "fit":
         from ekf.identify import start_parameters
 
