@@ -40,6 +40,8 @@ def check_ship(ship, packed) -> None:
         raise ValueError(f"hull table {ship.hull.names} is not the Esso Osaka's")
     if p[M.P_WAKE] != M.WAKE_KIJIMA or p[M.P_ENGINE] != M.ENGINE_CONSTANT_POWER or p[M.P_XG] != 0.0:
         raise ValueError("kernel is specialised to Kijima wake, constant power and x_G = 0")
+    if p[M.P_YP_ASTERN] != 0.0:
+        raise ValueError("kernel has no propeller walk astern (propeller.Y_P_astern must be 0)")
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
