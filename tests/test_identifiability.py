@@ -110,6 +110,10 @@ def test_single_turn_rudder_offset_not_identifiable(full):
     assert e["confused_with"] and set(e["confused_with"]) <= hull
     assert e["correlation"] >= 0.9
     assert 3.0 * e["std"] > 1.0                    # could not have been named at 1 deg
+    from trials.measured.decision import REASON_KINDS
+
+    assert e["reason_kind"] == "statistics"        # confounded and imprecise: the first reason that holds
+    assert all(x["reason_kind"] in REASON_KINDS for x in j["not_identifiable"])
     assert "port turn" in e["what_would_separate"] or "zigzag" in e["what_would_separate"]
     tr = {t["trial"]: t["std"] for t in e["trials"]}
     assert tr["a 35 deg port turn"] < 0.5 * e["std"]          # the mirror turn separates it
