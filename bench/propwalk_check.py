@@ -5,10 +5,15 @@ over the samples with the rudder amidships (|delta| < 5 deg) and a small yaw rat
 split by the propeller: astern (n < -3 rps) or ahead (n > 3 rps), with the mean n^2 [rps^2] of each
 set.  A single screw running astern walks its stern sideways (a right-handed screw to port: the bow
 swings to starboard, r' > 0), by a force that grows as n^2: what ``propeller.Y_P_astern``
-(:func:`mmg.model.propeller_lateral`) models.  No model is involved here, so the figures say what the
-records hold before any fit.
+(:func:`mmg.model.propeller_lateral`) models.  No model is involved in these figures, so they say what
+the records hold before any fit.
 
-    python bench/propwalk_check.py [--data DIR]
+With ``--ship SHIP`` (e.g. ``mmg identify``'s DIR/ship.yaml) a last column gives the yaw acceleration
+that ship's propeller walk alone gives at each record's mean astern n^2 (its lateral force and moment
+through the model's own mass matrix, :func:`mmg.model.force_accelerations`), to set beside the
+records' own figure.
+
+    python bench/propwalk_check.py [--data DIR] [--ship SHIP]
 """
 from __future__ import annotations
 
@@ -43,20 +48,38 @@ def record_figures(path: Path) -> dict:
     return out
 
 
+def walk_yaw_acceleration(ship, n2: float) -> float:
+    """Yaw acceleration [deg/s^2] of ``ship``'s propeller walk alone at revolutions n = -sqrt(n2), at rest."""
+    from mmg.model import force_accelerations, pack, propeller_lateral
+
+    p = pack(ship).p
+    Y, N = propeller_lateral(-math.sqrt(n2), p)
+    return float(np.degrees(force_accelerations(0.0, Y, N, p)[2]))
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", type=Path, default=DATA)
+    ap.add_argument("--ship", default=None, help="also the yaw acceleration this ship's propeller walk gives")
     a = ap.parse_args(argv)
+    ship = None
+    if a.ship is not None:
+        from mmg.ship import load_ship
+
+        ship = load_ship(a.ship)
     files = sorted((a.data / "random").glob("*.csv")) + sorted((a.data / "berthing").glob("*.csv"))
     if not files:
         print(f"{a.data}: no random/ or berthing/ records", file=sys.stderr)
         return 2
-    print("| record | astern: samples, r' [deg/s^2], n^2 [rps^2] | ahead: samples, r' [deg/s^2], n^2 [rps^2] | astern - ahead |")
-    print("|---|---|---|---|")
+    extra = f" {ship.name}'s walk [deg/s^2] |" if ship else ""
+    print("| record | astern: samples, r' [deg/s^2], n^2 [rps^2] | ahead: samples, r' [deg/s^2], n^2 [rps^2] | astern - ahead |"
+          + extra)
+    print("|---|---|---|---|" + ("---|" if ship else ""))
     for f in files:
         g = record_figures(f)
         (ka, ra, na), (kb, rb, nb) = g["astern"], g["ahead"]
-        print(f"| {f.stem} | {ka}, {ra:+.4f}, {na:.0f} | {kb}, {rb:+.4f}, {nb:.0f} | {ra - rb:+.4f} |")
+        walk = f" {walk_yaw_acceleration(ship, na):+.4f} |" if ship and ka else (" - |" if ship else "")
+        print(f"| {f.stem} | {ka}, {ra:+.4f}, {na:.0f} | {kb}, {rb:+.4f}, {nb:.0f} | {ra - rb:+.4f} |" + walk)
     return 0
 
 
