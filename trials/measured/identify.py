@@ -79,7 +79,7 @@ __all__ = ["identify", "IdentifyOptions",
            "fit_covariance", "ship_with_values", "PARAMETER_UNITS",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description", "identification_covariance", "start_noise", "DEFAULT_INITIAL_STATE",
-           "INITIAL_STATES", "fold_of", "manoeuvre_class", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
+           "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale", "Y_P_astern")
 DEFAULT_MAX_NFEV = 30
@@ -260,7 +260,7 @@ def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
 
     from ekf.identify import wind_scaled
 
-    if run.inputs.ext is None or not any(k in values for k in _WIND_KEYS):
+    if run.inputs.ext is None or not any(k in values for k in _wind_keys()):
         return run
     return replace(run, inputs=wind_scaled(run.inputs, values.get("wind_scale", 1.0),
                                            values.get("wind_sway_factor", 1.0), values.get("wind_yaw_factor", 1.0)))
@@ -295,7 +295,7 @@ def ship_with_values(ship: Ship, values: dict) -> Ship:
 
         s = replace(s, effects=s.effect_set().merged(
             E.effect_set({"rudder_offset": {"offset_deg": float(np.degrees(values["rudder_offset"]))}})))
-    wind = {k: values[name] for name, k in _WIND_KEYS.items() if name in values}
+    wind = {k: values[name] for name, k in _wind_keys().items() if name in values}
     if wind and s.wind is not None:
         new = {k: getattr(s.wind, k) * v for k, v in wind.items()}
         s = replace(s, wind=replace(s.wind, **new))
@@ -308,10 +308,13 @@ def ship_with_values(ship: Ship, values: dict) -> Ship:
     return s
 
 
-_WIND_KEYS = {"wind_scale": "scale", "wind_sway_factor": "sway_factor", "wind_yaw_factor": "yaw_factor"}
-"""``mmg identify --free`` name of a fitted wind value -> the key of the ship's ``wind:`` section (and of
-its ``wind`` effect) it multiplies: the records' loads were computed with the ship's values, so the
-fitted ones are factors on them."""
+def _wind_keys() -> dict:
+    """``mmg identify --free`` name of a fitted wind value -> the key of the ship's ``wind:`` section (and of
+    its ``wind`` effect) it multiplies (``wind_scale`` and :data:`ekf.identify.WIND_FACTORS`): the records'
+    loads were computed with the ship's values, so the fitted ones are factors on them."""
+    from ekf.identify import WIND_FACTORS
+
+    return {"wind_scale": "scale", **{k: par for k, (par, _) in WIND_FACTORS.items()}}
 
 
 _ship_with = ship_with_values
@@ -416,9 +419,9 @@ def _bounded_wind(ship: Ship, fp: list) -> list:
 
     if ship.wind is None:
         return fp
-    out = []
+    keys, out = _wind_keys(), []
     for f in fp:
-        key = _WIND_KEYS.get(f.name) if f.kind == "wind_scale" else None
+        key = keys.get(f.name) if f.kind == "wind_scale" else None
         c = float(getattr(ship.wind, key)) if key else 1.0
         out.append(replace(f, lower=f.lower / c, upper=f.upper / c) if key and c > 0 and c != 1.0 else f)
     return out
@@ -430,8 +433,8 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
 
     names = _free_names(ship, free)
     if not any(r.inputs.ext is not None for r in runs):
-        names = [n for n in names if n not in _WIND_KEYS]     # no wind loads to scale
-    if "Y_P_astern" in names and not any(np.mean(np.asarray(r.inputs.n) < 0) >= ASTERN_SHARE for r in runs):
+        names = [n for n in names if n not in _wind_keys()]     # no wind loads to scale
+    if "Y_P_astern" in names and not any(goes_astern(r) for r in runs):
         names = [n for n in names if n != "Y_P_astern"]       # nothing to fit it on: it stays the config's
         o.say(f"Y_P_astern not fitted: no record runs its propeller astern on {ASTERN_SHARE:.0%} of its samples")
     fp = _bounded_wind(ship, free_parameters(packed, ship.hull.names, names, o.prior_rel_std))
@@ -617,6 +620,13 @@ calls it an astern record: a sustained astern phase, not one noisy sample (the F
 berthing records run astern for 12-36 % of their samples, its turns and zigzags for none)."""
 
 
+def goes_astern(run: MeasuredRun) -> bool:
+    """Whether a record runs its propeller astern (n < 0) on at least :data:`ASTERN_SHARE` of its
+    samples: the one test of an astern record (:func:`manoeuvre_class`; the propeller walk is fitted
+    only where a record is one)."""
+    return bool(np.mean(np.asarray(run.inputs.n, float) < 0) >= ASTERN_SHARE)
+
+
 def manoeuvre_class(run: MeasuredRun) -> tuple:
     """The manoeuvre of a record, for stratified folds (:func:`fold_of`).
 
@@ -639,7 +649,7 @@ def manoeuvre_class(run: MeasuredRun) -> tuple:
     """
     n = np.asarray(run.inputs.n, float)
     rps = float(np.nanmedian(np.abs(n)))
-    if np.mean(n < 0) >= ASTERN_SHARE:
+    if goes_astern(run):
         return (2, 0, rps)
     d = np.asarray(run.inputs.delta, float)
     big = d[np.abs(d) > np.radians(2.0)]
@@ -791,6 +801,7 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
     from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
     from mmg.nondim import inertia_scale, mass_scale
 
+    wind_keys = _wind_keys()
     data = yaml.safe_load(Path(ship_path).read_text())
     ship = None
     for k, v in values.items():
@@ -814,8 +825,8 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
             data.setdefault("effects", {})
             data["effects"] = dict(data["effects"] or {})
             data["effects"]["rudder_offset"] = {"offset_deg": float(f"{np.degrees(v):.6g}")}
-        elif k in _WIND_KEYS and "wind" in data:
-            key = _WIND_KEYS[k]
+        elif k in wind_keys and "wind" in data:
+            key = wind_keys[k]
             eff = (data.get("effects") or {}).get("wind")
             if isinstance(eff, dict) and key in eff:               # the value given in the effects section
                 eff[key] = float(f"{float(eff[key]) * v:.6g}")
