@@ -36,6 +36,7 @@ data rows' J^T J apart from the prior's, so a caller can weigh the two different
 """
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
@@ -50,7 +51,8 @@ __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_param
            "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
            "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled", "WIND_FACTORS",
            "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "logged_residual", "record_effect_parameters", "effect_set_of",
-           "predict_logged", "start_parameters", "record_residuals", "model_states"]
+           "predict_logged", "start_parameters", "record_residuals", "model_states", "StraightRun",
+           "straight_run_residual", "STRAIGHT_RUN_DRIFT_SD"]
 
 RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
                     "l_R_prime": (P_LR, -2.0, 0.0)}
@@ -100,6 +102,30 @@ which family: :func:`trials.measured.diagnose._baseline_prior`."""
 
 
 @dataclass(frozen=True)
+class StraightRun:
+    """A record's leading steady straight run (rudder at its trim, no yaw): its first ``n`` samples.
+
+    Any hull sails a straight run with (almost) no drift through the water: the model's own trim
+    drift is 0.009 deg for the bundled Esso Osaka.  The sway over ground the record logs there is
+    then what the measurement and kinematic effects make of none (a heading bias: -u sin b; a
+    current: its part across the heading), whatever the hull coefficients are; this is the one
+    stretch of a turning circle where a heading bias does not trade with them
+    (:func:`straight_run_residual`)."""
+
+    n: int
+    """Samples of the straight run, from the record's first."""
+    sigma: float
+    """Standard error [m/s] of the run's mean logged sway as a measure of that: the noise's over the
+    run's samples and the hull's own straight-run drift (:data:`STRAIGHT_RUN_DRIFT_SD`)."""
+
+
+STRAIGHT_RUN_DRIFT_SD = math.radians(0.1)
+"""Std [rad] of a hull's drift angle in its straight run that the model does not have: ten times
+the bundled Esso Osaka's own trim drift (0.009 deg), for a real hull's asymmetry and the small
+wind a straight run is accepted with (:func:`trials.measured.diagnose_records.leading_straight_run`)."""
+
+
+@dataclass(frozen=True)
 class Segmented:
     """One record for the fit: measured states (N, 6), inputs and the segment starts (bool (N,))."""
 
@@ -119,6 +145,9 @@ class Segmented:
     speed_only: bool = False
     """The record logs the speed over ground, not u and v (``meas`` u is that speed, v a stand-in
     zero): u is compared as the predicted speed over ground and v not at all (:func:`logged_residual`)."""
+    straight: StraightRun | None = None
+    """Its leading steady straight run, whose mean sway over ground is one more residual of the fit
+    (:func:`straight_run_residual`); None: not used."""
 
     @property
     def restart(self) -> np.ndarray:
@@ -391,6 +420,26 @@ def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
     return replace(rec, inputs=wind_scaled(rec.inputs, *f)) if hit else rec
 
 
+def straight_run_residual(rec: Segmented, effects=None, free=(), theta=(), record: int | None = None) -> float | None:
+    """The mean sway over ground of ``rec``'s straight run (:class:`StraightRun`) that the effects at
+    ``theta`` predict, minus the logged one, over its ``sigma``; None where the record has none.
+
+    The model's states there are the logged ones through the effects (:meth:`mmg.effects.EffectSet.to_model`)
+    with no sway through the water, logged back (:meth:`~mmg.effects.EffectSet.to_logged`): a heading
+    bias b predicts -u sin b, a current its part across the heading, and the hull coefficients
+    nothing, so the residual moves with the effects' parameters alone."""
+    st = rec.straight
+    if st is None:
+        return None
+    meas = np.asarray(rec.meas[:st.n], float)
+    es = effect_set_of(effects, list(free), theta, record)
+    if rec.fixed is not None:
+        es = rec.fixed.merged(es)
+    mm = es.to_model(meas)
+    mm[:, 1] = 0.0
+    return float(np.mean(es.to_logged(mm)[:, 1] - meas[:, 1])) / st.sigma
+
+
 def logged_residual(pred: np.ndarray, rec: Segmented) -> np.ndarray:
     """Predicted minus measured states (N, 6) of what the record logs: for a record that logs only the
     speed over ground (:attr:`Segmented.speed_only`), u is that speed on both sides and v is 0."""
@@ -542,6 +591,12 @@ class FitOptions:
     loss, f_scale : str, float
         :func:`scipy.optimize.least_squares`'s loss ("linear": least squares; "soft_l1", "cauchy":
         robust) and its residual scale (in units of the scaled residuals).
+    straight_weight : float
+        Factor on each record's straight-run residual (:func:`straight_run_residual`, one row per
+        record that has a :class:`StraightRun`, after the records' blocks).  The records' rows are
+        weighted as if independent; a caller that inflates the fit's standard errors by
+        sqrt(tau) for their correlation (``mmg diagnose``) gives this that factor, so that the
+        straight run's mean keeps its own precision in the fit and in the inflated covariance.
     """
 
     stride: int = 2
@@ -554,6 +609,7 @@ class FitOptions:
     weights: object = None
     loss: str = "linear"
     f_scale: float = 1.0
+    straight_weight: float = 1.0
 
 
 class _SegmentFit:
@@ -574,6 +630,7 @@ class _SegmentFit:
         nch = 4 if self.pos is None else 6
         self.start = np.cumsum([0] + [len(r.meas[::opts.stride]) * nch for r in records])   # each record's block
         self.heads = {k: records[k].first_segment() for k in set(self.own) - {None}}   # what a start offset moves
+        self.straight = [k for k, r in enumerate(records) if r.straight is not None]   # one row each, after the blocks
         self.count = 0
 
     def block(self, theta, k, pk=None, rec=None):
@@ -583,13 +640,19 @@ class _SegmentFit:
         rec = self.records[k] if rec is None else rec
         return self.wts[k] * _residual_one(pk, rec, self.sc, o.stride, o.effects, self.free, theta, o.ship, self.pos, k)
 
+    def straight_row(self, theta, k):
+        """Record k's weighted straight-run residual (:func:`straight_run_residual`)."""
+        o = self.opts
+        return o.straight_weight * self.wts[k] * straight_run_residual(self.records[k], o.effects, self.free, theta, k)
+
     def resid(self, theta, parallel=True):
-        """Every record's residuals, then the prior's."""
+        """Every record's residuals, then their straight runs', then the prior's."""
         pk = apply_parameters(self.packed, self.free, theta)
         one = lambda k: self.block(theta, k, pk)  # noqa: E731
         ks = range(len(self.records))
         parts = list(self.pool.map(one, ks)) if parallel else [one(k) for k in ks]
-        return np.concatenate(parts + [(theta - self.theta0) / self.sig0])
+        straight = np.array([self.straight_row(theta, k) for k in self.straight])
+        return np.concatenate(parts + [straight, (theta - self.theta0) / self.sig0])
 
     def _steps(self, theta):
         """(step sizes, stepped parameter vectors), stepping down at an upper bound."""
@@ -610,7 +673,10 @@ class _SegmentFit:
         k, s = self.own[j], self.start
         b = self.block(step, k, rec=self.heads[k] if self.free[j].kind == "start" else None)
         col[s[k]:s[k] + len(b)] = (b - r0[s[k]:s[k] + len(b)]) / h
-        col[s[-1] + j] = 1.0 / self.sig0[j]
+        if k in self.straight:
+            i = s[-1] + self.straight.index(k)
+            col[i] = (self.straight_row(step, k) - r0[i]) / h
+        col[s[-1] + len(self.straight) + j] = 1.0 / self.sig0[j]
         return col
 
     def jac(self, theta):

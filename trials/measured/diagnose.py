@@ -25,7 +25,17 @@ checking the scale) and the ship config:
    10 Hz record are far from independent; BIC with the raw N would name an effect for every
    smooth misfit):
 
-       dBIC = sum_c N_eff,c ln(RSS_c,before / RSS_c,with) - k ln(sum_c N_eff,c)
+       dBIC = sum_c N_eff,c ln(RSS_c,before / RSS_c,with) - k ln(sum_c N_eff,c) + (chi2_straight,before - chi2_straight,with)
+
+   The last term is the **straight run's**: a record that opens with a steady straight run
+   (:func:`~trials.measured.diagnose_records.leading_straight_run`: rudder at its trim, no yaw, little
+   wind) logs there a mean sway over ground that any hull leaves at (almost) zero through the water,
+   so it is set by a heading bias (-u sin b) and a current's cross part alone, whatever the hull
+   coefficients (:func:`ekf.identify.straight_run_residual`, one residual per record with its own
+   standard error, in the fit with the round's sqrt(tau) as its weight so that it keeps that
+   precision beside the correlated channel rows).  On a turning circle it is the one stretch where a
+   heading bias does not trade with the hull terms (on turns of hulls that were not the model's a
+   1-1.5 deg bias had sd 1.7-2.3 deg without it).
 
    An effect is **named** when dBIC > :data:`BIC_THRESHOLD` (20: twice Kass & Raftery's "very
    strong", calibrated on clean records by the bench) and its parameters differ from their neutral values by more than
@@ -63,7 +73,7 @@ from mmg.ship import Ship
 
 from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration, clears_floor, evidence_short, floor,
                        floor_parts, magnitude, mean_heading, over_floor, record_kind, residual_floor)
-from .diagnose_records import Prepared, prepare, synthetic_record, write_frt_csv  # noqa: F401
+from .diagnose_records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis",
@@ -110,14 +120,6 @@ def _tau(x: np.ndarray) -> float:
     return float(min(max(1.0 + 2.0 * s, 1.0), n / 4.0))
 
 
-def _noise(meas: np.ndarray) -> np.ndarray:
-    """Noise level per column of the logged (N, 6) states: std of the 2nd difference / sqrt(6)
-    (white noise on a smooth signal), robust (MAD)."""
-    d2 = np.diff(meas, 2, axis=0)
-    mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0) * 1.4826
-    return mad / math.sqrt(6.0)
-
-
 def _diffs(pred: np.ndarray, seg) -> np.ndarray:
     """Residual columns u, v, r, x, y, heading (replayed minus logged, SI) of what the record logs
     (:func:`ekf.identify.logged_residual`: a record with only the speed over ground has its u
@@ -145,6 +147,9 @@ class _Model:
     free: list
     fit: object
     diffs: list          # per record (N, 6)
+    straight: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    """The straight-run residuals of the records that have one (:func:`ekf.identify.straight_run_residual`,
+    unweighted: in their own standard errors)."""
 
     @property
     def theta(self):
@@ -251,12 +256,20 @@ class _Fitter:
     def __init__(self, ship, packed, recs, scales, stride, max_nfev, ship_free):
         self.ship, self.packed, self.recs, self.scales = ship, packed, recs, scales
         self.stride, self.max_nfev, self.ship_free = stride, max_nfev, ship_free
+        self.straight_weight = 1.0     # the round's standard-error inflation (FitOptions.straight_weight)
 
     def diffs(self, effects, free, theta):
         from ekf.identify import predict_logged
 
         return [_diffs(predict_logged(self.packed, r.seg, effects, free, theta, self.ship), r.seg)
                 for r in self.recs]
+
+    def straight(self, effects, free, theta) -> np.ndarray:
+        """The records' straight-run residuals (:func:`ekf.identify.straight_run_residual`), unweighted."""
+        from ekf.identify import straight_run_residual
+
+        rows = [straight_run_residual(r.seg, list(effects) or None, free, theta, k) for k, r in enumerate(self.recs)]
+        return np.array([a for a in rows if a is not None], float)
 
     def fit(self, effects, start_ship=None, start_eff=None, max_nfev=None, start=None) -> _Model:
         """Fit the ship terms and ``effects``' parameters; ``start`` (the whole vector) or
@@ -273,8 +286,9 @@ class _Fitter:
         x0 = np.array(start, float)
         fit = identify_segments(self.packed, [r.seg for r in self.recs], free, self.scales, stride=self.stride,
                                 max_nfev=max_nfev or self.max_nfev, start=x0, effects=list(effects) or None,
-                                ship=self.ship)
-        return _Model(list(effects), free, fit, self.diffs(effects, free, fit.theta))
+                                ship=self.ship, straight_weight=self.straight_weight)
+        return _Model(list(effects), free, fit, self.diffs(effects, free, fit.theta),
+                      self.straight(effects, free, fit.theta))
 
 
 def _stack(diffs, stride):
@@ -292,9 +306,13 @@ def _scores(model_diffs, taus, stride):
 
 
 def _delta_bic(before, after, k, taus, stride):
+    """The channels' dBIC (module docstring) plus the change of the straight runs' chi-square: each is
+    one mean with its own known standard error (:class:`ekf.identify.StraightRun`), so -2 ln L moves
+    by the change of its square."""
     rss0, neff = _scores(before.diffs, taus, stride)
     rss1, _ = _scores(after.diffs, taus, stride)
-    return float(np.sum(neff * np.log(rss0 / rss1)) - k * math.log(float(np.sum(neff))))
+    straight = float(np.sum(before.straight ** 2) - np.sum(after.straight ** 2)) if len(before.straight) else 0.0
+    return float(np.sum(neff * np.log(rss0 / rss1)) - k * math.log(float(np.sum(neff)))) + straight
 
 
 def _effect_index(model: _Model, effect, presence_only: bool = False) -> list:
@@ -546,7 +564,7 @@ def _config_model(fitter, d_config) -> _Model:
     fit = IdentifyResult(free=free, theta=th, std=np.array([f.sigma for f in free]), corr=np.eye(len(free)),
                          cost_initial=math.nan, cost_final=math.nan, n_residuals=0, iterations=0,
                          message="the config as given (the fit replayed worse)")
-    return _Model([], free, fit, d_config)
+    return _Model([], free, fit, d_config, fitter.straight([], free, th))
 
 
 def _baseline(fitter, noise, say):
@@ -627,6 +645,7 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
     current, named, rounds, remaining = base, [], [], list(cand)
     while remaining:
         taus, inflate = _taus(current, o.stride)
+        fitter.straight_weight = inflate
         results, parts = [], []
         for cls in remaining:
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
@@ -721,7 +740,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
         o = replace(o, stride=_default_stride(recs, L))
     U = float(np.median(np.concatenate([np.hypot(r.seg.meas[:, 0], r.seg.meas[:, 1]) for r in recs])))
     U = max(U, 0.05 * math.sqrt(9.80665 * L))
-    noise = np.median(np.vstack([_noise(r.seg.meas) for r in recs]), axis=0)
+    noise = np.median(np.vstack([noise_level(r.seg.meas) for r in recs]), axis=0)
     cand, cand_log = _candidates(recs, list(o.candidates) if o.candidates is not None else E.names(), say)
     kind = record_kind([r.seg.inputs.delta for r in recs])
     sfree = _ship_free(ship, packed, o.ship_free, kind)

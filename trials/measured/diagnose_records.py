@@ -12,13 +12,28 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-__all__ = ["Prepared", "prepare", "synthetic_record", "write_frt_csv", "RESTART_SMOOTH"]
+__all__ = ["Prepared", "prepare", "synthetic_record", "write_frt_csv", "RESTART_SMOOTH", "leading_straight_run",
+           "noise_level"]
 
 RESTART_SMOOTH = 6.0
 """Every segment restarts from the logged state smoothed over this many sqrt(L/g) (quadratic
 Savitzky-Golay: 3.3 s for the 3 m model, 35 s at 325 m): a restart from one noisy sample leaves a
 transient through the segment that a current or heading bias (which shift the restart states)
 would partly fit (clean records: 3/20 named an effect with single-sample restarts)."""
+
+STRAIGHT_YAW = 0.02
+"""Largest non-dimensional yaw rate |r| L / U of a sample of a straight run (the development set's
+yaw-rate noise at 325 m and 10 kn is 0.013)."""
+STRAIGHT_RUDDER_DEG = 1.0
+"""Largest move [deg] of the rudder from its first logged angle within a straight run."""
+STRAIGHT_MIN_SAMPLES = 3
+"""Fewest samples of a straight run that is used."""
+STRAIGHT_WIND = 0.5
+"""Largest mean relative wind speed over a straight run, as a fraction of the ship's speed, for it to
+be used: a wind sets a ship on a drift that the model's wind loads would have to predict to a tenth
+of a degree.  At half the ship's speed a VLCC's lateral wind force over its hull's sway stiffness,
+rho_a A_L C_Y / (rho L T Y_v') (V/U)^2, gives about 0.03 deg; the development set's 10-18 m/s winds
+at 10 kn gave 0.3-0.9 deg."""
 
 # --------------------------------------------------------------------------- records
 
@@ -33,10 +48,13 @@ class Prepared:
     notes: list = field(default_factory=list)
 
 
-def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | None = None) -> list[Prepared]:
+def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | None = None,
+            straight_run: bool = True) -> list[Prepared]:
     """Read and prepare the records (paths, :class:`trials.files.records.TrialRecord` or ready
     :class:`Prepared`); a malformed one raises :class:`~mmg.errors.InputError` naming it.  Each is
-    named after its file (:func:`trials.files.output.record_labels`), in the JSON and the plots."""
+    named after its file (:func:`trials.files.output.record_labels`), in the JSON and the plots.
+    With ``straight_run``, a record's leading steady straight run (:func:`leading_straight_run`)
+    is marked for the fit."""
     from dataclasses import replace
 
     from ekf.identify import Segmented, segment_resets
@@ -73,9 +91,65 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
         seg = Segmented(run.name, run.meas, run.inputs, segment_resets(run.t, math.inf if run.speed_only else seg_s),
                         context=ctx,
                         start=_smoothed(run.t, run.meas, RESTART_SMOOTH * math.sqrt(L / 9.80665)),
-                        fixed=run.effects, speed_only=run.speed_only)
+                        fixed=run.effects, speed_only=run.speed_only,
+                        straight=_straight(run, rec, ch, L) if straight_run else None)
         out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes)))
     return out
+
+
+def _straight(run, rec, ch: dict, L: float):
+    """The run's :func:`leading_straight_run`; None for a record without sway or rudder, or whose logged
+    wind was not carried through a resampling (its wind over the straight run unknown)."""
+    if run.speed_only or run.inputs.delta is None or len(run.inputs.delta) != len(run.meas):
+        return None
+    if ch["wind_speed_rel"] is None and getattr(rec, "wind_speed_rel", None) is not None:
+        return None
+    return leading_straight_run(run.meas, run.inputs.delta, L, ch["wind_speed_rel"])
+
+
+def noise_level(meas: np.ndarray) -> np.ndarray:
+    """Noise level per column of the logged (N, 6) states: std of the 2nd difference / sqrt(6)
+    (white noise on a smooth signal), robust (MAD)."""
+    d2 = np.diff(meas, 2, axis=0)
+    mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0) * 1.4826
+    return mad / math.sqrt(6.0)
+
+
+def leading_straight_run(meas: np.ndarray, delta: np.ndarray, L: float, wind_speed_rel=None):
+    """The record's leading steady straight run (:class:`ekf.identify.StraightRun`), or None.
+
+    Its samples are the first ones while the rudder stays within :data:`STRAIGHT_RUDDER_DEG` of its first
+    angle and the yaw rate within :data:`STRAIGHT_YAW` U / L; at least :data:`STRAIGHT_MIN_SAMPLES`
+    of them, and a mean relative wind (when logged) of at most :data:`STRAIGHT_WIND` times the
+    ship's speed.  Its sigma: the record's own sway noise (:func:`noise_level`) over the run's
+    samples with the hull's drift std :data:`ekf.identify.STRAIGHT_RUN_DRIFT_SD` times the speed.
+
+    Parameters
+    ----------
+    meas : (N, 6) array
+        Logged u, v [m/s], r [rad/s], x, y [m], heading [rad].
+    delta : (N,) array
+        Logged rudder angle [rad].
+    L : float
+        Ship length [m].
+    wind_speed_rel : (N,) array, optional
+        Logged relative wind speed [m/s].
+    """
+    from ekf.identify import STRAIGHT_RUN_DRIFT_SD, StraightRun
+
+    meas = np.asarray(meas, float)
+    d = np.asarray(delta, float)
+    U = float(np.hypot(meas[0, 0], meas[0, 1]))
+    if len(meas) < STRAIGHT_MIN_SAMPLES + 2 or not U > 0:
+        return None
+    steady = (np.abs(d - d[0]) <= math.radians(STRAIGHT_RUDDER_DEG)) & (np.abs(meas[:, 2]) * L / U <= STRAIGHT_YAW)
+    n = int(np.argmin(steady)) if not steady.all() else len(steady)
+    if n < STRAIGHT_MIN_SAMPLES:
+        return None
+    if wind_speed_rel is not None and float(np.mean(np.abs(np.asarray(wind_speed_rel, float)[:n]))) > STRAIGHT_WIND * U:
+        return None
+    sigma = math.hypot(float(noise_level(meas)[1]) / math.sqrt(n), U * STRAIGHT_RUN_DRIFT_SD)
+    return StraightRun(n=n, sigma=sigma)
 
 
 def _smoothed(t: np.ndarray, meas: np.ndarray, window_s: float) -> np.ndarray:

@@ -145,7 +145,8 @@ class _Info:
         from ekf.identify import FitOptions, _SegmentFit
 
         f = self.fitter
-        opts = FitOptions(stride=self.stride, effects=list(effects) or None, ship=f.ship)
+        opts = FitOptions(stride=self.stride, effects=list(effects) or None, ship=f.ship,
+                          straight_weight=getattr(f, "straight_weight", 1.0))
         with ThreadPoolExecutor(max_workers=2) as pool:
             sf = _SegmentFit(f.packed, segs, free, f.scales, opts, pool)
             J = sf.jac(np.asarray(theta, float))

@@ -1,0 +1,135 @@
+"""The straight run's evidence in ``mmg diagnose``: the mean sway over ground of a record's leading
+steady straight run, which a heading bias and a current's cross part set and the hull does not.
+
+The logged states here are written from plain kinematics in the test (earth-frame velocity resolved
+in the logged heading's axes, as the development set's README says the logs are made), not with the
+effects' own code, so a sign or frame error in :mod:`mmg.effects` or in the residual fails them.
+"""
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from ekf.identify import (STRAIGHT_RUN_DRIFT_SD, Segmented, StraightRun, effect_parameters,
+                          straight_run_residual)
+from mmg.effects import Current, HeadingBias
+from trials.measured.diagnose import _delta_bic
+from trials.measured.diagnose_records import STRAIGHT_RUDDER_DEG, leading_straight_run
+
+U = 5.144          # 10 kn through the water
+PSI = math.radians(30.0)
+SIGMA = 0.01       # m/s
+
+
+def _logged(bias_deg=0.0, current=(0.0, 0.0), n=12):
+    """(N, 6) logged u, v, r, x, y, heading of a straight run at true heading PSI, no drift through
+    the water, a current of (speed [m/s], towards [deg]) and a compass reading ``bias_deg`` high."""
+    cs, cd = current
+    vn = U * math.cos(PSI) + cs * math.cos(math.radians(cd))
+    ve = U * math.sin(PSI) + cs * math.sin(math.radians(cd))
+    psi_log = PSI + math.radians(bias_deg)
+    u = vn * math.cos(psi_log) + ve * math.sin(psi_log)
+    v = -vn * math.sin(psi_log) + ve * math.cos(psi_log)
+    t = np.arange(n, dtype=float)
+    return np.column_stack([np.full(n, u), np.full(n, v), np.zeros(n), vn * t, ve * t, np.full(n, psi_log)])
+
+
+def _seg(meas):
+    return Segmented("straight", meas, None, np.zeros(len(meas), bool), straight=StraightRun(n=len(meas), sigma=SIGMA))
+
+
+def _residual(meas, effects, values):
+    free = effect_parameters(effects)
+    return straight_run_residual(_seg(meas), effects, free, np.array(values, float))
+
+
+def test_a_heading_bias_is_read_from_the_straight_run():
+    meas = _logged(bias_deg=1.2)
+    # the true bias explains the logged sway; none leaves -(-U sin b) / sigma
+    assert _residual(meas, [HeadingBias], [1.2]) == pytest.approx(0.0, abs=1e-9)
+    assert _residual(meas, [HeadingBias], [0.0]) == pytest.approx(U * math.sin(math.radians(1.2)) / SIGMA, rel=1e-6)
+    # the opposite sign doubles it
+    assert abs(_residual(meas, [HeadingBias], [-1.2])) > 1.9 * abs(_residual(meas, [HeadingBias], [0.0]))
+
+
+def test_a_current_is_read_from_the_straight_run_by_its_cross_part():
+    cs, cd = 0.3, 200.0
+    meas = _logged(current=(cs, cd))
+    cn, ce = cs * math.cos(math.radians(cd)), cs * math.sin(math.radians(cd))
+    assert _residual(meas, [Current], [cn, ce]) == pytest.approx(0.0, abs=1e-9)
+    cross = cs * math.sin(math.radians(cd) - PSI)              # its part across the heading, to starboard
+    assert _residual(meas, [Current], [0.0, 0.0]) == pytest.approx(-cross / SIGMA, rel=1e-6)
+    assert _residual(meas, [Current], [-cn, -ce]) == pytest.approx(-2 * cross / SIGMA, rel=1e-6)
+    # a current along the heading sets no sway: the straight run cannot see it
+    along = _logged(current=(0.3, 30.0))
+    assert _residual(along, [Current], [0.0, 0.0]) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_bias_and_a_current_together():
+    meas = _logged(bias_deg=-0.8, current=(0.2, 120.0))
+    cn, ce = 0.2 * math.cos(math.radians(120.0)), 0.2 * math.sin(math.radians(120.0))
+    assert _residual(meas, [HeadingBias, Current], [-0.8, cn, ce]) == pytest.approx(0.0, abs=1e-9)
+    assert abs(_residual(meas, [HeadingBias, Current], [0.0, cn, ce])) > 5.0
+
+
+def test_a_record_without_a_straight_run_has_no_row():
+    seg = Segmented("x", _logged(), None, np.zeros(12, bool))
+    assert straight_run_residual(seg, [HeadingBias], effect_parameters([HeadingBias]), np.array([1.0])) is None
+
+
+def _run(n_straight=10, n=40, L=325.0):
+    meas = _logged(n=n)
+    delta = np.zeros(n)
+    delta[n_straight:] = np.radians(np.minimum(35.0, 2.3 * (1 + np.arange(n - n_straight))))
+    return meas, delta, L
+
+
+def test_the_straight_run_ends_where_the_rudder_moves():
+    meas, delta, L = _run()
+    st = leading_straight_run(meas, delta, L)
+    assert st.n == 10
+    # noise-free sway: the sigma is the hull's drift allowance alone
+    assert st.sigma == pytest.approx(U * STRAIGHT_RUN_DRIFT_SD, rel=1e-3)
+    small = delta.copy()
+    small[3:] = np.radians(0.9 * STRAIGHT_RUDDER_DEG)       # a move within the tolerance keeps it straight
+    small[10:] = delta[10:]
+    assert leading_straight_run(meas, small, L).n == 10
+
+
+def test_no_straight_run_when_yawing_windy_or_too_short():
+    meas, delta, L = _run()
+    yawing = meas.copy()
+    yawing[:, 2] = 0.05 * U / L                             # r' = 0.05: a turn already under way
+    assert leading_straight_run(yawing, delta, L) is None
+    assert leading_straight_run(meas, delta, L, wind_speed_rel=np.full(len(delta), 0.6 * U)) is None
+    assert leading_straight_run(meas, delta, L, wind_speed_rel=np.full(len(delta), 0.4 * U)).n == 10
+    m2, d2, _ = _run(n_straight=2)
+    assert leading_straight_run(m2, d2, L) is None
+
+
+def test_the_noise_of_the_sway_widens_sigma_by_one_over_root_n():
+    meas, delta, L = _run(n=400)
+    rng = np.random.default_rng(1)
+    noisy = meas.copy()
+    noisy[:, 1] += rng.normal(0.0, 0.02, len(meas))
+    st = leading_straight_run(noisy, delta, L)
+    expect = math.hypot(0.02 / math.sqrt(10), U * STRAIGHT_RUN_DRIFT_SD)
+    assert st.sigma == pytest.approx(expect, rel=0.15)
+
+
+def test_the_decision_statistic_counts_the_straight_runs_chi_square():
+    """dBIC adds the fall of the straight runs' chi-square: a bias that explains a 4-sigma straight run
+    gains 16 over the same channel residuals."""
+    rng = np.random.default_rng(0)
+    d = [rng.normal(size=(200, 6))]
+    taus = np.ones(6)
+    before = SimpleNamespace(diffs=d, straight=np.array([4.0]))
+    after = SimpleNamespace(diffs=d, straight=np.array([0.0]))
+    none0 = SimpleNamespace(diffs=d, straight=np.zeros(0))
+    none1 = SimpleNamespace(diffs=d, straight=np.zeros(0))
+    base = _delta_bic(none0, none1, 1, taus, 1)
+    assert _delta_bic(before, after, 1, taus, 1) == pytest.approx(base + 16.0)
+    assert _delta_bic(after, before, 1, taus, 1) == pytest.approx(base - 16.0)
