@@ -7,7 +7,9 @@ effects' own code, so a sign or frame error in :mod:`mmg.effects` or in the resi
 """
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -133,3 +135,55 @@ def test_the_decision_statistic_counts_the_straight_runs_chi_square():
     base = _delta_bic(none0, none1, 1, taus, 1)
     assert _delta_bic(before, after, 1, taus, 1) == pytest.approx(base + 16.0)
     assert _delta_bic(after, before, 1, taus, 1) == pytest.approx(base - 16.0)
+
+
+# --------------------------------------------------------------------------- the dev set (another simulator)
+
+DEV = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "diagnose-dev"
+
+
+def _dev(names):
+    if not (DEV / "manifest.json").is_file():
+        pytest.skip("dev set ../shared/data/diagnose-dev absent")
+    man = {f["file"]: f for f in json.loads((DEV / "manifest.json").read_text())["files"]}
+    return [(DEV / f"data/{n}.csv", man[f"data/{n}.csv"]) for n in names]
+
+
+def test_the_straight_runs_of_another_simulators_logs():
+    """Its logs open with 10 s straight ahead, then the execute.  The straight run found is those
+    samples; its logged drift is the hidden bias (dev_09: -1.0, dev_19: +2.0 deg), zero on a clean
+    log (dev_05), and none is taken where a wind blows (dev_28, 18 m/s on a 10 kn ship)."""
+    import mmg
+    from trials.measured.diagnose_records import prepare
+
+    ship = mmg.load_ship(mmg.ship_path("esso_osaka"))
+    runs = _dev(["dev_09", "dev_19", "dev_05", "dev_28"])
+    prep = prepare(ship, [p for p, _ in runs])
+    for (path, entry), p in zip(runs, prep):
+        st = p.seg.straight
+        if entry["effects"] == ["wind"]:
+            assert st is None, path.name
+            continue
+        assert 10 <= st.n <= 12, (path.name, st.n)
+        m = p.seg.meas[:st.n]
+        drift = math.degrees(float(np.mean(np.arctan2(-m[:, 1], m[:, 0]))))
+        bias = entry["parameters"].get("heading_bias", {}).get("bias_deg", 0.0)
+        assert abs(drift - bias) < 3 * math.degrees(st.sigma / U), (path.name, drift, bias)
+
+
+def test_a_diagnosis_reports_its_straight_run():
+    """dev_09 (a port turn, compass 1 deg low): the straight run is in the JSON and on the console,
+    many of its standard errors off before the bias and within two after."""
+    import mmg
+    from trials.measured.diagnose import diagnose
+
+    ship = mmg.load_ship(mmg.ship_path("esso_osaka"))
+    (path, entry), = _dev(["dev_09"])
+    d = diagnose(ship, [path])
+    assert d.named == ["heading_bias"]
+    st, = d.to_json()["straight_runs"]
+    assert st["record"] == "dev_09" and st["samples"] >= 10
+    assert abs(st["logged_drift_deg"] - entry["parameters"]["heading_bias"]["bias_deg"]) < 0.2
+    assert abs(st["z_before"]) > 5.0 and abs(st["z_after"]) < 2.0
+    line = next(x for x in d.summary_lines() if x.startswith("straight run"))
+    assert "dev_09" in line and "deg" in line and " s)" in line

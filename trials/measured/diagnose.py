@@ -76,7 +76,7 @@ from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, Z_THRESHOLD, calibration,
 from .diagnose_records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
 
-__all__ = ["diagnose", "DiagnoseOptions", "Diagnosis",
+__all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table",
            "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
@@ -435,6 +435,8 @@ class Diagnosis:
     """The freed ship coefficients: config, fitted, prior std, z (:func:`ship_fit_table`)."""
     baseline: str = "fitted"
     """"fitted", or "config (the fit replayed worse)" when the baseline fit was not kept."""
+    straight_runs: list = field(default_factory=list)
+    """The records' leading straight runs the fit used (:func:`straight_run_table`)."""
 
     def summary_lines(self) -> list:
         """The console text (:func:`trials.measured.diagnose_report.summary_lines`)."""
@@ -456,7 +458,7 @@ class Diagnosis:
                "ship_coefficients": self.ship_values,
                "files": [r.source for r in self.records], "names": [r.name for r in self.records],
                "seconds": round(self.seconds, 2),
-               "identifiability": self.identifiability}
+               "identifiability": self.identifiability, "straight_runs": self.straight_runs}
         if self.runs:
             out["runs"] = [dict(r.to_json(), name=r.records[0].name, file=r.records[0].source) for r in self.runs]
         return out
@@ -873,6 +875,30 @@ def _within_reason(c: dict, unit: str) -> str:
             "mismatch lends it (calibrated)")
 
 
+def straight_run_table(recs, before: _Model, after: _Model) -> list:
+    """[{"record", "samples", "seconds", "logged_drift_deg", "sd_deg", "z_before", "z_after"}] of the
+    records that open with a straight run (:class:`ekf.identify.StraightRun`): its length, the drift
+    angle over ground it logs, atan2(-v, u) in the logged heading's axes (a heading bias b reads as b,
+    a current as its cross part over the speed), that angle's standard error, and its residual in
+    those standard errors before and after the named effects."""
+    out, k = [], 0
+    for r in recs:
+        st = r.seg.straight
+        if st is None:
+            continue
+        m = np.asarray(r.seg.meas[:st.n], float)
+        t = np.asarray(r.seg.inputs.t, float)
+        U = float(np.mean(np.hypot(m[:, 0], m[:, 1])))
+        zb = float(before.straight[k]) if k < len(before.straight) else math.nan
+        za = float(after.straight[k]) if k < len(after.straight) else math.nan
+        out.append({"record": r.name, "samples": int(st.n), "seconds": float(f"{t[st.n - 1] - t[0]:.3g}"),
+                    "logged_drift_deg": float(f"{math.degrees(float(np.mean(np.arctan2(-m[:, 1], m[:, 0])))):.3g}"),
+                    "sd_deg": float(f"{math.degrees(st.sigma / U):.3g}"),
+                    "z_before": round(zb, 2), "z_after": round(za, 2)})
+        k += 1
+    return out
+
+
 def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int) -> Diagnosis:
     """The :class:`Diagnosis`: baseline = (the config's differences, the baseline fit), search = (final
     fit, named effects, rounds) of :func:`_search`, cands = (candidates, log) of :func:`_candidates`;
@@ -901,4 +927,5 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
                      records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
                      pred_after=[r.seg.meas + d for r, d in zip(recs, current.diffs)],
                      seconds=0.0, effects=current.effects, intervals_95=ivs, evidence=effect_evidence(named, rounds),
-                     model_form_mismatch=mfm, ship_fit=ship_fit_table(current.free[:ns], current.theta[:ns]))
+                     model_form_mismatch=mfm, ship_fit=ship_fit_table(current.free[:ns], current.theta[:ns]),
+                     straight_runs=straight_run_table(recs, base, current))

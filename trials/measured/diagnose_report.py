@@ -22,7 +22,8 @@ import numpy as np
 from .decision import false_alarm_probability  # noqa: F401  (re-exported: the report's evidence)
 
 __all__ = ["Z95", "effect_estimate", "effect_intervals", "polar_interval", "effect_evidence",
-           "summary_lines", "not_identifiable_line", "fmt3", "format_rms", "format_values", "channel_text"]
+           "summary_lines", "not_identifiable_line", "fmt3", "format_rms", "format_values", "channel_text",
+           "straight_run_line"]
 
 Z95 = 1.959963984540054
 """The two-sided 95 % point of the standard normal."""
@@ -304,6 +305,8 @@ def summary_lines(diag) -> list[str]:
     for k, v in (diag.model_form_mismatch or {}).items():
         lines.append(f"model-form mismatch: {k} fitted {fmt3(v['fitted'])} against the config's {fmt3(v['config'])} "
                      f"({fmt3(v['z'])} prior std away): not written to --out-ship")
+    for st in getattr(diag, "straight_runs", None) or []:
+        lines.append(straight_run_line(st))
     lines.append(f"{'residual RMS (replay - log)':<28}{'config':>10}{'ship fitted':>13}{'+ named':>10}")
     for c in diag.rms_after:
         u = CHANNEL_UNITS.get(c, "")
@@ -315,6 +318,14 @@ def summary_lines(diag) -> list[str]:
         lines.append(f"  record {r.records[0].name}: " + ("; ".join(
             f"{e} {format_values(e, r.parameters.get(e, {}))}" for e in r.named) or "nothing named"))
     return lines
+
+
+def straight_run_line(st: dict) -> str:
+    """``straight run of dev_09 (10 samples, 9 s): drift over ground -0.95 deg (sd 0.107), 8.9 sd -> 0.2 sd with
+    the named effects``: one entry of :func:`trials.measured.diagnose.straight_run_table`."""
+    return (f"straight run of {st['record']} ({st['samples']} samples, {fmt3(st['seconds'])} s): drift over ground "
+            f"{fmt3(st['logged_drift_deg'])} deg (sd {fmt3(st['sd_deg'])}), {fmt3(abs(st['z_before']))} sd -> "
+            f"{fmt3(abs(st['z_after']))} sd with the named effects")
 
 
 def channel_text(channel: str, rms_si: float, noise_si: float, mean_si: float | None = None) -> str:
