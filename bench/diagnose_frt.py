@@ -266,6 +266,12 @@ def summary(results: list) -> list[str]:
             ni[x.get("effect")] = ni.get(x.get("effect"), 0) + 1
     if ni:
         lines.append("Not identifiable: " + ", ".join(f"{k} on {v} record{'s' if v > 1 else ''}" for k, v in ni.items()) + ".")
+    st = [(Path(r["file"]).stem, x) for r in ok for x in r["diagnosis"].get("straight_runs") or []]
+    lines.append(f"A leading straight run (the fit's straight-run residual) on {len(st)} of {len(ok)}" +
+                 (": " + ", ".join(f"{nm} {x['samples']} samples, drift over ground {_f(x['logged_drift_deg'])} deg "
+                                   f"(sd {_f(x['sd_deg'])}), {_f(abs(x['z_before']))} -> {_f(abs(x['z_after']))} sd"
+                                   for nm, x in st) + "." if st else
+                  " (none opens steady, straight and with a relative wind under half the ship's speed)."))
     un = [r for r in ok if r["diagnosis"].get("unexplained")]
     lines.append(f"`unexplained` on {len(un)} of {len(ok)}.")
     for r in bad:

@@ -187,3 +187,41 @@ def test_a_diagnosis_reports_its_straight_run():
     assert abs(st["z_before"]) > 5.0 and abs(st["z_after"]) < 2.0
     line = next(x for x in d.summary_lines() if x.startswith("straight run"))
     assert "dev_09" in line and "deg" in line and " s)" in line
+
+
+# --------------------------------------------------------------------------- a name beside its rival
+
+
+def _res(name, dbic, ok):
+    return (dbic, ok, SimpleNamespace(name=name), None, {}, {}, 5.0, 1.0, 0.5)
+
+
+def test_a_rival_is_a_candidate_with_as_much_evidence_that_could_not_be_named():
+    from trials.measured.diagnose import BIC_THRESHOLD, _rival
+    from trials.measured.decision import WEAK_BIC
+
+    bias = _res("heading_bias", 60.0, True)
+    # a current under its floor with more evidence than the bias: its rival
+    assert _rival([bias, _res("current", 130.0, False)], bias)[2].name == "current"
+    # within WEAK_BIC below it: still as much evidence
+    assert _rival([bias, _res("current", 60.0 - 0.9 * WEAK_BIC, False)], bias)[2].name == "current"
+    # clearly less evidence, or none worth a name, or a candidate that could be named: no rival
+    assert _rival([bias, _res("current", 60.0 - 1.1 * WEAK_BIC, False)], bias) is None
+    assert _rival([_res("heading_bias", 10.0, True), _res("current", BIC_THRESHOLD - 1, False)],
+                  _res("heading_bias", 10.0, True)) is None
+    assert _rival([bias, _res("current", 130.0, True)], bias) is None
+
+
+def test_a_withheld_name_and_its_rival_are_reported_as_rivals():
+    from trials.measured.decision import REASON_KINDS
+    from trials.measured.diagnose import rivals_withheld, withheld
+
+    rounds = [{"round": 1, "candidates": [],
+               "withheld": [{"effect": "heading_bias", "rival": "current", "delta_bic": 3.2, "z": 1.1,
+                             "parameters": {"bias_deg": 0.1}}]}]
+    w, = withheld(rounds)
+    r, = rivals_withheld(rounds)
+    assert (w["effect"], w["confused_with"], r["effect"], r["confused_with"]) == \
+        ("heading_bias", ["current"], "current", ["heading_bias"])
+    assert w["reason_kind"] == r["reason_kind"] == "rival" and "rival" in REASON_KINDS
+    assert "dBIC 3.2" in w["reason"] and "z 1.1" in w["reason"]
