@@ -594,9 +594,10 @@ class FitOptions:
     straight_weight : float
         Factor on each record's straight-run residual (:func:`straight_run_residual`, one row per
         record that has a :class:`StraightRun`, after the records' blocks).  The records' rows are
-        weighted as if independent; a caller that inflates the fit's standard errors by
-        sqrt(tau) for their correlation (``mmg diagnose``) gives this that factor, so that the
-        straight run's mean keeps its own precision in the fit and in the inflated covariance.
+        weighted as if independent; where they are correlated, a caller gives the straight run
+        (one mean, with its own standard error) the weight that keeps its balance against them:
+        ``mmg diagnose`` gives sqrt(tau_v), the v rows' correlation time, as its dBIC counts each v
+        row 1/tau_v times (:mod:`trials.measured.diagnose`).
     """
 
     stride: int = 2
@@ -734,7 +735,8 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
         How to fit; defaults when omitted.
     **kwargs
         Any :class:`FitOptions` field by name (``stride``, ``n_jobs``, ``max_nfev``, ``progress``,
-        ``start``, ``effects``, ``ship``, ``weights``, ``loss``, ``f_scale``), over ``options``.
+        ``start``, ``effects``, ``ship``, ``weights``, ``loss``, ``f_scale``, ``straight_weight``), over
+        ``options``.
     """
     from scipy.optimize import least_squares
 

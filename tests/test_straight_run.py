@@ -225,3 +225,11 @@ def test_a_withheld_name_and_its_rival_are_reported_as_rivals():
         ("heading_bias", ["current"], "current", ["heading_bias"])
     assert w["reason_kind"] == r["reason_kind"] == "rival" and "rival" in REASON_KINDS
     assert "dBIC 3.2" in w["reason"] and "z 1.1" in w["reason"]
+
+
+def test_no_straight_run_when_the_record_opens_with_the_helm_over():
+    meas, delta, L = _run()
+    over = np.full(len(delta), np.radians(10.0))              # opens at the execute, 10 deg of helm held
+    assert leading_straight_run(meas, over, L) is None
+    trim = delta + np.radians(1.5)                              # a 1.5 deg trim helm is straight
+    assert leading_straight_run(meas, trim, L).n == 10

@@ -39,7 +39,8 @@ checking the scale) and the ship config:
    family seed 18000 a 1 deg bias on a port turn fitted -0.93 deg at z 12.4 but at dBIC -1.3, the
    fit having traded the channels for the straight run.)  On a turning circle it is the one stretch where a
    heading bias does not trade with the hull terms (on turns of hulls that were not the model's a
-   1-1.5 deg bias had sd 1.7-2.3 deg without it).
+   1-1.5 deg bias had sd 1.7-2.3 deg without it).  Its samples are also among the v rows; the
+   straight run's own term is bounded by its hull-drift allowance, so the double count is small.
 
    An effect is **named** when dBIC > :data:`BIC_THRESHOLD` (20: twice Kass & Raftery's "very
    strong", calibrated on clean records by the bench) and its parameters differ from their neutral values by more than
@@ -260,7 +261,7 @@ class _Fitter:
     def __init__(self, ship, packed, recs, scales, stride, max_nfev, ship_free):
         self.ship, self.packed, self.recs, self.scales = ship, packed, recs, scales
         self.stride, self.max_nfev, self.ship_free = stride, max_nfev, ship_free
-        self.straight_weight = 1.0     # the round's standard-error inflation (FitOptions.straight_weight)
+        self.straight_weight = 1.0     # the round's sqrt(tau_v) (FitOptions.straight_weight; set by _search)
 
     def diffs(self, effects, free, theta):
         from ekf.identify import predict_logged
@@ -315,7 +316,9 @@ def _delta_bic(before, after, k, taus, stride):
     by the change of its square."""
     rss0, neff = _scores(before.diffs, taus, stride)
     rss1, _ = _scores(after.diffs, taus, stride)
-    straight = float(np.sum(before.straight ** 2) - np.sum(after.straight ** 2)) if len(before.straight) else 0.0
+    if len(before.straight) != len(after.straight):
+        raise ValueError("the two models' straight runs differ in number (models of other records)")
+    straight = float(np.sum(before.straight ** 2) - np.sum(after.straight ** 2))
     return float(np.sum(neff * np.log(rss0 / rss1)) - k * math.log(float(np.sum(neff)))) + straight
 
 
@@ -860,16 +863,17 @@ def diagnose_each(ship: Ship, items, options: DiagnoseOptions | None = None, pro
 
 
 def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()):
-    """(not_identifiable entries, every candidate's figures): :func:`trials.measured.identifiability.assess`,
-    a candidate of the last round whose dBIC and z cleared but whose size did not clear its
-    calibrated floor (:func:`within_mismatch`), and one with evidence short of a name
-    (:func:`weak_evidence`)."""
+    """(not_identifiable entries, every candidate's figures): a candidate whose name was withheld beside
+    its rival (:func:`withheld`), :func:`trials.measured.identifiability.assess`, a candidate of the last
+    round whose dBIC and z cleared but whose size did not clear its calibrated floor
+    (:func:`within_mismatch`), one with evidence short of a name (:func:`weak_evidence`), and a rival
+    nothing else reports (:func:`rivals_withheld`); one entry per effect, none for a named one."""
     from .identifiability import assess
 
     _, inflate = _taus(current, o.stride)
     weak = weak_evidence(rounds)
     entries, table = assess(fitter, current, named, cand, inflate, o.segment_s, o.say, weak=weak)
-    held = [h for h in withheld(rounds) if h["effect"] not in named]
+    held = list({h["effect"]: h for h in withheld(rounds) if h["effect"] not in named}.values())   # the last round's
     entries = held + [e for e in entries if e["effect"] not in {h["effect"] for h in held}]
     have = {e["effect"] for e in entries}
     extra = within_mismatch(rounds, fitter.ship.particulars.L) + [

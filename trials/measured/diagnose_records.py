@@ -26,6 +26,10 @@ STRAIGHT_YAW = 0.02
 yaw-rate noise at 325 m and 10 kn is 0.013)."""
 STRAIGHT_RUDDER_DEG = 1.0
 """Largest move [deg] of the rudder from its first logged angle within a straight run."""
+STRAIGHT_TRIM_DEG = 3.0
+"""Largest |first logged rudder angle| [deg] of a straight run: a trim helm (the bundled Esso Osaka's
+is 0.3 deg, a 1.5 deg rudder offset shifts the logged one by as much), not a record that opens
+with the helm already over."""
 STRAIGHT_MIN_SAMPLES = 3
 """Fewest samples of a straight run that is used."""
 STRAIGHT_WIND = 0.5
@@ -119,7 +123,8 @@ def leading_straight_run(meas: np.ndarray, delta: np.ndarray, L: float, wind_spe
     """The record's leading steady straight run (:class:`ekf.identify.StraightRun`), or None.
 
     Its samples are the first ones while the rudder stays within :data:`STRAIGHT_RUDDER_DEG` of its first
-    angle and the yaw rate within :data:`STRAIGHT_YAW` U / L; at least :data:`STRAIGHT_MIN_SAMPLES`
+    angle (itself a trim helm, within :data:`STRAIGHT_TRIM_DEG` of amidships) and the yaw rate within
+    :data:`STRAIGHT_YAW` U / L; at least :data:`STRAIGHT_MIN_SAMPLES`
     of them, and a mean relative wind (when logged) of at most :data:`STRAIGHT_WIND` times the
     ship's speed.  Its sigma: the record's own sway noise (:func:`noise_level`) over the run's
     samples with the hull's drift std :data:`ekf.identify.STRAIGHT_RUN_DRIFT_SD` times the speed.
@@ -140,7 +145,7 @@ def leading_straight_run(meas: np.ndarray, delta: np.ndarray, L: float, wind_spe
     meas = np.asarray(meas, float)
     d = np.asarray(delta, float)
     U = float(np.hypot(meas[0, 0], meas[0, 1]))
-    if len(meas) < STRAIGHT_MIN_SAMPLES + 2 or not U > 0:
+    if len(meas) < STRAIGHT_MIN_SAMPLES + 2 or not U > 0 or abs(d[0]) > math.radians(STRAIGHT_TRIM_DEG):
         return None
     steady = (np.abs(d - d[0]) <= math.radians(STRAIGHT_RUDDER_DEG)) & (np.abs(meas[:, 2]) * L / U <= STRAIGHT_YAW)
     n = int(np.argmin(steady)) if not steady.all() else len(steady)

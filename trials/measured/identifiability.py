@@ -33,7 +33,8 @@ candidate whose dBIC showed some evidence, short of a name, while its precision 
 (:func:`trials.measured.diagnose.weak_evidence`), and one whose evidence and precision passed but
 whose size the calibrated floor stopped (:func:`trials.measured.diagnose.within_mismatch`).  Each
 entry's ``reason`` says why in words and figures, its ``reason_kind`` which rule it was
-(:data:`trials.measured.decision.REASON_KINDS`: statistics, floor, evidence, information).
+(:data:`trials.measured.decision.REASON_KINDS`: statistics, floor, evidence, information, and rival
+for a name withheld beside a rival, :func:`trials.measured.diagnose.withheld`).
 
 ``what_would_separate``: the information of candidate additional trials (the mirror of a turn,
 a 20/20 zigzag where the records have none, a 35 deg turn where they have none), simulated with the
