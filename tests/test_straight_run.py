@@ -233,3 +233,21 @@ def test_no_straight_run_when_the_record_opens_with_the_helm_over():
     assert leading_straight_run(meas, over, L) is None
     trim = delta + np.radians(1.5)                              # a 1.5 deg trim helm is straight
     assert leading_straight_run(meas, trim, L).n == 10
+
+
+def test_a_fit_the_straight_run_contradicts_is_not_named():
+    """The straight run reads a bias (plus a current's cross part) directly: a candidate whose fit leaves
+    it beyond the naming z, and further off than before, is not named; one that brings it in is."""
+    from trials.measured.diagnose import Z_THRESHOLD, straight_contradicts, within_mismatch
+
+    assert straight_contradicts([0.5], [5.7])                      # a 0.06 deg drift read as a 0.56 deg bias
+    assert not straight_contradicts([9.0], [0.2])                  # the bias the straight run shows
+    assert not straight_contradicts([4.0], [3.5])                  # off, but less than without it
+    assert not straight_contradicts([0.5], [0.9 * Z_THRESHOLD])
+    assert not straight_contradicts([], [])                        # no straight run: no say
+    rounds = [{"round": 1, "candidates": [
+        {"effect": "heading_bias", "delta_bic": 22.0, "z": 5.5, "magnitude": 0.56, "floor": 0.39,
+         "clears_threshold": False, "parameters": {"bias_deg": -0.56}, "straight_z": [5.66],
+         "straight_contradicts": True}]}]
+    e, = within_mismatch(rounds, 325.0)
+    assert e["reason_kind"] == "straight_run" and "5.66 sd off" in e["reason"]

@@ -58,13 +58,14 @@ STATISTICAL_REASON = "its standard error and correlation"
 not have shown the size to detect: :func:`trials.measured.identifiability.verdict`), as against its
 calibrated floor, its evidence or too little information."""
 
-REASON_KINDS = ("statistics", "floor", "evidence", "information", "rival")
+REASON_KINDS = ("statistics", "floor", "evidence", "information", "rival", "straight_run")
 """The kinds of ``not_identifiable`` reasons, each entry's ``reason_kind``: its standard error and
 confounding (:data:`STATISTICAL_REASON`), the calibrated floor (the ship's own mismatch lends it as much),
 evidence short of a name, too little information (:func:`trials.measured.identifiability.verdict`,
 :func:`trials.measured.diagnose.within_mismatch`, :func:`trials.measured.diagnose.weak_evidence`), and a
 name withheld because another candidate with as much evidence takes its evidence away
-(:func:`trials.measured.diagnose.withheld`)."""
+(:func:`trials.measured.diagnose.withheld`), or whose fit the record's straight run contradicts
+(:func:`trials.measured.diagnose.straight_contradicts`)."""
 
 MAGNITUDE_UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1",
                    "shallow_water": "T/H"}

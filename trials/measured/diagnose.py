@@ -81,7 +81,7 @@ from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, WEAK_BIC, Z_THRESHOLD, ca
 from .diagnose_records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values
 
-__all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table",
+__all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "straight_contradicts",
            "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
@@ -622,8 +622,20 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
                                                                             fitter.heading):
         m, dbic, vals, se, z = _nested_start(fitter, current, cls, taus, inflate, ns, o, (m, dbic, vals, se, z))
     mag = magnitude(cls.name, vals, L)
-    ok = dbic > BIC_THRESHOLD and z > Z_THRESHOLD and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
+    ok = (dbic > BIC_THRESHOLD and z > Z_THRESHOLD and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
+          and not straight_contradicts(current.straight, m.straight))
     return dbic, ok, cls, m, vals, se, z, mag, _confounding(m, cls)
+
+
+def straight_contradicts(before, after) -> bool:
+    """Whether a model leaves some record's straight run (:class:`ekf.identify.StraightRun`) more than
+    :data:`~trials.measured.decision.Z_THRESHOLD` of its standard errors off, and further off than the
+    model it was tested against: the straight run reads a heading bias plus a current's cross part
+    directly, so an effect whose fit it contradicts is asked for by the rest of the record (the
+    ship's own mismatch on a turn), not by itself.  (Fresh family seed 21000: a 0.5 deg rudder offset
+    on a port turn was named as a -0.56 deg heading bias, the straight run reading 0.06 +- 0.11 deg.)"""
+    b, a = np.abs(np.asarray(before, float)), np.abs(np.asarray(after, float))
+    return bool(len(a) and np.any((a > Z_THRESHOLD) & (a > b)))
 
 
 def _nested_start(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions, first):
@@ -690,7 +702,10 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
                                        "magnitude": float(f"{g:.4g}"), "floor": floor(c.name, fitter.kind),
                                        **pa, "R": round(rr, 4) if math.isfinite(rr) else None,
-                                       "clears_threshold": bool(ok), "parameters": v, "standard_errors": s}
+                                       "clears_threshold": bool(ok), "parameters": v, "standard_errors": s,
+                                       **({"straight_z": [round(float(x), 2) for x in m.straight],
+                                           "straight_contradicts": straight_contradicts(current.straight, m.straight)}
+                                          if len(m.straight) else {})}
                                       for (d, ok, c, m, v, s, z, g, rr), pa in zip(results, parts)]})
         best = _best_standing(fitter, current, results, taus, inflate, ns, o, rounds[-1], say)
         if best is None:
@@ -731,7 +746,7 @@ def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptio
                        max_nfev=o.max_nfev)
         dbic = _delta_bic(with_rival, m, len(cls.fit_parameters()), taus, o.stride)
         stands, z, vals = _holds(fitter, m, cls, inflate)
-        stands = stands and dbic > BIC_THRESHOLD
+        stands = stands and dbic > BIC_THRESHOLD and not straight_contradicts(with_rival.straight, m.straight)
         rnd.setdefault("withheld" if not stands else "beside_rival", []).append(
             {"effect": cls.name, "rival": rival[2].name, "delta_bic": round(dbic, 2), "z": round(z, 2),
              "parameters": vals})
@@ -963,6 +978,15 @@ def within_mismatch(rounds, L: float) -> list:
     for c in last["candidates"]:
         if c["delta_bic"] > BIC_THRESHOLD and c["z"] > Z_THRESHOLD and not c["clears_threshold"]:
             unit = MAGNITUDE_UNITS.get(c["effect"], "")
+            if c.get("straight_contradicts") and _over_floor(c):
+                z = max(abs(x) for x in c["straight_z"])
+                out.append({"effect": c["effect"], "confused_with": ["the ship's own coefficients"],
+                            "correlation": None, "what_would_separate": "a ship model closer to this ship",
+                            "reason": (f"at dBIC {c['delta_bic']:.3g}, z {c['z']:.3g}, {_size_text(c, unit)}, but its fit "
+                                       f"leaves the record's straight run {z:.3g} sd off: the straight run reads it "
+                                       "directly, so the rest of the record asks for it, not the effect"),
+                            "reason_kind": "straight_run"})
+                continue
             out.append({"effect": c["effect"], "confused_with": ["the ship's own coefficients"], "correlation": None,
                         "what_would_separate": "a ship model closer to this ship (e.g. identified on other "
                                                "records) or a larger effect",
