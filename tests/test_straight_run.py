@@ -251,3 +251,31 @@ def test_a_fit_the_straight_run_contradicts_is_not_named():
          "straight_contradicts": True}]}]
     e, = within_mismatch(rounds, 325.0)
     assert e["reason_kind"] == "straight_run" and "5.66 sd off" in e["reason"]
+
+
+def test_a_name_the_statistics_cannot_separate_is_demoted_and_its_parameters_dropped():
+    """`_demote` refits without the effect, from the model's own values less that effect's."""
+    from ekf.identify import FreeParameter, effect_parameters
+    from mmg.effects import RudderOffset
+    from trials.measured.diagnose import DiagnoseOptions, _demote, _Model
+
+    ship_free = [FreeParameter("Y_beta", "hull", 0, 0.4, 0.06, -np.inf, np.inf)]
+    effects = [Current, RudderOffset]
+    free = ship_free + effect_parameters(effects)
+    theta = np.array([0.41, 0.02, -0.03, 6.97])
+    fit = SimpleNamespace(theta=theta)
+    model = _Model(effects, free, fit, [])
+    calls = []
+
+    class Stub:
+        def fit(self, keep, start=None, max_nfev=None):
+            calls.append((list(keep), np.asarray(start)))
+            return "refitted"
+
+    rounds = [{"round": 1, "candidates": []}]
+    m, named = _demote(Stub(), model, ["current", "rudder_offset"], ["rudder_offset"], rounds, DiagnoseOptions(),
+                       lambda s: None)
+    assert m == "refitted" and named == ["current"]
+    (keep, start), = calls
+    assert keep == [Current] and np.allclose(start, [0.41, 0.02, -0.03])
+    assert rounds[-1]["demoted"] == [{"effect": "rudder_offset"}]

@@ -349,7 +349,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
             f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
         fl = floor_in_fit_unit(cls.name, least_floor(cls.name, getattr(fitter, "kind", "")), L)
         row["confounded"], reason, kind = verdict(b, det, fl, (weak or {}).get(cls.name), _unit(cls), _size_unit(cls))
-        row["floor"] = fl
+        row["floor"], row["reason_kind"] = fl, kind
         if cls.name in named or reason is None:
             continue
         if trials is None:
