@@ -279,3 +279,13 @@ def test_a_name_the_statistics_cannot_separate_is_demoted_and_its_parameters_dro
     (keep, start), = calls
     assert keep == [Current] and np.allclose(start, [0.41, 0.02, -0.03])
     assert rounds[-1]["demoted"] == [{"effect": "rudder_offset"}]
+
+
+def test_only_a_confounded_name_whose_floor_exceeds_what_matters_is_demoted():
+    from trials.measured.diagnose import to_demote
+
+    rows = [{"effect": "rudder_offset", "named": True, "reason_kind": "statistics", "floor": 5.84, "detection_size": 1.0},
+            {"effect": "wind", "named": True, "reason_kind": "statistics", "floor": 0.0, "detection_size": 0.5},
+            {"effect": "heading_bias", "named": True, "reason_kind": None, "floor": 0.39, "detection_size": 1.0},
+            {"effect": "current", "named": False, "reason_kind": "statistics", "floor": 9.0, "detection_size": 1.0}]
+    assert to_demote(rows) == ["rudder_offset"]

@@ -790,6 +790,14 @@ def _prune(fitter, current, named, rounds, ns: int, o: DiagnoseOptions, say):
     return current, named
 
 
+def to_demote(table) -> list:
+    """The named effects of an identifiability ``table`` (:func:`trials.measured.identifiability.assess`)
+    that :func:`_demote` takes out: the statistics reason holds for them and their calibrated floor is
+    above their detection size."""
+    return [t["effect"] for t in table if t["named"] and t.get("reason_kind") == "statistics"
+            and t.get("floor", 0.0) > t["detection_size"]]
+
+
 def _demote(fitter, current, named, demote, rounds, o: DiagnoseOptions, say):
     """The model without the named effects in ``demote`` (refitted from where it was): names the records
     cannot separate from the ship's own coefficients (the statistics reason of
@@ -860,8 +868,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
                      o.stride)
     res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o, rounds)
-    demote = [t["effect"] for t in res.identifiability if t["named"] and t.get("reason_kind") == "statistics"
-              and t.get("floor", 0.0) > t["detection_size"]]
+    demote = to_demote(res.identifiability)
     if demote:
         current, named = _demote(fitter, current, named, demote, rounds, o, say)
         res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise,
