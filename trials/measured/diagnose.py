@@ -945,32 +945,24 @@ def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()
 def withheld(rounds) -> list:
     """``not_identifiable`` entries (kind "rival") of the candidates whose name was withheld because a
     rival with as much evidence took theirs away (:func:`_best_standing`)."""
-    out = []
-    for rnd in rounds:
-        for w in rnd.get("withheld", []):
-            out.append({"effect": w["effect"], "confused_with": [w["rival"]], "correlation": None,
-                        "what_would_separate": _SEPARATE_RIVALS,
-                        "reason": (f"{w['rival']} explains the same evidence on these records: beside it "
-                                   f"{w['effect']} falls to dBIC {w['delta_bic']:.3g}, z {w['z']:.3g}"),
-                        "reason_kind": "rival"})
-    return out
-
-
-_SEPARATE_RIVALS = "a record where they act differently: the mirror turn or a zigzag, or a longer straight run"
+    return [_rival_entry(w["effect"], w["rival"], f"{w['rival']} explains the same evidence on these records: "
+                         f"beside it {w['effect']} falls to dBIC {w['delta_bic']:.3g}, z {w['z']:.3g}")
+            for rnd in rounds for w in rnd.get("withheld", [])]
 
 
 def rivals_withheld(rounds) -> list:
     """``not_identifiable`` entries (kind "rival") of the rivals that took a withheld candidate's evidence
     (:func:`_best_standing`): used only where nothing else reports them."""
-    out = []
-    for rnd in rounds:
-        for w in rnd.get("withheld", []):
-            out.append({"effect": w["rival"], "confused_with": [w["effect"]], "correlation": None,
-                        "what_would_separate": _SEPARATE_RIVALS,
-                        "reason": (f"it explains the evidence {w['effect']} had (beside it {w['effect']} falls to "
-                                   f"dBIC {w['delta_bic']:.3g}, z {w['z']:.3g}), but did not clear a name itself"),
-                        "reason_kind": "rival"})
-    return out
+    return [_rival_entry(w["rival"], w["effect"], f"it explains the evidence {w['effect']} had (beside it "
+                         f"{w['effect']} falls to dBIC {w['delta_bic']:.3g}, z {w['z']:.3g}), but did not clear "
+                         "a name itself")
+            for rnd in rounds for w in rnd.get("withheld", [])]
+
+
+def _rival_entry(effect: str, other: str, reason: str) -> dict:
+    return {"effect": effect, "confused_with": [other], "correlation": None,
+            "what_would_separate": "a record where they act differently: the mirror turn or a zigzag, or a longer "
+                                   "straight run", "reason": reason, "reason_kind": "rival"}
 
 
 def weak_evidence(rounds) -> dict:
