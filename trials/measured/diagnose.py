@@ -865,15 +865,14 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     d_config, base, kept = _baseline(fitter, noise, say)
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
     current, named = _prune(fitter, current, named, rounds, len(sfree), o, say)
-    res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
-                     o.stride)
-    res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o, rounds)
-    demote = to_demote(res.identifiability)
+    ni, table = _identifiability(fitter, current, named, cand, o, rounds)
+    demote = to_demote(table)
     if demote:
         current, named = _demote(fitter, current, named, demote, rounds, o, say)
-        res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise,
-                         len(sfree), o.stride)
-        res.not_identifiable, res.identifiability = _identifiability(fitter, current, named, cand, o, rounds)
+        ni, table = _identifiability(fitter, current, named, cand, o, rounds)
+    res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
+                     o.stride)
+    res.not_identifiable, res.identifiability = ni, table
     res.baseline = "fitted" if kept else "config (the fit replayed worse)"
     res.seconds = time.perf_counter() - t0
     if o.per_run and len(recs) > 1:
