@@ -8,10 +8,13 @@ with no floor: ``MMG_DIAGNOSE_CALIBRATION=none``), and runs with effects.  The f
 afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the records that set them.
 
     python bench/calibrate_diagnose.py bench/out/diagnose_mismatch_cal.json[:KIND] ... [--alpha 0.05] [--write]
+        [--kinds turn turn_pair]
 
 ``PATH:KIND`` takes only the records of one kind of a run (``turn``, ``zigzag``): a run made while
 the diagnosis of the other kind was another (the rudder's inflow freed on zigzags too, variant 6
-in ``docs/diagnose.md``) still calibrates this one.
+in ``docs/diagnose.md``) still calibrates this one.  ``--kinds`` writes only those kinds' floors
+(:func:`trials.measured.calibration.merge_kinds`), the others kept from the packaged file: the
+diagnosis of turns changed (the drift terms freed, stop 38) and its runs recalibrate turns alone.
 """
 from __future__ import annotations
 
@@ -27,7 +30,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 OUT = REPO / "configs" / "calibration" / "diagnose.yaml"
 
-from trials.measured.calibration import calibrate, only_kind, short_of_name
+from trials.measured.calibration import calibrate, merge_kinds, only_kind, short_of_name
 
 
 def main(argv=None):
@@ -36,6 +39,8 @@ def main(argv=None):
                     "PATH:KIND takes only that run's records of one kind (turn, zigzag)")
     ap.add_argument("--alpha", type=float, default=0.05)
     ap.add_argument("--write", action="store_true", help=f"write {OUT.relative_to(REPO)}")
+    ap.add_argument("--kinds", nargs="+", default=None, metavar="KIND",
+                    help="write only these kinds' floors (turn, zigzag, turn_pair); the others kept from the packaged file")
     a = ap.parse_args(argv)
     import yaml
 
@@ -59,6 +64,11 @@ def main(argv=None):
     print("residual floors (u, v / U, r L / U, heading deg):", cal.residual_floors)
     k, n = short_of_name(records, mmg.load_ship("esso_osaka").particulars.L)
     print(f"clean records with a candidate short of a name (reported not_identifiable; packaged floors): {k} of {n}")
+    if a.kinds:
+        old = yaml.safe_load(OUT.read_text()) if OUT.exists() else {}
+        doc = merge_kinds(old, doc, a.kinds)
+        doc["source"] = (f"{old.get('source', '')}; then for {', '.join(a.kinds)} only: {doc['source']}").lstrip("; ")
+        doc = {"source": doc.pop("source"), **doc}
     if a.write:
         OUT.parent.mkdir(parents=True, exist_ok=True)
         OUT.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "

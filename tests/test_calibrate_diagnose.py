@@ -116,3 +116,19 @@ def test_a_hidden_effect_larger_than_its_floor_lends_no_clean_sample(cal):
     assert len(clean["current"]["turn"]) == 1
     clean, _, _ = cal.clean_magnitudes([rec], L, hidden={"turn": {"rudder_offset": 0.8}})
     assert "current" not in clean
+
+
+def test_merge_kinds_replaces_only_the_kinds_named(cal):
+    old = {"source": "a", "alpha": 0.05,
+           "floors": {"current": {"turn": 1.0, "zigzag": 2.0, "turn_pair": 3.0}, "rudder_offset": {"turn": 5.0, "zigzag": 0.6}},
+           "residual_floors": {"turn": {"u": 0.03}, "zigzag": {"u": 0.004}},
+           "clean": {"current": {"turn": [0.1], "zigzag": [0.2]}}}
+    new = {"alpha": 0.05, "floors": {"current": {"turn": 0.5}, "rudder_offset": {"turn": 6.0}, "wind": {"turn": 0.0}},
+           "residual_floors": {"turn": {"u": 0.02}}, "clean": {"current": {"turn": [0.0, 0.3]}}}
+    m = cal.merge_kinds(old, new, ["turn", "turn_pair"])
+    assert m["floors"]["current"] == {"zigzag": 2.0, "turn": 0.5}         # turn_pair had none in new: dropped
+    assert m["floors"]["rudder_offset"] == {"zigzag": 0.6, "turn": 6.0}
+    assert m["floors"]["wind"] == {"turn": 0.0}
+    assert m["residual_floors"] == {"zigzag": {"u": 0.004}, "turn": {"u": 0.02}}
+    assert m["clean"]["current"] == {"zigzag": [0.2], "turn": [0.0, 0.3]}
+    assert old["floors"]["current"]["turn"] == 1.0                          # the input is not changed

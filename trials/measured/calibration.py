@@ -45,6 +45,7 @@ __all__ = [
     "clean_magnitudes",
     "floors",
     "hidden_effects",
+    "merge_kinds",
     "only_kind",
     "record_kind_of",
     "residual_floors",
@@ -263,6 +264,30 @@ class Calibration:
                  "unit": self.units.get(e, "")}
                 for e, kinds in self.clean.items() for k, v in kinds.items()]
         return pd.DataFrame(rows)
+
+
+def merge_kinds(old: dict, new: dict, kinds) -> dict:
+    """The calibration document ``old`` with the floors, residual floors and clean samples of the
+    record ``kinds`` (e.g. ``("turn", "turn_pair")``) taken from ``new``, the other kinds' kept: a
+    change of the diagnosis of one kind of record (its baseline) is recalibrated on that kind's runs
+    alone.  A kind ``new`` has no floor for is dropped from ``old`` too: no floor of the diagnosis it
+    replaced survives."""
+    kinds = set(kinds)
+    out = {k: v for k, v in old.items() if k not in ("floors", "residual_floors", "clean")}
+    out.update({k: v for k, v in new.items() if k not in ("floors", "residual_floors", "clean", "source")})
+    for key in ("floors", "clean"):
+        effects = set(old.get(key, {})) | set(new.get(key, {}))
+        merged = {}
+        for e in sorted(effects, key=lambda e: (list(old.get(key, {})) + list(new.get(key, {}))).index(e)):
+            row = {k: v for k, v in old.get(key, {}).get(e, {}).items() if k not in kinds}
+            row.update({k: v for k, v in new.get(key, {}).get(e, {}).items() if k in kinds})
+            if row:
+                merged[e] = row
+        out[key] = merged
+    res = {k: v for k, v in old.get("residual_floors", {}).items() if k not in kinds}
+    res.update({k: v for k, v in new.get("residual_floors", {}).items() if k in kinds})
+    out["residual_floors"] = res
+    return out
 
 
 def short_of_name(records, L: float) -> tuple[int, int]:
