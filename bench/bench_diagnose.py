@@ -71,15 +71,18 @@ def timing():
     from trials.measured.diagnose import diagnose, synthetic_record
 
     ship = mmg.load_ship("esso_osaka")
-    rec = synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.3, "direction_deg": 120.0}}, dt=1.0,
-                           duration=3500.0, speed=10 * 0.5144, seed=3)
     diagnose(ship, [synthetic_record(ship, "turning", {}, dt=1.0, duration=300.0)], candidates=["current"])  # compile
-    t0 = time.perf_counter()
-    d = diagnose(ship, [rec])
-    dt = time.perf_counter() - t0
-    print(f"timing: one diagnose of a {rec.t[-1]:.0f} s full-scale record at 1 s ({len(rec.t)} samples): {dt:.1f} s "
-          f"wall (issue 26: <= 15 s); named {d.named} {d.parameters}")
-    return dt
+    worst = 0.0
+    for kind, rudder in (("zigzag", 20.0), ("turning", 35.0)):       # a turn frees the drift terms as well
+        rec = synthetic_record(ship, kind, {"current": {"speed_mps": 0.3, "direction_deg": 120.0}}, dt=1.0,
+                               duration=3500.0, speed=10 * 0.5144, seed=3, rudder_deg=rudder)
+        t0 = time.perf_counter()
+        d = diagnose(ship, [rec])
+        dt = time.perf_counter() - t0
+        worst = max(worst, dt)
+        print(f"timing: one diagnose of a {rec.t[-1]:.0f} s full-scale {kind} record at 1 s ({len(rec.t)} samples): "
+              f"{dt:.1f} s wall (issue 26: <= 15 s); named {d.named} {d.parameters}", flush=True)
+    return worst
 
 
 def _refuse_bad_options(ap, a) -> None:
