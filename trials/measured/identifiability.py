@@ -126,10 +126,21 @@ def block_confounding(cov: np.ndarray, idx) -> dict:
 def sym_inv(A: np.ndarray) -> np.ndarray:
     """Inverse of a symmetric positive definite ``A`` whose parameters differ by many orders of
     magnitude (added masses in kg beside primed derivatives): inverted in the scaled form
-    D A D, D = diag(A)^-1/2, so that the scale does not cost the precision."""
+    D A D, D = diag(A)^-1/2, so that the scale does not cost the precision; through its eigenvalues,
+    each held at least :data:`EIG_FLOOR` times the largest."""
     A = np.asarray(A, float)
     d = 1.0 / np.sqrt(np.abs(np.diag(A)))
-    return d[:, None] * np.linalg.inv(A * np.outer(d, d)) * d[None, :]
+    S = A * np.outer(d, d)
+    w, V = np.linalg.eigh(0.5 * (S + S.T))
+    w = np.maximum(w, EIG_FLOOR * max(float(w[-1]), np.finfo(float).tiny))
+    return d[:, None] * ((V / w) @ V.T) * d[None, :]
+
+
+EIG_FLOOR = 1e-12
+"""Smallest eigenvalue :func:`sym_inv` keeps, relative to the largest (of the scaled matrix): an
+``A`` singular to rounding (a turn's drift terms beside the hull's other terms and the added
+masses, 19 parameters) still gives a positive definite inverse, where a plain inverse gave a
+negative variance (the clean ST35 log of ``tests/test_diagnose_own_logs.py``)."""
 
 
 # --------------------------------------------------------------------------- information
