@@ -66,9 +66,8 @@ def main(argv=None):
     print(f"clean records with a candidate short of a name (reported not_identifiable; packaged floors): {k} of {n}")
     if a.kinds:
         old = yaml.safe_load(OUT.read_text()) if OUT.exists() else {}
-        doc = merge_kinds(old, doc, a.kinds)
-        doc["source"] = (f"{old.get('source', '')}; then for {', '.join(a.kinds)} only: {doc['source']}").lstrip("; ")
-        doc = {"source": doc.pop("source"), **doc}
+        source = f"{old.get('source', '')}; then for {', '.join(a.kinds)} only: {doc['source']}".lstrip("; ")
+        doc = {"source": source, **{k: v for k, v in merge_kinds(old, doc, a.kinds).items() if k != "source"}}
     if a.write:
         OUT.parent.mkdir(parents=True, exist_ok=True)
         OUT.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "

@@ -273,7 +273,7 @@ def merge_kinds(old: dict, new: dict, kinds) -> dict:
     alone.  A kind ``new`` has no floor for is dropped from ``old`` too: no floor of the diagnosis it
     replaced survives."""
     kinds = set(kinds)
-    out = {k: v for k, v in old.items() if k not in ("floors", "residual_floors", "clean")}
+    out = dict(old)                                       # the old document's keys, in its order
     out.update({k: v for k, v in new.items() if k not in ("floors", "residual_floors", "clean", "source")})
     for key in ("floors", "clean"):
         effects = set(old.get(key, {})) | set(new.get(key, {}))
