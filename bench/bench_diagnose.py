@@ -73,7 +73,7 @@ def timing():
     ship = mmg.load_ship("esso_osaka")
     diagnose(ship, [synthetic_record(ship, "turning", {}, dt=1.0, duration=300.0)], candidates=["current"])  # compile
     worst = 0.0
-    for kind, rudder in (("zigzag", 20.0), ("turning", 35.0)):       # a turn frees the drift terms as well
+    for kind, rudder in (("zigzag", 20.0), ("turning", 35.0)):       # a turn frees the rudder inflow as well
         rec = synthetic_record(ship, kind, {"current": {"speed_mps": 0.3, "direction_deg": 120.0}}, dt=1.0,
                                duration=3500.0, speed=10 * 0.5144, seed=3, rudder_deg=rudder)
         t0 = time.perf_counter()
