@@ -6,10 +6,11 @@ moved as a real ship's: :func:`trials.measured.mismatch.mismatch_member`), in a 
 300 deg acting through that member's own wind loads.  The diagnosis's baseline holds the drift
 nonlinearities (Y_bb, Y_bbr, Y_brr, N_bb, N_bbr, N_brr) at the config's values; it leaves a 3.7 deg
 heading residual and does not name the wind.  Freeing them on turns (branch
-``exp/turn-drift-terms``, ``docs/diagnose.md`` stop 38) names it, on this seed and on three of four
-seeds tried, and leaves 0.3 deg; it did not land because on the noiseless ST35 truth file of the
-ship itself the freed terms wander past 2 prior std (issue 26, acceptance 3).  Expected to fail
-until a baseline that frees them only where a record needs them lands."""
+``exp/turn-drift-terms``, ``docs/diagnose.md`` stop 38) names it and leaves under 1 deg; it did not
+land: freed on every turn, the terms wander past 2 prior std on the noiseless ST35 truth file of the
+ship itself (issue 26, acceptance 3); freed behind a dBIC and size gate, shallow water was named on
+2 of 20 clean turns of a fresh seed.  Expected to fail until a baseline that frees them only where a
+record needs them lands."""
 import math
 
 import numpy as np
