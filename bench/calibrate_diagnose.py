@@ -13,8 +13,8 @@ afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the record
 ``PATH:KIND`` takes only the records of one kind of a run (``turn``, ``zigzag``): a run made while
 the diagnosis of the other kind was another (the rudder's inflow freed on zigzags too, variant 6
 in ``docs/diagnose.md``) still calibrates this one.  ``--kinds`` writes only those kinds' floors
-(:func:`trials.measured.calibration.merge_kinds`), the others kept from the packaged file: the
-diagnosis of turns changed (the drift terms freed, stop 38) and its runs recalibrate turns alone.
+(:func:`trials.measured.calibration.merge_kinds`), the others kept from the packaged file: where
+the diagnosis of one kind of record changes, its runs recalibrate that kind alone.
 """
 from __future__ import annotations
 

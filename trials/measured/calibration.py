@@ -276,9 +276,8 @@ def merge_kinds(old: dict, new: dict, kinds) -> dict:
     out = dict(old)                                       # the old document's keys, in its order
     out.update({k: v for k, v in new.items() if k not in ("floors", "residual_floors", "clean", "source")})
     for key in ("floors", "clean"):
-        effects = set(old.get(key, {})) | set(new.get(key, {}))
         merged = {}
-        for e in sorted(effects, key=lambda e: (list(old.get(key, {})) + list(new.get(key, {}))).index(e)):
+        for e in dict.fromkeys([*old.get(key, {}), *new.get(key, {})]):     # old's effects first, in order
             row = {k: v for k, v in old.get(key, {}).get(e, {}).items() if k not in kinds}
             row.update({k: v for k, v in new.get(key, {}).get(e, {}).items() if k in kinds})
             if row:
