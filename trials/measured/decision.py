@@ -38,7 +38,7 @@ import numpy as np
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
-           "REASON_KINDS"]
+           "REASON_KINDS", "KIND_FALLBACK", "by_kind"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -51,8 +51,12 @@ WEAK_BIC = 2.0
 """dBIC above which a candidate short of :data:`BIC_THRESHOLD`, but precise (z) and over its floor,
 is reported ``not_identifiable`` rather than dropped (:func:`evidence_short`): Kass & Raftery
 (1995) call 2-6 "positive" evidence and below 2 "not worth more than a bare mention"."""
-KINDS = ("turn", "zigzag", "turn_pair")
-"""Kinds of record set (:func:`record_kind`); the floors are calibrated for the first two."""
+KINDS = ("turn", "zigzag", "turn_pair", "turn_drift")
+"""Kinds of record set the floors are calibrated for: :func:`record_kind`'s three, and ``turn_drift``,
+a single turn whose baseline freed the hull's drift nonlinearities
+(:data:`trials.measured.diagnose.DRIFT_KIND`)."""
+KIND_FALLBACK = {"turn_drift": "turn"}
+"""The kind whose calibration stands in where a calibration file has none for a kind."""
 STATISTICAL_REASON = "its standard error and correlation"
 """The ``reason`` of a ``not_identifiable`` entry reported for its statistics (its standard error could
 not have shown the size to detect: :func:`trials.measured.identifiability.verdict`), as against its
@@ -199,15 +203,15 @@ def least_floor(effect: str, kind: str, floors: dict | None = None) -> float:
     floors = (calibration().get("floors") or {}) if floors is None else floors
     comp = _component_floors(effect, kind, floors)
     if comp:
-        return float(min(floors[c][kind] for c in comp))
-    return float((floors.get(effect) or {}).get(kind, 0.0))
+        return float(min(by_kind(floors[c], kind) for c in comp))
+    return float(by_kind(floors.get(effect), kind, 0.0))
 
 
 def _component_floors(effect: str, kind: str, floors: dict) -> tuple:
     """The names of the part floors ``effect`` is judged by on ``kind`` (:data:`COMPONENT_FLOORS`),
     where ``floors`` holds them all; else ()."""
     comp = COMPONENT_FLOORS.get(kind, ()) if effect == "current" else ()
-    return comp if comp and all(kind in (floors.get(c) or {}) for c in comp) else ()
+    return comp if comp and all(by_kind(floors.get(c), kind) is not None for c in comp) else ()
 
 
 def record_kind(rudders) -> str:
@@ -268,9 +272,18 @@ def calibration() -> dict:
     return data
 
 
+def by_kind(table: dict | None, kind: str, default=None):
+    """``table[kind]``, or where the calibration has no entry for that kind, its
+    :data:`KIND_FALLBACK`'s (else ``default``)."""
+    table = table or {}
+    if kind in table:
+        return table[kind]
+    return table.get(KIND_FALLBACK.get(kind), default)
+
+
 def floor(effect: str, kind: str) -> float:
     """The calibrated magnitude an effect must exceed on a record of ``kind`` (0 where not calibrated)."""
-    return float(((calibration().get("floors") or {}).get(effect) or {}).get(kind, 0.0))
+    return float(by_kind((calibration().get("floors") or {}).get(effect), kind, 0.0))
 
 
 def false_alarm_probability(effect_name: str, kind: str, statistic_value: float):
@@ -291,7 +304,7 @@ def false_alarm_probability(effect_name: str, kind: str, statistic_value: float)
         (k + 1) / (n + 1), k of the n clean calibration records on which the candidate's magnitude
         was at least the value; None where the effect and kind are not calibrated.
     """
-    clean = ((calibration().get("clean") or {}).get(effect_name) or {}).get(kind)
+    clean = by_kind((calibration().get("clean") or {}).get(effect_name), kind)
     if not clean or statistic_value is None or not math.isfinite(statistic_value):
         return None
     a = np.asarray(clean, float)
@@ -315,7 +328,7 @@ def residual_floor(channel: str, U: float, L: float, kind: str = "zigzag") -> fl
     kind : str
         The kind of record (:func:`record_kind`).
     """
-    f = float(((calibration().get("residual_floors") or {}).get(kind) or {}).get(channel, 0.0))
+    f = float((by_kind(calibration().get("residual_floors"), kind) or {}).get(channel, 0.0))
     if channel in ("u", "v"):
         return f * U
     if channel == "r":
