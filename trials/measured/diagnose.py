@@ -237,7 +237,7 @@ def _baseline_prior(f, term):
     return f
 
 
-def _ship_free(ship: Ship, packed, names=None, kind: str = "zigzag", drift: bool = True):
+def _ship_free(ship: Ship, packed, names=None, kind: str = "zigzag", drift: bool = False):
     """The ship's own parameters the diagnosis fits (``names``, or by default :data:`SHIP_FREE_TERMS`,
     :data:`CONSTANTS_FREE`, on a ``kind`` of record set other than ``"zigzag"`` :data:`TURN_CONSTANTS_FREE`
     and, with ``drift``, :data:`TURN_HULL_TERMS`, and :data:`MASS_FREE`) with the diagnosis's priors."""
