@@ -1,6 +1,6 @@
-"""What freeing the drift terms on a turn (``trials.measured.diagnose._drift_terms``, branch
-exp/turn-drift-terms) buys on clean records: per record the baseline's heading residual without and
-with them and the dBIC of freeing them, on clean turns of the mismatch family and on the main job's
+"""What freeing the drift terms on a turn (``trials.measured.diagnose._drift_terms``) buys on
+clean records: per record the baseline's heading residual without and with them (freed or not) and
+the dBIC of freeing them, on clean turns of the mismatch family and on the main job's
 ST35 files (the ship that made them), to set a size gate beside the dBIC one.
 
     python bench/drift_gate.py [--seed0 1000] [--n 24] [--jobs 2]
@@ -28,7 +28,8 @@ def _gate(ship, rec) -> tuple:
     base = next(float(_H.search(x).group(1)) for x in lines if x.startswith("baseline (ship fitted"))
     g = next((x for x in lines if "drift terms" in x), "")
     dbic = float(re.search(r"dBIC ([0-9.e+-]+)", g).group(1)) if g else float("nan")
-    after = float(_H.search(g).group(1)) if "freed" in g else base
+    fall = re.search(r"heading residual ([0-9.e+-]+) deg less", g)
+    after = base - float(fall.group(1)) if fall else base
     return base, after, dbic, "freed" in g
 
 
