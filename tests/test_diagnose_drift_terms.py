@@ -1,13 +1,15 @@
 """The diagnosis frees the hull's drift nonlinearities on a single turn where the record needs them
 (trials.measured.diagnose._drift_terms): a ship whose hull is not the config's polynomial at the drift
-of a 35 deg turn must not hide a wind, and a record of the ship itself must not have them wander.
+of a 35 deg turn must not hide a wind, and such a turn is judged by floors of its own (kind
+``turn_drift``).
 
 The record: a 35 deg port turn of a member of the mismatch family with the cross-flow hull (its
 sway force and yaw moment in the cross-flow integrals, not Kijima's polynomial, every constant
 moved as a real ship's: :func:`trials.measured.mismatch.mismatch_member`), in a 10 m/s wind from
 300 deg acting through that member's own wind loads.  With the drift terms held at the config's
-values the baseline leaves a 3.7 deg heading residual and the wind is not named (main before stop
-38); freed, the residual is under 1 deg and the wind is named."""
+values the baseline leaves a 3.7 deg heading residual and the wind is not named (main up to stop
+38, where this test was a strict xfail); freed, the residual is under 1 deg and the wind is named.
+That a record of the ship itself does not free them is the slow ``test_diagnose_own_logs.py``."""
 import math
 
 import numpy as np
