@@ -1,7 +1,8 @@
 """What freeing the drift terms on a turn (``trials.measured.diagnose._drift_terms``) buys on
 clean records: per record the baseline's heading residual without and with them (freed or not) and
 the dBIC of freeing them, on clean turns of the mismatch family and on the main job's
-ST35 files (the ship that made them), to set a size gate beside the dBIC one.
+ST35 files (the ship that made them): the figures the size gate (``diagnose.drift_fall_min``)
+was checked on, and dBIC beside them (stop 38's gate also asked dBIC > 20; dropped in stop 39).
 
     python bench/drift_gate.py [--seed0 1000] [--n 24] [--jobs 2]
 """

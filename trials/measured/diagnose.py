@@ -86,10 +86,12 @@ __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "st
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
-"""Hull terms whose coefficients the diagnosis fits with every model (plus :data:`TURN_HULL_TERMS`,
-:data:`CONSTANTS_FREE`, :data:`TURN_CONSTANTS_FREE` on turns, :data:`MASS_FREE`)."""
+"""Hull terms whose coefficients the diagnosis fits with every model (plus :data:`CONSTANTS_FREE`,
+:data:`TURN_CONSTANTS_FREE` on turns, :data:`TURN_HULL_TERMS` on single turns that need them,
+:data:`MASS_FREE`)."""
 TURN_HULL_TERMS = ("beta|beta|", "beta^2*r", "beta*r^2")
-"""Hull terms it fits as well on turns: the drift nonlinearities.  A 35 deg turn holds a drift of
+"""Hull terms it fits as well on a single turn whose records need them (:func:`_drift_terms`): the
+drift nonlinearities.  A 35 deg turn holds a drift of
 10-15 deg for most of the record, where a real hull's side force and moment leave a polynomial
 fitted for small drift (Kijima's) by more than its linear and r|r| terms can take up: on the
 cross-flow members of the mismatch family the baseline left a 1.6-3 deg heading residual and a
