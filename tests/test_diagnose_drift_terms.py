@@ -82,3 +82,46 @@ def test_a_kind_without_calibration_falls_back_to_its_parent():
     assert by_kind({**table, "turn_drift": 0.05}, "turn_drift") == 0.05
     assert by_kind(table, "turn_pair", 0.0) == 0.0           # no parent: the default
     assert KIND_FALLBACK["turn_drift"] == "turn"
+
+
+def test_shallow_water_changes_the_coefficients_it_lists():
+    """What the depth correction lists is what it changes when packed (mmg.effects.shallow_water.pack),
+    and every other effect lists nothing."""
+    import mmg
+    import mmg.effects as E
+    from mmg import model as M
+    from mmg.model import pack
+
+    ship = mmg.load_ship("esso_osaka")
+    pk = pack(ship)
+    sw = E.get("shallow_water")
+    shallow = sw.pack(pk, {"depth_to_draft": 1.5}, ship=ship)
+    moved = {n for n, a, b in zip(ship.hull.names, pk.hull_coef, shallow.hull_coef) if not math.isclose(a, b)}
+    moved |= {n for n, i in (("m_x", M.P_MX), ("m_y", M.P_MY), ("J_z", M.P_JZ)) if not math.isclose(pk.p[i], shallow.p[i])}
+    if not math.isclose(pk.poly[M.POLY_WP0][0], shallow.poly[M.POLY_WP0][0]):
+        moved.add("w_P0")
+    assert set(sw.changed_coefficients(ship)) == moved
+    assert {"N_bbr", "N_brr"} <= moved                                # the drift terms a turn_drift fit frees
+    for name in ("current", "wind", "heading_bias", "rudder_offset"):
+        assert E.get(name).changed_coefficients(ship) == ()
+
+
+def test_an_effect_whose_coefficients_are_all_free_is_not_fitted():
+    import mmg
+    import mmg.effects as E
+    from trials.measured.diagnose import _covered
+
+    ship = mmg.load_ship("esso_osaka")
+    sw, cur = E.get("shallow_water"), E.get("current")
+
+    class F:                                   # the fitter's two attributes _covered reads
+        def __init__(self, names):
+            self.ship = ship
+            self.ship_free = [type("P", (), {"name": n})() for n in names]
+
+    every = list(sw.changed_coefficients(ship))
+    keep, out = _covered(F(every + ["epsilon"]), [cur, sw], lambda m: None)
+    assert keep == [cur] and [o["effect"] for o in out] == ["shallow_water"]
+    assert set(out[0]["confused_with"]) == set(every) and out[0]["reason_kind"] == "statistics"
+    keep, out = _covered(F([n for n in every if n != "N_brr"]), [cur, sw], lambda m: None)   # one held: fitted
+    assert keep == [cur, sw] and out == []

@@ -200,6 +200,13 @@ class Effect(abc.ABC):
         """Why the effect cannot be applied to this record (None when it can)."""
         return cls.missing(ctx.channels)
 
+    @classmethod
+    def changed_coefficients(cls, ship) -> tuple:
+        """The names of the ship's own coefficients a ``"coefficients"`` effect changes (hull terms by
+        their config names, ``m_x``, ``m_y``, ``J_z``, ``w_P0``); () for an effect of another kind.  A
+        fit that frees every one of them cannot tell the effect from the ship."""
+        return ()
+
     # ---------------------------------------------------------------- how it acts
     @classmethod
     def slots(cls, values: dict) -> dict:

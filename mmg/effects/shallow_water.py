@@ -76,6 +76,12 @@ class ShallowWater(Effect):
         return {"depth_to_draft": (1.0 / h) if h > 1e-9 else math.inf}
 
     @classmethod
+    def changed_coefficients(cls, ship) -> tuple:
+        f = factors(ship, 0.5)                      # the keys only: which quantities the depth corrects
+        wake = ("w_P0",) if "one_minus_w" in f else ()
+        return tuple(n for n in ship.hull.names if n in f) + tuple(n for n in ("m_x", "m_y", "J_z") if n in f) + wake
+
+    @classmethod
     def pack(cls, packed, values, ship=None):
         if ship is None:
             raise ValueError("shallow_water needs the ship (its particulars and hull names)")

@@ -669,6 +669,30 @@ def drift_fall_min() -> float:
     return float(((calibration().get("residual_floors") or {}).get("zigzag") or {}).get("heading", 0.0))
 
 
+def _covered(fitter, cand, say) -> tuple[list, list]:
+    """(the candidates to fit, ``not_identifiable`` entries of those left out): a coefficient effect
+    whose every changed coefficient (:meth:`mmg.effects.Effect.changed_coefficients`) the baseline
+    frees is a change of the ship's own coefficients there, not something the records can tell from
+    them, and is not fitted.  Shallow water on a turn whose drift terms are freed (:data:`DRIFT_KIND`):
+    over 169 such candidate fits of the calibration and check draws of stop 39 its dBIC never passed
+    18.1 and its z never 1.73 (a name needs 20 and 3), and not fitting it takes a 3500 s turn from
+    17.7 s to under the 15 s asked (``bench/bench_diagnose.py --timing-only``)."""
+    free = {f.name for f in fitter.ship_free}
+    keep, out = [], []
+    for cls in cand:
+        ch = cls.changed_coefficients(fitter.ship)
+        if not ch or not set(ch) <= free:
+            keep.append(cls)
+            continue
+        reason = f"a change of coefficients this fit frees, every one ({', '.join(ch)})"
+        say(f"candidate {cls.name} not fitted: {reason}")
+        out.append({"effect": cls.name, "confused_with": list(ch), "correlation": None,
+                    "what_would_separate": "the water depth from a chart or an echo sounder, or a zigzag "
+                                           "diagnosed with these records", "reason": reason,
+                    "reason_kind": "statistics"})
+    return keep, out
+
+
 def _taus(current, stride):
     """(correlation times [samples] of each channel's residual, the standard-error inflation)."""
     taus = np.array([np.median([_tau(d[::stride, j]) for d in current.diffs]) for j in range(6)])
@@ -973,6 +997,8 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     if o.ship_free is None and kind == "turn" and not any(r.seg.speed_only for r in recs):
         base, kept = _drift_terms(fitter, d_config, base, kept, o, say)
         sfree = fitter.ship_free
+    cand, covered = _covered(fitter, cand, say)
+    cand_log = cand_log + [{"effect": c["effect"], "skipped": c["reason"]} for c in covered]
     current, named, rounds = _search(fitter, base, cand, len(sfree), o, say)
     current, named = _prune(fitter, current, named, rounds, len(sfree), o, say)
     ni, table = _identifiability(fitter, current, named, cand, o, rounds)
@@ -982,7 +1008,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
         ni, table = _identifiability(fitter, current, named, cand, o, rounds)
     res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
                      o.stride)
-    res.not_identifiable, res.identifiability = ni, table
+    res.not_identifiable, res.identifiability = ni + covered, table
     res.baseline = "fitted" if kept else "config (the fit replayed worse)"
     res.seconds = time.perf_counter() - t0
     if o.per_run and len(recs) > 1:
