@@ -69,9 +69,16 @@ def test_drift_terms_freed_and_wind_named_on_a_cross_flow_turn(case):
 def test_a_turn_that_frees_them_is_judged_by_floors_of_its_own(case):
     from trials.measured.diagnose import DRIFT_KIND
 
+    from trials.measured.decision import calibration
+
     d = case[3]
     kinds = {rd.get("kind") for rd in d.to_json().get("rounds", [])}
     assert kinds == {DRIFT_KIND}, kinds
+    floors = calibration()["floors"]
+    for rd in d.to_json()["rounds"]:
+        for c in rd["candidates"]:
+            if c["effect"] in floors:                        # judged by the turn_drift floors, not the turn ones
+                assert c["floor"] == floors[c["effect"]][DRIFT_KIND] != floors[c["effect"]]["turn"], c
 
 
 def test_a_kind_without_calibration_falls_back_to_its_parent():
@@ -122,6 +129,6 @@ def test_an_effect_whose_coefficients_are_all_free_is_not_fitted():
     every = list(sw.changed_coefficients(ship))
     keep, out = _covered(F(every + ["epsilon"]), [cur, sw], lambda m: None)
     assert keep == [cur] and [o["effect"] for o in out] == ["shallow_water"]
-    assert set(out[0]["confused_with"]) == set(every) and out[0]["reason_kind"] == "statistics"
+    assert set(out[0]["confused_with"]) == set(every) and out[0]["reason_kind"] == "coefficients"
     keep, out = _covered(F([n for n in every if n != "N_brr"]), [cur, sw], lambda m: None)   # one held: fitted
     assert keep == [cur, sw] and out == []

@@ -49,6 +49,8 @@ def test_clean_own_logs_name_nothing(tmp_path, trial):
     for path in _simulate(tmp_path, trial):
         d = diagnose(ship, [path])
         _check_clean(d)
+        # the ship that made it: its drift terms are the config's (diagnose._drift_terms keeps them)
+        assert {rd.get("kind") for rd in d.rounds} <= {"zigzag", "turn"}, [rd.get("kind") for rd in d.rounds]
 
 
 def test_zz20_with_one_knot_current_names_the_current_alone(tmp_path):

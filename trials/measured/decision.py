@@ -53,7 +53,7 @@ is reported ``not_identifiable`` rather than dropped (:func:`evidence_short`): K
 (1995) call 2-6 "positive" evidence and below 2 "not worth more than a bare mention"."""
 KINDS = ("turn", "zigzag", "turn_pair", "turn_drift")
 """Kinds of record set the floors are calibrated for: :func:`record_kind`'s three, and ``turn_drift``,
-a single turn whose baseline freed the hull's drift nonlinearities
+turns to one side whose baseline freed the hull's drift nonlinearities
 (:data:`trials.measured.diagnose.DRIFT_KIND`)."""
 KIND_FALLBACK = {"turn_drift": "turn"}
 """The kind whose calibration stands in where a calibration file has none for a kind."""
@@ -62,14 +62,15 @@ STATISTICAL_REASON = "its standard error and correlation"
 not have shown the size to detect: :func:`trials.measured.identifiability.verdict`), as against its
 calibrated floor, its evidence or too little information."""
 
-REASON_KINDS = ("statistics", "floor", "evidence", "information", "rival", "straight_run")
+REASON_KINDS = ("statistics", "floor", "evidence", "information", "rival", "straight_run", "coefficients")
 """The kinds of ``not_identifiable`` reasons, each entry's ``reason_kind``: its standard error and
 confounding (:data:`STATISTICAL_REASON`), the calibrated floor (the ship's own mismatch lends it as much),
 evidence short of a name, too little information (:func:`trials.measured.identifiability.verdict`,
 :func:`trials.measured.diagnose.within_mismatch`, :func:`trials.measured.diagnose.weak_evidence`), and a
 name withheld because another candidate with as much evidence takes its evidence away
 (:func:`trials.measured.diagnose.withheld`), or whose fit the record's straight run contradicts
-(:func:`trials.measured.diagnose.straight_contradicts`)."""
+(:func:`trials.measured.diagnose.straight_contradicts`), or a coefficient effect not fitted because the fit
+frees every coefficient it changes (:func:`trials.measured.diagnose._covered`)."""
 
 MAGNITUDE_UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1",
                    "shallow_water": "T/H"}

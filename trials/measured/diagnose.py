@@ -15,11 +15,15 @@ checking the scale) and the ship config:
    :data:`TURN_CONSTANTS_FREE`, and the added masses and moment, :data:`MASS_FREE`; :func:`ekf.identify.identify_segments`
    with its prior) with no effect: constants of the
    config that are merely a bit off (added mass, wake, hull) are absorbed here, so they do not
-   pass for an effect.  ``rms_before`` is this model's residual.
+   pass for an effect.  On turns to one side whose records log their sway, the drift
+   nonlinearities (:data:`TURN_HULL_TERMS`) as well where they lower the heading residual by more
+   than :func:`drift_fall_min` (:func:`_drift_terms`); such a record set is then of kind
+   :data:`DRIFT_KIND`, with floors of its own.  ``rms_before`` is this model's residual.
 3. **Candidates**: each registered effect (:mod:`mmg.effects`) not yet in the model and
    applicable to every record (a wind candidate needs the relative-wind channels, non-zero, and a
    ship wind section; otherwise it is skipped with that reason) is fitted together with the same
-   ship coefficients.  Score: the Bayesian information criterion with per-channel unknown noise
+   ship coefficients; a coefficient effect whose every changed coefficient the baseline frees
+   (shallow water on :data:`DRIFT_KIND`) is not, and is reported ``not_identifiable`` (:func:`_covered`).  Score: the Bayesian information criterion with per-channel unknown noise
    variances and an effective sample count per channel, N_eff = N / tau, tau the integrated
    autocorrelation time of the current model's residual in that channel (the residuals of a
    10 Hz record are far from independent; BIC with the raw N would name an effect for every
@@ -87,10 +91,10 @@ __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "st
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
 """Hull terms whose coefficients the diagnosis fits with every model (plus :data:`CONSTANTS_FREE`,
-:data:`TURN_CONSTANTS_FREE` on turns, :data:`TURN_HULL_TERMS` on single turns that need them,
+:data:`TURN_CONSTANTS_FREE` on turns, :data:`TURN_HULL_TERMS` on turns to one side that need them,
 :data:`MASS_FREE`)."""
 TURN_HULL_TERMS = ("beta|beta|", "beta^2*r", "beta*r^2")
-"""Hull terms it fits as well on a single turn whose records need them (:func:`_drift_terms`): the
+"""Hull terms it fits as well on turns to one side whose records need them (:func:`_drift_terms`): the
 drift nonlinearities.  A 35 deg turn holds a drift of
 10-15 deg for most of the record, where a real hull's side force and moment leave a polynomial
 fitted for small drift (Kijima's) by more than its linear and r|r| terms can take up: on the
@@ -99,8 +103,8 @@ cross-flow members of the mismatch family the baseline left a 1.6-3 deg heading 
 stop 37), with these terms freed 0.35-0.45 deg and the wind named (dBIC 46-76).  On a zigzag the
 drift stays small and these terms would only trade with the linear ones."""
 DRIFT_KIND = "turn_drift"
-"""The kind of record set (:data:`~trials.measured.decision.KINDS`) of a single turn whose baseline
-freed the drift nonlinearities (:func:`_drift_terms`): its floors are calibrated apart from those
+"""The kind of record set (:data:`~trials.measured.decision.KINDS`) of turns to one side (calibrated on
+single turns) whose baseline freed the drift nonlinearities (:func:`_drift_terms`): its floors are calibrated apart from those
 of the turns that keep them at the config's (``"turn"``), since the ship's own mismatch lends the
 candidates other sizes on the two baselines (fresh seed 27000, stop 38: one set of floors over both
 named shallow water on 2 of 20 clean Kijima turns)."""
@@ -629,8 +633,8 @@ def _drift_terms(fitter, d_config, base, kept, o: DiagnoseOptions, say):
     config's, and the wind was not named.  On a clean record of the ship that made it the six terms,
     nearly collinear, would wander on whatever the replay leaves (the main job's clean ST35 truth
     file: a fall of 0.0020 deg at dBIC 28; freed, N_bb 3.1 and Y_bbr 3.3 prior std off the config):
-    the size test keeps them.  Called on single turns whose records log their sway.  Where the terms
-    are freed, ``fitter.ship_free`` takes them and ``fitter.kind`` becomes :data:`DRIFT_KIND` (floors
+    the size test keeps them.  Called on turns to one side (record_kind ``"turn"``) whose records
+    log their sway.  Where the terms are freed, ``fitter.ship_free`` takes them and ``fitter.kind`` becomes :data:`DRIFT_KIND` (floors
     of their own); where not, both and the baseline are left as they were."""
     free0 = list(fitter.ship_free)
     ship, packed = fitter.ship, fitter.packed
@@ -661,12 +665,22 @@ def _drift_terms(fitter, d_config, base, kept, o: DiagnoseOptions, say):
 def drift_fall_min() -> float:
     """The fall of the heading residual [deg] that freeing the drift terms must bring:
     the calibrated heading residual the ship's own mismatch leaves on a zigzag, where the drift stays
-    small (``residual_floors.zigzag.heading`` of the packaged calibration; 0 without one).  A fall
+    small (``residual_floors.zigzag.heading`` of the calibration in use, else of the packaged one, so
+    that calibration runs without floors gate as a user's diagnosis does; 0 without either).  A fall
     smaller than what a ship that is not its model leaves where these terms play no part is not a
     drift the config misses: on the main job's noiseless ST35 truth file, diagnosed with the ship
     that made it, they took the heading residual from 0.0087 to 0.0067 deg at dBIC 28, and wandered
     3.3 prior std (``bench/drift_gate.py`` prints the falls)."""
-    return float(((calibration().get("residual_floors") or {}).get("zigzag") or {}).get("heading", 0.0))
+    f = ((calibration().get("residual_floors") or {}).get("zigzag") or {}).get("heading")
+    if f is None:                 # a calibration without it (MMG_DIAGNOSE_CALIBRATION=none): the packaged one's
+        import yaml
+
+        from mmg.resources import config_dir
+
+        p = config_dir() / "calibration" / "diagnose.yaml"
+        packaged = (yaml.safe_load(p.read_text()) or {}) if p.is_file() else {}
+        f = ((packaged.get("residual_floors") or {}).get("zigzag") or {}).get("heading", 0.0)
+    return float(f)
 
 
 def _covered(fitter, cand, say) -> tuple[list, list]:
@@ -689,7 +703,7 @@ def _covered(fitter, cand, say) -> tuple[list, list]:
         out.append({"effect": cls.name, "confused_with": list(ch), "correlation": None,
                     "what_would_separate": "the water depth from a chart or an echo sounder, or a zigzag "
                                            "diagnosed with these records", "reason": reason,
-                    "reason_kind": "statistics"})
+                    "reason_kind": "coefficients"})
     return keep, out
 
 
@@ -1006,8 +1020,8 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     if demote:
         current, named = _demote(fitter, current, named, demote, rounds, o, say)
         ni, table = _identifiability(fitter, current, named, cand, o, rounds)
-    res = _diagnosis(ship, recs, (d_config, base), (current, named, rounds), (cand, cand_log), noise, len(sfree),
-                     o.stride)
+    res = _diagnosis(ship, recs, (d_config, base, fitter.kind), (current, named, rounds), (cand, cand_log), noise,
+                     len(sfree), o.stride)
     res.not_identifiable, res.identifiability = ni + covered, table
     res.baseline = "fitted" if kept else "config (the fit replayed worse)"
     res.seconds = time.perf_counter() - t0
@@ -1189,10 +1203,11 @@ def straight_run_table(recs, before: _Model, after: _Model) -> list:
 
 
 def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int) -> Diagnosis:
-    """The :class:`Diagnosis`: baseline = (the config's differences, the baseline fit), search = (final
+    """The :class:`Diagnosis`: baseline = (the config's differences, the baseline fit, the kind of record
+    set the floors were read for), search = (final
     fit, named effects, rounds) of :func:`_search`, cands = (candidates, log) of :func:`_candidates`;
     the named effects' values with standard errors inflated by the residuals' correlation, what is left."""
-    d_config, base = baseline
+    d_config, base, kind = baseline
     current, named, rounds = search
     cand, cand_log = cands
     _, inflate = _taus(current, stride)
@@ -1205,8 +1220,7 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
         ses[cls.name] = s
         ivs[cls.name] = effect_intervals(cls, *effect_estimate(current, cls, inflate))
     cand_log = cand_log + [{"effect": c.name, "named": c.name in named} for c in cand]
-    unexpl, desc, _ = _describe(recs, current.diffs, noise, None, ship.particulars.L,
-                                rounds[0].get("kind") if rounds else None)
+    unexpl, desc, _ = _describe(recs, current.diffs, noise, None, ship.particulars.L, kind)
     mfm = model_form_mismatch(current.free[:ns], current.theta[:ns])
     th_out = [f.prior if f.name in mfm else v for f, v in zip(current.free[:ns], current.theta[:ns])]
     ship_vals = _ship_values(ship, current.free[:ns], th_out)        # mismatched: the config's, not written as fitted
