@@ -38,7 +38,7 @@ import numpy as np
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
-           "REASON_KINDS", "KIND_FALLBACK", "by_kind"]
+           "REASON_KINDS", "KIND_FALLBACK", "by_kind", "packaged_calibration"]
 
 BIC_THRESHOLD = 20.0
 """dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
@@ -250,20 +250,30 @@ def calibration() -> dict:
     import os
     from pathlib import Path
 
-    import yaml
-
-    from mmg.resources import config_dir
-
-    from mmg.errors import InputError
-
     env = os.environ.get("MMG_DIAGNOSE_CALIBRATION")
     if env and env.lower() == "none":
         return {}
-    p = Path(env) if env else config_dir() / "calibration" / "diagnose.yaml"
-    if not p.is_file():
-        if env:                           # a file the user named and that is not there: refused, not ignored
-            raise InputError(str(p), "MMG_DIAGNOSE_CALIBRATION", "no such calibration file (or 'none' for no floors)")
-        return {}
+    return _read_calibration(Path(env)) if env else packaged_calibration()
+
+
+@lru_cache(maxsize=1)
+def packaged_calibration() -> dict:
+    """The calibration shipped in the wheel (``configs/calibration/diagnose.yaml``) whatever
+    ``MMG_DIAGNOSE_CALIBRATION`` says; empty when absent."""
+    from mmg.resources import config_dir
+
+    p = config_dir() / "calibration" / "diagnose.yaml"
+    return _read_calibration(p) if p.is_file() else {}
+
+
+def _read_calibration(p) -> dict:
+    """A calibration file read and checked (one-line :class:`~mmg.errors.InputError` when it is not one)."""
+    import yaml
+
+    from mmg.errors import InputError
+
+    if not p.is_file():                   # a file the user named and that is not there: refused, not ignored
+        raise InputError(str(p), "MMG_DIAGNOSE_CALIBRATION", "no such calibration file (or 'none' for no floors)")
     try:
         data = yaml.safe_load(p.read_text()) or {}
     except yaml.YAMLError as e:

@@ -23,7 +23,8 @@ checking the scale) and the ship config:
    applicable to every record (a wind candidate needs the relative-wind channels, non-zero, and a
    ship wind section; otherwise it is skipped with that reason) is fitted together with the same
    ship coefficients; a coefficient effect whose every changed coefficient the baseline frees
-   (shallow water on :data:`DRIFT_KIND`) is not, and is reported ``not_identifiable`` (:func:`_covered`).  Score: the Bayesian information criterion with per-channel unknown noise
+   (shallow water on :data:`DRIFT_KIND`) is not, and is reported ``not_identifiable``
+   (:func:`_covered`).  Score: the Bayesian information criterion with per-channel unknown noise
    variances and an effective sample count per channel, N_eff = N / tau, tau the integrated
    autocorrelation time of the current model's residual in that channel (the residuals of a
    10 Hz record are far from independent; BIC with the raw N would name an effect for every
@@ -104,7 +105,8 @@ stop 37), with these terms freed 0.35-0.45 deg and the wind named (dBIC 46-76). 
 drift stays small and these terms would only trade with the linear ones."""
 DRIFT_KIND = "turn_drift"
 """The kind of record set (:data:`~trials.measured.decision.KINDS`) of turns to one side (calibrated on
-single turns) whose baseline freed the drift nonlinearities (:func:`_drift_terms`): its floors are calibrated apart from those
+single turns) whose baseline freed the drift nonlinearities (:func:`_drift_terms`): its floors are
+calibrated apart from those
 of the turns that keep them at the config's (``"turn"``), since the ship's own mismatch lends the
 candidates other sizes on the two baselines (fresh seed 27000, stop 38: one set of floors over both
 named shallow water on 2 of 20 clean Kijima turns)."""
@@ -634,8 +636,9 @@ def _drift_terms(fitter, d_config, base, kept, o: DiagnoseOptions, say):
     nearly collinear, would wander on whatever the replay leaves (the main job's clean ST35 truth
     file: a fall of 0.0020 deg at dBIC 28; freed, N_bb 3.1 and Y_bbr 3.3 prior std off the config):
     the size test keeps them.  Called on turns to one side (record_kind ``"turn"``) whose records
-    log their sway.  Where the terms are freed, ``fitter.ship_free`` takes them and ``fitter.kind`` becomes :data:`DRIFT_KIND` (floors
-    of their own); where not, both and the baseline are left as they were."""
+    log their sway.  Where the terms are freed, ``fitter.ship_free`` takes them and ``fitter.kind``
+    becomes :data:`DRIFT_KIND` (floors of their own); where not, both and the baseline are left as
+    they were."""
     free0 = list(fitter.ship_free)
     ship, packed = fitter.ship, fitter.packed
     free1 = _ship_free(ship, packed, None, fitter.kind, drift=True)
@@ -671,16 +674,15 @@ def drift_fall_min() -> float:
     drift the config misses: on the main job's noiseless ST35 truth file, diagnosed with the ship
     that made it, they took the heading residual from 0.0087 to 0.0067 deg at dBIC 28, and wandered
     3.3 prior std (``bench/drift_gate.py`` prints the falls)."""
-    f = ((calibration().get("residual_floors") or {}).get("zigzag") or {}).get("heading")
-    if f is None:                 # a calibration without it (MMG_DIAGNOSE_CALIBRATION=none): the packaged one's
-        import yaml
+    from .decision import packaged_calibration
 
-        from mmg.resources import config_dir
+    def zigzag_heading(cal):
+        return ((cal.get("residual_floors") or {}).get("zigzag") or {}).get("heading")
 
-        p = config_dir() / "calibration" / "diagnose.yaml"
-        packaged = (yaml.safe_load(p.read_text()) or {}) if p.is_file() else {}
-        f = ((packaged.get("residual_floors") or {}).get("zigzag") or {}).get("heading", 0.0)
-    return float(f)
+    f = zigzag_heading(calibration())
+    if f is None:                          # none in use (MMG_DIAGNOSE_CALIBRATION=none): the packaged one's
+        f = zigzag_heading(packaged_calibration())
+    return float(f or 0.0)
 
 
 def _covered(fitter, cand, say) -> tuple[list, list]:
