@@ -85,7 +85,7 @@ either way).  Floors: 0.01 for a hull coefficient, 0.05 for a rudder constant; `
 absolute.  Effect parameters carry their own prior (:class:`mmg.effects.Parameter`)."""
 
 DIAGNOSIS_PRIOR_REL_STD = {**PRIOR_REL_STD, "mass": 0.2, "hull": 0.15, "hull_nonlinear": 0.30, "resistance": 0.10,
-                           "w_P0": 0.20, "epsilon": 0.10, "hull_floor": 0.002}
+                           "w_P0": 0.20, "epsilon": 0.10, "hull_floor": 0.002, "rudder": 0.15}
 """The diagnosis's policy (:func:`trials.measured.diagnose.diagnose`), beside :data:`PRIOR_REL_STD` in
 the one table of prior widths: what is known of a config's source, not identification's factor of
 2.  Linear sway/yaw derivatives (``hull``: the terms in beta, r, v) from captive tests or
@@ -94,7 +94,9 @@ about 30 %, the resistance (``resistance``: cos(beta)^2, u^2) to 10 %, the wake 
 (``w_P0``, relative here) to 20 %; the rudder's inflow ratio epsilon = (1 - w_R) / (1 - w_P) to 10 %
 (``epsilon``: the rudder normal force goes as epsilon^2, so its force to about 20 %, the spread of
 the rudder-wake regressions and of the rudder lift slope a config takes from Fujii's formula);
-``hull_floor`` is the smallest std of a primed hull coefficient.
+``hull_floor`` is the smallest std of a primed hull coefficient.  The rudder's flow-straightening
+coefficients gamma_R (``rudder``, freed on zigzags) to 15 %, the spread of a ship's rudder constants
+about a config's (the floor of 0.05 of :func:`free_parameters` holds for small ones).
 The added masses at 20 %: the diagnosis frees them with every candidate effect, and an added mass
 a few % off leaves a residual (surge speed loss in the turn, sway and yaw lag) an effect would
 otherwise take; a wider prior would let them take an effect's residual instead.  Which term is in

@@ -43,12 +43,24 @@ def test_drift_terms_are_the_kijima_drift_terms():
     assert not drift & {f.name for f in _ship_free(ship, pack(ship), kind="zigzag", drift=True)}
 
 
-def test_the_size_gate_is_the_zigzag_heading_residual_floor():
-    from trials.measured.decision import calibration
+def test_the_size_gate_does_not_move_with_the_zigzag_floors(tmp_path, monkeypatch):
+    """The gate is a number of its own (the zigzag heading floor when turn_drift was calibrated): a
+    calibration in use whose zigzag heading floor is another leaves it, and the turns' diagnosis, as
+    they were."""
+    import yaml
+
+    from trials.measured import decision
     from trials.measured.diagnose import drift_fall_min
 
-    assert drift_fall_min() == pytest.approx(calibration()["residual_floors"]["zigzag"]["heading"])
-    assert 0.05 < drift_fall_min() < 1.0                       # deg: a size, not a rounding
+    before = drift_fall_min()
+    assert 0.05 < before < 1.0                       # deg: a size, not a rounding
+    cal = dict(decision.packaged_calibration())
+    cal["residual_floors"] = {**cal["residual_floors"], "zigzag": {**cal["residual_floors"]["zigzag"], "heading": 3.0}}
+    p = tmp_path / "cal.yaml"
+    p.write_text(yaml.safe_dump(cal))
+    monkeypatch.setenv("MMG_DIAGNOSE_CALIBRATION", str(p))
+    assert decision.calibration()["residual_floors"]["zigzag"]["heading"] == 3.0
+    assert drift_fall_min() == before
 
 
 def test_cross_flow_member_is_the_case(case):

@@ -12,7 +12,8 @@ checking the scale) and the ship config:
 2. **Baseline**: fit the ship coefficients the records inform (:data:`SHIP_FREE_TERMS`: the
    resistance, the linear sway/yaw derivatives and the yaw damping r|r| term, the wake
    w_P0, :data:`CONSTANTS_FREE`, on turns the rudder's inflow ratio epsilon,
-   :data:`TURN_CONSTANTS_FREE`, and the added masses and moment, :data:`MASS_FREE`; :func:`ekf.identify.identify_segments`
+   :data:`TURN_CONSTANTS_FREE`, on zigzags the rudder's flow straightening for either sign of its
+   inflow angle, :data:`ZIGZAG_CONSTANTS_FREE`, and the added masses and moment, :data:`MASS_FREE`; :func:`ekf.identify.identify_segments`
    with its prior) with no effect: constants of the
    config that are merely a bit off (added mass, wake, hull) are absorbed here, so they do not
    pass for an effect.  On turns to one side whose records log their sway, the drift
@@ -88,11 +89,13 @@ from .diagnose_report import fmt3, format_rms, format_values
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "straight_contradicts",
            "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
+           "ZIGZAG_CONSTANTS_FREE",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
 """Hull terms whose coefficients the diagnosis fits with every model (plus :data:`CONSTANTS_FREE`,
-:data:`TURN_CONSTANTS_FREE` on turns, :data:`TURN_HULL_TERMS` on turns to one side that need them,
+:data:`TURN_CONSTANTS_FREE` on turns, :data:`ZIGZAG_CONSTANTS_FREE` on zigzags, :data:`TURN_HULL_TERMS` on
+turns to one side that need them,
 :data:`MASS_FREE`)."""
 TURN_HULL_TERMS = ("beta|beta|", "beta^2*r", "beta*r^2")
 """Hull terms it fits as well on turns to one side whose records need them (:func:`_drift_terms`): the
@@ -196,6 +199,21 @@ off) a 10 m/s wind on a port turn was fitted at dBIC 19.5 and z 1.9 without epsi
 trades with the freed linear hull terms (a Nomoto gain is their ratio): freeing it there too (variant 6
 in ``docs/diagnose.md``) made a following 18 m/s wind on a 20/20 zigzag of the development set
 not identifiable (correlation 0.997 with m_x, m_y, epsilon)."""
+ZIGZAG_CONSTANTS_FREE = ("gamma_R_pos", "gamma_R_neg")
+"""Rudder constants it fits as well on zigzags (:func:`~trials.measured.decision.record_kind`
+``zigzag``): the flow-straightening coefficients gamma_R of the rudder's inflow angle for positive and
+negative beta_R, each with its own prior (std 15 % of the config value, at least 0.05:
+``rudder`` of :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`).  A real ship's two differ (the MMG
+standard's KVLCC2: 0.395 and 0.640), and a difference the config does not have makes the rudder's
+force asymmetric in a zigzag, where beta_R swings both ways: it is what the ship's own mismatch lends
+a rudder offset there.  On the zigzags of stop 39's fresh draws (family seeds 26000-31000, 140
+clean or offset records) the round-1 offset's error was correlated -0.92 with gamma_R_pos / gamma_R_neg
+- 1 of the member, and three 1 deg offsets were fitted at 0.61-0.62 deg, under the zigzag floor that
+asymmetry set (0.65 deg).  Freed, the two take the asymmetry: on family seed 32000 the 1 deg offsets
+were fitted at 0.93-1.10 deg (0.87-1.39 without) and the clean zigzags' offsets fell from 0.08-0.53 to
+0.02-0.26 deg.  The offset stays identifiable because it acts at every drift and the asymmetry only
+with drift or yaw, but the two correlate (0.97-0.99 in that fit), so its standard error grows.  On a
+turn to one side beta_R keeps one sign and only one of the two would be seen; it is not freed there."""
 MASS_FREE = ("m_x", "m_y", "J_z")
 """Added masses and the added moment of inertia the diagnosis fits with every model (prior: the
 config value, relative std from :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`, the diagnosis's policy
@@ -247,13 +265,16 @@ def _baseline_prior(f, term):
 
 def _ship_free(ship: Ship, packed, names=None, kind: str = "zigzag", drift: bool = False):
     """The ship's own parameters the diagnosis fits (``names``, or by default :data:`SHIP_FREE_TERMS`,
-    :data:`CONSTANTS_FREE`, on a ``kind`` of record set other than ``"zigzag"`` :data:`TURN_CONSTANTS_FREE`
-    and, with ``drift``, :data:`TURN_HULL_TERMS`, and :data:`MASS_FREE`) with the diagnosis's priors."""
+    :data:`CONSTANTS_FREE`, on a ``"zigzag"`` :data:`ZIGZAG_CONSTANTS_FREE`, on any other ``kind`` of
+    record set :data:`TURN_CONSTANTS_FREE` and, with ``drift``, :data:`TURN_HULL_TERMS`, and
+    :data:`MASS_FREE`) with the diagnosis's priors."""
     from ekf.identify import DIAGNOSIS_PRIOR_REL_STD, free_parameters
 
     if names is None:
         names = [n for n, t in zip(ship.hull.names, ship.hull.terms) if t in SHIP_FREE_TERMS] + list(CONSTANTS_FREE)
-        if kind != "zigzag":
+        if kind == "zigzag":
+            names += list(ZIGZAG_CONSTANTS_FREE)
+        else:
             names += [n for n, t in zip(ship.hull.names, ship.hull.terms) if t in TURN_HULL_TERMS and drift]
             names += list(TURN_CONSTANTS_FREE)
         mass = list(MASS_FREE)
@@ -665,24 +686,22 @@ def _drift_terms(fitter, d_config, base, kept, o: DiagnoseOptions, say):
     return base, kept
 
 
+DRIFT_FALL_MIN = 0.2192
+"""The fall of the heading residual [deg] that freeing the drift terms must bring
+(:func:`_drift_terms`): the heading residual the ship's own mismatch left on a clean zigzag, where the
+drift stays small, as calibrated when the gate was chosen and ``turn_drift`` calibrated (stop 39:
+``residual_floors.zigzag.heading`` of the packaged calibration then, 0.2192 deg).  A fall smaller
+than what a ship that is not its model leaves where these terms play no part is not a drift the
+config misses: on the main job's noiseless ST35 truth file, diagnosed with the ship that made it,
+they took the heading residual from 0.0087 to 0.0067 deg at dBIC 28, and wandered 3.3 prior std
+(``bench/drift_gate.py`` prints the falls).  A number of its own, not read from the zigzag floors in
+use: those moved when the zigzag baseline freed gamma_R (stop 40, :data:`ZIGZAG_CONSTANTS_FREE`),
+and the turns' gate and the ``turn_drift`` floors calibrated with it must not move with them."""
+
+
 def drift_fall_min() -> float:
-    """The fall of the heading residual [deg] that freeing the drift terms must bring:
-    the calibrated heading residual the ship's own mismatch leaves on a zigzag, where the drift stays
-    small (``residual_floors.zigzag.heading`` of the calibration in use, else of the packaged one, so
-    that calibration runs without floors gate as a user's diagnosis does; 0 without either).  A fall
-    smaller than what a ship that is not its model leaves where these terms play no part is not a
-    drift the config misses: on the main job's noiseless ST35 truth file, diagnosed with the ship
-    that made it, they took the heading residual from 0.0087 to 0.0067 deg at dBIC 28, and wandered
-    3.3 prior std (``bench/drift_gate.py`` prints the falls)."""
-    from .decision import packaged_calibration
-
-    def zigzag_heading(cal):
-        return ((cal.get("residual_floors") or {}).get("zigzag") or {}).get("heading")
-
-    f = zigzag_heading(calibration())
-    if f is None:                          # none in use (MMG_DIAGNOSE_CALIBRATION=none): the packaged one's
-        f = zigzag_heading(packaged_calibration())
-    return float(f or 0.0)
+    """:data:`DRIFT_FALL_MIN` [deg], the size gate of :func:`_drift_terms`."""
+    return DRIFT_FALL_MIN
 
 
 def _covered(fitter, cand, say) -> tuple[list, list]:
