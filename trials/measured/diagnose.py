@@ -207,8 +207,8 @@ negative beta_R, each with its own prior (std 15 % of the config value, at least
 standard's KVLCC2: 0.395 and 0.640), and a difference the config does not have makes the rudder's
 force asymmetric in a zigzag, where beta_R swings both ways: it is what the ship's own mismatch lends
 a rudder offset there.  On the zigzags of stop 39's fresh draws (family seeds 26000-31000, 140
-clean or offset records) the round-1 offset's error was correlated -0.92 with gamma_R_pos / gamma_R_neg
-- 1 of the member, and three 1 deg offsets were fitted at 0.61-0.62 deg, under the zigzag floor that
+clean or offset records) the round-1 offset's error was correlated -0.92 with the log of the member's
+gamma_R_pos / gamma_R_neg, and three 1 deg offsets were fitted at 0.61-0.62 deg, under the zigzag floor that
 asymmetry set (0.65 deg).  Freed, the two take the asymmetry: on family seed 32000 the 1 deg offsets
 were fitted at 0.93-1.10 deg (0.87-1.39 without) and the clean zigzags' offsets fell from 0.08-0.53 to
 0.02-0.26 deg.  The offset stays identifiable because it acts at every drift and the asymmetry only
