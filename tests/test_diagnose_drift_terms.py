@@ -59,8 +59,13 @@ def test_the_size_gate_does_not_move_with_the_zigzag_floors(tmp_path, monkeypatc
     p = tmp_path / "cal.yaml"
     p.write_text(yaml.safe_dump(cal))
     monkeypatch.setenv("MMG_DIAGNOSE_CALIBRATION", str(p))
-    assert decision.calibration()["residual_floors"]["zigzag"]["heading"] == 3.0
-    assert drift_fall_min() == before
+    decision.calibration.cache_clear()                # read once per process: read it anew here
+    try:
+        assert decision.calibration()["residual_floors"]["zigzag"]["heading"] == 3.0
+        assert drift_fall_min() == before
+    finally:
+        monkeypatch.delenv("MMG_DIAGNOSE_CALIBRATION")
+        decision.calibration.cache_clear()            # the other tests see the packaged one again
 
 
 def test_cross_flow_member_is_the_case(case):
