@@ -89,7 +89,7 @@ from .diagnose_report import fmt3, format_rms, format_values
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "straight_contradicts",
            "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
-           "ZIGZAG_CONSTANTS_FREE",
+           "CONSTANTS_FREE", "TURN_CONSTANTS_FREE", "ZIGZAG_CONSTANTS_FREE", "TURN_HULL_TERMS", "DRIFT_FALL_MIN",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 
 SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
@@ -222,8 +222,9 @@ the turn, sway and yaw lag) that an effect would otherwise take."""
 
 
 def _ship_values(ship: Ship, free, theta) -> dict:
-    """Fitted ship values by config name: hull coefficients, ``w_P0``, and the added masses as the
-    config's primed ``m_x_prime``, ``m_y_prime``, ``J_z_prime``."""
+    """Fitted ship values by config name: hull coefficients, ``w_P0``, ``epsilon``, ``gamma_R_pos``,
+    ``gamma_R_neg``, and the added masses as the config's primed ``m_x_prime``, ``m_y_prime``,
+    ``J_z_prime``."""
     from mmg.nondim import inertia_scale, mass_scale
 
     pa = ship.particulars

@@ -793,7 +793,8 @@ def _change_text(pct: float) -> str:
 
 def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None) -> str:
     """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
-    ``w_P0`` constant term, ``epsilon``) and ``note`` in its header and ``source``; with
+    ``w_P0`` constant term, ``Y_P_astern``, the rudder's ``epsilon``, ``kappa``, ``gamma_R_pos``,
+    ``gamma_R_neg``, ``l_R_prime``, the added masses, a rudder offset and the wind factors) and ``note`` in its header and ``source``; with
     ``covariance`` (:func:`fit_covariance`) its ``covariance:`` section (else none: the initial
     ship's own section, if any, is about other values and is dropped)."""
     import yaml
