@@ -206,7 +206,7 @@ negative beta_R, each with its own prior (std 15 % of the config value, at least
 ``rudder`` of :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`).  A real ship's two differ (the MMG
 standard's KVLCC2: 0.395 and 0.640), and a difference the config does not have makes the rudder's
 force asymmetric in a zigzag, where beta_R swings both ways: it is what the ship's own mismatch lends
-a rudder offset there.  On the zigzags of stop 39's fresh draws (family seeds 26000-31000, 140
+a rudder offset there.  On the zigzags of stop 39's fresh draws (family seeds 28000-31000, 140
 clean or offset records) the round-1 offset's error was correlated -0.92 with the log of the member's
 gamma_R_pos / gamma_R_neg, and three 1 deg offsets were fitted at 0.61-0.62 deg, under the zigzag floor that
 asymmetry set (0.65 deg).  Freed, the two take the asymmetry: on family seed 32000 the 1 deg offsets
