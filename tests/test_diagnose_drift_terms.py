@@ -68,9 +68,9 @@ def test_the_size_gate_does_not_move_with_the_zigzag_floors(tmp_path, monkeypatc
     import yaml
 
     from trials.measured import decision
-    from trials.measured.diagnose import drift_fall_min
+    from trials.measured.diagnose import DRIFT_FALL_MIN
 
-    before = drift_fall_min()
+    before = DRIFT_FALL_MIN
     # the value the turn_drift floors were calibrated with (stop 39); another needs their recalibration
     assert before == pytest.approx(0.2192)
     cal = dict(decision.packaged_calibration())
@@ -81,7 +81,9 @@ def test_the_size_gate_does_not_move_with_the_zigzag_floors(tmp_path, monkeypatc
     decision.calibration.cache_clear()                # read once per process: read it anew here
     try:
         assert decision.calibration()["residual_floors"]["zigzag"]["heading"] == 3.0
-        assert drift_fall_min() == before
+        from trials.measured.diagnose import DRIFT_FALL_MIN as after   # read after the calibration changed
+
+        assert after == before
     finally:
         monkeypatch.delenv("MMG_DIAGNOSE_CALIBRATION")
         decision.calibration.cache_clear()            # the other tests see the packaged one again

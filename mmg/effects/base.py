@@ -103,6 +103,9 @@ class Effect(abc.ABC):
     parameters: ClassVar[tuple]  # of Parameter
     channels: ClassVar[tuple] = ()
     affects: ClassVar[tuple] = ()   # residual channels it shows in: u, v, r, heading, position
+    measured_by: ClassVar[str] = "a measurement of it independent of the motion"
+    """What measures the effect itself (a ``"coefficients"`` effect's advice where the records cannot
+    tell it from the coefficients it changes)."""
 
     # ---------------------------------------------------------------- values
     @classmethod

@@ -61,6 +61,7 @@ class ShallowWater(Effect):
     description = "shallow-water corrections of the hull coefficients, added masses and wake"
     parameters = (Parameter("depth_to_draft", "1", math.inf, 1.15, math.inf, math.inf, "water depth over draft H/T"),)
     affects = ("u", "v", "r", "heading", "position")
+    measured_by = "the water depth from a chart or an echo sounder"
 
     @classmethod
     def values(cls, given=None, owner=None):

@@ -18,7 +18,7 @@ checking the scale) and the ship config:
    config that are merely a bit off (added mass, wake, hull) are absorbed here, so they do not
    pass for an effect.  On turns to one side whose records log their sway, the drift
    nonlinearities (:data:`TURN_HULL_TERMS`) as well where they lower the heading residual by more
-   than :func:`drift_fall_min` (:func:`_drift_terms`); such a record set is then of kind
+   than :data:`DRIFT_FALL_MIN` (:func:`_drift_terms`); such a record set is then of kind
    :data:`DRIFT_KIND`, with floors of its own.  ``rms_before`` is this model's residual.
 3. **Candidates**: each registered effect (:mod:`mmg.effects`) not yet in the model and
    applicable to every record (a wind candidate needs the relative-wind channels, non-zero, and a
@@ -647,7 +647,7 @@ def _drift_terms(fitter, d_config, base, kept, o: DiagnoseOptions, say):
     """(baseline, kept) with the drift nonlinearities (:data:`TURN_HULL_TERMS`) freed where the records
     ask for them: their fit, started from the baseline, must lower the heading residual of the
     baseline fitted on by as many evaluations (the better of the two) by more than
-    :func:`drift_fall_min`, and replay the records no worse than the config.
+    :data:`DRIFT_FALL_MIN`, and replay the records no worse than the config.
 
     A size test, not an evidence one.  On 48 clean family turns (``python bench/drift_gate.py --n
     48``, seed 1000) the fall parts the hull forms: 0.83-5.55 deg on every cross-flow member, at most
@@ -677,7 +677,7 @@ def _drift_terms(fitter, d_config, base, kept, o: DiagnoseOptions, say):
     dbic = _delta_bic(ref, m, len(free1) - len(free0), taus, o.stride)
     better = _scaled_rss(m.diffs, fitter.scales) <= _scaled_rss(d_config, fitter.scales)
     fall = _rms(ref.diffs)["heading"] - _rms(m.diffs)["heading"]
-    if better and fall > drift_fall_min():
+    if better and fall > DRIFT_FALL_MIN:
         say(f"baseline: the drift terms freed (dBIC {fmt3(dbic)}, heading residual {fmt3(fall)} deg less): "
             f"residual RMS {format_rms(_rms(m.diffs))}")
         fitter.kind = DRIFT_KIND
@@ -700,11 +700,6 @@ use: those moved when the zigzag baseline freed gamma_R (stop 40, :data:`ZIGZAG_
 and the turns' gate and the ``turn_drift`` floors calibrated with it must not move with them."""
 
 
-def drift_fall_min() -> float:
-    """:data:`DRIFT_FALL_MIN` [deg], the size gate of :func:`_drift_terms`."""
-    return DRIFT_FALL_MIN
-
-
 def _covered(fitter, cand, say) -> tuple[list, list]:
     """(the candidates to fit, ``not_identifiable`` entries of those left out): a coefficient effect
     whose every changed coefficient (:meth:`mmg.effects.Effect.changed_coefficients`) the baseline
@@ -723,8 +718,8 @@ def _covered(fitter, cand, say) -> tuple[list, list]:
         reason = f"a change of coefficients this fit frees, every one ({', '.join(ch)})"
         say(f"candidate {cls.name} not fitted: {reason}")
         out.append({"effect": cls.name, "confused_with": list(ch), "correlation": None,
-                    "what_would_separate": "the water depth from a chart or an echo sounder, or a zigzag "
-                                           "diagnosed with these records", "reason": reason,
+                    "what_would_separate": f"{cls.measured_by}, or a zigzag diagnosed with these records",
+                    "reason": reason,
                     "reason_kind": "coefficients"})
     return keep, out
 
