@@ -17,7 +17,10 @@ the summary (mean heading RMS scaled / identified, better on N of M, divergences
 prints the tables as Markdown (docs/benchmark_frt.md), ``--json FILE`` writes
 :meth:`~trials.measured.nested.NestedCV.to_json`.
 
-Run: ``python bench/identify_cv.py [--hull auto|kijima|crossflow] [--folds 4] [--inner-folds 2]
+``--prior W1 W2 ...`` (several prior widths) makes each hull form at each width a candidate of the
+inner choice, so the prior width too is chosen inside the training folds.
+
+Run: ``python bench/identify_cv.py [--hull auto|kijima|crossflow] [--prior 0.5 [0.25 ...]] [--folds 4] [--inner-folds 2]
 [--records turning zigzag random berthing] [--jobs 2] [--markdown] [--json out.json]``.
 
 ``--offset-spread DEG`` also replays every kept-out record, with both models, under rudder offsets
@@ -61,7 +64,9 @@ def _args(argv=None):
                     help="which shared record folders to use (default all four)")
     ap.add_argument("--wind", choices=["on", "off"], default="on")
     ap.add_argument("--free", nargs="+", default=None, help="free parameters (default: trials.measured.identify.DEFAULT_FREE)")
-    ap.add_argument("--prior", type=float, default=0.5, help="prior std relative to the config value")
+    ap.add_argument("--prior", type=float, nargs="+", default=[0.5],
+                    help="prior std relative to the config value; several values: each is a candidate of the "
+                         "inner choice beside the hull forms (hull form x prior width, chosen in each fold)")
     ap.add_argument("--weighting", choices=["samples", "equal", "relative"], default=None,
                     help="record weighting in the fit (default: trials.measured.identify.DEFAULT_WEIGHTING)")
     ap.add_argument("--folds-by", choices=["order", "revolutions", "manoeuvre"], default="order",
@@ -87,7 +92,9 @@ def _args(argv=None):
 
 
 def _options(a) -> dict:
-    extra = {"wind": a.wind == "on", "prior_rel_std": a.prior}
+    extra = {"wind": a.wind == "on"}
+    if len(a.prior) == 1:
+        extra["prior_rel_std"] = a.prior[0]
     if a.free:
         extra["free"] = a.free
     if a.weighting:
@@ -101,6 +108,18 @@ def _options(a) -> dict:
     if a.initial_state:
         extra["initial_state"] = a.initial_state
     return extra
+
+
+def candidates(forms, priors) -> dict:
+    """The candidates of the inner choice: each hull form (:func:`trials.measured.nested.hull_candidates`),
+    and with several prior widths each form at each width (named ``"<form>, prior <width>"``)."""
+    from dataclasses import replace
+
+    base = hull_candidates(SHIP, forms)
+    if len(priors) == 1:
+        return base
+    return {f"{f}, prior {p:g}": replace(c, name=f"{f}, prior {p:g}", options={**c.options, "prior_rel_std": float(p)})
+            for f, c in base.items() for p in priors}
 
 
 def _cell(s: dict, key: str) -> str:
@@ -187,13 +206,14 @@ def main(argv=None) -> None:
         sys.exit("FRT-DS-ESSO data not found (set MMG_FRT_DATA)")
     files = [p for s in a.records for p in sorted((d / s).glob("*.csv"))]
     forms = tuple(HULL_FORMS) if a.hull == "auto" else (a.hull,)
-    cands = hull_candidates(SHIP, forms)
+    cands = candidates(forms, a.prior)
     initial = mmg.load_ship(INITIAL)
     opts = _options(a)
     runs = load_runs(initial, files, wind=opts["wind"])
     print(f"nested cross-validation: {len(runs)} records ({', '.join(a.records)}), {a.folds} outer folds, "
           f"hull {a.hull} ({' / '.join(c.ship.name for c in cands.values())}), inner folds {a.inner_folds}, "
-          f"scored against {initial.name}; wind {a.wind}; free {a.free or 'default'}; prior {a.prior:g}; "
+          f"scored against {initial.name}; wind {a.wind}; free {a.free or 'default'}; "
+          f"prior {' / '.join(f'{p:g}' for p in a.prior)}; "
           f"weighting {a.weighting or 'default'}; folds by {a.folds_by}; backend {a.backend} ({a.jobs} jobs)", flush=True)
     t0 = time.perf_counter()
     res = nested_cross_validate(cands, runs, folds=a.folds, inner_folds=a.inner_folds, initial=initial,
