@@ -80,3 +80,21 @@ def test_ceiling_heading_windows():
     n1 = int(np.sum(t <= 60.0))
     assert whole == pytest.approx(math.sqrt((n1 * 9.0 + (len(t) - n1) * 81.0) / len(t)))
     assert all(math.isnan(x) for x in ce._rms_deg(np.r_[e[:-1], np.nan], t, 60.0))
+
+
+def test_damped_heading_bound_is_the_first_order_response():
+    """With yaw damping the heading error of a constant yaw acceleration a is a T_r (t - T_r (1 - e^-t/T_r)):
+    checked against a step-by-step integration of r' = a - r / T_r, psi' = r; no damping gives the undamped
+    bound; more damping a smaller heading error."""
+    yc = _load("yaw_residual_check")
+    a, t_r, T, dt = 0.03, 8.0, 60.0, 1e-3
+    r = psi = 0.0
+    acc = []
+    for k in range(int(T / dt)):                                     # semi-implicit Euler, fine steps
+        r += dt * (a - r / t_r)
+        psi += dt * r
+        acc.append(psi)
+    rms = math.sqrt(np.mean(np.square(acc)))
+    assert yc.heading_rms_damped(a, t_r, T) == pytest.approx(rms, rel=2e-3)
+    assert yc.heading_rms_damped(a, float("inf"), T) == yc.heading_rms_of(a, T)
+    assert yc.heading_rms_damped(a, 4.0, T) < yc.heading_rms_damped(a, 8.0, T) < yc.heading_rms_of(a, T)
