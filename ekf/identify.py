@@ -634,6 +634,7 @@ class _SegmentFit:
         self.start = np.cumsum([0] + [len(r.meas[::opts.stride]) * nch for r in records])   # each record's block
         self.heads = {k: records[k].first_segment() for k in set(self.own) - {None}}   # what a start offset moves
         self.straight = [k for k, r in enumerate(records) if r.straight is not None]   # one row each, after the blocks
+        self.longest_first = sorted(range(n), key=lambda k: -len(records[k].meas))   # the pool's order (see resid)
         self.count = 0
 
     def block(self, theta, k, pk=None, rec=None):
@@ -652,8 +653,11 @@ class _SegmentFit:
         """Every record's residuals, then their straight runs', then the prior's."""
         pk = apply_parameters(self.packed, self.free, theta)
         one = lambda k: self.block(theta, k, pk)  # noqa: E731
-        ks = range(len(self.records))
-        parts = list(self.pool.map(one, ks)) if parallel else [one(k) for k in ks]
+        if parallel:       # longest records first, so no long one is left to run alone at the end
+            done = dict(zip(self.longest_first, self.pool.map(one, self.longest_first)))
+            parts = [done[k] for k in range(len(self.records))]
+        else:
+            parts = [one(k) for k in range(len(self.records))]
         straight = np.array([self.straight_row(theta, k) for k in self.straight])
         return np.concatenate(parts + [straight, (theta - self.theta0) / self.sig0])
 
