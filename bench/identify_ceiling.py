@@ -9,7 +9,8 @@ three ways, heading RMS [deg] over the whole record and over its first ``--horiz
 * ``scaled``: the Froude-scaled ``esso_osaka_3m`` replayed open loop from the record's first sample (the
   model every figure of docs/benchmark_frt.md is compared with);
 * ``identified``: the identified model replayed the same way (what a prediction of the record would be);
-* ``fit``: the fit's own replay of the record, from its fitted start state and with the record's own
+* ``fit``: the fit's own replay of the record, from its fitted start state (``--initial-state fit``, the
+  default of ``mmg identify``; the first sample with ``sample``) and with the record's own
   nuisance effects (``--nuisance``, e.g. ``current``: a steady current fitted to each record alone, which no
   prediction of an unseen record can have).  With ``--nuisance`` this is a bound the model form cannot
   pass on these records even with a disturbance of its own per record.
@@ -17,7 +18,7 @@ three ways, heading RMS [deg] over the whole record and over its first ``--horiz
 Printed: one row per record, then per model the mean, the ratio of the scaled mean to it and on how
 many records it is lower than the scaled model.  ``--json FILE`` writes the figures.
 
-Usage: ``python bench/identify_ceiling.py [--hull kijima crossflow] [--nuisance current]
+Usage: ``python bench/identify_ceiling.py [--hull kijima crossflow] [--nuisance current] [--initial-state fit|sample]
 [--records turning zigzag random berthing] [--json out.json]`` (a fit of 35 records: about 5 minutes per
 hull form on 2 cores; with a per-record nuisance about twice that).
 """
@@ -48,7 +49,7 @@ def _rms_deg(err_rad: np.ndarray, t: np.ndarray, horizon: float) -> tuple[float,
     return float(np.sqrt(np.mean(e ** 2))), float(np.sqrt(np.mean(e[first] ** 2)))
 
 
-def _fit_heading_errors(ident, hull_ship, nuisance: tuple) -> list[np.ndarray]:
+def _fit_heading_errors(ident, hull_ship, nuisance: tuple, initial_state: str) -> list[np.ndarray]:
     """Each training record's heading error [rad] in the fit's own whole-record replay (fitted start state,
     the record's nuisance effects), every sample."""
     from dataclasses import replace
@@ -57,7 +58,7 @@ def _fit_heading_errors(ident, hull_ship, nuisance: tuple) -> list[np.ndarray]:
     from mmg.model import pack
     from trials.measured import identify as I
 
-    o = replace(I.IdentifyOptions(), record_nuisance=nuisance)
+    o = replace(I.IdentifyOptions(), record_nuisance=nuisance, initial_state=initial_state)
     packed = pack(hull_ship)
     fp, nu = I._free_of(hull_ship, packed, ident.runs, I.DEFAULT_FREE, replace(o, say=lambda *_: None))
     sc = I._scales(ident.runs, hull_ship.particulars.L, o.velocity_weight)
@@ -66,7 +67,7 @@ def _fit_heading_errors(ident, hull_ship, nuisance: tuple) -> list[np.ndarray]:
     return [np.where(np.abs(d[:, 3]) >= 1e3, np.nan, d[:, 3] * sc.psi) for d in res]
 
 
-def run(form: str, paths: list, nuisance: tuple, horizon: float) -> dict:
+def run(form: str, paths: list, nuisance: tuple, horizon: float, initial_state: str = "fit") -> dict:
     """Fit ``form`` on ``paths`` and score every record three ways (module docstring)."""
     import mmg
     from trials.measured.identify import identify, load_runs
@@ -76,9 +77,9 @@ def run(form: str, paths: list, nuisance: tuple, horizon: float) -> dict:
     scaled = mmg.load_ship(SHIP)
     runs = load_runs(hull_ship, paths, say=lambda *_: None)
     t0 = time.perf_counter()
-    ident = identify(hull_ship, runs, initial=scaled, record_nuisance=nuisance)
+    ident = identify(hull_ship, runs, initial=scaled, record_nuisance=nuisance, initial_state=initial_state)
     secs = time.perf_counter() - t0
-    fit_err = _fit_heading_errors(ident, hull_ship, nuisance)
+    fit_err = _fit_heading_errors(ident, hull_ship, nuisance, initial_state)
     rows = {}
     for r, e in zip(ident.runs, fit_err):
         out = {}
@@ -87,7 +88,7 @@ def run(form: str, paths: list, nuisance: tuple, horizon: float) -> dict:
             out[key] = _rms_deg(rp.pred[:, 5] - rp.run.meas[:, 5], rp.run.t, horizon)
         out["fit"] = _rms_deg(e, r.t, horizon)
         rows[r.name] = out
-    return {"form": form, "nuisance": list(nuisance), "seconds": secs, "stages": list(ident.stages),
+    return {"form": form, "nuisance": list(nuisance), "initial_state": initial_state, "seconds": secs, "stages": list(ident.stages),
             "records": rows}
 
 
@@ -114,6 +115,8 @@ def main(argv=None) -> int:
     ap.add_argument("--nuisance", nargs="+", default=(), metavar="EFFECT",
                     help="effects fitted once per record (mmg.effects, e.g. current)")
     ap.add_argument("--horizon", type=float, default=60.0, help="the short window [s] (default 60)")
+    ap.add_argument("--initial-state", choices=("fit", "sample"), default="fit",
+                    help="each record's start state in the fit (mmg identify --initial-state; default fit)")
     ap.add_argument("--json", default=None, metavar="FILE")
     a = ap.parse_args(argv)
     data = frt_data_dir()
@@ -125,7 +128,7 @@ def main(argv=None) -> int:
     for form in a.hull:
         print(f"fitting {form} on {len(paths)} records{' with per-record ' + ', '.join(a.nuisance) if a.nuisance else ''}"
               " ...", flush=True)
-        res = run(form, paths, tuple(a.nuisance), a.horizon)
+        res = run(form, paths, tuple(a.nuisance), a.horizon, a.initial_state)
         results.append(res)
         print(f"{form}: fitted in {res['seconds']:.0f} s; stages {[s['evaluations'] for s in res['stages']]} "
               f"evaluations")
