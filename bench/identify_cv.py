@@ -18,7 +18,8 @@ prints the tables as Markdown (docs/benchmark_frt.md), ``--json FILE`` writes
 :meth:`~trials.measured.nested.NestedCV.to_json`.
 
 ``--prior W1 W2 ...`` (several prior widths) makes each hull form at each width a candidate of the
-inner choice, so the prior width too is chosen inside the training folds.
+inner choice, so the prior width too is chosen inside the training folds; ``--initial-state fit sample``
+does the same for the start-state treatment of the fits.
 
 Run: ``python bench/identify_cv.py [--hull auto|kijima|crossflow] [--prior 0.5 [0.25 ...]] [--folds 4] [--inner-folds 2]
 [--records turning zigzag random berthing] [--jobs 2] [--markdown] [--json out.json]``.
@@ -78,8 +79,9 @@ def _args(argv=None):
                     help="weight of the u, v, r residuals beside the heading's (identify(velocity_weight=))")
     ap.add_argument("--nuisance", nargs="+", default=(), metavar="EFFECT",
                     help="effects fitted once per training record as nuisances (e.g. current)")
-    ap.add_argument("--initial-state", choices=("fit", "sample"), default=None,
-                    help="each record's start state in the fits (mmg identify --initial-state; default its default, "
+    ap.add_argument("--initial-state", choices=("fit", "sample"), nargs="+", default=None,
+                    help="each record's start state in the fits (mmg identify --initial-state; several: each a "
+                         "candidate of the inner choice beside the hull forms; default its default, "
                          "'fit'; docs/benchmark_frt.md's figures: 'sample')")
     ap.add_argument("--horizon", type=float, default=60.0, help="the short-horizon window [s] (default 60)")
     ap.add_argument("--backend", choices=("serial", "loky"), default="loky")
@@ -105,21 +107,27 @@ def _options(a) -> dict:
         extra["velocity_weight"] = a.velocity_weight
     if a.max_nfev:
         extra["max_nfev"] = a.max_nfev
-    if a.initial_state:
-        extra["initial_state"] = a.initial_state
+    if a.initial_state and len(a.initial_state) == 1:
+        extra["initial_state"] = a.initial_state[0]
     return extra
 
 
-def candidates(forms, priors) -> dict:
+def candidates(forms, priors, starts=(None,)) -> dict:
     """The candidates of the inner choice: each hull form (:func:`trials.measured.nested.hull_candidates`),
-    and with several prior widths each form at each width (named ``"<form>, prior <width>"``)."""
+    and with several prior widths (``priors``) or start-state treatments (``starts``: ``"fit"``, ``"sample"``)
+    each form at each of them, named ``"<form>, prior <width>, start <start>"`` (a part only where there
+    are several)."""
     from dataclasses import replace
+    from itertools import product
 
     base = hull_candidates(SHIP, forms)
-    if len(priors) == 1:
-        return base
-    return {f"{f}, prior {p:g}": replace(c, name=f"{f}, prior {p:g}", options={**c.options, "prior_rel_std": float(p)})
-            for f, c in base.items() for p in priors}
+    out = {}
+    for (f, c), p, st in product(base.items(), priors, starts):
+        name = f + (f", prior {p:g}" if len(priors) > 1 else "") + (f", start {st}" if len(starts) > 1 else "")
+        opts = {**c.options, **({"prior_rel_std": float(p)} if len(priors) > 1 else {}),
+                **({"initial_state": st} if len(starts) > 1 else {})}
+        out[name] = replace(c, name=name, options=opts) if name != f else c
+    return out
 
 
 def _cell(s: dict, key: str) -> str:
@@ -206,7 +214,7 @@ def main(argv=None) -> None:
         sys.exit("FRT-DS-ESSO data not found (set MMG_FRT_DATA)")
     files = [p for s in a.records for p in sorted((d / s).glob("*.csv"))]
     forms = tuple(HULL_FORMS) if a.hull == "auto" else (a.hull,)
-    cands = candidates(forms, a.prior)
+    cands = candidates(forms, a.prior, a.initial_state or (None,))
     initial = mmg.load_ship(INITIAL)
     opts = _options(a)
     runs = load_runs(initial, files, wind=opts["wind"])

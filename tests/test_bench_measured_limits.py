@@ -32,6 +32,12 @@ def test_several_prior_widths_make_each_hull_form_at_each_width_a_candidate():
         assert c.name == name
         assert c.options["prior_rel_std"] == float(name.rsplit(" ", 1)[1])
         assert c.ship.name == one[name.split(",")[0]].ship.name          # the form's own config, unchanged
+    starts = cv.candidates(("kijima", "crossflow"), [0.5], ["fit", "sample"])
+    assert {n: c.options for n, c in starts.items()} == {
+        "kijima, start fit": {"initial_state": "fit"}, "kijima, start sample": {"initial_state": "sample"},
+        "crossflow, start fit": {"initial_state": "fit"}, "crossflow, start sample": {"initial_state": "sample"}}
+    assert cv._options(cv._args(["--initial-state", "fit", "sample"])).get("initial_state") is None
+    assert cv._options(cv._args(["--initial-state", "sample"]))["initial_state"] == "sample"
     # the common options carry the width only when there is one (else each candidate's own applies)
     a = cv._args(["--prior", "0.5", "0.25"])
     assert "prior_rel_std" not in cv._options(a)
