@@ -488,3 +488,26 @@ def test_fitted_wind_factors_multiply_the_configs_and_stay_within_its_range(tmp_
     out = tmp_path / "out.yaml"
     out.write_text(ship_yaml(path, {"wind_yaw_factor": f.upper}, "test"))
     assert mmg.load_ship(out).wind.yaw_factor == pytest.approx(3.0, rel=1e-5)
+
+
+def test_pooled_residuals_are_in_record_order_whatever_order_the_pool_runs_them():
+    """The pool takes the records longest first; the residual vector must still hold each record's block in
+    the records' order: equal, bit for bit, to the serial evaluation, with records given shortest first."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ekf.identify import FitOptions, _SegmentFit
+
+    ship = mmg.load_ship(SHIP)
+    runs = [_synthetic_runs(ship, seeds=(k,), duration=d)[0] for k, d in ((0, 30.0), (1, 90.0), (2, 60.0))]
+    pk = pack(ship)
+    free = free_parameters(pk, ship.hull.names, ["N_r", "Y_beta"])
+    segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, 20.0)) for r in runs]
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        fit = _SegmentFit(pk, segs, free, Scales(0.005, 0.005, 0.001, np.radians(0.5)), FitOptions(), pool)
+        assert fit.longest_first == [1, 2, 0]
+        theta = fit.theta0 * 1.1
+        pooled, serial = fit.resid(theta), fit.resid(theta, parallel=False)
+    assert np.array_equal(pooled, serial)
+    assert len(pooled) == fit.start[-1] + len(free)                  # the blocks, then the prior's rows
+    first = fit.block(theta, 0)                                      # the shortest record's block comes first
+    assert np.array_equal(pooled[: len(first)], first)
