@@ -121,6 +121,7 @@ def candidates(forms, priors, starts=(None,)) -> dict:
     from itertools import product
 
     base = hull_candidates(SHIP, forms)
+    priors, starts = list(dict.fromkeys(priors)), list(dict.fromkeys(starts))     # a value given twice counts once
     out = {}
     for (f, c), p, st in product(base.items(), priors, starts):
         name = f + (f", prior {p:g}" if len(priors) > 1 else "") + (f", start {st}" if len(starts) > 1 else "")

@@ -32,6 +32,13 @@ def test_several_prior_widths_make_each_hull_form_at_each_width_a_candidate():
         assert c.name == name
         assert c.options["prior_rel_std"] == float(name.rsplit(" ", 1)[1])
         assert c.ship.name == one[name.split(",")[0]].ship.name          # the form's own config, unchanged
+    both = cv.candidates(("kijima",), [0.5, 0.25, 0.5], ["fit", "sample"])
+    assert {n: c.options for n, c in both.items()} == {
+        "kijima, prior 0.5, start fit": {"prior_rel_std": 0.5, "initial_state": "fit"},
+        "kijima, prior 0.5, start sample": {"prior_rel_std": 0.5, "initial_state": "sample"},
+        "kijima, prior 0.25, start fit": {"prior_rel_std": 0.25, "initial_state": "fit"},
+        "kijima, prior 0.25, start sample": {"prior_rel_std": 0.25, "initial_state": "sample"}}
+    assert set(cv.candidates(("kijima",), [0.5, 0.5])) == {"kijima"}          # a width given twice counts once
     starts = cv.candidates(("kijima", "crossflow"), [0.5], ["fit", "sample"])
     assert {n: c.options for n, c in starts.items()} == {
         "kijima, start fit": {"initial_state": "fit"}, "kijima, start sample": {"initial_state": "sample"},
@@ -66,8 +73,9 @@ def test_model_yaw_acceleration_is_the_equations_of_motion_at_the_logged_state()
     p = pack(ship).p
 
     class Run:
-        meas = np.zeros((3, 6))
-        inputs = ReplayInputs(t=np.arange(3.0), delta=np.zeros(3), n=np.zeros(3), ext=np.array([[0, 0, 0], [0, 0, 2.0], [0, 1.0, 0]]))
+        meas = np.zeros((4, 6))
+        inputs = ReplayInputs(t=np.arange(4.0), delta=np.zeros(4), n=np.zeros(4),
+                              ext=np.array([[0, 0, 0], [0, 0, 2.0], [0, 1.0, 0], [3.0, 0, 0]]))
 
     acc = yc.model_yaw_acceleration(ship, Run())
     m, xg = p[P_M], p[P_XG]
@@ -75,15 +83,16 @@ def test_model_yaw_acceleration_is_the_equations_of_motion_at_the_logged_state()
     assert acc[0] == pytest.approx(0.0, abs=1e-15)
     assert acc[1] == pytest.approx(np.linalg.solve(M, [0.0, 2.0])[1], rel=1e-12)
     assert acc[2] == pytest.approx(np.linalg.solve(M, [1.0, 0.0])[1], rel=1e-12)
+    assert acc[3] == pytest.approx(0.0, abs=1e-15)                    # a surge force alone gives no yaw
 
 
 def test_ceiling_heading_windows():
     ce = _load("identify_ceiling")
-    t = np.arange(0.0, 120.0, 0.1)
-    e = np.radians(np.where(t <= 60.0, 3.0, 9.0))
+    t = np.arange(100.0, 220.0, 0.1)                                 # the window counts from the first sample
+    e = np.radians(np.where(t - 100.0 <= 60.0, 3.0, 9.0))
     whole, first = ce._rms_deg(e, t, 60.0)
     assert first == pytest.approx(3.0)
-    n1 = int(np.sum(t <= 60.0))
+    n1 = int(np.sum(t - 100.0 <= 60.0))
     assert whole == pytest.approx(math.sqrt((n1 * 9.0 + (len(t) - n1) * 81.0) / len(t)))
     assert all(math.isnan(x) for x in ce._rms_deg(np.r_[e[:-1], np.nan], t, 60.0))
 
