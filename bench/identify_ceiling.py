@@ -49,22 +49,6 @@ def _rms_deg(err_rad: np.ndarray, t: np.ndarray, horizon: float) -> tuple[float,
     return float(np.sqrt(np.mean(e ** 2))), float(np.sqrt(np.mean(e[first] ** 2)))
 
 
-def _fit_heading_errors(ident, hull_ship, nuisance: tuple) -> list[np.ndarray]:
-    """Each training record's heading error [rad] in the fit's own whole-record replay (fitted start state,
-    the record's nuisance effects), every sample: the fit's own free parameters and values
-    (``ident.fit``), so nothing of the fit is derived again."""
-    import mmg.effects as E
-    from ekf.identify import record_residuals
-    from mmg.model import pack
-    from trials.measured import identify as I
-
-    nu = [E.get(n, "record_nuisance") for n in nuisance] or None
-    sc = I._scales(ident.runs, hull_ship.particulars.L, ident.velocity_weight)
-    res = record_residuals(pack(hull_ship), I._segmented(ident.runs, np.inf), ident.fit.free, ident.fit.theta, sc,
-                           stride=1, effects=nu, ship=hull_ship)
-    return [np.where(np.abs(d[:, 3]) >= 1e3, np.nan, d[:, 3] * sc.psi) for d in res]
-
-
 def run(form: str, paths: list, nuisance: tuple, horizon: float, initial_state: str = "fit") -> dict:
     """Fit ``form`` on ``paths`` and score every record three ways (module docstring)."""
     import mmg
@@ -77,7 +61,7 @@ def run(form: str, paths: list, nuisance: tuple, horizon: float, initial_state: 
     t0 = time.perf_counter()
     ident = identify(hull_ship, runs, initial=scaled, record_nuisance=nuisance, initial_state=initial_state)
     secs = time.perf_counter() - t0
-    fit_err = _fit_heading_errors(ident, hull_ship, nuisance)
+    fit_err = [d[:, 3] for d in ident.fit_residuals()]
     rows = {}
     for r, e in zip(ident.runs, fit_err):
         out = {}

@@ -442,6 +442,11 @@ def straight_run_residual(rec: Segmented, effects=None, free=(), theta=(), recor
     return float(np.mean(es.to_logged(mm)[:, 1] - meas[:, 1])) / st.sigma
 
 
+FAILED_RESIDUAL = 1e3
+"""The scaled residual a diverged (non-finite) segment's samples are given: a large, finite misfit the
+least-squares fit can still step away from."""
+
+
 def logged_residual(pred: np.ndarray, rec: Segmented) -> np.ndarray:
     """Predicted minus measured states (N, 6) of what the record logs: for a record that logs only the
     speed over ground (:attr:`Segmented.speed_only`), u is that speed on both sides and v is 0."""
@@ -463,7 +468,7 @@ def _residual_one(packed, rec: Segmented, sc: np.ndarray, stride: int, effects=N
     d = diff[:, [0, 1, 2, 5]] / sc
     if pos is not None:
         d = np.column_stack([d, diff[:, [3, 4]] / pos])
-    d[~np.isfinite(d)] = 1e3                          # a diverged segment: a large, finite misfit
+    d[~np.isfinite(d)] = FAILED_RESIDUAL              # a diverged segment: a large, finite misfit
     return d.ravel()
 
 

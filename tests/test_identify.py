@@ -323,6 +323,12 @@ def test_per_record_currents_are_nuisances_that_keep_the_shared_fit_unbiased():
         assert v[f"current.north_mps[c{k}]"] == pytest.approx(cn, abs=2e-3)
         assert v[f"current.east_mps[c{k}]"] == pytest.approx(ce, abs=2e-3)
     assert ident.ship.effect_set().get("current") is None         # not part of the identified ship
+    own = [d[:, :2] for d in ident.fit_residuals()]          # u, v over ground: the fit's own replays keep each current
+    pred = [ident.replay(r).pred[:, :2] - r.meas[:, :2] for r in runs]   # a prediction has none
+    for k, c in enumerate(currents):
+        speed = float(np.hypot(*c))
+        assert np.sqrt(np.mean(np.sum(own[k] ** 2, axis=1))) < 0.1 * speed
+        assert np.sqrt(np.mean(np.sum(pred[k] ** 2, axis=1))) > 0.5 * speed
     plain = identify(ship, runs, free=["N_r"], segment_s=(30.0, np.inf), say=lambda m: None)
     assert abs(plain.fit.values()["N_r"] / true["N_r"] - 1) > abs(v["N_r"] / true["N_r"] - 1)
 
@@ -511,3 +517,23 @@ def test_pooled_residuals_are_in_record_order_whatever_order_the_pool_runs_them(
     assert len(pooled) == fit.start[-1] + len(free)                  # the blocks, then the prior's rows
     first = fit.block(theta, 0)                                      # the shortest record's block comes first
     assert np.array_equal(pooled[: len(first)], first)
+
+
+def test_fit_residuals_are_the_replay_errors_of_the_fitted_model_in_si_units():
+    """From the first sample, no nuisance: the fit's own residuals are the identified model's open-loop
+    replay (trials.measured.predict.replay_record, another code path) minus the record, u, v [m/s],
+    r [rad/s], heading [rad]; a record whose replay fails gives NaN, not the fit's finite stand-in."""
+    ship = mmg.load_ship(SHIP)
+    runs = _synthetic_runs(ship.with_hull({"N_r": ship.hull.value("N_r") * 1.2}), duration=60.0)
+    ident = identify(ship, runs, free=["N_r"], segment_s=(np.inf,), say=lambda m: None, initial_state="sample",
+                     max_nfev=3)
+    for r, d in zip(runs, ident.fit_residuals()):
+        err = ident.replay(r).pred - r.meas
+        assert d.shape == (len(r.t), 4)
+        for j, c in enumerate((0, 1, 2, 5)):
+            np.testing.assert_allclose(d[:, j], err[:, c], atol=1e-6 * np.abs(err[:, c]).max())
+    assert np.abs(ident.fit_residuals(stride=3)[0] - ident.fit_residuals()[0][::3]).max() == 0.0
+    bad = MeasuredRun(name="bad", source="bad", meas=runs[0].meas.copy(), inputs=runs[0].inputs)
+    from dataclasses import replace
+    broken = replace(ident, runs=[bad], fit=replace(ident.fit, theta=np.array([np.nan])))
+    assert np.isnan(broken.fit_residuals()[0][1:]).all()             # after the start sample, which is the record's

@@ -167,6 +167,8 @@ class Identification:
     """The fit's residuals' integrated autocorrelation time [samples at the fit's stride] (module docstring)."""
     initial_state: str = DEFAULT_INITIAL_STATE
     """How each record's start state was taken (:data:`INITIAL_STATES`)."""
+    record_nuisance: tuple = ()
+    """The :mod:`mmg.effects` fitted once per training record as a nuisance (:class:`IdentifyOptions`)."""
     stages: tuple = ()
     """One dict per fit stage, in order: ``segment_s`` (segment length [s]; ``inf``: the whole record,
     no cut), ``description`` (:func:`stage_description`), ``evaluations`` (residual evaluations used),
@@ -176,6 +178,23 @@ class Identification:
         """Open-loop replay scores (:meth:`trials.measured.predict.Replayed.scores`) of ``runs`` (the training
         records when omitted) with the identified or the initial model."""
         return [{"name": r.name, **self.replay(r, model).scores()} for r in (runs or self.runs)]
+
+    def fit_residuals(self, stride: int = 1) -> list[np.ndarray]:
+        """Each training record's residuals in the fit's own whole-record replay (its fitted start state
+        and per-record nuisances, the fit's free parameters at their fitted values), unscaled: one array
+        (n_k, 4) of u, v [m/s], r [rad/s] and heading [rad] at every ``stride``-th sample; NaN where that
+        replay failed.  What no prediction of an unseen record can have: the in-sample bound
+        (``bench/identify_ceiling.py``)."""
+        import mmg.effects as E
+        from ekf.identify import FAILED_RESIDUAL, record_residuals
+
+        prior = self.prior or self.initial
+        nu = [E.get(n, "record_nuisance") for n in self.record_nuisance] or None
+        sc = _scales(self.runs, prior.particulars.L, self.velocity_weight)
+        res = record_residuals(pack(prior), _segmented(self.runs, np.inf), self.fit.free, self.fit.theta, sc,
+                               stride=stride, effects=nu, ship=prior)
+        unit = np.array([sc.u, sc.v, sc.r, sc.psi])
+        return [np.where(np.abs(d[:, :4]) >= FAILED_RESIDUAL, np.nan, d[:, :4] * unit) for d in res]
 
     def physical_check(self):
         """:func:`trials.measured.physical.physical_check` of the identified model against its prior
@@ -569,7 +588,8 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, options: IdentifyOpti
     return Identification(ship=_ship_with(ship, fit.values()), initial=ship if o.initial is None else o.initial,
                           fit=fit, runs=runs, segment_s=seg, prior=None if o.initial is None else ship,
                           record_weighting=o.record_weighting, velocity_weight=float(o.velocity_weight),
-                          stages=tuple(done), tau=tau, initial_state=o.initial_state)
+                          stages=tuple(done), tau=tau, initial_state=o.initial_state,
+                          record_nuisance=tuple(o.record_nuisance))
 
 
 FOLD_ASSIGNMENTS = ("order", "revolutions", "manoeuvre")
