@@ -1,6 +1,6 @@
 """The helpers of the issue-27 limit benches: bench/identify_cv.py's candidate grid (hull form x prior width,
 chosen inside the folds), bench/yaw_residual_check.py's heading bound and model yaw acceleration, and
-bench/identify_ceiling.py's heading RMS windows."""
+bench/identify_ceiling.py's heading RMS windows, and bench/fold_values.py's jackknife and fold table."""
 from __future__ import annotations
 
 import importlib.util
@@ -113,3 +113,42 @@ def test_damped_heading_bound_is_the_first_order_response():
     assert yc.heading_rms_damped(a, t_r, T) == pytest.approx(rms, rel=2e-3)
     assert yc.heading_rms_damped(a, float("inf"), T) == yc.heading_rms_of(a, T)
     assert yc.heading_rms_damped(a, 4.0, T) < yc.heading_rms_damped(a, 8.0, T) < yc.heading_rms_of(a, T)
+
+
+def test_jackknife_se_of_leave_one_group_out_means_is_the_standard_error_of_the_group_means():
+    """Independent formula: for K equal groups and theta_i the mean of all but group i, the delete-a-group
+    jackknife SE equals the standard error of the mean of the K group means, sd(group means) / sqrt(K)."""
+    fv = _load("fold_values")
+    rng = np.random.default_rng(7)
+    groups = rng.normal(3.0, 2.0, (4, 25))
+    theta = [np.delete(groups, i, axis=0).mean() for i in range(4)]
+    gm = groups.mean(axis=1)
+    assert fv.jackknife_se(theta) == pytest.approx(np.std(gm, ddof=1) / math.sqrt(4), rel=1e-12)
+    assert fv.jackknife_se([1.5, 1.5, 1.5]) == 0.0
+
+
+def test_fold_table_flags_sign_changes_spread_and_ratio_to_the_fits_own_se():
+    """Three folds of a fixed Kijima fit: N_r of both signs, spread counted in its prior std
+    (max(0.5 |value|, 0.01)), the jackknife SE set against a stated covariance's SE; a record's own
+    nuisance value is left out."""
+    from types import SimpleNamespace
+
+    import mmg
+
+    fv = _load("fold_values")
+    nr = mmg.load_ship("esso_osaka_3m").hull.value("N_r")
+    vals = [{"N_r": nr, "N_0": 0.0, "current.north_mps[a]": 9.0}, {"N_r": -nr, "N_0": 0.001}, {"N_r": nr, "N_0": 0.002}]
+    nested = {"records": [{"fold": k, "choice": "kijima", "values": v} for k, v in enumerate(vals)]}
+    cov = SimpleNamespace(names=("N_r", "N_0"), std=lambda: (0.01, 0.0))
+    rows, s = fv.table(nested, 0.5, cov)
+    row = {r.split(" | ")[0].lstrip("| "): r for r in rows[3:]}
+    assert set(row) == {"N_r", "N_0"}
+    sigma = 0.5 * abs(nr)
+    spread = float(row["N_r"].split(" | ")[7])
+    assert spread == pytest.approx(2 * abs(nr) / sigma, abs=0.05)          # from -|N_r| to +|N_r|: 4 prior stds
+    assert s["sign"] == 1 and s["spread_over_2"] == 1
+    jk = math.sqrt(2 / 3 * sum((x - nr / 3) ** 2 for x in (nr, -nr, nr)))
+    assert s["ratios"] == {"N_r": pytest.approx(jk / 0.01, rel=1e-3)}       # N_0's SE is 0: no ratio
+    mixed = {"records": [{"fold": 0, "choice": "kijima", "values": vals[0]},
+                         {"fold": 1, "choice": "crossflow", "values": {"N_r": 0.1, "N_0": 0.0}}]}
+    assert fv.table(mixed)[0][3].split(" | ")[7] == "nan"                  # no jackknife across forms

@@ -1,0 +1,119 @@
+"""How far apart are the fits of a cross-validation's folds? (issue 27: the generalisation gap)
+
+Each outer fold of ``bench/identify_cv.py`` fits the model on about three quarters of the records; its JSON
+(``--json``) keeps each fold's fitted values.  Were the identified parameters set by the physics the
+records share, the fold fits would lie close together: their spread would match the statistical
+uncertainty the fit states.  Where they differ by more, what a fit learns depends on which records it was
+given, and an unseen record is predicted by a model that would have come out otherwise had it been
+among them: the gap between the in-sample and the held-out figures.
+
+Per parameter this prints the prior (the config value the fit starts from, and its prior std,
+:func:`ekf.identify.free_parameters`), each fold's fitted value, whether the folds disagree in sign, the
+folds' spread (max - min) in prior stds, and the delete-a-group jackknife standard error of a fit on all
+the records, sqrt((K - 1) / K * sum_i (theta_i - mean theta)^2) over the K folds (each fold leaves one
+group of records out: a standard error that counts the record-to-record variation).  With ``--ship
+DIR/ship.yaml`` (``mmg identify`` on all the records, which writes the fit's covariance) it also prints
+that covariance's standard error and the jackknife's ratio to it.
+
+The jackknife needs every fold to have fitted the same candidate (a fixed hull form: ``--hull kijima``);
+folds of different forms are printed without it.
+
+    python bench/fold_values.py NESTED.json [--ship DIR/ship.yaml] [--prior 0.5]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+SHIP = "esso_osaka_3m"
+
+
+def fold_values(nested: dict) -> tuple[list[str], list[dict]]:
+    """(each fold's choice, each fold's fitted shared values) of a :meth:`trials.measured.nested.NestedCV.to_json`
+    dict, in fold order; a record's own nuisance values (names with ``[``) are left out."""
+    by_fold = {}
+    for r in nested["records"]:
+        by_fold.setdefault(r["fold"], (r["choice"], {k: v for k, v in r["values"].items() if "[" not in k}))
+    folds = sorted(by_fold)
+    return [by_fold[f][0] for f in folds], [by_fold[f][1] for f in folds]
+
+
+def jackknife_se(theta: np.ndarray) -> float:
+    """Delete-a-group jackknife standard error from the K leave-one-group-out estimates ``theta``."""
+    theta = np.asarray(theta, float)
+    k = len(theta)
+    return float(np.sqrt((k - 1) / k * np.sum((theta - theta.mean()) ** 2)))
+
+
+def priors(form: str, names, width: float) -> dict:
+    """{name: (prior value, prior std)} of the fit's free parameters for hull form ``form``."""
+    from ekf.identify import free_parameters
+    from mmg.model import pack
+    from trials.measured.nested import hull_candidates
+
+    ship = hull_candidates(SHIP, (form,))[form].ship
+    return {p.name: (p.prior, p.sigma) for p in free_parameters(pack(ship), ship.hull.names, list(names), width)}
+
+
+def table(nested: dict, width: float = 0.5, covariance=None) -> tuple[list[str], dict]:
+    """The printed rows and a summary dict (module docstring)."""
+    choices, values = fold_values(nested)
+    forms = {c.split(",")[0] for c in choices}
+    same = len(set(choices)) == 1
+    names = [n for n in values[0] if all(n in v for v in values)]
+    pri = priors(next(iter(forms)), names, width) if len(forms) == 1 else {}
+    cov = {} if covariance is None else dict(zip(covariance.names, covariance.std()))
+    head = ("| parameter | prior | prior std | " + " | ".join(f"fold {k}" for k in range(len(values)))
+            + " | signs differ | spread / prior std | jackknife SE | fit's SE | ratio |")
+    rows = [f"folds' choices: {', '.join(choices)}", head, "|" + "---|" * (head.count("|") - 1)]
+    summ = {"n": len(names), "sign": 0, "spread_over_2": 0, "ratios": {}}
+    for n in names:
+        th = np.array([v[n] for v in values])
+        p, s = pri.get(n, (np.nan, np.nan))
+        signs = bool(np.any(th > 0) and np.any(th < 0))
+        spread = (th.max() - th.min()) / s if s > 0 else np.nan
+        jk = jackknife_se(th) if same else np.nan
+        se = cov.get(n, np.nan)
+        ratio = jk / se if se > 0 else np.nan
+        summ["sign"] += signs
+        summ["spread_over_2"] += bool(spread > 2.0)
+        if np.isfinite(ratio):
+            summ["ratios"][n] = ratio
+        rows.append(f"| {n} | {p:+.4g} | {s:.3g} | " + " | ".join(f"{x:+.4g}" for x in th)
+                    + f" | {'yes' if signs else ''} | {spread:.1f} | {jk:.3g} | {se:.3g} | {ratio:.1f} |")
+    return rows, summ
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("json", type=Path, help="bench/identify_cv.py --json output")
+    ap.add_argument("--ship", default=None, help="a ship YAML with a covariance section (mmg identify on all records)")
+    ap.add_argument("--prior", type=float, default=0.5, help="the fits' prior width (relative std; default 0.5)")
+    a = ap.parse_args(argv)
+    cov = None
+    if a.ship:
+        from mmg.ship import load_ship
+
+        cov = load_ship(a.ship).covariance
+    rows, s = table(json.loads(a.json.read_text()), a.prior, cov)
+    print("\n".join(rows))
+    line = (f"{s['n']} parameters: the folds disagree in sign on {s['sign']}; spread over 2 prior stds on "
+            f"{s['spread_over_2']}")
+    if s["ratios"]:
+        r = np.array(list(s["ratios"].values()))
+        line += (f"; jackknife SE / the fit's SE: median {np.median(r):.1f}, above 3 on {int(np.sum(r > 3))} of "
+                 f"{len(r)}")
+    print(line)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
