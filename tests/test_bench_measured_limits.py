@@ -1,5 +1,5 @@
 """The helpers of the issue-27 limit benches: bench/identify_cv.py's candidate grid (hull form x prior width,
-chosen inside the folds), bench/yaw_residual_check.py's heading bound and model yaw acceleration, and
+chosen inside the folds), bench/yaw_residual_check.py's heading bound and model yaw acceleration,
 bench/identify_ceiling.py's heading RMS windows, and bench/fold_values.py's jackknife and fold table."""
 from __future__ import annotations
 
