@@ -1,6 +1,7 @@
 """The helpers of the issue-27 limit benches: bench/identify_cv.py's candidate grid (hull form x prior width,
 chosen inside the folds), bench/yaw_residual_check.py's heading bound and model yaw acceleration,
-bench/identify_ceiling.py's heading RMS windows, and bench/fold_values.py's jackknife and fold table."""
+bench/identify_ceiling.py's heading RMS windows, bench/fold_values.py's jackknife and fold table, and
+bench/frt_gap.py's figures by record kind."""
 from __future__ import annotations
 
 import importlib.util
@@ -152,3 +153,18 @@ def test_fold_table_flags_sign_changes_spread_and_ratio_to_the_fits_own_se():
     mixed = {"records": [{"fold": 0, "choice": "kijima", "values": vals[0]},
                          {"fold": 1, "choice": "crossflow", "values": {"N_r": 0.1, "N_0": 0.0}}]}
     assert fv.table(mixed)[0][3].split(" | ")[7] == "nan"                  # no jackknife across forms
+
+
+def test_gap_by_kind_needed_mean_and_replacement_by_hand():
+    """Four records, scaled 30/30/90/90 deg (mean 60), identified 10/20/60/40: 3x asks for a mean of 20, a sum
+    of 80; the turns give 30, so the two random runs may sum to 50: a mean of 25.  With the random runs at
+    in-sample 5 and 15 the mean is (10 + 20 + 5 + 15) / 4 = 12.5: 4.8x."""
+    gap = _load("frt_gap")
+    rows = {"turn_a": (30.0, 10.0), "turn_cut_b": (30.0, 20.0), "random_c": (90.0, 60.0), "random_d": (90.0, 40.0)}
+    assert gap.kind_of("turn_cut_b") == "turn"
+    assert gap.needed_mean(rows, "random") == pytest.approx(25.0)
+    assert gap.ratio_with(rows, {"random_c": 5.0, "random_d": 15.0, "turn_a": 0.0}, ("random",)) == pytest.approx(60 / 12.5)
+    kinds = {r["kind"]: r for r in gap.kind_table(rows)}
+    assert set(kinds) == {"turn", "random"}
+    assert kinds["random"]["identified"] == pytest.approx(50.0) and kinds["random"]["share"] == pytest.approx(100 / 130)
+    assert kinds["turn"]["n"] == 2 and kinds["turn"]["scaled"] == pytest.approx(30.0)
