@@ -25,7 +25,9 @@ Run: ``python bench/identify_cv.py [--hull auto|kijima|crossflow] [--prior 0.5 [
 [--records turning zigzag random berthing] [--jobs 2] [--markdown] [--json out.json]``.
 
 ``--offset-spread DEG`` also replays every kept-out record, with both models, under rudder offsets
-from -DEG to +DEG (the ``rudder_offset`` effect) and prints the range of heading RMS each model spans.
+from -DEG to +DEG (the ``rudder_offset`` effect) and prints the range of heading RMS each model spans;
+``--offset-spread-of FILE`` does it for the fold models of an earlier run's ``--json`` (rebuilt from their
+fitted values), without fitting.
 """
 from __future__ import annotations
 
@@ -90,6 +92,8 @@ def _args(argv=None):
     ap.add_argument("--json", default=None, metavar="FILE", help="also write the result as JSON")
     ap.add_argument("--offset-spread", type=float, default=0.0, metavar="DEG",
                     help="also score each kept-out record under rudder offsets within +-DEG (both models)")
+    ap.add_argument("--offset-spread-of", type=Path, default=None, metavar="JSON",
+                    help="with --offset-spread: scan the fold models of an earlier run's --json instead of fitting")
     return ap.parse_args(argv)
 
 
@@ -219,6 +223,9 @@ def main(argv=None) -> None:
     initial = mmg.load_ship(INITIAL)
     opts = _options(a)
     runs = load_runs(initial, files, wind=opts["wind"])
+    if a.offset_spread_of is not None:
+        offset_spread(fold_models(json.loads(a.offset_spread_of.read_text())), runs, initial, a.offset_spread or 1.0)
+        return
     print(f"nested cross-validation: {len(runs)} records ({', '.join(a.records)}), {a.folds} outer folds, "
           f"hull {a.hull} ({' / '.join(c.ship.name for c in cands.values())}), inner folds {a.inner_folds}, "
           f"scored against {initial.name}; wind {a.wind}; free {a.free or 'default'}; "
@@ -241,29 +248,51 @@ def main(argv=None) -> None:
         offset_spread(res.records, runs, initial, a.offset_spread)
 
 
-def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> None:
+def fold_models(nested: dict) -> list[dict]:
+    """The kept-out records of a nested run's JSON (:meth:`~trials.measured.nested.NestedCV.to_json`) with
+    each fold's identified ship rebuilt from its fitted values (the prior of the fold's hull form,
+    :func:`trials.measured.identify.ship_with_values`): what :func:`offset_spread` needs, without refitting."""
+    from trials.measured.identify import ship_with_values
+
+    priors = {}
+    out = []
+    for r in nested["records"]:
+        form = r["choice"].split(",")[0]
+        if form not in priors:
+            priors[form] = hull_candidates(SHIP, (form,))[form].ship
+        out.append({**r, "ship": ship_with_values(priors[form], r["values"])})
+    return out
+
+
+def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> dict:
     """Per kept-out record: the heading RMS [deg] of the initial and the identified model under rudder
     offsets in [-spread_deg, +spread_deg] (``n`` values): the range each spans and the offset each
-    prefers; then the comparison with each model at its own preferred offset (an oracle, both alike)."""
-    from trials.measured.identify import _ship_with, with_ship_effects
+    prefers; then the comparison with each model at its own preferred offset (an oracle, both alike).
+
+    The identified model is replayed as its scores were (:meth:`trials.measured.identify.Identification.replay`:
+    the record's wind loads scaled by the fold's fitted wind factors); a record whose zero-offset replay
+    does not give its scored heading RMS is named (stop 42: before, the fitted wind scale was left out)."""
+    from trials.measured.identify import ship_with_values, with_fitted_wind, with_ship_effects
     from trials.measured.predict import replay_record
 
     by_name = {r.name: r for r in runs}
     offs = np.linspace(-spread_deg, spread_deg, n)
 
     def scan(ship, run):
-        out = []
-        for o in offs:
-            s = _ship_with(ship, {"rudder_offset": np.radians(o)})
-            out.append(replay_record(s, with_ship_effects(run, s)).scores()["heading_rms_deg"])
-        return np.array(out)
+        return np.array([replay_record(s, with_ship_effects(run, s)).scores()["heading_rms_deg"]
+                         for s in (ship_with_values(ship, {"rudder_offset": np.radians(o)}) for o in offs)])
 
     print(f"\nrudder offsets {offs[0]:+.2f} .. {offs[-1]:+.2f} deg ({n} values): heading RMS range [deg] and "
           f"preferred offset [deg] of each model")
-    best_a, best_b = [], []
+    best_a, best_b, off_by = [], [], []
+    zero = int(np.argmin(np.abs(offs)))
     for c in cv:
         run = by_name[c["name"]]
-        ra, rb = scan(initial, run), scan(c["ship"], run)
+        ra, rb = scan(initial, run), scan(c["ship"], with_fitted_wind(run, c["values"]))
+        for who, r in (("scaled", ra), ("identified", rb)):
+            want = c[who]["heading_rms_deg"]
+            if offs[zero] == 0.0 and not np.isclose(r[zero], want, rtol=1e-6, equal_nan=True):
+                off_by.append(f"{c['name']} ({who}: {r[zero]:.2f} against {want:.2f} scored)")
         ka, kb = int(np.nanargmin(ra)), int(np.nanargmin(rb))
         best_a.append(ra[ka])
         best_b.append(rb[kb])
@@ -273,7 +302,9 @@ def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> None:
     print(f"each model at its own preferred offset: mean {best_a.mean():.2f} (initial) against {best_b.mean():.2f} "
           f"(identified), ratio {best_a.mean() / best_b.mean():.2f}, identified better on "
           f"{int(np.sum(best_b < best_a))} of {len(cv)}")
-
+    if off_by:
+        print(f"zero offset not replayed as scored on {len(off_by)}: {'; '.join(off_by)}")
+    return {"initial": best_a, "identified": best_b, "not_as_scored": off_by}
 
 if __name__ == "__main__":
     main()

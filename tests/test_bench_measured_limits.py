@@ -168,3 +168,47 @@ def test_gap_by_kind_needed_mean_and_replacement_by_hand():
     assert set(kinds) == {"turn", "random"}
     assert kinds["random"]["identified"] == pytest.approx(50.0) and kinds["random"]["share"] == pytest.approx(100 / 130)
     assert kinds["turn"]["n"] == 2 and kinds["turn"]["scaled"] == pytest.approx(30.0)
+
+
+def _windy_run(ship, k: int = 0):
+    """A 90 s zigzag record replayed by ``ship`` under steady prescribed wind loads (Fujiwara's, 4 m/s)."""
+    from dataclasses import replace
+
+    from mmg.model import pack
+    from mmg.replay import ReplayInputs, replay
+    from mmg.wind import wind_forces
+    from trials.measured.predict import MeasuredRun
+
+    t = np.arange(0.0, 90.0 + 1e-9, 0.1)
+    delta = np.convolve(np.radians(20.0) * np.sign(np.sin(2 * np.pi * t / 40.0)), np.ones(5) / 5, mode="same")
+    inp = ReplayInputs(t=t, delta=delta, n=np.full_like(t, 6.0))
+    X, Y, N = wind_forces(np.full_like(t, 4.0), np.full_like(t, np.radians(60.0 - 120.0 * k)), ship.wind.geometry)
+    inp = replace(inp, ext=np.column_stack([X, Y, N]))
+    return MeasuredRun(name=f"w{k}", source=f"w{k}", meas=replay(pack(ship), inp, [0.2, 0, 0, 0, 0, 0]), inputs=inp)
+
+
+def test_offset_scan_replays_the_fold_model_as_its_scores_were_wind_scale_included():
+    """A fold model rebuilt from its JSON values (fold_models), its fitted wind scale 0.3: the offset scan's
+    zero-offset replay gives the heading RMS that Identification.replay scored, for both models; scanning
+    without the fitted values (the bench before stop 42) replays another model and is named."""
+    from types import SimpleNamespace
+
+    import mmg
+    from trials.measured.identify import Identification
+    from trials.measured.nested import replay_scores
+    from trials.measured.predict import replay_record
+
+    cv = _load("identify_cv")
+    ship = mmg.load_ship("esso_osaka_3m")
+    run = _windy_run(ship)
+    values = {"N_r": 0.6 * ship.hull.value("N_r"), "wind_scale": 0.3}
+    rec = cv.fold_models({"records": [{"name": run.name, "choice": "kijima", "values": values}]})[0]
+    ident = Identification(ship=rec["ship"], initial=ship, fit=SimpleNamespace(values=lambda: values), runs=[run],
+                           segment_s=np.inf)
+    rec["scaled"] = replay_scores(replay_record(ship, run))
+    rec["identified"] = replay_scores(ident.replay(run))
+    assert rec["identified"]["heading_rms_deg"] > 1.0                # the model differs from the one that made it
+    out = cv.offset_spread([rec], [run], ship, 1.0, n=3)
+    assert out["not_as_scored"] == []
+    old = cv.offset_spread([{**rec, "values": {}}], [run], ship, 1.0, n=3)
+    assert [s.split(" ")[0] for s in old["not_as_scored"]] == [run.name]
