@@ -15,6 +15,7 @@ group of records out: a standard error that counts the record-to-record variatio
 DIR/ship.yaml`` (``mmg identify`` on all the records, which writes the fit's covariance) it also prints
 that covariance's standard error and the jackknife's ratio to it.
 
+The computation is :mod:`trials.measured.foldspread`'s (``mmg identify --cv`` reports the same check).
 The jackknife needs every fold to have fitted the same candidate (a fixed hull form: ``--hull kijima``);
 folds of different forms are printed without it.
 
@@ -36,23 +37,6 @@ if str(REPO) not in sys.path:
 SHIP = "esso_osaka_3m"
 
 
-def fold_values(nested: dict) -> tuple[list[str], list[dict]]:
-    """(each fold's choice, each fold's fitted shared values) of a :meth:`trials.measured.nested.NestedCV.to_json`
-    dict, in fold order; a record's own nuisance values (names with ``[``) are left out."""
-    by_fold = {}
-    for r in nested["records"]:
-        by_fold.setdefault(r["fold"], (r["choice"], {k: v for k, v in r["values"].items() if "[" not in k}))
-    folds = sorted(by_fold)
-    return [by_fold[f][0] for f in folds], [by_fold[f][1] for f in folds]
-
-
-def jackknife_se(theta: np.ndarray) -> float:
-    """Delete-a-group jackknife standard error from the K leave-one-group-out estimates ``theta``."""
-    theta = np.asarray(theta, float)
-    k = len(theta)
-    return float(np.sqrt((k - 1) / k * np.sum((theta - theta.mean()) ** 2)))
-
-
 def priors(form: str, names, width: float) -> dict:
     """{name: (prior value, prior std)} of the fit's free parameters for hull form ``form``."""
     from ekf.identify import free_parameters
@@ -65,24 +49,23 @@ def priors(form: str, names, width: float) -> dict:
 
 def table(nested: dict, width: float = 0.5, covariance=None) -> tuple[list[str], dict]:
     """The printed rows and a summary dict (module docstring)."""
-    choices, values = fold_values(nested)
+    from trials.measured.foldspread import fold_spread, fold_values
+
+    choices, _ = fold_values(nested["records"])
     forms = {c.split(",")[0] for c in choices}
-    same = len(set(choices)) == 1
-    names = [n for n in values[0] if all(n in v for v in values)]
+    sp = fold_spread(nested["records"], None if covariance is None else dict(zip(covariance.names, covariance.std())))
+    values, names = sp.values, sp.names
     pri = priors(next(iter(forms)), names, width) if len(forms) == 1 else {}
-    cov = {} if covariance is None else dict(zip(covariance.names, covariance.std()))
     head = ("| parameter | prior | prior std | " + " | ".join(f"fold {k}" for k in range(len(values)))
             + " | signs differ | spread / prior std | jackknife SE | fit's SE | ratio |")
     rows = [f"folds' choices: {', '.join(choices)}", head, "|" + "---|" * (head.count("|") - 1)]
     summ = {"n": len(names), "sign": 0, "spread_over_2": 0, "ratios": {}}
-    for n in names:
-        th = np.array([v[n] for v in values])
+    for j, n in enumerate(names):
+        th = values[:, j]
         p, s = pri.get(n, (np.nan, np.nan))
-        signs = bool(np.any(th > 0) and np.any(th < 0))
+        signs = bool(sp.sign_differs[j])
         spread = (th.max() - th.min()) / s if s > 0 else np.nan
-        jk = jackknife_se(th) if same else np.nan
-        se = cov.get(n, np.nan)
-        ratio = jk / se if se > 0 else np.nan
+        jk, se, ratio = sp.jackknife[j], sp.stated[j], sp.ratio[j]
         summ["sign"] += signs
         summ["spread_over_2"] += bool(spread > 2.0)
         if np.isfinite(ratio):

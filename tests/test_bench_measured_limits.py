@@ -119,13 +119,14 @@ def test_damped_heading_bound_is_the_first_order_response():
 def test_jackknife_se_of_leave_one_group_out_means_is_the_standard_error_of_the_group_means():
     """Independent formula: for K equal groups and theta_i the mean of all but group i, the delete-a-group
     jackknife SE equals the standard error of the mean of the K group means, sd(group means) / sqrt(K)."""
-    fv = _load("fold_values")
+    from trials.measured.foldspread import jackknife_se
+
     rng = np.random.default_rng(7)
     groups = rng.normal(3.0, 2.0, (4, 25))
     theta = [np.delete(groups, i, axis=0).mean() for i in range(4)]
     gm = groups.mean(axis=1)
-    assert fv.jackknife_se(theta) == pytest.approx(np.std(gm, ddof=1) / math.sqrt(4), rel=1e-12)
-    assert fv.jackknife_se([1.5, 1.5, 1.5]) == 0.0
+    assert jackknife_se(theta) == pytest.approx(np.std(gm, ddof=1) / math.sqrt(4), rel=1e-12)
+    assert jackknife_se([1.5, 1.5, 1.5]) == 0.0
 
 
 def test_fold_table_flags_sign_changes_spread_and_ratio_to_the_fits_own_se():

@@ -537,3 +537,31 @@ def test_fit_residuals_are_the_replay_errors_of_the_fitted_model_in_si_units():
     from dataclasses import replace
     broken = replace(ident, runs=[bad], fit=replace(ident.fit, theta=np.array([np.nan])))
     assert np.isnan(broken.fit_residuals()[0][1:]).all()             # after the start sample, which is the record's
+
+
+def test_cv_report_sets_the_written_std_against_the_folds_jackknife(tmp_path):
+    """--cv's report: per parameter, the std written into ship.yaml beside the delete-a-group jackknife of
+    the folds' fits, sqrt((K-1)/K sum (theta_i - mean)^2), and their ratio; folds of another free set than
+    the written fit's are not compared."""
+    import re
+
+    from trials.measured.identify import cross_validate
+
+    ship = mmg.load_ship(SHIP)
+    runs = _synthetic_runs(ship.with_hull({"N_r": ship.hull.value("N_r") * 1.2}), seeds=(0, 1, 2), duration=40.0)
+    kw = dict(free=["N_r", "N_beta"], segment_s=(np.inf,), say=lambda m: None, max_nfev=4)
+    ident = identify(ship, runs, **kw)
+    cv = cross_validate(ship, runs, folds=3, **kw)
+    rep = write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path, cv)["report"].read_text()
+    assert "## The written standard errors against the folds' spread" in rep
+    written = mmg.load_ship(tmp_path / "ship.yaml").covariance
+    for name in ("N_r", "N_beta"):
+        th = np.array([next(c["values"][name] for c in cv if c["fold"] == k) for k in range(3)])
+        jk = np.sqrt(2 / 3 * np.sum((th - th.mean()) ** 2))
+        std = written.std()[written.names.index(name)]
+        row = re.search(rf"^\| {name} \| \S+ \| (\S+) \| (\S+) \| (\S+) \|", rep, flags=re.M)
+        assert float(row[1]) == pytest.approx(std, rel=0.05) and float(row[2]) == pytest.approx(jk, rel=0.05)
+        assert float(row[3]) == pytest.approx(jk / std, abs=0.06)
+    other = cross_validate(ship, runs, folds=3, **{**kw, "free": ["N_r"]})
+    rep2 = write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path, other)["report"].read_text()
+    assert "no fold spread" in rep2 and "## The written standard errors" not in rep2

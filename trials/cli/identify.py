@@ -78,7 +78,7 @@ def _nested_as_cv(nested) -> list:
     if res is None:
         return None
     return [{"name": r["name"], "fold": r["fold"], "initial": r["scaled"], "identified": r["identified"],
-             "ship": r["ship"]} for r in res.records]
+             "ship": r["ship"], "values": r["values"], "choice": r["choice"]} for r in res.records]
 
 
 def _print_nested(nested, out: Path) -> None:

@@ -703,8 +703,9 @@ def _fold(task) -> list[dict]:
     """One cross-validation fold: identify on its training records, replay its kept-out ones."""
     ship, ref, train, tests, k, kw = task
     ident = identify(ship, train, **kw)
+    values = {n: float(v) for n, v in ident.fit.values().items()}
     return [{"name": r.name, "fold": k, "initial": replay_record(ref, r).scores(),
-             "identified": ident.replay(r).scores(), "ship": ident.ship} for r in tests]
+             "identified": ident.replay(r).scores(), "ship": ident.ship, "values": values} for r in tests]
 
 
 def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress=None, initial: Ship | None = None,
@@ -714,7 +715,8 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     (and the other scores) of the initial model (``initial``, the prior ``ship`` when omitted) and of
     the model identified from ``ship`` without it (``kw``: :func:`identify`'s options); ``folds_by``:
     how records are dealt into folds (:func:`fold_of`).  Each record's dict also holds ``"ship"``,
-    the model identified without it (for further replays of the kept-out record).
+    the model identified without it (for further replays of the kept-out record), and ``"values"``, that
+    fit's values by name (:mod:`trials.measured.foldspread`).
 
     The folds are independent: ``backend`` ``"serial"`` (default: one after the other, ``progress(k,
     folds)`` after each), ``"loky"`` (``n_jobs`` local processes) or ``"dask"`` (the workers of
@@ -979,6 +981,37 @@ def _report_test(ident: Identification, test_runs) -> list:
     return lines
 
 
+def _report_spread(cv: list, ident: Identification) -> list:
+    """The report's check of the written standard errors against the folds' spread
+    (:mod:`trials.measured.foldspread`); nothing where the folds carry no values or chose different forms."""
+    from .foldspread import fold_spread
+
+    if not all("values" in c for c in cv):
+        return []
+    cov = identification_covariance(ident)
+    stated = dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"]))))) if cov else {}
+    sp = fold_spread(cv, stated)
+    shared = {n for n in ident.fit.values() if "[" not in n}
+    if not sp.same_choice or set(sp.names) != shared:
+        return ["", "The folds fitted another model than the one written (another hull form or free set): "
+                    "no fold spread (it compares fits of one model)."]
+    lines = ["", "## The written standard errors against the folds' spread", "",
+             "Each fold fitted the model without its kept-out records.  The jackknife standard error over the "
+             f"{len(sp.values)} folds counts how the fit moves when a group of records is left out; the written one "
+             "(ship.yaml's covariance) counts the noise of one model fitted to all of them.  A ratio well above 1 "
+             "says the records differ from one another in ways the model does not carry, and the covariance "
+             "(and `mmg imo --samples`, which draws from it) is too sure by about that factor.", "",
+             "| parameter | identified | written std | jackknife std | ratio | folds' signs differ |",
+             "|---|---|---|---|---|---|"]
+    fitted = ident.fit.values()
+    for j, n in enumerate(sp.names):
+        lines.append(f"| {n} | {fitted.get(n, np.nan):.5g} | {sp.stated[j]:.2g} | {sp.jackknife[j]:.2g} | "
+                     f"{sp.ratio[j]:.1f} | {'yes' if sp.sign_differs[j] else ''} |")
+    lines += ["", f"Median ratio {sp.median_ratio():.1f} over {int(np.isfinite(sp.ratio).sum())} parameters "
+                  f"({len(sp.values)} folds: a rough figure)."]
+    return lines
+
+
 def _report_cv(cv: list) -> list:
     """The report's cross-validation table and summary."""
     lines = []
@@ -1016,6 +1049,6 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     if test_runs:
         lines += _report_test(ident, test_runs)
     if cv:
-        lines += _report_cv(cv)
+        lines += _report_cv(cv) + _report_spread(cv, ident)
     (out_dir / "report.md").write_text("\n".join(lines) + "\n")
     return {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
