@@ -52,7 +52,7 @@ __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_param
            "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled", "WIND_FACTORS",
            "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "logged_residual", "record_effect_parameters", "effect_set_of",
            "predict_logged", "start_parameters", "record_residuals", "model_states", "StraightRun",
-           "straight_run_residual", "STRAIGHT_RUN_DRIFT_SD"]
+           "straight_run_residual", "STRAIGHT_RUN_DRIFT_SD", "FAILED_RESIDUAL"]
 
 RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
                     "l_R_prime": (P_LR, -2.0, 0.0)}

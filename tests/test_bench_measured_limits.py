@@ -204,6 +204,8 @@ def test_offset_scan_replays_the_fold_model_as_its_scores_were_wind_scale_includ
     run = _windy_run(ship)
     values = {"N_r": 0.6 * ship.hull.value("N_r"), "wind_scale": 0.3}
     rec = cv.fold_models({"records": [{"name": run.name, "choice": "kijima", "values": values}]})[0]
+    assert rec["ship"].hull.value("N_r") == pytest.approx(values["N_r"])          # the fold's values written in
+    assert rec["ship"].wind.scale == pytest.approx(0.3 * ship.wind.scale)
     ident = Identification(ship=rec["ship"], initial=ship, fit=SimpleNamespace(values=lambda: values), runs=[run],
                            segment_s=np.inf)
     rec["scaled"] = replay_scores(replay_record(ship, run))
@@ -213,3 +215,4 @@ def test_offset_scan_replays_the_fold_model_as_its_scores_were_wind_scale_includ
     assert out["not_as_scored"] == []
     old = cv.offset_spread([{**rec, "values": {}}], [run], ship, 1.0, n=3)
     assert [s.split(" ")[0] for s in old["not_as_scored"]] == [run.name]
+    assert cv.offset_spread([rec], [run], ship, 1.0, n=4)["not_as_scored"] is None     # no zero offset: unchecked

@@ -525,13 +525,16 @@ def test_fit_residuals_are_the_replay_errors_of_the_fitted_model_in_si_units():
     r [rad/s], heading [rad]; a record whose replay fails gives NaN, not the fit's finite stand-in."""
     ship = mmg.load_ship(SHIP)
     runs = _synthetic_runs(ship.with_hull({"N_r": ship.hull.value("N_r") * 1.2}), duration=60.0)
-    ident = identify(ship, runs, free=["N_r"], segment_s=(np.inf,), say=lambda m: None, initial_state="sample",
-                     max_nfev=3)
-    for r, d in zip(runs, ident.fit_residuals()):
-        err = ident.replay(r).pred - r.meas
-        assert d.shape == (len(r.t), 4)
-        for j, c in enumerate((0, 1, 2, 5)):
-            np.testing.assert_allclose(d[:, j], err[:, c], atol=1e-6 * np.abs(err[:, c]).max())
+    kw = dict(free=["N_r"], segment_s=(np.inf,), say=lambda m: None, initial_state="sample", max_nfev=3)
+    other = identify(mmg.load_ship(f"{SHIP}_crossflow"), runs, initial=ship, **kw)    # fitted in another form
+    assert other.prior is not None
+    ident = identify(ship, runs, **kw)
+    for fitted in (ident, other):
+        for r, d in zip(runs, fitted.fit_residuals()):
+            err = fitted.replay(r).pred - r.meas
+            assert d.shape == (len(r.t), 4)
+            for j, c in enumerate((0, 1, 2, 5)):
+                np.testing.assert_allclose(d[:, j], err[:, c], atol=1e-6 * np.abs(err[:, c]).max())
     assert np.abs(ident.fit_residuals(stride=3)[0] - ident.fit_residuals()[0][::3]).max() == 0.0
     bad = MeasuredRun(name="bad", source="bad", meas=runs[0].meas.copy(), inputs=runs[0].inputs)
     from dataclasses import replace

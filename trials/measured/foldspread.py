@@ -32,10 +32,22 @@ def jackknife_se(theta) -> float:
 
 
 def fold_values(records: list[dict]) -> tuple[list[str], list[dict]]:
-    """(each fold's choice, each fold's fitted shared values) from kept-out record dicts carrying ``fold``,
-    ``values`` and optionally ``choice`` (:func:`trials.measured.identify.cross_validate`'s, a nested
-    cross-validation's ``records``), in fold order; a record's own values (names with ``[``: start offsets,
-    per-record nuisances) are left out."""
+    """Each fold's choice and fitted shared values, in fold order.
+
+    Parameters
+    ----------
+    records : list of dict
+        Kept-out records carrying ``fold``, ``values`` and optionally ``choice``
+        (:func:`trials.measured.identify.cross_validate`'s, a nested cross-validation's ``records``).
+
+    Returns
+    -------
+    choices : list of str
+        Each fold's candidate (``""`` where the records name none).
+    values : list of dict
+        Each fold's fitted values by name; a record's own values (names with ``[``: start offsets,
+        per-record nuisances) are left out.
+    """
     by_fold = {}
     for r in records:
         shared = {k: float(v) for k, v in r["values"].items() if "[" not in k}
@@ -58,15 +70,20 @@ class FoldSpread:
         Jackknife standard error of each (NaN when the folds chose different candidates).
     stated : ndarray
         The stated standard error of each (the written covariance's; NaN where it has none).
-    same_choice : bool
-        Whether every fold fitted the same candidate (the jackknife needs it).
+    choices : tuple of str
+        Each fold's candidate (``""`` where the records name none).
     """
 
     names: tuple
     values: np.ndarray
     jackknife: np.ndarray
     stated: np.ndarray
-    same_choice: bool = True
+    choices: tuple = ()
+
+    @property
+    def same_choice(self) -> bool:
+        """Whether every fold fitted the same candidate (the jackknife needs it)."""
+        return len(set(self.choices)) <= 1
 
     @property
     def ratio(self) -> np.ndarray:
@@ -98,13 +115,29 @@ class FoldSpread:
             return [None if not np.isfinite(x) else float(x) for x in np.ravel(a)]
 
         return {"names": list(self.names), "values": [clean(v) for v in self.values], "jackknife_se": clean(self.jackknife),
-                "stated_se": clean(self.stated), "same_choice": self.same_choice}
+                "stated_se": clean(self.stated), "choices": list(self.choices)}
 
 
 def fold_spread(records: list[dict], stated: dict | None = None) -> FoldSpread:
-    """The :class:`FoldSpread` of a cross-validation's kept-out records (:func:`fold_values`) against the
-    stated standard errors ``stated`` ({name: std}, e.g. the written covariance's); raises ValueError below
-    two folds."""
+    """How far apart the folds' fits are, against stated standard errors.
+
+    Parameters
+    ----------
+    records : list of dict
+        A cross-validation's kept-out records (:func:`fold_values`).
+    stated : dict, optional
+        {name: standard error}, e.g. the written covariance's; NaN ratios without it.
+
+    Returns
+    -------
+    FoldSpread
+        Over the parameters every fold fitted.
+
+    Raises
+    ------
+    ValueError
+        Below two folds.
+    """
     choices, values = fold_values(records)
     if len(values) < 2:
         raise ValueError(f"a fold spread needs 2 or more folds, got {len(values)}")
@@ -113,4 +146,4 @@ def fold_spread(records: list[dict], stated: dict | None = None) -> FoldSpread:
     same = len(set(choices)) == 1
     jk = np.array([jackknife_se(th[:, j]) if same else np.nan for j in range(len(names))])
     st = np.array([(stated or {}).get(n, np.nan) for n in names], float)
-    return FoldSpread(names, th, jk, st, same)
+    return FoldSpread(names, th, jk, st, tuple(choices))

@@ -186,15 +186,14 @@ class Identification:
         replay failed.  What no prediction of an unseen record can have: the in-sample bound
         (``bench/identify_ceiling.py``)."""
         import mmg.effects as E
-        from ekf.identify import FAILED_RESIDUAL, record_residuals
+        from ekf.identify import FAILED_RESIDUAL
 
         prior = self.prior or self.initial
         nu = [E.get(n, "record_nuisance") for n in self.record_nuisance] or None
-        sc = _scales(self.runs, prior.particulars.L, self.velocity_weight)
-        res = record_residuals(pack(prior), _segmented(self.runs, np.inf), self.fit.free, self.fit.theta, sc,
-                               stride=stride, effects=nu, ship=prior)
+        res, sc = _whole_record_residuals((prior, pack(prior), self.runs, self.fit.free, nu), self.fit.theta,
+                                          self.velocity_weight, stride)
         unit = np.array([sc.u, sc.v, sc.r, sc.psi])
-        return [np.where(np.abs(d[:, :4]) >= FAILED_RESIDUAL, np.nan, d[:, :4] * unit) for d in res]
+        return [np.where(d[:, :4] == FAILED_RESIDUAL, np.nan, d[:, :4] * unit) for d in res]
 
     def physical_check(self):
         """:func:`trials.measured.physical.physical_check` of the identified model against its prior
@@ -510,17 +509,23 @@ def _segmented(runs, seg: float):
             for r in runs]
 
 
+def _whole_record_residuals(problem: tuple, theta, velocity_weight: float, stride: int):
+    """(each record's scaled residuals of its whole-record replay at ``theta``, the scales): the last stage's
+    residuals; problem = (ship, packed ship, runs, free parameters, nuisance effects or None)."""
+    from ekf.identify import record_residuals
+
+    ship, packed, runs, fp, nuisance = problem
+    sc = _scales(runs, ship.particulars.L, velocity_weight)
+    return record_residuals(packed, _segmented(runs, np.inf), fp, theta, sc, stride=stride, effects=nuisance,
+                            ship=ship), sc
+
+
 def _residual_tau(problem: tuple, fit, o: IdentifyOptions, stride: int = 2) -> float:
     """The integrated autocorrelation time [samples at ``stride``] of the last stage's residuals: each
     channel's (u, v, r, heading) median over the records, the mean over the channels (as ``mmg diagnose``)."""
-    from ekf.identify import record_residuals
-
     from .diagnose import _tau
 
-    ship, packed, runs, fp, nuisance = problem
-    res = record_residuals(packed, _segmented(runs, np.inf), fp, fit.theta,
-                           _scales(runs, ship.particulars.L, o.velocity_weight), stride=stride, effects=nuisance,
-                           ship=ship)
+    res, _ = _whole_record_residuals(problem, fit.theta, o.velocity_weight, stride)
     taus = [np.median([_tau(d[:, j]) for d in res]) for j in range(4)]
     return float(np.mean(taus))
 
@@ -981,26 +986,29 @@ def _report_test(ident: Identification, test_runs) -> list:
     return lines
 
 
-def _report_spread(cv: list, ident: Identification) -> list:
-    """The report's check of the written standard errors against the folds' spread
-    (:mod:`trials.measured.foldspread`); nothing where the folds carry no values or chose different forms."""
+def _report_spread(cv: list, ident: Identification, cov: dict | None) -> list:
+    """The report's check of the written standard errors (``cov``, ship.yaml's covariance section) against
+    the folds' spread (:mod:`trials.measured.foldspread`); nothing where the folds carry no values."""
     from .foldspread import fold_spread
 
     if not all("values" in c for c in cv):
         return []
-    cov = identification_covariance(ident)
-    stated = dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"]))))) if cov else {}
-    sp = fold_spread(cv, stated)
+    if cov is None:
+        return ["", "No covariance was written (singular fit): the folds' spread is not compared."]
+    sp = fold_spread(cv, dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"]))))))
     shared = {n for n in ident.fit.values() if "[" not in n}
-    if not sp.same_choice or set(sp.names) != shared:
+    left = sorted(shared - set(sp.names))
+    droppable = {"Y_P_astern", *_wind_keys()}          # left out of a fold whose records cannot fit them (_free_of)
+    if not sp.same_choice or not set(sp.names) <= shared or not set(left) <= droppable:
         return ["", "The folds fitted another model than the one written (another hull form or free set): "
                     "no fold spread (it compares fits of one model)."]
     lines = ["", "## The written standard errors against the folds' spread", "",
              "Each fold fitted the model without its kept-out records.  The jackknife standard error over the "
              f"{len(sp.values)} folds counts how the fit moves when a group of records is left out; the written one "
              "(ship.yaml's covariance) counts the noise of one model fitted to all of them.  A ratio well above 1 "
-             "says the records differ from one another in ways the model does not carry, and the covariance "
-             "(and `mmg imo --samples`, which draws from it) is too sure by about that factor.", "",
+             "says the records differ from one another in ways the model does not carry (or that the fits stopped "
+             "short of their optimum: the report's stages), and the covariance (and `mmg imo --samples`, which "
+             "draws from it) is too sure by about that factor.", "",
              "| parameter | identified | written std | jackknife std | ratio | folds' signs differ |",
              "|---|---|---|---|---|---|"]
     fitted = ident.fit.values()
@@ -1009,6 +1017,8 @@ def _report_spread(cv: list, ident: Identification) -> list:
                      f"{sp.ratio[j]:.1f} | {'yes' if sp.sign_differs[j] else ''} |")
     lines += ["", f"Median ratio {sp.median_ratio():.1f} over {int(np.isfinite(sp.ratio).sum())} parameters "
                   f"({len(sp.values)} folds: a rough figure)."]
+    if left:
+        lines += [f"Not in every fold's fit (no record to fit it on there): {', '.join(left)}."]
     return lines
 
 
@@ -1049,6 +1059,6 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     if test_runs:
         lines += _report_test(ident, test_runs)
     if cv:
-        lines += _report_cv(cv) + _report_spread(cv, ident)
+        lines += _report_cv(cv) + _report_spread(cv, ident, cov)
     (out_dir / "report.md").write_text("\n".join(lines) + "\n")
     return {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
