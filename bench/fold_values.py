@@ -93,6 +93,8 @@ def refit(nested: dict, fold: int, max_nfev: int) -> list[str]:
     if "," in choice:
         raise SystemExit(f"--refit: fold {fold} chose {choice!r}; only a plain hull form is refitted")
     kept = {r["name"] for r in recs if r["fold"] == fold}
+    if frt_data_dir() is None:
+        raise SystemExit("--refit: FRT-DS-ESSO data not found (set MMG_FRT_DATA)")
     paths = [p for p in sorted(Path(frt_data_dir()).glob("*/*.csv")) if p.stem in {r["name"] for r in recs}]
     ship = hull_candidates(SHIP, (form,))[form].ship
     runs = load_runs(ship, [p for p in paths if p.stem not in kept], say=lambda *_: None)
@@ -106,9 +108,10 @@ def refit(nested: dict, fold: int, max_nfev: int) -> list[str]:
             "| parameter | run's value | refitted | shift / jackknife SE |", "|---|---|---|---|"]
     shifts = []
     for j, n in enumerate(sp.names):
-        d = (new[n] - old[j]) / sp.jackknife[j] if sp.jackknife[j] > 0 else np.nan
+        v = new.get(n, np.nan)                   # nan: the refit left it out (no record to fit it on)
+        d = (v - old[j]) / sp.jackknife[j] if sp.jackknife[j] > 0 else np.nan
         shifts.append(abs(d))
-        rows.append(f"| {n} | {old[j]:+.4g} | {new[n]:+.4g} | {d:+.2f} |")
+        rows.append(f"| {n} | {old[j]:+.4g} | {v:+.4g} | {d:+.2f} |")
     rows.append(f"shift / jackknife SE: median {np.nanmedian(shifts):.2f}, largest {np.nanmax(shifts):.2f}")
     return rows
 
