@@ -5,7 +5,8 @@ Froude-scaled model's.  The mean is over records of four kinds (the shared folde
 runs, berthing runs) whose open-loop heading errors differ by an order of magnitude, so a few kinds may
 decide it.  From a nested cross-validation's JSON (``bench/identify_cv.py --json``) this prints, per kind,
 the mean heading RMS of the scaled and the identified model and the kind's share of the identified
-model's sum; then the mean the random runs would need for 3x with the other kinds as they are.
+model's sum; each fold's mean and choice; then the mean the random runs would need for 3x with the other
+kinds as they are.
 
 With ``--in-sample CEILING.json`` (``bench/identify_ceiling.py --json``: the model fitted on every record,
 replayed on its own training records from their first samples) it also prints what the held-out mean
@@ -33,6 +34,15 @@ TARGET = 3.0
 def kind_of(name: str) -> str:
     """The kind of a record by its name's first word (``turn_cut_...`` is a turn)."""
     return name.split("_")[0]
+
+
+def fold_means(nested: dict) -> dict:
+    """{fold: (its choice, the identified model's mean whole-record heading RMS [deg] over its kept-out records)}."""
+    out = {}
+    for f in sorted({r["fold"] for r in nested["records"]}):
+        rs = [r for r in nested["records"] if r["fold"] == f]
+        out[f] = (rs[0].get("choice", ""), float(np.mean([r["identified"]["heading_rms_deg"] for r in rs])))
+    return out
 
 
 def held_out(nested: dict) -> dict:
@@ -85,7 +95,8 @@ def main(argv=None) -> int:
     ap.add_argument("--in-sample", type=Path, default=None)
     ap.add_argument("--form", default=None, help="which fit of the in-sample JSON (default: its first)")
     a = ap.parse_args(argv)
-    rows = held_out(json.loads(a.nested.read_text()))
+    nested = json.loads(a.nested.read_text())
+    rows = held_out(nested)
     s = np.mean([x[0] for x in rows.values()])
     i = np.mean([x[1] for x in rows.values()])
     print(f"{a.nested.name}: {len(rows)} kept-out records, mean heading RMS scaled {s:.2f} / identified {i:.2f} deg "
@@ -93,6 +104,8 @@ def main(argv=None) -> int:
     print("| kind | records | scaled [deg] | identified [deg] | share of the identified sum |\n|---|---|---|---|---|")
     for r in kind_table(rows):
         print(f"| {r['kind']} | {r['n']} | {r['scaled']:.1f} | {r['identified']:.1f} | {r['share']:.0%} |")
+    print("per fold, the identified model's mean over its kept-out records: " + "; ".join(
+        f"fold {f} ({c}) {m:.2f} deg" for f, (c, m) in fold_means(nested).items()))
     print(f"for {TARGET:g}x with the other kinds as they are, the random runs would need a mean of "
           f"{needed_mean(rows, 'random'):.1f} deg")
     if a.in_sample:

@@ -290,7 +290,7 @@ def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> dict:
 
     print(f"\nrudder offsets {offs[0]:+.2f} .. {offs[-1]:+.2f} deg ({n} values): heading RMS range [deg] and "
           f"preferred offset [deg] of each model")
-    best_a, best_b, off_by = [], [], []
+    best_a, best_b, off_by, spans, edge = [], [], [], [], [0, 0]
     zero = int(np.argmin(np.abs(offs)))
     checked = bool(offs[zero] == 0.0)
     for c in cv:
@@ -303,12 +303,20 @@ def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> dict:
         ka, kb = int(np.nanargmin(ra)), int(np.nanargmin(rb))
         best_a.append(ra[ka])
         best_b.append(rb[kb])
+        spans.append((np.nanmax(ra) - np.nanmin(ra), np.nanmax(rb) - np.nanmin(rb)))
+        edge[0] += ka in (0, n - 1)
+        edge[1] += kb in (0, n - 1)
         print(f"{c['name']:32s} {np.nanmin(ra):6.2f} - {np.nanmax(ra):6.2f} {offs[ka]:+6.2f} "
               f"{np.nanmin(rb):7.2f} - {np.nanmax(rb):7.2f} {offs[kb]:+6.2f}")
     best_a, best_b = np.array(best_a), np.array(best_b)
     print(f"each model at its own preferred offset: mean {best_a.mean():.2f} (initial) against {best_b.mean():.2f} "
           f"(identified), ratio {best_a.mean() / best_b.mean():.2f}, identified better on "
           f"{int(np.sum(best_b < best_a))} of {len(cv)}")
+    sp = np.array(spans)
+    print(f"range of heading RMS over the offsets [deg]: initial {sp[:, 0].min():.1f}-{sp[:, 0].max():.1f} (median "
+          f"{np.median(sp[:, 0]):.1f}), identified {sp[:, 1].min():.1f}-{sp[:, 1].max():.1f} (median "
+          f"{np.median(sp[:, 1]):.1f}); preferred offset at the edge of the scan on {edge[0]} (initial) and "
+          f"{edge[1]} (identified) of {len(cv)}")
     if not checked:
         print("no zero offset among the values (an even number): the replays were not checked against the scores")
     elif off_by:

@@ -169,6 +169,9 @@ def test_gap_by_kind_needed_mean_and_replacement_by_hand():
     assert set(kinds) == {"turn", "random"}
     assert kinds["random"]["identified"] == pytest.approx(50.0) and kinds["random"]["share"] == pytest.approx(100 / 130)
     assert kinds["turn"]["n"] == 2 and kinds["turn"]["scaled"] == pytest.approx(30.0)
+    recs = [{"name": n, "fold": k % 2, "choice": "kijima", "identified": {"heading_rms_deg": x[1]}}
+            for k, (n, x) in enumerate(rows.items())]
+    assert gap.fold_means({"records": recs}) == {0: ("kijima", pytest.approx(35.0)), 1: ("kijima", pytest.approx(30.0))}
 
 
 def _windy_run(ship, k: int = 0):
