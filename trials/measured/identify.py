@@ -185,11 +185,10 @@ class Identification:
         (n_k, 4) of u, v [m/s], r [rad/s] and heading [rad] at every ``stride``-th sample; NaN where that
         replay failed.  What no prediction of an unseen record can have: the in-sample bound
         (``bench/identify_ceiling.py``)."""
-        import mmg.effects as E
         from ekf.identify import FAILED_RESIDUAL
 
         prior = self.prior or self.initial
-        nu = [E.get(n, "record_nuisance") for n in self.record_nuisance] or None
+        nu = _nuisance_effects(self.record_nuisance) or None
         res, sc = _whole_record_residuals((prior, pack(prior), self.runs, self.fit.free, nu), self.fit.theta,
                                           self.velocity_weight, stride)
         unit = np.array([sc.u, sc.v, sc.r, sc.psi])
@@ -445,6 +444,13 @@ def _bounded_wind(ship: Ship, fp: list) -> list:
     return out
 
 
+def _nuisance_effects(names) -> list:
+    """The :mod:`mmg.effects` classes of ``record_nuisance`` names (an unknown name is refused there)."""
+    import mmg.effects as E
+
+    return [E.get(n, "record_nuisance") for n in names]
+
+
 def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
     """(free parameters, the per-record nuisance effects or None)."""
     from ekf.identify import free_parameters
@@ -462,10 +468,9 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
         fp = fp + start_parameters(_start_sigmas(ship, runs, o), names=[r.name for r in runs])
     if not o.record_nuisance:
         return fp, None
-    import mmg.effects as E
     from ekf.identify import record_effect_parameters
 
-    nuisance = [E.get(n, "record_nuisance") for n in o.record_nuisance]
+    nuisance = _nuisance_effects(o.record_nuisance)
     return fp + record_effect_parameters(nuisance, len(runs), names=[r.name for r in runs]), nuisance
 
 
@@ -887,8 +892,14 @@ def _stage_lines(ident: Identification) -> list[str]:
     return out
 
 
-def _report_fit(ident: Identification) -> list:
-    """The report's title, stages, values with standard errors, warnings and strong correlations."""
+def _cov_std(cov: dict | None) -> dict:
+    """{name: standard error} of a ``covariance:`` section (:func:`identification_covariance`); {} for None."""
+    return dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"], float))))) if cov else {}
+
+
+def _report_fit(ident: Identification, cov: dict | None) -> list:
+    """The report's title, stages, values with standard errors (of ``cov``, the written covariance section),
+    warnings and strong correlations."""
     fit = ident.fit
     lines = [f"# Identification of {ident.initial.name}", ""]
     if ident.prior is not None:
@@ -904,8 +915,7 @@ def _report_fit(ident: Identification) -> list:
              f"{max(ident.tau, 1.0):.3g} samples; :func:`identification_covariance`); where it is singular, the "
              "fit's own Gauss-Newton ones.", "",
              "| parameter | config | identified | std | change |", "|---|---|---|---|---|"]
-    cov = identification_covariance(ident)
-    std = dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"]))))) if cov else {}
+    std = _cov_std(cov)
     starts = [f for f in fit.free if f.kind == "start"]
     for name, row in fit.to_pandas().iterrows():
         if name.startswith("start."):
@@ -995,7 +1005,7 @@ def _report_spread(cv: list, ident: Identification, cov: dict | None) -> list:
         return []
     if cov is None:
         return ["", "No covariance was written (singular fit): the folds' spread is not compared."]
-    sp = fold_spread(cv, dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"]))))))
+    sp = fold_spread(cv, _cov_std(cov))
     shared = {n for n in ident.fit.values() if "[" not in n}
     left = sorted(shared - set(sp.names))
     droppable = {"Y_P_astern", *_wind_keys()}          # left out of a fold whose records cannot fit them (_free_of)
@@ -1055,7 +1065,7 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
     cov = identification_covariance(ident)
     (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov))
-    lines = _report_fit(ident) + _report_physical(ident.physical_check()) + _report_training(ident)
+    lines = _report_fit(ident, cov) + _report_physical(ident.physical_check()) + _report_training(ident)
     if test_runs:
         lines += _report_test(ident, test_runs)
     if cv:
