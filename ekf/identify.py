@@ -52,7 +52,7 @@ __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_param
            "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled", "WIND_FACTORS",
            "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "logged_residual", "record_effect_parameters", "effect_set_of",
            "predict_logged", "start_parameters", "record_residuals", "model_states", "StraightRun",
-           "straight_run_residual", "STRAIGHT_RUN_DRIFT_SD", "FAILED_RESIDUAL"]
+           "straight_run_residual", "STRAIGHT_RUN_DRIFT_SD", "FAILED_RESIDUAL", "run_jackknife_covariance"]
 
 RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
                     "l_R_prime": (P_LR, -2.0, 0.0)}
@@ -492,6 +492,12 @@ class IdentifyResult:
     solution, unscaled; None where not computed."""
     ss_data: float | None = None
     """Sum of squares of the data rows' residuals at the solution (twice the cost without the prior's part)."""
+    record_scores: np.ndarray | None = None
+    """(n_records, n) each record's score J_k^T r_k at the solution: its data rows (its block and its
+    straight-run row) alone, in the fit's weighted units; None where not computed."""
+    record_info: np.ndarray | None = None
+    """(n_records, n, n) each record's J_k^T J_k at the solution, as :attr:`record_scores`; their sum is
+    :attr:`info_data`."""
 
     def warnings(self) -> list[str]:
         """What a reader of the values should not miss, one sentence each: a parameter on one of its
@@ -642,6 +648,12 @@ class _SegmentFit:
         self.longest_first = sorted(range(n), key=lambda k: -len(records[k].meas))   # the pool's order (see resid)
         self.count = 0
 
+    def record_rows(self) -> list[np.ndarray]:
+        """Each record's data rows in the residual vector: its block, then its straight-run row if any."""
+        s, end = self.start, self.start[-1]
+        return [np.r_[np.arange(s[k], s[k + 1]), [end + self.straight.index(k)] if k in self.straight else []]
+                .astype(int) for k in range(len(self.records))]
+
     def block(self, theta, k, pk=None, rec=None):
         """Record k's weighted residuals (of ``rec``, a part of it such as its first segment, when given)."""
         o = self.opts
@@ -710,8 +722,9 @@ class _SegmentFit:
         return np.column_stack([cols[j] for j in range(n)])
 
 
-def _result(free, sol, cost_initial: float) -> IdentifyResult:
-    """The fit with its Gauss-Newton covariance scaled by the residual variance per degree of freedom."""
+def _result(free, sol, cost_initial: float, record_rows=None) -> IdentifyResult:
+    """The fit with its Gauss-Newton covariance scaled by the residual variance per degree of freedom;
+    with ``record_rows`` (one index array per record: its data rows) each record's score and information."""
     J = sol.jac
     n = len(free)
     dof = max(len(sol.fun) - n, 1)
@@ -724,10 +737,63 @@ def _result(free, sol, cost_initial: float) -> IdentifyResult:
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(std, std)
     Jd, fd = np.asarray(J)[:-n], sol.fun[:-n]                # the prior's rows are the last n
+    scores = info = None
+    if record_rows is not None:
+        scores = np.array([Jd[i].T @ fd[i] for i in record_rows]).reshape(len(record_rows), n)
+        info = np.array([Jd[i].T @ Jd[i] for i in record_rows]).reshape(len(record_rows), n, n)
     return IdentifyResult(free=free, theta=sol.x, std=std, corr=corr, cost_initial=cost_initial,
                           cost_final=float(sol.cost), n_residuals=len(sol.fun), iterations=int(sol.nfev),
                           message=str(sol.message), status=int(sol.status), info_data=Jd.T @ Jd,
-                          ss_data=float(fd @ fd))
+                          ss_data=float(fd @ fd), record_scores=scores, record_info=info)
+
+
+def run_jackknife_covariance(result: IdentifyResult, groups) -> np.ndarray:
+    """Delete-one-group jackknife covariance of a fit's parameters over its independent records.
+
+    For each group g of records (a run and its cut copies: one group), the fit without it is taken
+    one Gauss-Newton step from the solution: ``delta_g = (H - H_g)^-1 s_g``, H the fit's information
+    (data rows' J^T J plus the prior's diag(1 / sigma^2)), H_g and s_g the group's own J^T J and
+    score J^T r (:attr:`IdentifyResult.record_info`, :attr:`IdentifyResult.record_scores`).  The
+    covariance is ``(G - 1) / G * sum_g (delta_g - mean)(delta_g - mean)^T``: how far the estimate
+    moves from one group of records to the next, whatever the residuals' correlation within a record
+    or a model form the records share.  The prior does not move with the records, so a parameter the
+    records do not inform gets none of its variance here.
+
+    Parameters
+    ----------
+    result : IdentifyResult
+        A fit made by :func:`identify_segments` (its per-record scores and information).
+    groups : sequence of int
+        Each record's group label, in the fit's record order.
+
+    Returns
+    -------
+    ndarray
+        (n, n) over every free parameter (a record's own ones included).
+
+    Raises
+    ------
+    ValueError
+        Without per-record scores, a label per record, or with fewer than two groups.
+    """
+    if result.record_scores is None or result.record_info is None:
+        raise ValueError("run jackknife: the fit carries no per-record scores (made by identify_segments?)")
+    groups = np.asarray(groups)
+    if len(groups) != len(result.record_scores):
+        raise ValueError(f"run jackknife: {len(groups)} group labels for {len(result.record_scores)} records")
+    labels = list(dict.fromkeys(groups.tolist()))
+    if len(labels) < 2:
+        raise ValueError(f"run jackknife: needs two or more independent groups of records, got {len(labels)}")
+    sig = np.array([f.sigma for f in result.free], float)
+    H = result.record_info.sum(axis=0) + np.diag(1.0 / sig ** 2)
+    deltas = []
+    for g in labels:
+        m = groups == g
+        deltas.append(np.linalg.solve(H - result.record_info[m].sum(axis=0), result.record_scores[m].sum(axis=0)))
+    d = np.array(deltas)
+    d -= d.mean(axis=0)
+    G = len(labels)
+    return (G - 1) / G * d.T @ d
 
 
 def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
@@ -764,4 +830,4 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
                             max_nfev=o.max_nfev, bounds=(lo, hi), loss=o.loss, f_scale=o.f_scale)
     finally:
         pool.shutdown()
-    return _result(free, sol, 0.5 * float(r_init @ r_init))
+    return _result(free, sol, 0.5 * float(r_init @ r_init), fit.record_rows())
