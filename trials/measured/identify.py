@@ -74,13 +74,14 @@ import numpy as np
 
 from mmg.errors import InputError
 from mmg.model import pack
+from mmg.parameters import unit_of
 from mmg.ship import Ship
 
 from .predict import MeasuredRun, measured_run, replay_record
 
 __all__ = ["identify", "IdentifyOptions",
            "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
-           "fit_covariance", "ship_with_values", "PARAMETER_UNITS",
+           "fit_covariance", "ship_with_values",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description", "identification_covariance", "run_covariance", "fold_spread_json",
            "COVARIANCE_METHOD", "start_noise", "DEFAULT_INITIAL_STATE",
@@ -290,53 +291,25 @@ def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
 
 def ship_with_values(ship: Ship, values: dict) -> Ship:
     """``ship`` with fitted parameter values (by their ``mmg identify --free`` names, in the fit's units:
-    :data:`PARAMETER_UNITS`) written in; ``wind_scale`` multiplies the ship's wind scale."""
-    from dataclasses import replace
+    :func:`mmg.parameters.unit_of`) written in through the parameter table (:mod:`mmg.parameters`); a wind
+    value multiplies the ship's; names not in the table (a record's own nuisances) are left out."""
+    from mmg.parameters import with_value
 
     hull = {k: v for k, v in values.items() if k in ship.hull.names}
-    s = ship.with_hull(hull) if hull else ship
-    if "w_P0" in values:
-        w = list(s.propeller.w_P0)
-        w[0] = values["w_P0"]
-        s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
-    if "Y_P_astern" in values:
-        s = replace(s, propeller=replace(s.propeller, Y_P_astern=float(values["Y_P_astern"])))
-    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
-    from mmg.nondim import inertia_scale, mass_scale
-
-    pa = s.particulars
-    mass = {f"{k}_prime": values[k] / (inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T))
-            for k in MASS_CONSTANTS if k in values}
-    if mass:
-        s = replace(s, mass=replace(s.mass, **mass))
-    rud = {k: values[k] for k in ("epsilon", "kappa", *RUDDER_CONSTANTS) if k in values}
-    if rud:
-        s = replace(s, rudder=replace(s.rudder, **rud))
-    if "rudder_offset" in values:                 # the rudder_offset effect of mmg.effects, in degrees
-        import mmg.effects as E
-
-        s = replace(s, effects=s.effect_set().merged(
-            E.effect_set({"rudder_offset": {"offset_deg": float(np.degrees(values["rudder_offset"]))}})))
-    wind = {k: values[name] for name, k in _wind_keys().items() if name in values}
-    if wind and s.wind is not None:
-        new = {k: getattr(s.wind, k) * v for k, v in wind.items()}
-        s = replace(s, wind=replace(s.wind, **new))
-        w = s.effect_set().get("wind")
-        if w is not None:
-            import mmg.effects as E
-
-            new = {k: float(w.get(k, 1.0)) * v for k, v in wind.items()}
-            s = replace(s, effects=s.effect_set().merged(E.effect_set({"wind": {**w, **new}})))
+    s = ship.with_hull(hull) if hull else ship                # the hull in one step
+    for k, v in values.items():
+        if k not in hull:
+            s = with_value(s, k, v)
     return s
 
 
 def _wind_keys() -> dict:
     """``mmg identify --free`` name of a fitted wind value -> the key of the ship's ``wind:`` section (and of
-    its ``wind`` effect) it multiplies (``wind_scale`` and :data:`ekf.identify.WIND_FACTORS`): the records'
-    loads were computed with the ship's values, so the fitted ones are factors on them."""
-    from ekf.identify import WIND_FACTORS
+    its ``wind`` effect) it multiplies (:data:`mmg.parameters.WIND_COLUMNS`): the records' loads were computed
+    with the ship's values, so the fitted ones are factors on them."""
+    from mmg.parameters import WIND_COLUMNS
 
-    return {"wind_scale": "scale", **{k: par for k, (par, _) in WIND_FACTORS.items()}}
+    return {k: key for k, (key, _) in WIND_COLUMNS.items()}
 
 
 _ship_with = ship_with_values
@@ -466,7 +439,8 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
     if "Y_P_astern" in names and not any(goes_astern(r) for r in runs):
         names = [n for n in names if n != "Y_P_astern"]       # nothing to fit it on: it stays the config's
         o.say(f"Y_P_astern not fitted: no record runs its propeller astern on {ASTERN_SHARE:.0%} of its samples")
-    fp = _bounded_wind(ship, free_parameters(packed, ship.hull.names, names, o.prior_rel_std))
+    fp = _bounded_wind(ship, free_parameters(packed, ship.hull.names, names, o.prior_rel_std,
+                                                  hull_terms=ship.hull.terms))
     if o.initial_state == "fit":
         from ekf.identify import start_parameters
 
@@ -761,9 +735,6 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     return [r for part in parts for r in part]
 
 
-PARAMETER_UNITS = {"rudder_offset": "rad", "m_x": "kg", "m_y": "kg", "J_z": "kg m^2"}
-"""The unit of a fitted parameter where it is not non-dimensional (``"1"``): the fit's own (SI)."""
-
 
 def _covariance_section(fit, cov: np.ndarray, note: str, method: str = "") -> dict | None:
     """The ``covariance:`` section of the shared parameters (a record's own nuisance left out: the block
@@ -774,7 +745,7 @@ def _covariance_section(fit, cov: np.ndarray, note: str, method: str = "") -> di
         return None
     cov = 0.5 * (cov + cov.T)
     names = [fit.free[i].name for i in keep]
-    return {"names": names, "units": [PARAMETER_UNITS.get(n, "1") for n in names],
+    return {"names": names, "units": [unit_of(n) for n in names],
             "values": [float(f"{fit.theta[i]:.10g}") for i in keep],
             "matrix": [[float(f"{x:.10g}") for x in row] for row in cov], "source": note,
             **({"method": method} if method else {})}
@@ -783,7 +754,7 @@ def _covariance_section(fit, cov: np.ndarray, note: str, method: str = "") -> di
 def fit_covariance(fit, note: str = "") -> dict | None:
     """The ``covariance:`` section of a ship YAML from a fit (:class:`ekf.identify.IdentifyResult`) with
     its own Gauss-Newton covariance (``corr * std std^T``: the whole inverse J^T J, prior rows included,
-    times the residual variance): its shared parameters' names, units (:data:`PARAMETER_UNITS`), fitted
+    times the residual variance): its shared parameters' names, units (:func:`mmg.parameters.unit_of`), fitted
     values and covariance; None when it is not finite (a singular fit).  What ``mmg identify`` writes is
     :func:`identification_covariance`'s."""
     std = np.asarray(fit.std, dtype=float)
@@ -883,41 +854,11 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
     ship's own section, if any, is about other values and is dropped)."""
     import yaml
 
-    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
-    from mmg.nondim import inertia_scale, mass_scale
+    from mmg.parameters import write_yaml_value
 
-    wind_keys = _wind_keys()
     data = yaml.safe_load(Path(ship_path).read_text())
-    ship = None
     for k, v in values.items():
-        if k in data["hull"]["coefficients"]:
-            data["hull"]["coefficients"][k]["value"] = float(f"{v:.6g}")
-        elif k == "w_P0":
-            data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
-        elif k == "Y_P_astern":
-            data["propeller"]["Y_P_astern"] = float(f"{v:.6g}")
-        elif k in ("epsilon", "kappa", *RUDDER_CONSTANTS):
-            data["rudder"][k] = float(f"{v:.6g}")
-        elif k in MASS_CONSTANTS:
-            if ship is None:
-                from mmg.ship import load_ship
-
-                ship = load_ship(ship_path)
-            pa = ship.particulars
-            sc = inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
-            data["mass"][f"{k}_prime"] = float(f"{v / sc:.6g}")
-        elif k == "rudder_offset":
-            data.setdefault("effects", {})
-            data["effects"] = dict(data["effects"] or {})
-            data["effects"]["rudder_offset"] = {"offset_deg": float(f"{np.degrees(v):.6g}")}
-        elif k in wind_keys and "wind" in data:
-            key = wind_keys[k]
-            eff = (data.get("effects") or {}).get("wind")
-            if isinstance(eff, dict) and key in eff:               # the value given in the effects section
-                eff[key] = float(f"{float(eff[key]) * v:.6g}")
-                data["wind"].pop(key, None)
-            else:
-                data["wind"][key] = float(f"{float(data['wind'].get(key, 1.0)) * v:.6g}")
+        write_yaml_value(data, k, v, ship_path)
     data.pop("covariance", None)
     if covariance is not None:
         data["covariance"] = covariance
