@@ -112,3 +112,33 @@ def test_an_unknown_name_is_refused_by_the_fit_and_the_sampler_and_left_out_by_t
         _ship_values(ship, ["N_q"])
     assert with_value(ship, "start.u[rec0]", 1.0) is ship
     assert unit_of("m_x") == "kg" and unit_of("J_z") == "kg m^2" and unit_of("rudder_offset") == "rad"
+
+
+def test_an_effect_registered_alone_carries_its_magnitude_unit_and_detection_size(monkeypatch):
+    """A made-up effect, registered and nothing else: the diagnosis's magnitude and detection size are its
+    own; a bundled effect's magnitude against its definition computed here (a current's speed over sqrt(g L))."""
+    import math
+
+    import mmg.effects as E
+    from mmg.effects.base import Effect, Parameter
+    from trials.measured.decision import magnitude
+    from trials.measured.identifiability import detection_size
+
+    class Trim(Effect):
+        name = "made_up_trim"
+        kind = "coefficients"
+        description = "a made-up trim"
+        parameters = (Parameter("trim_deg", "deg", 0.0, -5.0, 5.0, 1.0),)
+        magnitude_unit = "deg"
+        detection_size = (0.25, "deg")
+
+        @classmethod
+        def magnitude(cls, values, L):
+            return abs(float(values["trim_deg"]))
+
+    monkeypatch.setitem(E.REGISTRY, Trim.name, Trim)
+    assert magnitude("made_up_trim", {"trim_deg": -0.7}, 3.0) == 0.7
+    assert detection_size("made_up_trim", 3.0) == 0.25
+    assert magnitude("current", {"speed_mps": 0.15}, 325.0) == pytest.approx(0.15 / math.sqrt(9.80665 * 325.0), rel=1e-14)
+    assert detection_size("current", 325.0) == pytest.approx(0.0027 * math.sqrt(9.80665 * 325.0), rel=1e-14)
+    assert math.isnan(magnitude("no_such_effect", {}, 3.0))

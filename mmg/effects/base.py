@@ -106,6 +106,20 @@ class Effect(abc.ABC):
     measured_by: ClassVar[str] = "a measurement of it independent of the motion"
     """What measures the effect itself (a ``"coefficients"`` effect's advice where the records cannot
     tell it from the coefficients it changes)."""
+    magnitude_unit: ClassVar[str] = "1"
+    """The unit of :meth:`magnitude`."""
+    detection_size: ClassVar[tuple] = (math.inf, "1")
+    """(size, unit): the smallest size of the effect that matters physically, in its fit parameters'
+    unit (``"sqrt(gL)"``: a speed over sqrt(g L)): the size a diagnosis should be able to show.  An effect
+    whose marginal 2-sigma on the records exceeds it could have been there at a size that matters
+    without being named.  Infinite: none stated."""
+
+    @classmethod
+    def magnitude(cls, values: dict, L: float) -> float:
+        """How large the effect is in a measure that does not depend on the ship's size (unit
+        :attr:`magnitude_unit`), from its reported values (:meth:`from_fit`) and the ship's length
+        ``L`` [m]; NaN where the effect states none."""
+        return math.nan
 
     # ---------------------------------------------------------------- values
     @classmethod

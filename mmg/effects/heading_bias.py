@@ -25,6 +25,14 @@ class HeadingBias(Effect):
     description = "constant bias of the logged heading (velocities resolved in it)"
     parameters = (Parameter("bias_deg", "deg", 0.0, -30.0, 30.0, 10.0, "logged minus true heading", 0.0),)
     affects = ("v", "u")
+    magnitude_unit = "deg"
+    detection_size = (1.0, "deg")
+    """1 deg of logged against true heading."""
+
+    @classmethod
+    def magnitude(cls, values, L):
+        """|bias| [deg]."""
+        return abs(float(values["bias_deg"]))
 
     @staticmethod
     def _rot(u, v, a):

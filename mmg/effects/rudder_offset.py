@@ -22,6 +22,14 @@ class RudderOffset(Effect):
     description = "rudder blade offset from the indicator"
     parameters = (Parameter("offset_deg", "deg", 0.0, -_LIM, _LIM, 5.0, "blade minus indicated angle", 0.0),)
     affects = ("r", "heading", "position")
+    magnitude_unit = "deg"
+    detection_size = (1.0, "deg")
+    """1 deg of blade against indicated angle."""
+
+    @classmethod
+    def magnitude(cls, values, L):
+        """|offset| [deg]."""
+        return abs(float(values["offset_deg"]))
 
     @classmethod
     def slots(cls, values):

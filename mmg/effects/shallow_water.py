@@ -62,6 +62,15 @@ class ShallowWater(Effect):
     parameters = (Parameter("depth_to_draft", "1", math.inf, 1.15, math.inf, math.inf, "water depth over draft H/T"),)
     affects = ("u", "v", "r", "heading", "position")
     measured_by = "the water depth from a chart or an echo sounder"
+    magnitude_unit = "T/H"
+    detection_size = (0.5, "1")
+    """T/H 0.5 (H/T 2, where the hull derivatives have changed by tens of per cent)."""
+
+    @classmethod
+    def magnitude(cls, values, L):
+        """Draught over depth T/H (0 in deep water)."""
+        h = float(values["depth_to_draft"])
+        return 0.0 if not math.isfinite(h) or h <= 0 else 1.0 / h
 
     @classmethod
     def values(cls, given=None, owner=None):

@@ -80,6 +80,14 @@ class Wind(Effect):
                             "direction the steady true wind comes from, clockwise from north"))
     channels = ("wind_speed_rel", "wind_dir_rel")
     affects = ("r", "heading", "v", "position")
+    magnitude_unit = "1"
+    detection_size = (0.5, "1")
+    """0.5 on the scale of the published loads."""
+
+    @classmethod
+    def magnitude(cls, values, L):
+        """|scale| of the loads."""
+        return abs(float(values["scale"]))
 
     @classmethod
     def fit_parameters(cls):

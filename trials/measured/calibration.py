@@ -35,6 +35,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .decision import MAGNITUDE_UNITS
+
 __all__ = [
     "MIN_PASSING",
     "RESIDUAL_QUANTILE",
@@ -52,8 +54,7 @@ __all__ = [
     "short_of_name",
 ]
 
-UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1", "shallow_water": "T/H",
-         "current_along": "sqrt(gL)", "current_across": "sqrt(gL)"}
+UNITS = {**MAGNITUDE_UNITS, "current_along": MAGNITUDE_UNITS["current"], "current_across": MAGNITUDE_UNITS["current"]}
 """Units of the floors and clean magnitudes, per effect (and per part of a current on zigzags)."""
 RESIDUAL_UNITS = {"u": "fraction of U", "v": "fraction of U", "r": "r L / U", "heading": "deg"}
 """Units of the residual floors, per channel."""

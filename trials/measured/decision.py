@@ -35,6 +35,8 @@ from functools import lru_cache
 
 import numpy as np
 
+import mmg.effects as E
+
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
@@ -72,9 +74,8 @@ name withheld because another candidate with as much evidence takes its evidence
 (:func:`trials.measured.diagnose.straight_contradicts`), or a coefficient effect not fitted because the fit
 frees every coefficient it changes (:func:`trials.measured.diagnose._covered`)."""
 
-MAGNITUDE_UNITS = {"current": "sqrt(gL)", "rudder_offset": "deg", "heading_bias": "deg", "wind": "1",
-                   "shallow_water": "T/H"}
-"""The unit of each effect's :func:`magnitude`."""
+MAGNITUDE_UNITS = {n: c.magnitude_unit for n, c in E.REGISTRY.items()}
+"""The unit of each effect's :func:`magnitude` (:attr:`mmg.effects.Effect.magnitude_unit`)."""
 
 
 def evidence_short(delta_bic: float, z: float) -> bool:
@@ -84,36 +85,11 @@ def evidence_short(delta_bic: float, z: float) -> bool:
 
 
 def magnitude(effect: str, values: dict, L: float) -> float:
-    """How large an effect is, in a measure that does not depend on the ship's size.
-
-    Parameters
-    ----------
-    effect : str
-        The effect's name.
-    values : dict
-        Its reported values (:meth:`mmg.effects.Effect.from_fit`: ``speed_mps``, ``offset_deg``,
-        ``bias_deg``, ``scale``, ``depth_to_draft``).
-    L : float
-        Ship length [m].
-
-    Returns
-    -------
-    float
-        current: speed / sqrt(g L); rudder offset, heading bias: |angle| [deg]; wind: the load
-        scale; shallow water: T/H (0 in deep water); NaN for an effect it does not know.
-    """
-    if effect == "current":
-        return float(values["speed_mps"]) / math.sqrt(9.80665 * L)
-    if effect == "rudder_offset":
-        return abs(float(values["offset_deg"]))
-    if effect == "heading_bias":
-        return abs(float(values["bias_deg"]))
-    if effect == "wind":
-        return abs(float(values["scale"]))
-    if effect == "shallow_water":
-        h = float(values["depth_to_draft"])
-        return 0.0 if not math.isfinite(h) or h <= 0 else 1.0 / h
-    return math.nan
+    """How large an effect is, in a measure that does not depend on the ship's size: the effect's own
+    :meth:`mmg.effects.Effect.magnitude` (unit :data:`MAGNITUDE_UNITS`) of its reported values and the ship's
+    length ``L`` [m]; NaN for an effect not registered."""
+    cls = E.REGISTRY.get(effect)
+    return cls.magnitude(values, L) if cls is not None else math.nan
 
 
 def current_components(values: dict, L: float, heading: float) -> tuple[float, float]:

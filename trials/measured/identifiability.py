@@ -51,21 +51,16 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+import mmg.effects as E
+
 from .decision import STATISTICAL_REASON
 
 __all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "floor_in_fit_unit", "block_confounding",
            "assess", "verdict", "not_identifiable_lines", "STATISTICAL_REASON"]
 
-DETECTION_SIZE = {"rudder_offset": (1.0, "deg"), "heading_bias": (1.0, "deg"), "current": (0.0027, "sqrt(gL)"),
-                  "wind": (0.5, "1"), "shallow_water": (0.5, "1")}
-"""The smallest size of each effect that matters physically, in its fit parameters' unit: the
-size a diagnosis should be able to show (issue 26's acceptance sizes).  rudder_offset: 1 deg of
-blade against indicated angle; heading_bias: 1 deg of logged against true heading; current: 0.0027
-sqrt(g L) in its worst-determined direction (3 % of a trial speed of Froude number 0.09: 0.15 m/s at
-325 m, 0.015 m/s for the 3 m model), a drift of 0.27 L per 100 s at full scale; wind: 0.5 on the scale
-of the published loads; shallow_water: T/H 0.5 (H/T 2, where the hull derivatives have changed by
-tens of per cent).  An effect whose marginal 2-sigma on the records exceeds this size could
-have been present at a size that matters without being named."""
+DETECTION_SIZE = {n: c.detection_size for n, c in E.REGISTRY.items()}
+"""The smallest size of each effect that matters physically, in its fit parameters' unit
+(:attr:`mmg.effects.Effect.detection_size`, where each effect states and explains it)."""
 R_CONFOUNDED = 0.9
 """Multiple correlation of the effect's parameters with the rest above which confounding, not
 noise, is why the effect cannot be shown."""
@@ -77,10 +72,19 @@ _CONFUSED_MIN = 0.5
 """|correlation| of another parameter with the effect's worst direction to be named as confused with it."""
 
 
+def _size_of(effect: str) -> tuple:
+    """(size, unit) of ``effect``: :data:`DETECTION_SIZE`'s, else the registered effect's own (an effect
+    registered after this module was imported), else (inf, "1")."""
+    if effect in DETECTION_SIZE:
+        return DETECTION_SIZE[effect]
+    cls = E.REGISTRY.get(effect)
+    return cls.detection_size if cls is not None else (math.inf, "1")
+
+
 def detection_size(effect: str, L: float) -> float:
     """The :data:`DETECTION_SIZE` of ``effect`` in its fit unit for a ship of length ``L`` [m]
     (inf for an effect not in the table)."""
-    v, unit = DETECTION_SIZE.get(effect, (math.inf, "1"))
+    v, unit = _size_of(effect)
     return v * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else v
 
 
@@ -88,7 +92,7 @@ def floor_in_fit_unit(effect: str, fl: float, L: float) -> float:
     """A calibrated floor (:func:`trials.measured.decision.floor`, in the unit of
     :func:`~trials.measured.decision.magnitude`: a current's speed over sqrt(g L)) in the unit of
     :func:`detection_size` (the effect's fit parameters: m/s for a current), for a ship of length ``L`` [m]."""
-    _, unit = DETECTION_SIZE.get(effect, (math.inf, "1"))
+    _, unit = _size_of(effect)
     return fl * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else fl
 
 
@@ -279,11 +283,9 @@ def _unit(cls) -> str:
 def _size_unit(cls) -> str:
     """The unit of :func:`detection_size` and :func:`floor_in_fit_unit` of ``cls``: its fit parameter's
     where :data:`DETECTION_SIZE` scales with the ship (a current: m/s), else its size's (deg, T/H)."""
-    from .decision import MAGNITUDE_UNITS
-
-    if DETECTION_SIZE.get(cls.name, (0.0, "1"))[1] == "sqrt(gL)":
+    if _size_of(cls.name)[1] == "sqrt(gL)":
         return _unit(cls)
-    u = MAGNITUDE_UNITS.get(cls.name, "1")
+    u = cls.magnitude_unit
     return "" if u == "1" else u
 
 
