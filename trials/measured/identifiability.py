@@ -1,4 +1,4 @@
-"""What the records cannot tell apart (``mmg diagnose``'s ``not_identifiable``, issue 26).
+"""What the records cannot tell apart (``mmg diagnose``'s ``not_identifiable``).
 
 A candidate effect the forward selection of :func:`trials.measured.diagnose.diagnose` does not
 name is either absent or one the records cannot separate from the ship's own coefficients (or
@@ -24,7 +24,7 @@ the naming z threshold (:data:`trials.measured.diagnose.Z_THRESHOLD`, 3; never l
 exceeds its :data:`DETECTION_SIZE` (the records could not have named it at a size that matters:
 an effect of that size would have been within the threshold's z of nothing), and confounding is the
 reason: R >= :data:`R_CONFOUNDED` or marginal / conditional std >= :data:`STD_RATIO_CONFOUNDED`.
-An effect skipped for lack of channels is not assessed.  Also reported (since stop 35), with its
+An effect skipped for lack of channels is not assessed.  Also reported, with its
 own reason: one whose marginal std could not have shown its detection size though confounding is
 not why (the records hold too little information on it at all: a 1.5 deg heading bias on a single
 turn of a ship whose hull form is not the model's, sd 2.06 deg, R 0.899, was dropped silently);
@@ -59,7 +59,7 @@ __all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_
 DETECTION_SIZE = {"rudder_offset": (1.0, "deg"), "heading_bias": (1.0, "deg"), "current": (0.0027, "sqrt(gL)"),
                   "wind": (0.5, "1"), "shallow_water": (0.5, "1")}
 """The smallest size of each effect that matters physically, in its fit parameters' unit: the
-size a diagnosis should be able to show (issue 26's acceptance sizes).  rudder_offset: 1 deg of
+size a diagnosis should be able to show (the sizes a diagnosis is judged on).  rudder_offset: 1 deg of
 blade against indicated angle; heading_bias: 1 deg of logged against true heading; current: 0.0027
 sqrt(g L) in its worst-determined direction (3 % of a trial speed of Froude number 0.09: 0.15 m/s at
 325 m, 0.015 m/s for the 3 m model), a drift of 0.27 L per 100 s at full scale; wind: 0.5 on the scale
