@@ -1,4 +1,4 @@
-"""Augmented EKF on the raw 5 s sea-trial log (issue 5, item 2: a near-efficient filter).
+"""Augmented EKF on the raw 5 s sea-trial log (a near-efficient filter).
 
 The paper-style filter (:mod:`ekf.filter`) measures u, v, r, n *recovered* at 0.1 s from
 the 5 s log by 3-point parabolas, with Table 8's R (10^2-10^5 x the real error variance,

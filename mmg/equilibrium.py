@@ -154,7 +154,7 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
         scale = power / (2 * np.pi * nn) / (rho * nn**2 * D**5 * kq)
         if not (np.isfinite(scale) and scale > 0):
             # K_Q(J) <= 0: the propeller is beyond zero torque (it would drive the shaft); a negative
-            # scale would turn the shaft's load into a drive that runs n through zero (issue 24)
+            # scale would turn the shaft's load into a drive that runs n through zero
             raise ValueError(f"at {nn * 60:.4g} rpm and {u0:.4g} m/s the propeller's K_Q(J = {J:.3g}) is {kq:.3g}: "
                              "no constant-power straight run (the rpm is far below the one the speed needs)")
     pk2 = pack_all(with_kq_scale(ship, scale))

@@ -71,7 +71,7 @@ def test_the_size_gate_does_not_move_with_the_zigzag_floors(tmp_path, monkeypatc
     from trials.measured.diagnose import DRIFT_FALL_MIN
 
     before = DRIFT_FALL_MIN
-    # the value the turn_drift floors were calibrated with (stop 39); another needs their recalibration
+    # the value the turn_drift floors were calibrated with; another needs their recalibration
     assert before == pytest.approx(0.2192)
     cal = dict(decision.packaged_calibration())
     cal["residual_floors"] = {**cal["residual_floors"], "zigzag": {**cal["residual_floors"]["zigzag"], "heading": 3.0}}

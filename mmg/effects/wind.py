@@ -28,7 +28,7 @@ small difference of large terms, is the least predictable part.  A factor here a
 curve's shape over the angles a record sees and the geometry a config guesses (no full-scale
 geometry is published for the bundled ships), so its prior is wider than a regression's fit
 accuracy: 0.35 puts 0.3 and 1.7 at 2 sigma.  The project's own evidence agrees: on the independent
-simulator's logs (issue 26) one scale fitted 0.36-0.82 for one and the same wind.  Further reading
+simulator's logs (``../shared/data/diagnose-dev``) one scale fitted 0.36-0.82 for one and the same wind.  Further reading
 (not checked here): Haddara & Guedes Soares (1999), Marine Structures 12:199-209, four methods
 compared on one tanker; Ueno, Kitamura, Sogihara & Fujiwara (2012), ACEM'12, the 76 ships behind
 Fujiwara's regression; Blendermann (1994), J. Wind Eng. Ind. Aerodyn. 51:339-351.

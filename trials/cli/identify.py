@@ -288,7 +288,7 @@ def add_parser(sub) -> None:
                    help="where each record's replay starts in the fit: 'fit' (default: offsets on the first sample's "
                         "u, v, r and heading fitted as the record's own nuisance, so one noisy sample does not drift a "
                         "whole replay; the written covariance then covers the truth: docs/imo.md) or 'sample' (the "
-                        "first sample as logged, the fit before stop 32)")
+                        "first sample as logged, the fit with no start-state nuisance)")
     p.add_argument("--max-nfev", type=_positive_int, default=None, metavar="N",
                    help="most evaluations of the residuals in each fit stage (segment-wise, then whole-record; "
                         "default trials.measured.identify.DEFAULT_MAX_NFEV); a stage that reaches it stops unconverged, "

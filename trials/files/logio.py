@@ -34,7 +34,7 @@ silently wrong record:
   heading jumping more than 1 rad/s sample after sample, speeds or the track beyond Froude number 1
   for the ship's length, a logged speed that is not the speed along the track (a log with
   ``interval_s``), positions far from the header's start, propeller speeds beyond 100 rps ("rpm?");
-* channels against each other (issue 24): surge and sway against the track's derivative rotated
+* channels against each other: surge and sway against the track's derivative rotated
   into the body frame (:func:`velocity_track_fit`; "in kn, not m/s?"), both wind speeds against
   the ship's velocity (:func:`wind_scale_fit`: one common factor), relative against true wind,
   a heading that does not point along the track.  ``bench/channel_margins.py`` prints what the

@@ -103,15 +103,15 @@ drift nonlinearities.  A 35 deg turn holds a drift of
 10-15 deg for most of the record, where a real hull's side force and moment leave a polynomial
 fitted for small drift (Kijima's) by more than its linear and r|r| terms can take up: on the
 cross-flow members of the mismatch family the baseline left a 1.6-3 deg heading residual and a
-10 m/s wind on a port turn was not identifiable (dBIC -12 to 11; 0 of 6 named over the draws of
-stop 37), with these terms freed 0.35-0.45 deg and the wind named (dBIC 46-76).  On a zigzag the
+10 m/s wind on a port turn was not identifiable (dBIC -12 to 11; 0 of 6 named over the calibration's
+draws), with these terms freed 0.35-0.45 deg and the wind named (dBIC 46-76).  On a zigzag the
 drift stays small and these terms would only trade with the linear ones."""
 DRIFT_KIND = "turn_drift"
 """The kind of record set (:data:`~trials.measured.decision.KINDS`) of turns to one side (calibrated on
 single turns) whose baseline freed the drift nonlinearities (:func:`_drift_terms`): its floors are
 calibrated apart from those
 of the turns that keep them at the config's (``"turn"``), since the ship's own mismatch lends the
-candidates other sizes on the two baselines (fresh seed 27000, stop 38: one set of floors over both
+candidates other sizes on the two baselines (fresh seed 27000: one set of floors over both
 named shallow water on 2 of 20 clean Kijima turns)."""
 SCREEN_NFEV = 6
 """Evaluation budget of a candidate's first (screening) fit; see :func:`diagnose`."""
@@ -206,7 +206,7 @@ negative beta_R, each with its own prior (std 15 % of the config value, at least
 ``rudder`` of :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`).  A real ship's two differ (the MMG
 standard's KVLCC2: 0.395 and 0.640), and a difference the config does not have makes the rudder's
 force asymmetric in a zigzag, where beta_R swings both ways: it is what the ship's own mismatch lends
-a rudder offset there.  On the zigzags of stop 39's fresh draws (family seeds 28000-31000, 140
+a rudder offset there.  On the zigzags of fresh draws (family seeds 28000-31000, 140
 clean or offset records) the round-1 offset's error was correlated -0.92 with the log of the member's
 gamma_R_pos / gamma_R_neg, and three 1 deg offsets were fitted at 0.61-0.62 deg, under the zigzag floor that
 asymmetry set (0.65 deg).  Freed, the two take the asymmetry: on family seed 32000 the 1 deg offsets
@@ -691,13 +691,13 @@ def _drift_terms(fitter, d_config, base, kept, o: DiagnoseOptions, say):
 DRIFT_FALL_MIN = 0.2192
 """The fall of the heading residual [deg] that freeing the drift terms must bring
 (:func:`_drift_terms`): the heading residual the ship's own mismatch left on a clean zigzag, where the
-drift stays small, as calibrated when the gate was chosen and ``turn_drift`` calibrated (stop 39:
+drift stays small, as calibrated when the gate was chosen and ``turn_drift`` calibrated (then
 ``residual_floors.zigzag.heading`` of the packaged calibration then, 0.2192 deg).  A fall smaller
 than what a ship that is not its model leaves where these terms play no part is not a drift the
 config misses: on the main job's noiseless ST35 truth file, diagnosed with the ship that made it,
 they took the heading residual from 0.0087 to 0.0067 deg at dBIC 28, and wandered 3.3 prior std
 (``bench/drift_gate.py`` prints the falls).  A number of its own, not read from the zigzag floors in
-use: those moved when the zigzag baseline freed gamma_R (stop 40, :data:`ZIGZAG_CONSTANTS_FREE`),
+use: those moved when the zigzag baseline freed gamma_R (:data:`ZIGZAG_CONSTANTS_FREE`),
 and the turns' gate and the ``turn_drift`` floors calibrated with it must not move with them."""
 
 
@@ -706,7 +706,7 @@ def _covered(fitter, cand, say) -> tuple[list, list]:
     whose every changed coefficient (:meth:`mmg.effects.Effect.changed_coefficients`) the baseline
     frees is a change of the ship's own coefficients there, not something the records can tell from
     them, and is not fitted.  Shallow water on a turn whose drift terms are freed (:data:`DRIFT_KIND`):
-    over 169 such candidate fits of the calibration and check draws of stop 39 its dBIC never passed
+    over 169 such candidate fits of the calibration and check draws of the ``turn_drift`` floors its dBIC never passed
     18.1 and its z never 1.73 (a name needs 20 and 3), and not fitting it takes a 3500 s turn from
     17.7 s to under the 15 s asked (``bench/bench_diagnose.py --timing-only``)."""
     free = {f.name for f in fitter.ship_free}

@@ -1,13 +1,13 @@
 """Ships that are not their model: the mismatch family that ``mmg diagnose``'s naming is calibrated on.
 
-A real ship differs from its predicted model (issue 26, "Calibrated against a ship that is not its
-model"): its hull derivatives, rudder and propeller constants, added masses and wind loads are all
-off by a few to a few tens of per cent, and its hull may not even follow the model's form.  This
-module draws such ships from a config (:func:`mismatch_ship`, :func:`mismatch_family`) and simulates
-full-scale trials of them with hidden effects (:func:`trial_records`) the way the independent
-development set ``../shared/data/diagnose-dev/`` was made: 10 kn approach at constant propeller
-revolutions, 35 deg turns to starboard and port, 10/10, 15/15 and 20/20 zigzags of nine reversals
-and a 60 s tail, 1 s samples, uniform log noise of the set's half-widths.
+A real ship differs from its predicted model: its hull derivatives, rudder and propeller constants,
+added masses and wind loads are all off by a few to a few tens of per cent, and its hull may not
+even follow the model's form.  This module draws such ships from a config (:func:`mismatch_ship`,
+:func:`mismatch_family`) and simulates full-scale trials of them with hidden effects
+(:func:`trial_records`) the way the independent development set ``../shared/data/diagnose-dev/`` was
+made: 10 kn approach at constant propeller revolutions, 35 deg turns to starboard and port, 10/10,
+15/15 and 20/20 zigzags of nine reversals and a 60 s tail, 1 s samples, uniform log noise of the
+set's half-widths.
 
 Every factor is ``1 + u`` with ``u`` uniform in ``[-h, h]`` (a random sign and size), ``h`` the
 relative half-width of :class:`MismatchSpec`.  A fraction of the family has its hull's nonlinear

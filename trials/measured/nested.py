@@ -1,4 +1,4 @@
-"""Nested cross-validation of ``mmg identify``: every choice made inside the training folds (issue 27).
+"""Nested cross-validation of ``mmg identify``: every choice made inside the training folds.
 
 A plain k-fold cross-validation (:func:`trials.measured.identify.cross_validate`) scores one
 procedure.  When the procedure has a choice to make (the hull form, a free set, a prior width, a
