@@ -1,4 +1,4 @@
-"""What the records cannot tell apart (``mmg diagnose``'s ``not_identifiable``, issue 26).
+"""What the records cannot tell apart (``mmg diagnose``'s ``not_identifiable``).
 
 A candidate effect the forward selection of :func:`trials.measured.diagnose.diagnose` does not
 name is either absent or one the records cannot separate from the ship's own coefficients (or
@@ -24,7 +24,7 @@ the naming z threshold (:data:`trials.measured.diagnose.Z_THRESHOLD`, 3; never l
 exceeds its :data:`DETECTION_SIZE` (the records could not have named it at a size that matters:
 an effect of that size would have been within the threshold's z of nothing), and confounding is the
 reason: R >= :data:`R_CONFOUNDED` or marginal / conditional std >= :data:`STD_RATIO_CONFOUNDED`.
-An effect skipped for lack of channels is not assessed.  Also reported (since stop 35), with its
+An effect skipped for lack of channels is not assessed.  Also reported, with its
 own reason: one whose marginal std could not have shown its detection size though confounding is
 not why (the records hold too little information on it at all: a 1.5 deg heading bias on a single
 turn of a ship whose hull form is not the model's, sd 2.06 deg, R 0.899, was dropped silently);
