@@ -25,7 +25,7 @@ from .nondim import inertia_scale, mass_scale
 
 __all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "RESISTANCE_TERMS",
            "hull_parameter", "parameter", "ship_value", "with_value", "write_yaml_value", "unit_of", "is_resistance",
-           "EffectPrior", "WIND_COLUMNS"]
+           "EffectPrior", "WIND_COLUMNS", "config_values", "MASS_NAMES"]
 
 PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
 """Prior std of a freed ship coefficient relative to its config value, per family (identification's: the
@@ -116,10 +116,22 @@ class ShipParameter:
     abs_std: float = 0.0
     bounds: Callable = lambda v: (-np.inf, np.inf)
     effect: EffectPrior | None = None
+    config_key: str = ""
+    """The key of the value in the config's own unit, where it differs from ``name`` (an added mass's primed
+    ``m_x_prime``: :meth:`in_config`)."""
+    config_scale: Callable | None = None
+    """``config_scale(ship)``: the config's unit in the fit's (the fit's value over it is the config's), where
+    they differ."""
 
     def config_value(self, packed: PackedShip) -> float:
         """The value the packed ship carries (the prior's centre), in the fit's unit."""
         return float(self.packed(packed))
+
+    def in_config(self, ship, value: float) -> tuple[str, float]:
+        """(the config's key, ``value`` in the config's unit): an added mass [kg] as the primed value."""
+        if self.config_scale is None:
+            return self.name, float(value)
+        return self.config_key, float(value) / self.config_scale(ship)
 
     def prior_std(self, value: float, rel: dict) -> float:
         """The prior std about ``value`` from the family table ``rel`` (its floor kept), or the absolute one."""
@@ -159,7 +171,8 @@ def _mass(name: str, slot: int, unit: str) -> ShipParameter:
         name, unit, "mass", "mass", slot, f"mass.{name}_prime",
         read=lambda s: getattr(s.mass, f"{name}_prime") * _mass_scale(s, name),
         write=lambda s, v: replace(s, mass=replace(s.mass, **{f"{name}_prime": v / _mass_scale(s, name)})),
-        write_yaml=write_yaml, packed=lambda p: p.p[slot], bounds=lambda v: (0.0, 3.0 * v))
+        write_yaml=write_yaml, packed=lambda p: p.p[slot], bounds=lambda v: (0.0, 3.0 * v),
+        config_key=f"{name}_prime", config_scale=lambda s: _mass_scale(s, name))
 
 
 def _with_w_P0(s, v):
@@ -259,6 +272,10 @@ flow-straightening coefficients gamma_R of the inflow angle (positive and negati
 lever l_R' of the yaw rate in it; the added masses and moment of inertia."""
 
 
+MASS_NAMES = tuple(n for n, p in CONSTANTS.items() if p.kind == "mass")
+"""The added masses and the added moment of inertia (the table's ``"mass"`` entries)."""
+
+
 def hull_parameter(name: str, index: int, term: str = "") -> ShipParameter:
     """The entry of hull coefficient ``name`` (primed, non-dimensional), at ``index`` of the ship's hull model;
     the straight-ahead resistance (:func:`is_resistance`) bounded to stay negative."""
@@ -320,6 +337,19 @@ def write_yaml_value(data: dict, name: str, value: float, ship_path) -> None:
     else:
         return
     p.write_yaml(data, value, ship_path)
+
+
+def config_values(ship, values: dict) -> dict:
+    """Fitted ``values`` (fit names and units) under the config's keys and in its units
+    (:meth:`ShipParameter.in_config`: the added masses primed); names not in the table as given."""
+    out = {}
+    for k, v in values.items():
+        try:
+            key, x = _of_ship(ship, k).in_config(ship, v)
+        except KeyError:
+            key, x = k, float(v)
+        out[key] = x
+    return out
 
 
 def unit_of(name: str) -> str:

@@ -142,3 +142,16 @@ def test_an_effect_registered_alone_carries_its_magnitude_unit_and_detection_siz
     assert magnitude("current", {"speed_mps": 0.15}, 325.0) == pytest.approx(0.15 / math.sqrt(9.80665 * 325.0), rel=1e-14)
     assert detection_size("current", 325.0) == pytest.approx(0.0027 * math.sqrt(9.80665 * 325.0), rel=1e-14)
     assert math.isnan(magnitude("no_such_effect", {}, 3.0))
+
+
+def test_fitted_values_under_the_configs_keys_prime_the_added_masses():
+    """An added mass [kg] goes to the config as m_x' = m_x / (rho L^2 T / 2), the moment of inertia as
+    J_z' = J_z / (rho L^4 T / 2) (the primes of mmg.nondim, written out here); others keep name and value."""
+    from mmg.parameters import config_values
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    pa = ship.particulars
+    got = config_values(ship, {"m_x": 20.0, "J_z": 90.0, "N_r": -0.05, "start.u[a]": 0.1})
+    assert got["m_x_prime"] == pytest.approx(20.0 / (0.5 * pa.rho * pa.L ** 2 * pa.T), rel=1e-12)
+    assert got["J_z_prime"] == pytest.approx(90.0 / (0.5 * pa.rho * pa.L ** 4 * pa.T), rel=1e-12)
+    assert got["N_r"] == -0.05 and got["start.u[a]"] == 0.1 and "m_x" not in got

@@ -47,16 +47,13 @@ def cmd_diagnose(args) -> int:
                 + ". The named effects are in the effects: section, so mmg predict with this config replays these "
                   "records with them; a current, a rudder offset or a heading bias belongs to these records, not the "
                   "ship: for other trials move it to their trial config's effects: section")
-        ship_text = ship_yaml(src, d.ship_values, note)
+        ship_text = ship_yaml(src, d.ship_fit_values, note)
         import yaml
 
         head, body = [], []
         for ln in ship_text.splitlines(keepends=True):
             (head if ln.startswith("#") and not body else body).append(ln)
         data = yaml.safe_load("".join(body))
-        for k, v in d.ship_values.items():            # the fitted added masses (ship_yaml writes the hull)
-            if k.endswith("_prime") and k in data.get("mass", {}):
-                data["mass"][k] = float(f"{v:.6g}")
         if d.parameters:
             eff = dict(data.get("effects") or {})
             for e, p in d.parameters.items():

@@ -80,6 +80,7 @@ import numpy as np
 
 from mmg.errors import InputError
 from mmg.model import pack
+from mmg.parameters import MASS_NAMES, config_values
 from mmg.ship import Ship
 
 from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, WEAK_BIC, Z_THRESHOLD, calibration, clears_floor, evidence_short, floor,
@@ -214,28 +215,11 @@ were fitted at 0.93-1.10 deg (0.87-1.39 without) and the clean zigzags' offsets 
 0.02-0.26 deg.  The offset stays identifiable because it acts at every drift and the asymmetry only
 with drift or yaw, but the two correlate (0.97-0.99 in that fit), so its standard error grows.  On a
 turn to one side beta_R keeps one sign and only one of the two would be seen; it is not freed there."""
-MASS_FREE = ("m_x", "m_y", "J_z")
+MASS_FREE = MASS_NAMES
 """Added masses and the added moment of inertia the diagnosis fits with every model (prior: the
 config value, relative std from :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`, the diagnosis's policy
 in the one table of prior widths): an added mass a few % off leaves a residual (surge speed loss in
 the turn, sway and yaw lag) that an effect would otherwise take."""
-
-
-def _ship_values(ship: Ship, free, theta) -> dict:
-    """Fitted ship values by config name: hull coefficients, ``w_P0``, ``epsilon``, ``gamma_R_pos``,
-    ``gamma_R_neg``, and the added masses as the config's primed ``m_x_prime``, ``m_y_prime``,
-    ``J_z_prime``."""
-    from mmg.nondim import inertia_scale, mass_scale
-
-    pa = ship.particulars
-    out = {}
-    for f, v in zip(free, theta):
-        if f.name in MASS_FREE:
-            sc = inertia_scale(pa.rho, pa.L, pa.T) if f.name == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
-            out[f"{f.name}_prime"] = float(v) / sc
-        else:
-            out[f.name] = float(v)
-    return out
 
 
 LINEAR_TERMS = ("beta", "r", "v")
@@ -475,6 +459,9 @@ class Diagnosis:
     seconds: float
     runs: list = field(default_factory=list)
     effects: list = field(default_factory=list)
+    ship_fit_values: dict = field(default_factory=dict)
+    """The ship's values as written to ``--out-ship``, by fit name in the fit's units (:mod:`mmg.parameters`;
+    :attr:`ship_values` has them under the config's keys)."""
     intervals_95: dict = field(default_factory=dict)
     """{effect: {parameter: [lo, hi] or "any"}} (:func:`trials.measured.diagnose_report.effect_intervals`)."""
     evidence: dict = field(default_factory=dict)
@@ -1241,11 +1228,12 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
     unexpl, desc, _ = _describe(recs, current.diffs, noise, None, ship.particulars.L, kind)
     mfm = model_form_mismatch(current.free[:ns], current.theta[:ns])
     th_out = [f.prior if f.name in mfm else v for f, v in zip(current.free[:ns], current.theta[:ns])]
-    ship_vals = _ship_values(ship, current.free[:ns], th_out)        # mismatched: the config's, not written as fitted
+    fit_vals = {f.name: float(v) for f, v in zip(current.free[:ns], th_out)}   # mismatched: the config's, not written as fitted
+    ship_vals = config_values(ship, fit_vals)
     return Diagnosis(named=named, parameters=params, standard_errors=ses, rms_config=_rms(d_config),
                      rms_before=_rms(base.diffs), rms_after=_rms(current.diffs), unexplained=unexpl,
                      unexplained_description=desc, candidates=cand_log, rounds=rounds, ship_values=ship_vals,
-                     records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
+                     ship_fit_values=fit_vals, records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
                      pred_after=[r.seg.meas + d for r, d in zip(recs, current.diffs)],
                      seconds=0.0, effects=current.effects, intervals_95=ivs, evidence=effect_evidence(named, rounds),
                      model_form_mismatch=mfm, ship_fit=ship_fit_table(current.free[:ns], current.theta[:ns]),
