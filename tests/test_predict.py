@@ -159,11 +159,13 @@ def test_cli_predict_end_to_end(slices, tmp_path, ship3m, capsys):
     assert rc == 0, err
     doc = json.loads(js.read_text(), parse_constant=lambda c: pytest.fail(f"JSON holds {c}"))
     assert list(doc) == ["runs"] and len(doc["runs"]) == 2
-    lib = predict(ship3m, slices)
-    for run, path, rep in zip(doc["runs"], slices, lib.runs):
-        assert list(run) == ["name", "file", *SCORE_KEYS]
+    lib = predict(ship3m, slices, window=(60.0, 30.0))          # --window 60 --every 30: the defaults
+    for run, path, rep, win in zip(doc["runs"], slices, lib.runs, lib.windows):
+        assert list(run) == ["name", "file", *SCORE_KEYS, "window"]
         assert run["file"] == str(path) and run["name"] == path.stem
-        assert run == {"name": path.stem, "file": str(path), **rep.scores()}   # the library's numbers, bit for bit
+        assert run == {"name": path.stem, "file": str(path), **rep.scores(),   # the library's numbers, bit for bit
+                       "window": win.to_json()}
+        assert run["window"]["n_windows"] == 1 and run["window"]["window_s"] < 60.0   # a 60 s slice: one, shorter
         assert all(np.isfinite(run[k]) for k in SCORE_KEYS)
         assert run["final_position_error_L"] == pytest.approx(run["final_position_error_m"] / 3.0, rel=1e-15)
     lines = out.strip().splitlines()
@@ -220,7 +222,7 @@ def test_cli_predict_wind_switch_and_start(slices, tmp_path, ship3m, capsys):
                              "--start", "20"], capsys)
     assert rc == 0, err
     doc = json.loads(js.read_text())
-    assert doc == predict(ship3m, slices[:1], start=20.0, wind=False).to_json()
+    assert doc == predict(ship3m, slices[:1], start=20.0, wind=False, window=(60.0, 30.0)).to_json()
     assert "wind off" in out
 
 

@@ -287,22 +287,29 @@ def replay_record(ship: Ship, rec: TrialRecord | MeasuredRun, start: float | Non
 
 @dataclass(frozen=True)
 class Prediction:
-    """Several records replayed with one ship: :attr:`runs` in the order given."""
+    """Several records replayed with one ship: :attr:`runs` in the order given; :attr:`windows`, when
+    asked for, each run's short-horizon scores (:class:`trials.measured.window.WindowScores`), in the
+    same order."""
 
     runs: list
+    windows: list | None = None
 
     def to_json(self, horizon_s: float | None = None) -> dict:
         """``{"runs": [{"name": ..., "file": ..., "heading_rms_deg": ..., ...}, ...]}`` (``mmg predict --json``;
         ``name``: the run's name, after its file, as printed and as its plot is named).  With
         ``horizon_s`` each run also has ``"first": {"horizon_s": ..., <the same scores over the first
-        horizon_s seconds>}`` (:meth:`Replayed.scores` ``until_s``: a short-horizon figure)."""
-        def row(r):
+        horizon_s seconds>}`` (:meth:`Replayed.scores` ``until_s``: a short-horizon figure); with
+        :attr:`windows`, ``"window"``: the means over the windows restarted from the measured state
+        (:meth:`trials.measured.window.WindowScores.to_json`)."""
+        def row(k, r):
             d = {"name": r.run.name, "file": r.run.source, **r.scores()}
             if horizon_s is not None:
                 d["first"] = {"horizon_s": float(horizon_s), **r.scores(until_s=horizon_s)}
+            if self.windows is not None:
+                d["window"] = self.windows[k].to_json()
             return d
 
-        return {"runs": [row(r) for r in self.runs]}
+        return {"runs": [row(k, r) for k, r in enumerate(self.runs)]}
 
     def to_pandas(self):
         """One row of scores per run, indexed by the run's name (after its file: unique)."""
@@ -311,7 +318,8 @@ class Prediction:
         return pd.DataFrame([{"name": r.run.name, "wind": r.run.wind, **r.scores()} for r in self.runs]).set_index("name")
 
 
-def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = None, progress=None) -> Prediction:
+def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = None, progress=None,
+            window: tuple[float, float] | None = None) -> Prediction:
     """Read and replay each record of ``paths`` (:func:`replay_record`); a bad record raises
     :class:`~mmg.errors.InputError` naming it.  Every record is read and made ready
     (:func:`measured_run`: channels, ``start``, wind) before the first is replayed, so a bad one
@@ -328,6 +336,9 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
         Override the ship config's wind switch.
     progress : callable, optional
         ``progress(i, n, name)`` after each replay (the run's name, after its file).
+    window : (float, float), optional
+        ``(window_s, every_s)`` [s]: also score each run over windows restarted from its measured
+        state (:func:`trials.measured.window.window_scores`; :attr:`Prediction.windows`).
 
     Returns
     -------
@@ -345,9 +356,13 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
     measured = [replace(measured_run(ship, read_for_ship(path, ship), start, wind), name=label)
                 for path, label in zip(paths, record_labels(paths))]
     packed = pack(ship)
-    runs = []
+    runs, windows = [], None if window is None else []
     for i, run in enumerate(measured):
         runs.append(replay_record(ship, run, packed=packed))
+        if window is not None:
+            from .window import window_scores
+
+            windows.append(window_scores(ship, run, *window, packed=packed))
         if progress:
             progress(i + 1, len(paths), run.name)
-    return Prediction(runs=runs)
+    return Prediction(runs=runs, windows=windows)
