@@ -268,3 +268,20 @@ def test_the_identified_models_window_scores_carry_its_fitted_wind_scale():
     unscaled = window_scores(ship, run)
     assert got == pytest.approx(by_hand.mean("heading_rms_deg"), rel=1e-12)
     assert unscaled.mean("heading_rms_deg") < 1e-6 < got            # the record is the unscaled model's own
+
+
+def test_window_kinds_of_a_predict_json_by_hand():
+    """Three runs of mmg predict's JSON: two turns (whole 10 and null: diverged; windows 4 and 2 deg over 3 and
+    5 windows, 1.0 and 3.0 m) -> whole 10 over 1 finite, windows 3 deg, 2 m, 8 windows; one zigzag."""
+    wk = _load("window_kinds")
+    w = lambda h, m, n: {"window_s": 60.0, "every_s": 30.0, "n_windows": n, "heading_rms_deg": h,   # noqa: E731
+                         "position_error_m": m, "position_error_L": m / 3.0}
+    doc = {"runs": [{"name": "turn_a", "heading_rms_deg": 10.0, "window": w(4.0, 1.0, 3)},
+                    {"name": "turn_cut_b", "heading_rms_deg": None, "window": w(2.0, 3.0, 5)},
+                    {"name": "zigzag_c", "heading_rms_deg": 7.0, "window": w(5.0, 0.5, 2)}]}
+    turn, zz = wk.kind_rows(doc)
+    assert (turn["kind"], turn["n"], turn["windows"], turn["n_whole"]) == ("turn", 2, 8, 1)
+    assert turn["heading_rms_deg"] == 10.0 and turn["window_heading_rms_deg"] == 3.0
+    assert turn["window_position_error_m"] == 2.0 and turn["window_position_error_L"] == pytest.approx(2.0 / 3.0)
+    assert zz["kind"] == "zigzag" and zz["window_heading_rms_deg"] == 5.0
+    assert wk.table([turn], 60.0, 30.0)[2] == "| turn | 2 | 8 | 10.0 (1 finite) | 3.0 | 2.00 | 0.67 |"
