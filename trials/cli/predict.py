@@ -16,6 +16,7 @@ def cmd_predict(args) -> int:
 
     from ..files.output import StagedFile, StagedOutput, check_output_dir, check_output_file, dumps_json
     from ..measured.predict import predict
+    from ..measured.window import with_windows
 
     check_output_file(args.json)
     if args.plots is not None:
@@ -30,8 +31,8 @@ def cmd_predict(args) -> int:
         release_notes()                    # every record read and accepted: their notes, then progress
         print(f"replayed {i}/{n}: {name}", file=sys.stderr, flush=True)
 
-    pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress,   # runs named after their files
-                   window=(args.window, args.every))
+    pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)   # runs named after their files
+    pred = with_windows(ship, pred, args.window, args.every)
     text = dumps_json(pred.to_json(horizon_s=args.horizon))
     names = [f"{r.run.name}.png" for r in pred.runs]
     with StagedFile(args.json) as tmp:     # the files first (renamed last, after the plots), then the console

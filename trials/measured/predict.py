@@ -288,8 +288,8 @@ def replay_record(ship: Ship, rec: TrialRecord | MeasuredRun, start: float | Non
 @dataclass(frozen=True)
 class Prediction:
     """Several records replayed with one ship: :attr:`runs` in the order given; :attr:`windows`, when
-    asked for, each run's short-horizon scores (:class:`trials.measured.window.WindowScores`), in the
-    same order."""
+    made (:func:`trials.measured.window.with_windows`), each run's short-horizon scores
+    (:class:`trials.measured.window.WindowScores`), in the same order."""
 
     runs: list
     windows: list | None = None
@@ -318,8 +318,7 @@ class Prediction:
         return pd.DataFrame([{"name": r.run.name, "wind": r.run.wind, **r.scores()} for r in self.runs]).set_index("name")
 
 
-def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = None, progress=None,
-            window: tuple[float, float] | None = None) -> Prediction:
+def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = None, progress=None) -> Prediction:
     """Read and replay each record of ``paths`` (:func:`replay_record`); a bad record raises
     :class:`~mmg.errors.InputError` naming it.  Every record is read and made ready
     (:func:`measured_run`: channels, ``start``, wind) before the first is replayed, so a bad one
@@ -336,9 +335,6 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
         Override the ship config's wind switch.
     progress : callable, optional
         ``progress(i, n, name)`` after each replay (the run's name, after its file).
-    window : (float, float), optional
-        ``(window_s, every_s)`` [s]: also score each run over windows restarted from its measured
-        state (:func:`trials.measured.window.window_scores`; :attr:`Prediction.windows`).
 
     Returns
     -------
@@ -356,13 +352,9 @@ def predict(ship: Ship, paths, start: float | None = None, wind: bool | None = N
     measured = [replace(measured_run(ship, read_for_ship(path, ship), start, wind), name=label)
                 for path, label in zip(paths, record_labels(paths))]
     packed = pack(ship)
-    runs, windows = [], None if window is None else []
+    runs = []
     for i, run in enumerate(measured):
         runs.append(replay_record(ship, run, packed=packed))
-        if window is not None:
-            from .window import window_scores
-
-            windows.append(window_scores(ship, run, *window, packed=packed))
         if progress:
             progress(i + 1, len(paths), run.name)
-    return Prediction(runs=runs, windows=windows)
+    return Prediction(runs=runs)

@@ -26,9 +26,9 @@ from mmg.model import pack
 from mmg.replay import ReplayInputs
 from mmg.ship import Ship
 
-from .predict import MeasuredRun, measured_run, replay_record
+from .predict import MeasuredRun, Prediction, measured_run, replay_record
 
-__all__ = ["WindowScores", "window_scores", "window_bounds", "WINDOW_S", "EVERY_S", "WINDOW_KEYS"]
+__all__ = ["WindowScores", "window_scores", "with_windows", "window_bounds", "WINDOW_S", "EVERY_S", "WINDOW_KEYS"]
 
 WINDOW_S = 60.0
 """Default window length [s]: a minute ahead."""
@@ -195,3 +195,10 @@ def window_scores(ship: Ship, run, window_s: float = WINDOW_S, every_s: float = 
     a = np.array(rows, float).reshape(-1, 5)
     return WindowScores(name=run.name, window_s=float(window_s), every_s=float(every_s), start_s=a[:, 0], end_s=a[:, 1],
                         heading_rms_deg=a[:, 2], position_error_m=a[:, 3], position_error_L=a[:, 4], short=short)
+
+
+def with_windows(ship: Ship, pred: Prediction, window_s: float = WINDOW_S, every_s: float = EVERY_S) -> Prediction:
+    """``pred`` (:func:`trials.measured.predict.predict` with ``ship``) with each run's :func:`window_scores`
+    (:attr:`~trials.measured.predict.Prediction.windows`: its JSON's ``window``, ``mmg predict``)."""
+    packed = pack(ship)
+    return replace(pred, windows=[window_scores(ship, r.run, window_s, every_s, packed=packed) for r in pred.runs])
