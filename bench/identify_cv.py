@@ -11,11 +11,13 @@ set and the kept-out records are replayed open loop with it and with the initial
 ``esso_osaka_3m``.  The kept-out records never reach a fit or a choice of their fold.
 
 Printed per kept-out record: the scaled and the identified model's heading RMS, yaw-rate RMS, speed RMS
-and final position error in L, over the whole record and over its first minute (``--horizon``); a
-diverged replay (its time and last finite state); each fold's choice with the inner figures behind it;
-the summary (mean heading RMS scaled / identified, better on N of M, divergences).  ``--markdown``
-prints the tables as Markdown (docs/benchmark_frt.md), ``--json FILE`` writes
-:meth:`~trials.measured.nested.NestedCV.to_json`.
+and final position error in L, over the whole record and over its first minute (``--horizon``), and the
+mean heading RMS over 60 s windows every 30 s restarted from the measured state
+(:func:`trials.measured.window.window_scores`); a diverged replay (its time and last finite state); each
+fold's choice with the inner figures behind it; the summary (mean heading RMS scaled / identified, better
+on N of M, divergences); per kind of record, the whole-record and the window mean heading RMS
+(:func:`kind_summary`).  ``--markdown`` prints the tables as Markdown (docs/benchmark_frt.md), ``--json
+FILE`` writes :meth:`~trials.measured.nested.NestedCV.to_json` with the per-kind figures as ``by_kind``.
 
 ``--prior W1 W2 ...`` (several prior widths) makes each hull form at each width a candidate of the
 inner choice, so the prior width too is chosen inside the training folds; ``--initial-state fit sample``
@@ -40,6 +42,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(1, str(Path(__file__).resolve().parent))
+
+from frt_gap import KINDS, kind_of  # noqa: E402  (the record kinds, defined once)
 
 import mmg  # noqa: E402
 from trials.measured.identify import load_runs  # noqa: E402
@@ -143,6 +148,12 @@ def _cell(s: dict, key: str) -> str:
 _cell.tag = "_60s"
 
 
+def _window_cell(s: dict) -> str:
+    """The mean heading RMS [deg] over a record's 60 s windows ("-" where no window stayed finite)."""
+    v = s.get("window_heading_rms_deg")
+    return "-" if v is None or not np.isfinite(v) else f"{v:.1f}"
+
+
 def _divergence_text(d) -> str:
     if d is None:
         return ""
@@ -159,14 +170,55 @@ def record_table(res, markdown: bool) -> list[str]:
     _cell.tag = tag
     keys = list(SCORE_NAMES) + [k + tag for k in SCORE_NAMES]
     head = (["record", "fold", "form"] + [f"{SHORT[k]} s / i" for k in SCORE_NAMES]
-            + [f"first {res.horizon_s:g} s: {SHORT[k]} s / i" for k in SCORE_NAMES] + ["diverged"])
+            + [f"first {res.horizon_s:g} s: {SHORT[k]} s / i" for k in SCORE_NAMES]
+            + ["60 s windows: heading [deg] s / i", "diverged"])
     rows = []
     for r in res.records:
         a, b = r["scaled"], r["identified"]
         div = "; ".join(f"{who} at {s['divergence']['t_s']:.1f} s" for who, s in (("scaled", a), ("identified", b))
                         if s["divergence"] is not None) or "no"
-        rows.append([r["name"], str(r["fold"]), r["choice"]] + [f"{_cell(a, k)} / {_cell(b, k)}" for k in keys] + [div])
+        rows.append([r["name"], str(r["fold"]), r["choice"]] + [f"{_cell(a, k)} / {_cell(b, k)}" for k in keys]
+                    + [f"{_window_cell(a)} / {_window_cell(b)}", div])
     return _table(head, rows, markdown)
+
+
+KIND_KEYS = (("heading_rms_deg", "whole record"), ("window_heading_rms_deg", "60 s windows every 30 s"))
+"""The per-kind figures (:func:`kind_summary`): the whole-record heading RMS and the mean over the windows
+restarted from the measured state (:func:`trials.measured.window.window_scores`), both [deg]."""
+
+
+def kind_summary(records, keys=tuple(k for k, _ in KIND_KEYS)) -> list[dict]:
+    """Per kind of record (:data:`frt_gap.KINDS`, by the record's name) the mean of each of ``keys`` over its
+    kept-out records, scaled and identified: ``{"kind", "n" (records), <key>: {"scaled", "identified", "n"}}``,
+    each key's means over the records where both models' figures are finite (``n`` of them; None when
+    none is).  ``records``: :attr:`trials.measured.nested.NestedCV.records` (``name``, ``scaled``,
+    ``identified`` score dicts) or their JSON."""
+    out = []
+    for kind in KINDS:
+        mine = [r for r in records if kind_of(r["name"]) == kind]
+        if not mine:
+            continue
+        row = {"kind": kind, "n": len(mine)}
+        for key in keys:
+            pairs = [(r["scaled"].get(key), r["identified"].get(key)) for r in mine]
+            pairs = np.array([p for p in pairs if None not in p and np.isfinite(p).all()], float).reshape(-1, 2)
+            mean = [float(x) for x in pairs.mean(axis=0)] if len(pairs) else [None, None]
+            row[key] = {"scaled": mean[0], "identified": mean[1], "n": len(pairs)}
+        out.append(row)
+    return out
+
+
+def kind_table(summary: list[dict], markdown: bool) -> list[str]:
+    """:func:`kind_summary` as a table: per kind, scaled / identified mean heading RMS [deg] over the whole
+    record and over the 60 s windows (with the records each is over when fewer than the kind's)."""
+    head = ["kind", "records"] + [f"{words}: heading RMS s / i [deg]" for _, words in KIND_KEYS]
+
+    def cell(row, key):
+        c = row[key]
+        txt = f"{c['scaled']:.1f} / {c['identified']:.1f}" if c["n"] else "-"
+        return txt + (f" ({c['n']} finite)" if c["n"] != row["n"] else "")
+
+    return _table(head, [[r["kind"], str(r["n"])] + [cell(r, k) for k, _ in KIND_KEYS] for r in summary], markdown)
 
 
 def _table(head, rows, markdown: bool) -> list[str]:
@@ -186,7 +238,10 @@ def summary_lines(res) -> list[str]:
            f"identified better on {s['better']} of {s['n']}"]
     for key, words in (("heading_rms_deg", "heading RMS [deg]"), ("yaw_rate_rms_degps", "yaw-rate RMS [deg/s]"),
                        ("speed_rms_mps", "speed RMS [m/s]"), ("final_position_error_L", "final position error [L]")):
-        for k, span in ((key, "whole record"), (key + tag, f"first {res.horizon_s:g} s")):
+        spans = ((key, "whole record"), (key + tag, f"first {res.horizon_s:g} s"), ("window_" + key, "60 s windows"))
+        for k, span in spans:
+            if not fin or k not in fin[0]["scaled"]:          # the window figures: where the run made them
+                continue
             x = [r["scaled"][k] for r in fin if np.isfinite(r["scaled"][k]) and np.isfinite(r["identified"][k])]
             y = [r["identified"][k] for r in fin if np.isfinite(r["scaled"][k]) and np.isfinite(r["identified"][k])]
             nb = sum(q < p for p, q in zip(x, y))
@@ -241,8 +296,12 @@ def main(argv=None) -> None:
     print("\n".join(("- " if a.markdown else "") + ln for ln in choice_lines(res)))
     print("\nSummary:\n")
     print("\n".join(("- " if a.markdown else "") + ln for ln in summary_lines(res)))
+    by_kind = kind_summary(res.records)
+    print("\nBy kind of record, held out (s: scaled, i: identified; the 60 s windows restart from the measured "
+          "state):\n")
+    print("\n".join(kind_table(by_kind, a.markdown)))
     if a.json:
-        Path(a.json).write_text(json.dumps(res.to_json(), indent=1) + "\n")
+        Path(a.json).write_text(json.dumps({**res.to_json(), "by_kind": by_kind}, indent=1) + "\n")
         print(f"\nwrote {a.json}")
     if a.offset_spread > 0:
         offset_spread(res.records, runs, initial, a.offset_spread)

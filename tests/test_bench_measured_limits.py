@@ -219,3 +219,69 @@ def test_offset_scan_replays_the_fold_model_as_its_scores_were_wind_scale_includ
     old = cv.offset_spread([{**rec, "values": {}}], [run], ship, 1.0, n=3)
     assert [s.split(" ")[0] for s in old["not_as_scored"]] == [run.name]
     assert cv.offset_spread([rec], [run], ship, 1.0, n=4)["not_as_scored"] is None     # no zero offset: unchecked
+
+
+def test_kind_summary_whole_record_and_window_means_by_hand():
+    """Four kept-out records of two kinds.  Turns: whole record scaled 30, 20 / identified 10, 20 -> 25 / 15;
+    windows scaled 6, 4 / identified 2, NaN -> the pair with the NaN left out: 6 / 2 over 1 record.
+    Random runs: the scaled whole-record replay of random_d diverged (None) -> 90 / 60 over 1; windows
+    12, 10 / 8, 6 -> 11 / 7 over 2.  No zigzag or berthing record: no row."""
+    cv = _load("identify_cv")
+    s = lambda h, w: {"heading_rms_deg": h, "window_heading_rms_deg": w}    # noqa: E731
+    recs = [{"name": "turn_a", "scaled": s(30.0, 6.0), "identified": s(10.0, 2.0)},
+            {"name": "turn_cut_b", "scaled": s(20.0, 4.0), "identified": s(20.0, float("nan"))},
+            {"name": "random_c", "scaled": s(90.0, 12.0), "identified": s(60.0, 8.0)},
+            {"name": "random_d", "scaled": s(None, 10.0), "identified": s(40.0, 6.0)}]
+    rows = cv.kind_summary(recs)
+    assert [r["kind"] for r in rows] == ["turn", "random"] and [r["n"] for r in rows] == [2, 2]
+    turn, rnd = rows
+    assert turn["heading_rms_deg"] == {"scaled": 25.0, "identified": 15.0, "n": 2}
+    assert turn["window_heading_rms_deg"] == {"scaled": 6.0, "identified": 2.0, "n": 1}
+    assert rnd["heading_rms_deg"] == {"scaled": 90.0, "identified": 60.0, "n": 1}
+    assert rnd["window_heading_rms_deg"] == {"scaled": 11.0, "identified": 7.0, "n": 2}
+    md = cv.kind_table(rows, markdown=True)
+    assert md[2] == "| turn | 2 | 25.0 / 15.0 | 6.0 / 2.0 (1 finite) |"
+    assert md[3] == "| random | 2 | 90.0 / 60.0 (1 finite) | 11.0 / 7.0 |"
+    none = cv.kind_summary([{"name": "zigzag_x", "scaled": s(None, None), "identified": s(1.0, 1.0)}])
+    assert none[0]["heading_rms_deg"] == {"scaled": None, "identified": None, "n": 0}
+    assert cv.kind_table(none, markdown=True)[2] == "| zigzag | 1 | - (0 finite) | - (0 finite) |"
+
+
+def test_the_identified_models_window_scores_carry_its_fitted_wind_scale():
+    """replay_scores with the identified ship scores the windows of the run as Identification.replay made it:
+    the record's wind loads times the fitted wind_scale 0.3 (built here by hand), not the unscaled ones."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    import mmg
+    from trials.measured.identify import Identification
+    from trials.measured.nested import replay_scores
+    from trials.measured.window import window_scores
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    run = _windy_run(ship)
+    values = {"wind_scale": 0.3}
+    ident = Identification(ship=ship, initial=ship, fit=SimpleNamespace(values=lambda: values), runs=[run],
+                           segment_s=np.inf)
+    got = replay_scores(ident.replay(run), ship=ship)["window_heading_rms_deg"]
+    by_hand = window_scores(ship, replace(run, inputs=replace(run.inputs, ext=0.3 * run.inputs.ext)))
+    unscaled = window_scores(ship, run)
+    assert got == pytest.approx(by_hand.mean("heading_rms_deg"), rel=1e-12)
+    assert unscaled.mean("heading_rms_deg") < 1e-6 < got            # the record is the unscaled model's own
+
+
+def test_window_kinds_of_a_predict_json_by_hand():
+    """Three runs of mmg predict's JSON: two turns (whole 10 and null: diverged; windows 4 and 2 deg over 3 and
+    5 windows, 1.0 and 3.0 m) -> whole 10 over 1 finite, windows 3 deg, 2 m, 8 windows; one zigzag."""
+    wk = _load("window_kinds")
+    w = lambda h, m, n: {"window_s": 60.0, "every_s": 30.0, "n_windows": n, "heading_rms_deg": h,   # noqa: E731
+                         "position_error_m": m, "position_error_L": m / 3.0}
+    doc = {"runs": [{"name": "turn_a", "heading_rms_deg": 10.0, "window": w(4.0, 1.0, 3)},
+                    {"name": "turn_cut_b", "heading_rms_deg": None, "window": w(2.0, 3.0, 5)},
+                    {"name": "zigzag_c", "heading_rms_deg": 7.0, "window": w(5.0, 0.5, 2)}]}
+    turn, zz = wk.kind_rows(doc)
+    assert (turn["kind"], turn["n"], turn["windows"], turn["n_whole"]) == ("turn", 2, 8, 1)
+    assert turn["heading_rms_deg"] == 10.0 and turn["window_heading_rms_deg"] == 3.0
+    assert turn["window_position_error_m"] == 2.0 and turn["window_position_error_L"] == pytest.approx(2.0 / 3.0)
+    assert zz["kind"] == "zigzag" and zz["window_heading_rms_deg"] == 5.0
+    assert wk.table([turn], 60.0, 30.0)[2] == "| turn | 2 | 8 | 10.0 (1 finite) | 3.0 | 2.00 | 0.67 |"

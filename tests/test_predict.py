@@ -153,17 +153,21 @@ def _run_cli(argv, capsys):
 def test_cli_predict_end_to_end(slices, tmp_path, ship3m, capsys):
     """``mmg predict`` on two slices: exact JSON layout, the library's numbers, one line per run, the plots."""
     from trials.measured.predict import predict
+    from trials.measured.window import with_windows
 
     js, plots = tmp_path / "out" / "pred.json", tmp_path / "plots"
     rc, out, err = _run_cli(["predict", "--ship", "esso_osaka_3m", *slices, "--json", js, "--plots", plots], capsys)
     assert rc == 0, err
     doc = json.loads(js.read_text(), parse_constant=lambda c: pytest.fail(f"JSON holds {c}"))
     assert list(doc) == ["runs"] and len(doc["runs"]) == 2
-    lib = predict(ship3m, slices)
-    for run, path, rep in zip(doc["runs"], slices, lib.runs):
-        assert list(run) == ["name", "file", *SCORE_KEYS]
+    lib = with_windows(ship3m, predict(ship3m, slices), 60.0, 30.0)    # --window 60 --every 30: the defaults
+    for run, path, rep, win in zip(doc["runs"], slices, lib.runs, lib.windows):
+        assert list(run) == ["name", "file", *SCORE_KEYS, "window"]
         assert run["file"] == str(path) and run["name"] == path.stem
-        assert run == {"name": path.stem, "file": str(path), **rep.scores()}   # the library's numbers, bit for bit
+        assert run == {"name": path.stem, "file": str(path), **rep.scores(),   # the library's numbers, bit for bit
+                       "window": win.to_json()}
+        assert run["window"]["n_windows"] == 1 and run["window"]["window_s"] < 60.0   # a 60 s slice: one, shorter
+        assert f"{path.stem}: from the measured state, 1 window of the whole" in out
         assert all(np.isfinite(run[k]) for k in SCORE_KEYS)
         assert run["final_position_error_L"] == pytest.approx(run["final_position_error_m"] / 3.0, rel=1e-15)
     lines = out.strip().splitlines()
@@ -214,13 +218,14 @@ def test_record_labels_are_unique_and_deterministic(tmp_path):
 def test_cli_predict_wind_switch_and_start(slices, tmp_path, ship3m, capsys):
     """--wind off and --start S reach the library: the JSON equals predict(..., start, wind=False)."""
     from trials.measured.predict import predict
+    from trials.measured.window import with_windows
 
     js = tmp_path / "p.json"
     rc, out, err = _run_cli(["predict", "--ship", "esso_osaka_3m", slices[0], "--json", js, "--wind", "off",
                              "--start", "20"], capsys)
     assert rc == 0, err
     doc = json.loads(js.read_text())
-    assert doc == predict(ship3m, slices[:1], start=20.0, wind=False).to_json()
+    assert doc == with_windows(ship3m, predict(ship3m, slices[:1], start=20.0, wind=False)).to_json()
     assert "wind off" in out
 
 
@@ -433,3 +438,19 @@ def test_cli_predict_horizon_gives_the_first_seconds(slices, tmp_path, ship3m, c
     assert whole["first"]["heading_rms_deg"] == whole["heading_rms_deg"]
     _refused(["predict", "--ship", "esso_osaka_3m", slices[0], "--json", js.with_name("q.json"), "--horizon", "0"],
              capsys, js.with_name("q.json"), contains=("--horizon",))
+
+
+@needs_frt
+def test_cli_predict_window_and_every_reach_the_library(slices, tmp_path, capsys):
+    """--window 20 --every 10 on a 59.9 s slice: floor((59.9 - 20) / 10) + 1 = 4 windows starting 0, 10, 20, 30 s
+    (counted by hand), their means in the JSON with units on the console; --every 0 is refused."""
+    js = tmp_path / "p.json"
+    rc, out, err = _run_cli(["predict", "--ship", "esso_osaka_3m", slices[0], "--json", js, "--window", "20",
+                             "--every", "10"], capsys)
+    assert rc == 0, err
+    w = json.loads(js.read_text())["runs"][0]["window"]
+    assert (w["window_s"], w["every_s"], w["n_windows"], w["n_diverged"]) == (20.0, 10.0, 4, 0)
+    assert "zz_slice: from the measured state, 4 windows of 20 s every 10 s: mean heading" in out
+    assert " deg RMS, mean final position " in out and " m (" in out and " L)" in out
+    _refused(["predict", "--ship", "esso_osaka_3m", slices[0], "--json", js.with_name("q.json"), "--every", "0"],
+             capsys, js.with_name("q.json"), contains=("--every",))

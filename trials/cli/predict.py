@@ -16,6 +16,7 @@ def cmd_predict(args) -> int:
 
     from ..files.output import StagedFile, StagedOutput, check_output_dir, check_output_file, dumps_json
     from ..measured.predict import predict
+    from ..measured.window import with_windows
 
     check_output_file(args.json)
     if args.plots is not None:
@@ -31,6 +32,7 @@ def cmd_predict(args) -> int:
         print(f"replayed {i}/{n}: {name}", file=sys.stderr, flush=True)
 
     pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)   # runs named after their files
+    pred = with_windows(ship, pred, args.window, args.every)
     text = dumps_json(pred.to_json(horizon_s=args.horizon))
     names = [f"{r.run.name}.png" for r in pred.runs]
     with StagedFile(args.json) as tmp:     # the files first (renamed last, after the plots), then the console
@@ -47,6 +49,7 @@ def cmd_predict(args) -> int:
         print(f"{r.run.name}: heading {s['heading_rms_deg']:.4g} deg RMS, yaw rate {s['yaw_rate_rms_degps']:.4g} deg/s RMS, "
               f"speed {s['speed_rms_mps']:.4g} m/s RMS, final position {s['final_position_error_m']:.4g} m "
               f"({s['final_position_error_L']:.4g} L), wind {r.run.wind}" + _first_text(r, args.horizon))
+    print("\n".join(_window_lines(pred)))
     if len(pred.runs) > 1:                 # the figure a comparison of two configs quotes
         sc = [r.scores() for r in pred.runs if r.diverged_at is None]
         mean = lambda k: sum(x[k] for x in sc) / len(sc)  # noqa: E731
@@ -71,6 +74,30 @@ def _first_text(r, horizon) -> str:
     return f"; first {horizon:g} s: heading {f['heading_rms_deg']:.4g} deg RMS, yaw rate {f['yaw_rate_rms_degps']:.4g} deg/s RMS"
 
 
+def _window_lines(pred) -> list[str]:
+    """The console's short-horizon lines: one per run (:meth:`trials.measured.window.WindowScores.text`), then
+    with several runs the mean over them of the window means."""
+    out = [w.text() for w in pred.windows]
+    h = [w.mean("heading_rms_deg") for w in pred.windows]
+    h = [x for x in h if x == x]
+    if len(pred.windows) > 1 and h:
+        w = pred.windows[0]
+        out.append(f"windows of {w.window_s:g} s every {w.every_s:g} s, mean over {len(h)} runs of each run's mean: "
+                   f"heading {sum(h) / len(h):.4g} deg RMS")
+    return out
+
+
+def _add_window_options(p) -> None:
+    """--window and --every: the short-horizon windows restarted from the measured state."""
+    from ..measured.window import EVERY_S, WINDOW_S
+
+    p.add_argument("--window", type=_finite_positive, default=WINDOW_S, metavar="S",
+                   help=f"length [s] of the windows each run is also predicted over from its measured state "
+                        f"(JSON key 'window': mean heading RMS and final position error; default {WINDOW_S:g})")
+    p.add_argument("--every", type=_finite_positive, default=EVERY_S, metavar="S",
+                   help=f"interval [s] between the starts of those windows (default {EVERY_S:g})")
+
+
 def add_parser(sub) -> None:
     """The predict subcommand of ``mmg`` (its options, help and function)."""
     p = sub.add_parser("predict", help="replay records open-loop against their own rudder and propeller history: "
@@ -88,4 +115,5 @@ def add_parser(sub) -> None:
     p.add_argument("--horizon", type=_finite_positive, default=None, metavar="S",
                    help="also the scores over the first S seconds of each replay (JSON key 'first'; the short-"
                         "horizon figure of docs/benchmark_frt.md, 60 s there)")
+    _add_window_options(p)
     p.set_defaults(func=cmd_predict)

@@ -102,15 +102,26 @@ def fit_model(ship: Ship, runs: list[MeasuredRun], **kw):
     return identify(ship, runs, **kw)
 
 
-def replay_scores(rep, horizon_s: float = HORIZON_S) -> dict:
+def replay_scores(rep, horizon_s: float = HORIZON_S, ship: Ship | None = None) -> dict:
     """Scores of one replay (:class:`trials.measured.predict.Replayed`): :data:`SCORE_NAMES` over the whole
     record, the same with the suffix ``_60s`` (``horizon_s``) over its first minute, and ``divergence``
     (:attr:`~trials.measured.predict.Replayed.divergence`: time and state, None when it stayed finite).
-    A window the divergence falls in has NaN scores and the divergence says why."""
+    A window the divergence falls in has NaN scores and the divergence says why.
+
+    With ``ship`` (the model that made ``rep``) also ``window_heading_rms_deg`` [deg] and
+    ``window_final_position_error_L`` [L]: the means over the 60 s windows every 30 s restarted from the
+    measured state (:func:`trials.measured.window.window_scores` of ``rep.run``, so with the same wind
+    loads and effects as ``rep``)."""
     whole, first = rep.scores(), rep.scores(until_s=horizon_s)
     tag = f"_{horizon_s:g}s"
     out = {k: whole[k] for k in SCORE_NAMES}
     out.update({k + tag: first[k] for k in SCORE_NAMES})
+    if ship is not None:
+        from .window import window_scores
+
+        w = window_scores(ship, rep.run)
+        out.update({"window_heading_rms_deg": w.mean("heading_rms_deg"),
+                    "window_final_position_error_L": w.mean("position_error_L")})
     out["divergence"] = rep.divergence
     return out
 
@@ -133,8 +144,8 @@ def _outer_task(task) -> list[dict]:
     ident = fit_model(cand.ship, train, initial=initial, **{**kw, **cand.options})
     values = {k: float(v) for k, v in ident.fit.values().items()}
     return [{"name": r.name, "fold": outer, "choice": cand.name,
-             "scaled": replay_scores(replay_record(initial, r), horizon_s),
-             "identified": replay_scores(ident.replay(r), horizon_s), "ship": ident.ship, "values": values}
+             "scaled": replay_scores(replay_record(initial, r), horizon_s, initial),
+             "identified": replay_scores(ident.replay(r), horizon_s, ident.ship), "ship": ident.ship, "values": values}
             for r in tests]
 
 

@@ -287,22 +287,29 @@ def replay_record(ship: Ship, rec: TrialRecord | MeasuredRun, start: float | Non
 
 @dataclass(frozen=True)
 class Prediction:
-    """Several records replayed with one ship: :attr:`runs` in the order given."""
+    """Several records replayed with one ship: :attr:`runs` in the order given; :attr:`windows`, when
+    made (:func:`trials.measured.window.with_windows`), each run's short-horizon scores
+    (:class:`trials.measured.window.WindowScores`), in the same order."""
 
     runs: list
+    windows: list | None = None
 
     def to_json(self, horizon_s: float | None = None) -> dict:
         """``{"runs": [{"name": ..., "file": ..., "heading_rms_deg": ..., ...}, ...]}`` (``mmg predict --json``;
         ``name``: the run's name, after its file, as printed and as its plot is named).  With
         ``horizon_s`` each run also has ``"first": {"horizon_s": ..., <the same scores over the first
-        horizon_s seconds>}`` (:meth:`Replayed.scores` ``until_s``: a short-horizon figure)."""
-        def row(r):
+        horizon_s seconds>}`` (:meth:`Replayed.scores` ``until_s``: a short-horizon figure); with
+        :attr:`windows`, ``"window"``: the means over the windows restarted from the measured state
+        (:meth:`trials.measured.window.WindowScores.to_json`)."""
+        def row(k, r):
             d = {"name": r.run.name, "file": r.run.source, **r.scores()}
             if horizon_s is not None:
                 d["first"] = {"horizon_s": float(horizon_s), **r.scores(until_s=horizon_s)}
+            if self.windows is not None:
+                d["window"] = self.windows[k].to_json()
             return d
 
-        return {"runs": [row(r) for r in self.runs]}
+        return {"runs": [row(k, r) for k, r in enumerate(self.runs)]}
 
     def to_pandas(self):
         """One row of scores per run, indexed by the run's name (after its file: unique)."""
