@@ -26,6 +26,10 @@ and their sources:
   the Esso Osaka against 15.96 L), on the astern revolutions strongly (docs/imo.md).
 
 Both are parameters of the order, not of the ship: a ship with its own engine data gives its own.
+:data:`REVERSAL_TIME_S` is a full-scale time: on a Froude-scaled model of scale lambda (its config's
+``full_scale:`` section, :attr:`mmg.ship.Ship.froude_scale`) the same reversal takes 120 / sqrt(lambda) s
+(times scale as sqrt(lambda) at equal Froude number; :func:`reversal_time`).  The ratio is
+non-dimensional and stays.
 """
 from __future__ import annotations
 
@@ -36,12 +40,22 @@ import numpy as np
 
 from .model import ENGINE_CONSTANT_RPM, P_ENGINE, PackedShip
 
-__all__ = ["AsternOrder", "ASTERN_RPM_RATIO", "REVERSAL_TIME_S", "prescribed_revolutions"]
+__all__ = ["AsternOrder", "ASTERN_RPM_RATIO", "REVERSAL_TIME_S", "prescribed_revolutions", "reversal_time"]
 
 ASTERN_RPM_RATIO = 0.7
 """Full-astern revolutions over the approach (ahead) revolutions (module docstring: source)."""
 REVERSAL_TIME_S = 120.0
-"""Time [s] of the linear ramp from the approach revolutions to the full-astern ones (module docstring)."""
+"""Time [s] of the linear ramp from the approach revolutions to the full-astern ones at full scale
+(module docstring; a model's: :func:`reversal_time`)."""
+
+
+def reversal_time(scale: float = 1.0) -> float:
+    """The ramp time [s] of the full-astern order on a ship of Froude scale ``scale`` (lambda = L of the
+    full-scale ship / L of this one; 1 at full scale): :data:`REVERSAL_TIME_S` / sqrt(lambda)."""
+    scale = float(scale)
+    if not (math.isfinite(scale) and scale > 0.0):
+        raise ValueError(f"scale: a positive finite number, got {scale!r}")
+    return REVERSAL_TIME_S / math.sqrt(scale)
 
 
 @dataclass(frozen=True)

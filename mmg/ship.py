@@ -247,6 +247,44 @@ class ParameterCovariance:
 
 
 @dataclass(frozen=True)
+class FullScale:
+    """The full-scale ship a model is a Froude-scaled model of: the ``full_scale:`` section of a ship YAML.
+
+    Attributes
+    ----------
+    name : str
+        The full-scale ship's name (its config, e.g. ``esso_osaka``), for the reader.
+    L : float
+        Its length between perpendiculars [m]; the scale lambda = ``L`` / the model's L.
+    """
+
+    name: str
+    L: float
+
+
+@dataclass(frozen=True)
+class IdentificationNotes:
+    """What ``mmg identify`` says of its own fit: the ``identification:`` section of the ship YAML it writes.
+
+    Attributes
+    ----------
+    converged : bool
+        Every fit stage converged (none stopped at its evaluation limit).
+    warnings : tuple of str
+        The identification's warnings, one sentence each.
+    covariance_method : str
+        How the written ``covariance:`` section was made.
+    training_replays_worse : tuple of str
+        The training records whose identified replay is worse (heading RMS) than the initial model's.
+    """
+
+    converged: bool
+    warnings: tuple = ()
+    covariance_method: str = ""
+    training_replays_worse: tuple = ()
+
+
+@dataclass(frozen=True)
 class Ship:
     """A ship: everything the simulator needs, in SI and primes."""
 
@@ -270,6 +308,16 @@ class Ship:
     again (:func:`trials.runs.trial.trial_from_dict`)."""
     covariance: ParameterCovariance | None = field(default=None, compare=False, repr=False)
     """The covariance of the identified parameters (the ``covariance:`` section), or None."""
+    full_scale: FullScale | None = field(default=None, compare=False, repr=False)
+    """The full-scale ship this one is a model of (the ``full_scale:`` section), or None: a full-scale ship."""
+    identification: IdentificationNotes | None = field(default=None, compare=False, repr=False)
+    """``mmg identify``'s account of the fit that made this ship (the ``identification:`` section), or None."""
+
+    @property
+    def froude_scale(self) -> float:
+        """lambda = L of the full-scale ship / L of this one (1 for a full-scale ship): times scale as
+        sqrt(lambda) between the two."""
+        return 1.0 if self.full_scale is None else self.full_scale.L / self.particulars.L
 
     def effect_set(self):
         """:attr:`effects` as an :class:`mmg.effects.EffectSet` (an empty one when None)."""
@@ -305,6 +353,10 @@ class Ship:
 #   steering     0 < T_E <= 60 s; 0 < rate_max <= 60 deg/s; 0 < delta_max <= 90 deg
 #   engine       constant power: SHP_0 not all zero; watts_per_hp 700-800;
 #                0 < shaft_inertia_coefficient <= 100
+#   full_scale   (a model's) the full-scale ship's name and L, a ship's length longer than this L
+#                (scale lambda = full_scale.L / L, Ship.froude_scale)
+#   identification  (mmg identify's) converged, warnings, covariance_method,
+#                training_replays_worse: what the fit says of itself (trials.imo reads it)
 #   effects      {name: {parameter: value}} of mmg.effects (current, wind, rudder_offset,
 #                heading_bias, shallow_water), each parameter within its effect's bounds;
 #                wind needs the wind section; wind.enabled: true is effects: {wind: {scale,
@@ -431,6 +483,18 @@ class _Covariance(_Strict):
     method: str = ""
 
 
+class _FullScale(_Strict):
+    name: str = ""
+    L: Quantity
+
+
+class _Identification(_Strict):
+    converged: bool
+    warnings: list[str] = []
+    covariance_method: str = ""
+    training_replays_worse: list[str] = []
+
+
 class _ShipFile(_Strict):
     name: str = Field(min_length=1)
     source: str = ""
@@ -444,6 +508,8 @@ class _ShipFile(_Strict):
     wind: Optional[_Wind] = None
     effects: Optional[dict] = None
     covariance: Optional[_Covariance] = None
+    full_scale: Optional[_FullScale] = None
+    identification: Optional[_Identification] = None
 
 
 _UNIT_HINT = {"L": "m", "B": "m", "T": "m", "S_wetted": "m^2", "x_G": "m", "rho": "kg/m^3", "D": "m", "P": "m",
@@ -698,7 +764,26 @@ def _build(f: _ShipFile, src: str) -> Ship:
         wind = replace(wind, enabled=True, **{k: effects.get("wind")[k] for k in wind.values()})
     return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
                 steering=steering, engine=engine, source=f.source, wind=wind, effects=effects, stated=stated,
-                covariance=_covariance(f, src))
+                covariance=_covariance(f, src), full_scale=_full_scale(f, src, particulars),
+                identification=_identification(f))
+
+
+def _full_scale(f: _ShipFile, src: str, pa: Particulars) -> FullScale | None:
+    """full_scale: the full-scale ship's L, longer than this ship's and a ship's length."""
+    if f.full_scale is None:
+        return None
+    L = _qty(src, "full_scale.L", f.full_scale.L, "length", *SHIP_LENGTH_RANGE)
+    if not L > pa.L:
+        raise InputError(src, "full_scale.L", f"{f.full_scale.L} is not longer than this ship's L = {pa.L:g} m "
+                                              f"(a model's full-scale ship is larger)")
+    return FullScale(f.full_scale.name, L)
+
+
+def _identification(f: _ShipFile) -> IdentificationNotes | None:
+    c = f.identification
+    if c is None:
+        return None
+    return IdentificationNotes(c.converged, tuple(c.warnings), c.covariance_method, tuple(c.training_replays_worse))
 
 
 def _covariance(f: _ShipFile, src: str) -> ParameterCovariance | None:

@@ -102,8 +102,8 @@ def test_figures_equal_those_of_simulate(cli_run):
 
 def test_cli_writes_the_exact_schema(cli_run):
     out, doc = cli_run
-    assert list(doc) == ["ship", "criteria"]
-    assert doc["ship"] == "Esso Osaka"
+    assert list(doc) == ["ship", "warnings", "criteria"]
+    assert doc["ship"] == "Esso Osaka" and doc["warnings"] == []
     assert {c["name"] for c in doc["criteria"]} == EXPECTED_NAMES
     assert len(doc["criteria"]) == len(EXPECTED_NAMES)
     for c in doc["criteria"]:

@@ -115,7 +115,7 @@ def test_scaled_samples_and_interval_widths(ships):
     assert len(ws) == 13                      # the six manoeuvres to both sides and the stopping test
     assert sum(w["width"] >= w["width_identified"] for w in ws) >= 9
     doc = json.loads(res.to_json())
-    assert list(doc) == ["ship", "criteria"] and all(len(c) == 7 for c in doc["criteria"])
+    assert list(doc) == ["ship", "warnings", "criteria"] and all(len(c) == 7 for c in doc["criteria"])
     from trials.imo.report import report_lines
 
     md = "\n".join(report_lines(res))
@@ -127,7 +127,7 @@ def test_cli_scale_to_writes_the_schema(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["imo", "esso_osaka_3m", "--scale-to", "esso_osaka", "--out", str(out)]) == 0
     doc = json.loads((out / "imo.json").read_text())
-    assert list(doc) == ["ship", "criteria"] and doc["ship"].startswith("Esso Osaka (scaled from")
+    assert list(doc) == ["ship", "warnings", "criteria"] and doc["ship"].startswith("Esso Osaka (scaled from")
     for c in doc["criteria"]:
         assert list(c) == ["name", "value", "unit", "limit", "interval", "probability", "verdict"]
     lim = {c["name"]: c["limit"] for c in doc["criteria"]}

@@ -157,10 +157,14 @@ def _print_outcome(ident, runs, out: Path, nested, t0: float) -> None:
                   f"converging; --max-nfev raises it", file=sys.stderr)
     for w in ident.physical_check().warnings():
         print(f"warning: {w}", file=sys.stderr)
-    warn = ident.fit.warnings()
+    from ..measured.identify import identification_summary
+
+    warn = identification_summary(ident)["warnings"]
     if warn:
         print(f"warning: {len(warn)} finding(s) on where the identified values should not be read as the ship's "
-              f"physics (sign changes, bounds, no convergence): {out / 'report.md'}, 'Warnings'", file=sys.stderr)
+              f"physics or the fit not as finished (sign changes, bounds, no convergence, training replays worse "
+              f"than the initial model's, physical checks): {out / 'report.md'}, 'Warnings', and the "
+              f"identification: section of {out / 'ship.yaml'} (mmg imo reads it)", file=sys.stderr)
 
 
 def _records(args, ship, wind):
@@ -258,7 +262,8 @@ def cmd_identify(args) -> int:
 def add_parser(sub) -> None:
     """The identify subcommand of ``mmg`` (its options, help and function)."""
     p = sub.add_parser("identify", help="identify hull coefficients and model-scale constants jointly over measured "
-                                        "records (segment-wise output error); writes DIR/ship.yaml and DIR/report.md")
+                                        "records (segment-wise output error); writes DIR/ship.yaml (with its "
+                                        "identification: section, the fit's warnings) and DIR/report.md")
     p.add_argument("--ship", required=True, help="initial ship YAML or bundled name (the prior)")
     p.add_argument("--train", required=True, nargs="+", metavar="LOG", help="training records")
     p.add_argument("--out", required=True, metavar="DIR", type=_output_path, help="output folder")

@@ -50,6 +50,10 @@ def cmd_imo(args) -> int:
     with StagedOutput(args.out) as stage:
         names = write_report(res, stage.dir)
     print(f"{res.ship} at {res.speed} (L/V = {res.L_over_V:.3g} s): wrote {', '.join(names)} to {args.out}")
+    for w in res.warnings:
+        print(f"warning: {w}")
+    if res.doubts.reason:
+        print(f"verdicts: {res.doubts.reason}")
     for r in res.rows():
         val = "-" if r["value"] is None else f"{r['value']:.3g} {r['unit']}"
         extra = ""
@@ -70,7 +74,8 @@ def cmd_imo(args) -> int:
 def add_parser(sub) -> None:
     """The imo subcommand of ``mmg`` (its options, help and function)."""
     p = sub.add_parser("imo", help="check the IMO manoeuvring standards (MSC.137(76)) on a ship, with their "
-                                   "uncertainty from its parameters' covariance; writes DIR/imo.json, DIR/imo.md")
+                                   "uncertainty from its parameters' covariance and its identification's warnings "
+                                   "(no pass from an unfinished fit); writes DIR/imo.json, DIR/imo.md")
     p.add_argument("ship", help="bundled ship name (esso_osaka) or ship YAML (mmg identify's DIR/ship.yaml)")
     p.add_argument("--out", required=True, metavar="DIR", type=_output_path,
                    help="output folder (imo.json, imo.md, tracks.png, zigzags.png, distributions.png)")

@@ -32,6 +32,8 @@ def _table(res) -> list[str]:
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in res.rows():
         unit = f" {r['unit']}"
+        if "note" in r:
+            r = {**r, "verdict": f"{r['verdict']} (identification)"}
         if sampled:
             lines.append(f"| {r['name']} | {_num(r['value'])}{unit if r['value'] is not None else ''} | "
                          f"{_num(res.nominal.get(r['name']))} | {_interval(r['interval'])} | {r['limit']:.3g}{unit} | "
@@ -39,6 +41,24 @@ def _table(res) -> list[str]:
         else:
             lines.append(f"| {r['name']} | {_num(r['value'])}{unit if r['value'] is not None else ''} | "
                          f"{r['limit']:.3g}{unit} | {r['verdict']} |")
+    return lines
+
+
+def _warnings(res) -> list[str]:
+    """The warnings block near the top of ``imo.md``: the identification's (its ship.yaml's
+    ``identification:`` section), what that does to the verdicts, and this check's own."""
+    d = res.doubts
+    lines = []
+    if d.warnings or d.reason:
+        lines += ["## Warnings of the identification", "",
+                  "From the ship's identification: section (mmg identify's account of the fit it was made by):", ""]
+        lines += [f"- {w}" for w in d.warnings] or ["- none listed"]
+        lines.append("")
+        if d.reason:
+            lines += [f"**Verdicts: {d.reason}.** A criterion its values would pass is reported 'undecided "
+                      f"(identification)' below; a fail stands.", ""]
+    if res.own_warnings:
+        lines += ["## Warnings of this check", ""] + [f"- {w}" for w in res.own_warnings] + [""]
     return lines
 
 
@@ -92,7 +112,8 @@ def _scaling(res) -> list[str]:
 
 
 def report_lines(res) -> list[str]:
-    """The lines of ``imo.md``: the criteria table, the rules, the notes, the convergence and the figures."""
+    """The lines of ``imo.md``: the warnings (:func:`_warnings`), the criteria table, the rules, the notes,
+    the convergence and the figures."""
     sampled = res.samples is not None
     lines = [f"# IMO manoeuvring standards: {res.ship}", "",
              f"Source of the criteria: {IMO_STANDARD}.", "",
@@ -101,6 +122,7 @@ def report_lines(res) -> list[str]:
              f"for L/V below 10 s, from 30 s, between).  A criterion's side is that of the turn or of a zigzag's "
              f"first rudder order; the initial-turning track reach is the distance run to the 10/10 zigzag's second "
              f"execute (heading changed by 10 deg with 10 deg rudder).", ""]
+    lines += _warnings(res)
     if sampled:
         pn = res.parameters
         src = pn.get("model", pn)
@@ -122,7 +144,7 @@ def report_lines(res) -> list[str]:
     if res.scaling is not None:
         lines += _scaling(res)
     lines += ["## Criteria", "", *_table(res), "", "Full-astern stopping test: " + " ".join(stop) + ".", ""]
-    other = [n for n in res.notes if not n.startswith(STOPPING)]
+    other = [n for n in res.notes if not n.startswith(STOPPING) and n not in res.own_warnings]
     if other:
         lines += ["## Notes", ""] + [f"- {n}" for n in other] + [""]
     if sampled:

@@ -8,6 +8,7 @@ sampling in :mod:`trials.imo.sampling`.
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,6 +20,7 @@ from mmg.ship import Ship, load_ship
 
 from ..analysis.metrics import IMO_STANDARD
 from . import sampling as S
+from .doubts import IdentificationDoubts, identification_doubts
 from .standard import MAX_RUN_LENGTHS_L, STOPPING, STOPPING_RUN, Criterion, approach_speed, criteria, \
     criterion_values, plan, run_manoeuvres
 
@@ -52,6 +54,11 @@ class ImoResult:
         With samples: ``names``, ``mean``, ``cov`` (the sampled parameters), ``draws`` (N x names), ``seed``.
     notes : tuple of str
         What a reader should know (effects left out, failed samples, the stopping test).
+    doubts : IdentificationDoubts
+        The identified ship's own warnings (its ``identification:`` section) and, where its fit did not
+        finish, why no criterion is reported as passed (:mod:`trials.imo.doubts`).
+    own_warnings : tuple of str
+        This check's own doubts: samples that failed to run, criteria a manoeuvre did not give.
     runs : dict
         The nominal runs: run name -> (TrialRun, metrics) (for the figures; not in the JSON).
     """
@@ -67,6 +74,8 @@ class ImoResult:
     samples: dict | None = None
     parameters: dict | None = None
     notes: tuple = ()
+    doubts: IdentificationDoubts = IdentificationDoubts()
+    own_warnings: tuple = ()
     runs: dict = field(default_factory=dict, repr=False, compare=False)
     sample_runs: dict = field(default_factory=dict, repr=False, compare=False)
     """With samples: the turning circles of the samples with the smallest, the median and the largest
@@ -80,6 +89,11 @@ class ImoResult:
     values), so :meth:`interval_widths` can say how much of each interval the scaling assumptions make."""
 
     @property
+    def warnings(self) -> list[str]:
+        """The identification's warnings, then this check's own (``imo.json``'s ``warnings``)."""
+        return list(self.doubts.warnings) + list(self.own_warnings)
+
+    @property
     def n_samples(self) -> int:
         """The number of parameter samples (0 without uncertainty)."""
         return 0 if self.samples is None else len(next(iter(self.samples.values())))
@@ -88,22 +102,29 @@ class ImoResult:
         if self.samples is None:
             v = self.nominal[c.name]
             verdict = "fail" if v is None or v > c.limit else "pass"   # a turn or zigzag that never gets there fails
-            return {"name": c.name, "value": v, "unit": c.unit, "limit": c.limit, "interval": None,
-                    "probability": None, "verdict": verdict}
-        s = S.summarise(self.samples[c.name], c.limit)
-        return {"name": c.name, "value": s["median"], "unit": c.unit, "limit": c.limit, "interval": s["interval"],
-                "probability": s["probability"], "verdict": s["verdict"]}
+            row = {"name": c.name, "value": v, "unit": c.unit, "limit": c.limit, "interval": None,
+                   "probability": None, "verdict": verdict}
+        else:
+            s = S.summarise(self.samples[c.name], c.limit)
+            row = {"name": c.name, "value": s["median"], "unit": c.unit, "limit": c.limit, "interval": s["interval"],
+                   "probability": s["probability"], "verdict": s["verdict"]}
+        shown = self.doubts.verdict(row["verdict"])
+        if shown != row["verdict"]:
+            row.update(verdict=shown, note=f"would pass, but {self.doubts.reason}")
+        return row
 
     def rows(self) -> list[dict]:
         """One dict per criterion, exactly the ``imo.json`` entries: ``name``, ``value`` (the median of the
         samples with uncertainty, else the ship's own), ``unit``, ``limit``, ``interval`` ([5 %, 95 %]
         percentiles, None without samples), ``probability`` (of meeting the limit, None without samples),
-        ``verdict`` (:data:`VERDICTS`)."""
+        ``verdict`` (:data:`VERDICTS`); and ``note`` where a pass is reported ``"undecided"`` because the
+        identification is in doubt (:attr:`doubts`), saying why."""
         return [self._row(c) for c in self.criteria]
 
     def as_dict(self) -> dict:
-        """``{"ship": ..., "criteria": [...]}``: what ``imo.json`` holds."""
-        return {"ship": self.ship, "criteria": self.rows()}
+        """``{"ship": ..., "warnings": [...], "criteria": [...]}``: what ``imo.json`` holds (:attr:`warnings`,
+        an empty list when there are none)."""
+        return {"ship": self.ship, "warnings": self.warnings, "criteria": self.rows()}
 
     def to_json(self, path: str | os.PathLike | None = None) -> str:
         """The JSON of :meth:`as_dict` (written to ``path`` when given); NaN and inf never appear (None)."""
@@ -221,6 +242,9 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
         percentiles, its probability the share of samples meeting the limit; verdict ``"pass"`` if that
         probability is >= 0.95, ``"fail"`` if <= 0.05, else ``"undecided"``.  Without samples the verdict
         is the value against the limit (a manoeuvre that does not give its figure fails, with a note).
+        On a ship whose ``identification:`` section says its fit did not converge or replays training
+        records worse than the initial model, a pass is ``"undecided"`` with a ``note``
+        (:mod:`trials.imo.doubts`); the section's warnings are the result's :attr:`ImoResult.warnings`.
 
     Raises
     ------
@@ -242,17 +266,19 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
     runs = run_manoeuvres(p)
     nominal = criterion_values(p, runs)
     crit = tuple(criteria(p.L_over_V))
-    notes += [f"{c.name}: the manoeuvre does not give it (no 180 deg of turn, no overshoot, no stop) within "
-              f"{MAX_RUN_LENGTHS_L:g} L/V: it fails" for c in crit if nominal[c.name] is None]
+    own = [f"{c.name}: the manoeuvre does not give it (no 180 deg of turn, no overshoot, no stop) within "
+           f"{MAX_RUN_LENGTHS_L:g} L/V: it fails" for c in crit if nominal[c.name] is None]
+    notes += own
     sampled = without = params = None
     if samples:
-        sampled, without, params = _sampled(p, sh, sc, (samples, cov, seed), executor, notes)
+        sampled, without, params = _sampled(p, sh, sc, (samples, cov, seed), executor, (notes, own))
     notes.append(stopping_note(runs[STOPPING_RUN]))
     pa = p.ship.particulars
     extremes = _extreme_turns(p, params, sampled) if samples else {}
     return ImoResult(ship=sh.name if sc is None else sc.base.name, speed=str(speed), u0=p.u0,
                      L_over_V=p.L_over_V, L=pa.L, B=pa.B, criteria=crit, nominal=nominal, samples=sampled,
-                     parameters=params, notes=tuple(notes), runs=runs, sample_runs=extremes, scaling=scaled,
+                     parameters=params, notes=tuple(notes), doubts=identification_doubts(sh),
+                     own_warnings=tuple(own), runs=runs, sample_runs=extremes, scaling=scaled,
                      samples_without_scaling=without)
 
 
@@ -275,29 +301,31 @@ def _scale_note(sc) -> str:
             f"geometry, mass, propeller, engine and steering (trials.imo.scaling)")
 
 
-def _run(p, names, rows, executor, notes: list) -> dict:
-    """Criterion name -> one value per row of ``rows`` (:func:`trials.imo.sampling.run_samples`); a note on failures."""
+def _run(p, names, rows, executor, notes: tuple) -> dict:
+    """Criterion name -> one value per row of ``rows`` (:func:`trials.imo.sampling.run_samples`); a note on
+    failures appended to each list of ``notes`` (the report's notes, the check's own warnings)."""
     out = S.run_samples(p, names, rows, executor)
     bad = [o["error"] for o in out if o["error"]]
     if bad:
-        notes.append(f"{len(bad)} of {len(out)} samples failed to run (counted as not meeting any criterion), "
+        for n in notes:
+            n.append(f"{len(bad)} of {len(out)} samples failed to run (counted as not meeting any criterion), "
                      f"e.g. {bad[0]}")
     return {c.name: [o["values"][c.name] for o in out] for c in criteria(p.L_over_V)}
 
 
-def _sampled(p, sh: Ship, sc, how: tuple, executor, notes: list):
+def _sampled(p, sh: Ship, sc, how: tuple, executor, notes: tuple):
     """(samples, samples with the scale effects fixed or None, parameters) of :func:`imo`; ``how`` =
-    (number of samples, covariance or None, seed)."""
+    (number of samples, covariance or None, seed); ``notes`` = (the report's notes, the check's own warnings)."""
     from .scaling import EFFECTS, full_scale_draws
 
     n, cov, seed = how
     if sc is None or cov is not None or sh.covariance is not None:
         names, mean, mat, more = S.covariance_of(p.ship if sc is None else sh, cov)
-        notes += more
+        notes[0].extend(more)
         draws = S.draw(mean, mat, n, seed)
     else:
         names, mean, mat, draws = [], np.zeros(0), np.zeros((0, 0)), np.zeros((n, 0))
-        notes.append(f"{sh.name} has no covariance: only the scale-effect corrections are sampled")
+        notes[0].append(f"{sh.name} has no covariance: only the scale-effect corrections are sampled")
     params = {"names": names, "mean": mean, "cov": mat, "draws": draws, "seed": seed}
     if sc is None:
         return _run(p, names, draws, executor, notes), None, params
@@ -312,7 +340,7 @@ def _sampled(p, sh: Ship, sc, how: tuple, executor, notes: list):
     without = None
     if names:
         _, rows0 = full_scale_draws(sc, sh, names, draws, np.zeros_like(xi))
-        without = _run(p, fnames, rows0, executor, [])
+        without = _run(p, fnames, rows0, executor, ())
     return sampled, without, full
 
 
@@ -327,11 +355,25 @@ def stopping_note(run_metrics) -> str:
             f"{m['time_to_stop_s']:.0f} s ({m['time_to_stop_s'] / 60:.1f} min)")
     return (f"{STOPPING}: rudder midships, full astern ordered at t = 0 from the approach revolutions "
             f"{m['approach_rpm']:.1f} rpm: a linear ramp to {o.astern_ratio:g} of them astern "
-            f"({-o.astern_ratio * m['approach_rpm']:.1f} rpm) in {o.ramp_s:g} s (mmg.engine_order.AsternOrder, "
+            f"({-o.astern_ratio * m['approach_rpm']:.1f} rpm) in {_ramp_text(o.ramp_s, run.trial.ship)} "
+            f"(mmg.engine_order.AsternOrder, "
             f"revolutions prescribed: no propeller torque needed; thrust from the four-quadrant B4-70 curve, "
             f"mmg.fourquadrant); stopped = surge speed down to 1 % of the "
             f"approach speed{head}.  Limit 15 L; the Administration may accept up to 20 L for ships of large "
             f"displacement")
+
+
+def _ramp_text(ramp_s: float, ship: Ship) -> str:
+    """The stopping ramp [s] and where it comes from: the full-scale reversal time, Froude-scaled on a model."""
+    from mmg.engine_order import REVERSAL_TIME_S, reversal_time
+
+    lam = ship.froude_scale
+    if not math.isclose(ramp_s, reversal_time(lam), rel_tol=1e-9):
+        return f"{ramp_s:.3g} s"
+    if lam == 1.0:
+        return f"{ramp_s:.3g} s (the full-scale reversal time)"
+    return (f"{ramp_s:.3g} s (the full-scale {REVERSAL_TIME_S:g} s Froude-scaled to this model: "
+            f"{REVERSAL_TIME_S:g} s / sqrt(lambda), lambda = {lam:.4g})")
 
 
 def _extreme_turns(p, params: dict, sampled: dict) -> dict:

@@ -21,13 +21,16 @@ water are left out):
 * the full-astern stopping test (5.3.4): track reach <= 15 L (the Administration may accept up to
   20 L for ships of large displacement; the verdict is against 15 L), the rudder at midships, the
   engine ordered full astern from the approach revolutions (:class:`mmg.engine_order.AsternOrder`:
-  a linear ramp to 0.7 of them astern in 120 s, the revolutions prescribed, the constants' sources
+  a linear ramp to 0.7 of them astern in 120 s at full scale, 120 / sqrt(lambda) s on a model of scale
+  lambda (:func:`mmg.engine_order.reversal_time`), the revolutions prescribed, the constants' sources
   there); the track reach is the distance along the path from the order to the ship stopped dead in
   the water, taken as the surge speed down to 1 % of the approach speed
   (:func:`trials.analysis.metrics.stopping_metrics`, which also gives the head reach and the lateral
   deviation).
 
-A criterion's side is that of the turn, or of a zigzag's first rudder order.
+A criterion's side is that of the turn, or of a zigzag's first rudder order.  The reversal ramp is the
+manoeuvres' one time in seconds: the approach is a steady state, the rudder is ordered at t = 0, the run
+lengths and time steps are in L / V and the steering gear's rate and time constant are the ship config's.
 """
 from __future__ import annotations
 

@@ -84,7 +84,7 @@ __all__ = ["identify", "IdentifyOptions",
            "fit_covariance", "ship_with_values",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description", "identification_covariance", "run_covariance", "fold_spread_json",
-           "COVARIANCE_METHOD", "start_noise", "DEFAULT_INITIAL_STATE",
+           "COVARIANCE_METHOD", "identification_summary", "start_noise", "DEFAULT_INITIAL_STATE",
            "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale", "Y_P_astern")
@@ -846,12 +846,15 @@ def _change_text(pct: float) -> str:
     return "-" if not np.isfinite(pct) else f"{pct:+.0f} %"
 
 
-def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None) -> str:
+def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None,
+              identification: dict | None = None) -> str:
     """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
     ``w_P0`` constant term, ``Y_P_astern``, the rudder's ``epsilon``, ``kappa``, ``gamma_R_pos``,
     ``gamma_R_neg``, ``l_R_prime``, the added masses, a rudder offset and the wind factors) and ``note`` in its header and ``source``; with
     ``covariance`` (:func:`fit_covariance`) its ``covariance:`` section (else none: the initial
-    ship's own section, if any, is about other values and is dropped)."""
+    ship's own section, if any, is about other values and is dropped); with ``identification``
+    (:func:`identification_summary`) its ``identification:`` section and its warnings as header comments
+    (else none, as the covariance)."""
     import yaml
 
     from mmg.parameters import write_yaml_value
@@ -860,12 +863,86 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
     for k, v in values.items():
         write_yaml_value(data, k, v, ship_path)
     data.pop("covariance", None)
+    data.pop("identification", None)
     if covariance is not None:
         data["covariance"] = covariance
+    if identification is not None:
+        data["identification"] = identification
     data["name"] = f"{data['name']} (identified)"
     data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
-    head = "".join(f"# {ln}\n" for ln in note.splitlines())
+    head = "".join(f"# {ln}\n" for ln in note.splitlines() + _warning_lines(identification))
     return head + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+
+
+def _warning_lines(identification: dict | None) -> list[str]:
+    """The header comment lines of an ``identification:`` section: whether the fit converged, then its warnings."""
+    if identification is None:
+        return []
+    from mmg.ship import one_line
+
+    w = identification["warnings"]
+    out = [("every fit stage converged" if identification["converged"] else
+            "NOT CONVERGED: a fit stage stopped at its evaluation limit")
+           + (f"; {len(w)} warning(s) (also in the identification: section):" if w else "; no warnings")]
+    return out + [f"- {one_line(x)}" for x in w]
+
+
+_COMPUTE = object()
+
+
+def identification_summary(ident: Identification, covariance=_COMPUTE) -> dict:
+    """What ``mmg identify`` says of its own fit: the ``identification:`` section of the ship.yaml it writes.
+
+    Parameters
+    ----------
+    ident : Identification
+    covariance : dict or None, optional
+        The ``covariance:`` section written beside it (:func:`identification_covariance` of ``ident`` when
+        omitted; None: none written).
+
+    Returns
+    -------
+    dict
+        ``converged`` (bool: every fit stage converged, scipy status > 0), ``warnings`` (list of str, one
+        sentence each: the fit's own (a value on its bound, a changed sign), each stage stopped at its
+        evaluation limit, each training record the identified model replays worse than the initial one,
+        each failed physical check), ``covariance_method`` (the covariance section's ``method`` when it
+        has one, else how :func:`identification_covariance` made it) and ``training_replays_worse``
+        (those records' names).
+    """
+    if covariance is _COMPUTE:
+        covariance = identification_covariance(ident)
+    fit = ident.fit
+    st = ident.stages or ({"description": stage_description(ident.segment_s), "max_nfev": None,
+                           "evaluations": fit.iterations, "status": fit.status},)
+    warn = [w for w in fit.warnings() if not (fit.status == 0 and w.startswith("the fit stopped at its evaluation"))]
+    for k, x in enumerate(st):                        # every stage's stop (the fit's own says the last one's only)
+        if not x["status"] > 0:
+            lim = "" if x.get("max_nfev") is None else f" ({x['max_nfev']})"
+            warn.append(f"stage {k + 1}/{len(st)} ({x['description'].split(':')[0]}) stopped at its evaluation "
+                        f"limit{lim} after {x['evaluations']} evaluations without converging: mmg identify --max-nfev "
+                        f"raises it")
+    worse = []
+    for a, b in zip(ident.scores(model="initial"), ident.scores()):
+        ha, hb = a["heading_rms_deg"], b["heading_rms_deg"]
+        if np.isfinite(ha) and not hb <= ha:
+            worse.append(a["name"])
+            warn.append(f"training record {a['name']}: the identified model replays it worse than the initial model "
+                        f"(heading RMS {hb:.2f} deg against {ha:.2f} deg)")
+    warn += [f"physical check: {w}" for w in ident.physical_check().warnings()]
+    return {"converged": bool(all(x["status"] > 0 for x in st)), "warnings": warn,
+            "covariance_method": _covariance_method(ident, covariance), "training_replays_worse": worse}
+
+
+def _covariance_method(ident: Identification, covariance: dict | None) -> str:
+    """The ``method`` of a covariance section, else how :func:`identification_covariance` makes it."""
+    if covariance is None:
+        return "none written (the fit's covariance is not finite)"
+    if covariance.get("method"):
+        return str(covariance["method"])
+    return (f"linearised posterior (J_d^T J_d / (s_d^2 tau) + diag(1 / sigma_prior^2))^-1: the prior at its stated "
+            f"std, the data's information divided by the residuals' correlation time tau = "
+            f"{max(float(ident.tau), 1.0):.3g} samples")
 
 
 def _stage_lines(ident: Identification) -> list[str]:
@@ -890,9 +967,9 @@ def _cov_std(cov: dict | None) -> dict:
     return dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"], float))))) if cov else {}
 
 
-def _report_fit(ident: Identification, cov: dict | None) -> list:
+def _report_fit(ident: Identification, cov: dict | None, warn: list) -> list:
     """The report's title, stages, values with standard errors (of ``cov``, the written covariance section),
-    warnings and strong correlations."""
+    warnings (``warn``: :func:`identification_summary`'s) and strong correlations."""
     fit = ident.fit
     lines = [f"# Identification of {ident.initial.name}", ""]
     if ident.prior is not None:
@@ -920,11 +997,11 @@ def _report_fit(ident: Identification, cov: dict | None) -> list:
     if starts:
         lines += ["", f"Each record's start state (u, v, r, heading of its first sample) was fitted as a nuisance "
                       f"({len(starts)} offsets, not listed; prior 0 with twice the record's noise level as std)."]
-    warn = fit.warnings()
     if warn:
         lines += ["", "## Warnings", "",
-                  "The identified values predict the training records (below); these say where they should not "
-                  "be read as the ship's physics:", ""] + [f"- {w}" for w in warn]
+                  "Where the identified values should not be read as the ship's physics, or the fit not as "
+                  "finished (also in ship.yaml's identification: section, which mmg imo reads):", ""] + \
+                 [f"- {w}" for w in warn]
     names = [f.name for f in fit.free]
     lines += ["", "## Correlations (|rho| >= 0.8)", ""]
     strong = [(names[i], names[j], fit.corr[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
@@ -1094,7 +1171,8 @@ def _report_cv(cv: list) -> list:
 
 
 def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
-    """Write ``out_dir/ship.yaml`` and ``out_dir/report.md``; return the paths written.
+    """Write ``out_dir/ship.yaml`` (with :func:`identification_summary` as its ``identification:`` section
+    and header comments) and ``out_dir/report.md``; return the paths written.
 
     ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
     replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given;
@@ -1104,8 +1182,9 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     note = (f"segment-wise output error over {len(ident.runs)} records "
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
     cov, post, _ = identification_covariance(ident, parts=True)
-    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov))
-    lines = _report_fit(ident, cov) + _report_physical(ident.physical_check()) + _report_training(ident)
+    summary = identification_summary(ident, cov)
+    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, summary))
+    lines = _report_fit(ident, cov, summary["warnings"]) + _report_physical(ident.physical_check()) + _report_training(ident)
     if test_runs:
         lines += _report_test(ident, test_runs)
     written = {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}

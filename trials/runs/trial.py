@@ -22,8 +22,9 @@ schedule  table of [time_s, rudder_deg] or [time_s, rudder_deg, rpm] rows, inlin
           file with columns time_s, rudder_deg[, rpm]; linear interpolation
 stopping  full astern from the approach (IMO MSC.137(76) 5.3.4): the rudder held at ``rudder``
           (default midships), the revolutions ordered from the approach ones to ``astern_ratio``
-          times them astern along a ramp of ``reversal`` seconds from ``execute``
-          (:class:`mmg.engine_order.AsternOrder`, its constants and sources); the revolutions are
+          times them astern along a ramp of ``reversal`` seconds from ``execute`` (default
+          120 s at full scale, 120 / sqrt(lambda) s on a model of scale lambda:
+          :func:`mmg.engine_order.reversal_time`) (:class:`mmg.engine_order.AsternOrder`, its constants and sources); the revolutions are
           prescribed whatever the ship's engine (no four-quadrant torque is needed); the run ends
           when the ship is stopped (surge speed down to 1 % of the approach speed)
 """
@@ -39,7 +40,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from mmg.disturbances import RudderOffset, SensorBias, UniformCurrent
-from mmg.engine_order import ASTERN_RPM_RATIO, REVERSAL_TIME_S, AsternOrder
+from mmg.engine_order import ASTERN_RPM_RATIO, AsternOrder, reversal_time
 from mmg.errors import InputError
 from mmg.integrate import CommandLaw
 from mmg.limits import MAX_SAMPLES, check_steps
@@ -123,7 +124,7 @@ class _Stopping(_Strict):
     kind: Literal["stopping"]
     rudder: str = "0 deg"
     astern_ratio: float = ASTERN_RPM_RATIO
-    reversal: str = f"{REVERSAL_TIME_S:g} s"
+    reversal: Optional[str] = None            # the ship's: mmg.engine_order.reversal_time
     execute: str = "0 s"
     _c = field_validator("rudder")(_q("angle"))
     _t = field_validator("reversal", "execute")(_q("time"))
@@ -641,7 +642,8 @@ def _manoeuvre(f: _TrialFile, ship: Ship, label: str, src: str, run: tuple[float
             conv[k] = _si(src, field, v, "time", 0.0, duration, hi_open=True,
                           why=f"the execute time must lie in [0, {duration:g} s), within the run")
         elif k == "reversal":
-            conv[k] = _si(src, field, v, "time", 0.0, 3600.0, why="a reversal from ahead to astern takes 0-60 min")
+            conv[k] = (reversal_time(ship.froude_scale) if v is None else      # a model's: Froude-scaled
+                       _si(src, field, v, "time", 0.0, 3600.0, why="a reversal from ahead to astern takes 0-60 min"))
         elif k == "astern_ratio":
             if not 0.0 < v <= 1.5:
                 raise InputError(src, field, f"{v!r}: the full-astern revolutions are a fraction (0, 1.5] of the "
@@ -1155,7 +1157,7 @@ def schedule(ship: Ship | str | Path, *, table=None, file: str | Path | None = N
 
 
 def stopping(ship: Ship | str | Path, *, speed: str, duration: str, astern_ratio: float = ASTERN_RPM_RATIO,
-             reversal: str = f"{REVERSAL_TIME_S:g} s", rudder: str = "0 deg", execute: str = "0 s", **kw) -> Trial:
+             reversal: str | None = None, rudder: str = "0 deg", execute: str = "0 s", **kw) -> Trial:
     """A full-astern stopping trial (IMO MSC.137(76) 5.3.4): the revolutions ordered astern, the rudder held.
 
     Parameters
@@ -1165,8 +1167,10 @@ def stopping(ship: Ship | str | Path, *, speed: str, duration: str, astern_ratio
         Approach speed (``"10 kn"``) and the longest simulated time (the run ends when the ship is stopped).
     astern_ratio : float, default :data:`mmg.engine_order.ASTERN_RPM_RATIO`
         Full-astern revolutions over the approach ones.
-    reversal : str, default "120 s"
-        Duration of the linear ramp from the approach revolutions to the full-astern ones.
+    reversal : str, optional
+        Duration of the linear ramp from the approach revolutions to the full-astern ones; default
+        :func:`mmg.engine_order.reversal_time` of the ship (120 s at full scale, 120 / sqrt(lambda) s on a
+        model of scale lambda: its config's ``full_scale:`` section).
     rudder : str, default "0 deg"
         Rudder held through the test (midships).
     execute : str, default "0 s"
@@ -1178,8 +1182,9 @@ def stopping(ship: Ship | str | Path, *, speed: str, duration: str, astern_ratio
     -------
     Trial
     """
-    man = {"kind": "stopping", "rudder": rudder, "astern_ratio": float(astern_ratio), "reversal": reversal,
-           "execute": execute}
+    man = {"kind": "stopping", "rudder": rudder, "astern_ratio": float(astern_ratio), "execute": execute}
+    if reversal is not None:
+        man["reversal"] = reversal
     return make_trial(ship, man, speed=speed, duration=duration, **kw)
 
 
