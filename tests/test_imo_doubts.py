@@ -54,7 +54,7 @@ def test_identification_stopped_at_its_limit_writes_its_doubts_into_ship_yaml(tm
              > replay_record(true, r).scores()["heading_rms_deg"]]
     assert worse == ["syn0"] and sec["training_replays_worse"] == worse
     assert any(w.startswith("training record syn0:") for w in sec["warnings"])
-    assert "tau" in sec["covariance_method"]                        # no method key yet: how it was made
+    assert sec["covariance_method"] == yaml.safe_load(text)["covariance"]["method"] == "posterior"   # one run: no jackknife
     head = [ln for ln in text.splitlines() if ln.startswith("#")]
     for w in sec["warnings"]:
         assert f"# - {w}" in head
