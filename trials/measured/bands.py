@@ -252,8 +252,9 @@ def _unwrapped_deg(psi: np.ndarray, first: float) -> np.ndarray:
 def _quantile_bounds(x: np.ndarray, q=QUANTILES) -> tuple[np.ndarray, np.ndarray]:
     """Per column of ``x`` (draws, N): the ``q`` quantiles with a NaN (a diverged draw) as -inf for the
     lower and +inf for the upper one."""
-    lo = np.quantile(np.where(np.isnan(x), -np.inf, x), q[0], axis=0)
-    hi = np.quantile(np.where(np.isnan(x), np.inf, x), q[1], axis=0)
+    with np.errstate(invalid="ignore"):
+        lo = np.quantile(np.where(np.isnan(x), -np.inf, x), q[0], axis=0)
+        hi = np.quantile(np.where(np.isnan(x), np.inf, x), q[1], axis=0)
     return np.where(np.isnan(lo), -np.inf, lo), np.where(np.isnan(hi), np.inf, hi)   # inf - inf in the interpolation
 
 

@@ -840,7 +840,8 @@ def _nuisance_groups(ident: Identification) -> dict:
             name = f"{effects[f.index].name}.{q.name[:-4] + '_rad' if deg and q.name.endswith('_deg') else q.name}"
             unit, k = ("rad", np.pi / 180.0) if deg else (q.unit, 1.0)
         out.setdefault(name, (unit, k, []))[2].append(float(v))
-    return out
+    order = {f"start.{x}": i for i, x in enumerate(STATE)}          # the start offsets in state order, first
+    return dict(sorted(out.items(), key=lambda kv: order.get(kv[0], len(order))))
 
 
 def run_spread(ident: Identification) -> dict | None:
