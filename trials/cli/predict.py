@@ -92,10 +92,13 @@ def _with_bands(doc: dict, bands, args) -> dict:
 
 def _print_bands(bands) -> None:
     """One console line per run's bands, then what was not drawn."""
+    import numpy as np
+
+    num = lambda x, unit: f"{x:.3g} {unit}" if np.isfinite(x) else "unbounded (diverged draws)"   # noqa: E731
     for b in bands or ():
         print(f"{b.nominal.run.name}: 90 % band from {b.draws} draws ({b.diverged} diverged): heading coverage "
-              f"{100 * b.coverage90:.0f} % of samples, median width {b.median_width_deg:.3g} deg; position coverage "
-              f"{100 * b.position_coverage90:.0f} %, median radius {b.median_radius_m:.3g} m")
+              f"{100 * b.coverage90:.0f} % of samples, median width {num(b.median_width_deg, 'deg')}; position "
+              f"coverage {100 * b.position_coverage90:.0f} %, median radius {num(b.median_radius_m, 'm')}")
     for n in sorted({n for b in bands or () for n in b.notes}):
         print(f"note: {n}")
 

@@ -108,10 +108,12 @@ class Bands:
 
     @property
     def position_coverage90(self) -> float:
-        """The share of the record's samples whose logged position lies within ``radius`` of the median track."""
+        """The share of the record's samples whose logged position lies within ``radius`` of the median track
+        (inside where the band is unbounded)."""
         m = self.nominal.run.meas
         with np.errstate(invalid="ignore"):
-            return float(np.mean(np.hypot(m[:, 3] - self.x_median, m[:, 4] - self.y_median) <= self.radius))
+            inside = np.hypot(m[:, 3] - self.x_median, m[:, 4] - self.y_median) <= self.radius
+        return float(np.mean(inside | (self.radius == np.inf)))        # unbounded: every draw diverged there too
 
     @property
     def median_width_deg(self) -> float:
@@ -264,7 +266,8 @@ def _position_band(xy: np.ndarray):
         warnings.simplefilter("ignore", RuntimeWarning)        # a sample where every draw diverged: NaN
         xm, ym = np.nanmedian(xy[:, :, 0], axis=0), np.nanmedian(xy[:, :, 1], axis=0)
     d = np.hypot(xy[:, :, 0] - xm, xy[:, :, 1] - ym)
-    r = np.quantile(np.where(np.isnan(d), np.inf, d), POSITION_QUANTILE, axis=0)
+    with np.errstate(invalid="ignore"):
+        r = np.quantile(np.where(np.isnan(d), np.inf, d), POSITION_QUANTILE, axis=0)
     return xm, ym, np.where(np.isnan(r), np.inf, r)
 
 

@@ -94,7 +94,7 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
     else:                        # ... or below it, under the axis label
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=8, frameon=False)
     rows = [("heading (deg)", np.degrees(m[:, 5]), np.degrees(p[:, 5])) if bands is None else
-            ("heading, unwrapped (deg)", bands.heading_deg, bands.nominal_deg),
+            ("heading (deg)\nunwrapped", bands.heading_deg, bands.nominal_deg),
             ("yaw rate (deg/s)", np.degrees(m[:, 2]), np.degrees(p[:, 2])),
             ("speed (m/s)", np.hypot(m[:, 0], m[:, 1]), np.hypot(p[:, 0], p[:, 1])),
             ("sway v (m/s)", m[:, 1], p[:, 1])]
@@ -102,10 +102,7 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
     for k, (lab, a, b) in enumerate(rows):
         a_ = fig.add_subplot(cell(k), sharex=axs[0] if axs else None)
         if k == 0 and bands is not None:
-            a_.fill_between(t, np.where(np.isfinite(bands.lo), bands.lo, np.nan),
-                            np.where(np.isfinite(bands.hi), bands.hi, np.nan), color="tab:blue", alpha=0.25, lw=0,
-                            label=f"90 % band, {bands.draws} draws ({bands.diverged} diverged); "
-                                  f"record inside {100 * bands.coverage90:.0f} % of samples")
+            _heading_band(a_, t, bands)
         a_.plot(t, a, "k-", lw=1, label="measured")
         a_.plot(t, b, "r--", lw=1, label="predicted" if bands is None else "predicted, nominal ship and start")
         if t_div is not None:
@@ -114,7 +111,12 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
         a_.set_ylabel(lab)
         a_.grid(True, alpha=0.3)
         axs.append(a_)
-    axs[0].legend(loc="best", fontsize=8)
+    if bands is not None:        # room above the data for the legend
+        lo, hi = axs[0].get_ylim()
+        axs[0].set_ylim(lo, hi + 0.7 * (hi - lo))
+        axs[0].legend(loc="upper left", fontsize=7, ncol=2)
+    else:
+        axs[0].legend(loc="best", fontsize=8)
     axs[0].set_title(f"{title}: time histories{div}")
     a_ = fig.add_subplot(cell(4), sharex=axs[0])
     a_.plot(t, np.degrees(run.inputs.delta), "b-", lw=1, label="rudder (deg)")
@@ -143,3 +145,15 @@ def _track_bands(ax, view, bands, L: float, t, every: float) -> None:
             ax.plot(*view.hv((xm + r * np.cos(ang)) / L, (ym + r * np.sin(ang)) / L), "-", color="tab:purple",
                     lw=0.9, label="90 % position band about the median track" if first else None)
             first = False
+
+
+def _heading_band(ax, t, bands) -> None:
+    """The shaded 90 % heading band, and where diverged draws leave it unbounded, hatched over the panel's height."""
+    ok = np.isfinite(bands.lo) & np.isfinite(bands.hi)
+    ax.fill_between(t, np.where(ok, bands.lo, np.nan), np.where(ok, bands.hi, np.nan), color="tab:blue", alpha=0.25,
+                    lw=0, label=f"90 % band, {bands.draws} draws ({bands.diverged} diverged); "
+                                f"record inside {100 * bands.coverage90:.0f} % of samples")
+    if not ok.all():
+        ax.fill_between(t, 0, 1, where=~ok, transform=ax.get_xaxis_transform(), facecolor="none",
+                        edgecolor="tab:blue", hatch="//", lw=0, alpha=0.5,
+                        label="band unbounded there (over 5 % of the draws diverged)")
