@@ -127,6 +127,7 @@ def test_coverage_counted_by_hand():
     assert b.coverage90 == pytest.approx(3 / 5)
     assert b.position_coverage90 == pytest.approx(3 / 5)         # |(3,4)| = 5 <= 5 in; 1 > 0.5 out; 2 > 1 out
     assert b.median_width_deg == pytest.approx(2.0)               # widths 1, 1, 2, inf, 2: sorted, the third
+    assert b.unbounded_share == pytest.approx(1 / 5)
     assert b.to_json()["heading_band_median_width_deg"] == pytest.approx(2.0)
 
 
@@ -214,7 +215,8 @@ def test_cli_predict_samples_json_keys_and_plots(tmp_path, capsys):
     assert doc["bands"] == {"samples": 20, "seed": 3, "notes": []}
     run = doc["runs"][0]
     assert list(run)[-len(BAND_KEYS):] == ["draws", "diverged_draws", "heading_band_deg", "coverage90",
-                                           "heading_band_median_width_deg", "position_band_m", "position_coverage90",
+                                           "heading_band_median_width_deg", "heading_band_unbounded_share",
+                                           "position_band_m", "position_coverage90",
                                            "position_band_median_radius_m"]
     assert list(run["heading_band_deg"]) == ["t_s", "lo", "hi"]
     assert list(run["position_band_m"]) == ["t_s", "x_median", "y_median", "radius"]
