@@ -240,7 +240,8 @@ def _ship_draws(ship: Ship, covariance, samples: int, seed: int, notes: list):
 
 
 def _one_replay(ship: Ship, run: MeasuredRun, names, row, mean, sp_names, sp_row, notes: set) -> np.ndarray:
-    """The predicted states (N, 6) of one draw: the ship's parameters ``row`` (``names``), the run spread's ``sp_row``."""
+    """The predicted x, y [m] and heading [rad] (N, 3) of one draw: the ship's parameters ``row`` (``names``), the
+    run spread's ``sp_row``."""
     from .identify import ship_with_values, with_fitted_wind, with_ship_effects
 
     values = {n: float(v) for n, v in zip(names, row)}
@@ -249,7 +250,7 @@ def _one_replay(ship: Ship, run: MeasuredRun, names, row, mean, sp_names, sp_row
     r = with_fitted_wind(run, wind) if wind else run
     r = with_ship_effects(r, s) if "rudder_offset" in values else r
     r = _disturbed(r, sp_names, sp_row, notes) if len(sp_names) else r
-    return replay_record(s, r).pred
+    return replay_record(s, r).pred[:, 3:6]
 
 
 def _unwrapped_deg(psi: np.ndarray, first: float) -> np.ndarray:
@@ -324,12 +325,12 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
         preds = list(pool.map(lambda k: _one_replay(ship, run, names, rows[k], mean, sp_names, sp_rows[k], seen),
                               range(samples)))
-    P = np.stack(preds)                                              # (draws, N, 6)
+    P = np.stack(preds)                                              # (draws, N, 3): x, y, psi
     nominal = replay_record(ship, run)
     first = float(np.unwrap(run.meas[:, 5])[0])
-    lo, hi = _quantile_bounds(_unwrapped_deg(P[:, :, 5], first))
-    xm, ym, radius = _position_band(P[:, :, 3:5])
+    lo, hi = _quantile_bounds(_unwrapped_deg(P[:, :, 2], first))
+    xm, ym, radius = _position_band(P[:, :, :2])
     return Bands(nominal=nominal, t=np.asarray(run.t, float), heading_deg=np.degrees(np.unwrap(run.meas[:, 5])),
                  lo=lo, hi=hi, nominal_deg=_unwrapped_deg(nominal.pred[:, 5], first), x_median=xm, y_median=ym,
-                 radius=radius, tracks=P[:SAMPLE_TRACKS, :, 3:5].copy(), draws=samples,
+                 radius=radius, tracks=P[:SAMPLE_TRACKS, :, :2].copy(), draws=samples,
                  diverged=int(np.sum(~np.isfinite(P).all(axis=(1, 2)))), notes=tuple(notes + sorted(seen)))
