@@ -49,7 +49,8 @@ def priors(form: str, names, width: float) -> dict:
     from trials.measured.nested import hull_candidates
 
     ship = hull_candidates(SHIP, (form,))[form].ship
-    return {p.name: (p.prior, p.sigma) for p in free_parameters(pack(ship), ship.hull.names, list(names), width)}
+    return {p.name: (p.prior, p.sigma) for p in free_parameters(pack(ship), ship.hull.names, list(names), width,
+                                                                     hull_terms=ship.hull.terms)}
 
 
 def table(nested: dict, width: float = 0.5, covariance=None) -> tuple[list[str], dict]:

@@ -13,10 +13,12 @@ criterion's 90 % interval holds the true value.
 
 Variants (the same seeds and draws' seed; no factor is tuned on them):
 
-* ``written``: what ``mmg identify`` writes into ship.yaml since each record's start state is fitted
-  as a nuisance (:func:`trials.measured.identify.identification_covariance`: the linearised posterior
-  with the prior at its stated std and the data's information divided by the fit's residuals'
-  correlation time tau);
+* ``written``: what ``mmg identify`` writes into ship.yaml
+  (:func:`trials.measured.identify.identification_covariance`: the linearised posterior with the prior
+  at its stated std and the data's information divided by the fit's residuals' correlation time tau,
+  plus the delete-one-run jackknife over the records);
+* ``run-jackknife``: the run-to-run part alone (:func:`trials.measured.identify.run_covariance`; with a
+  seed's four records a rank-3 matrix: it leaves most directions to the prior);
 * ``gauss-newton``: the fit's own Gauss-Newton covariance (:func:`~trials.measured.identify.fit_covariance`:
   what ``mmg identify`` wrote before);
 * ``tau``: that covariance times the residuals' integrated autocorrelation time tau (samples, the mean
@@ -30,7 +32,8 @@ Variants (the same seeds and draws' seed; no factor is tuned on them):
   data part (J^T J - diag(1 / sigma_prior^2), reconstructed from the written covariance, s^2 and the
   priors) scaled by the data rows' own residual variance, plus the prior's information unscaled:
   cov = (J_d^T J_d / s_d^2 + diag(1 / sigma_prior^2))^-1;
-* ``prior-stated-tau``: the same with the data part's variance times tau;
+* ``prior-stated-tau``: the same with the data part's variance times tau (the written covariance's
+  posterior part alone);
 * ``per-channel`` (added after seeds 0-39 showed the u, v, r residuals white, tau ~ 1, and the heading's
   correlated over the whole record, tau ~ 75 samples: the channel mean understates the heading's; judged
   on fresh seeds only): the posterior with each record's channel weighted by its own residual variance and
@@ -67,7 +70,10 @@ NOISE = (0.02 / math.sqrt(LAMBDA), 0.02 / math.sqrt(LAMBDA), 0.0002 * math.sqrt(
 RECORDS = (("turning", 35.0, 60.0), ("turning", -35.0, 60.0), ("zigzag", 20.0, 70.0), ("zigzag", -10.0, 70.0))
 """(kind, rudder [deg], duration [s]) of each seed's records: short (60-70 s, about 110-130 sqrt(L/g))."""
 PERTURB = 0.15
-VARIANTS = ("written", "gauss-newton", "tau", "prior-stated", "prior-stated-tau", "per-channel")
+VARIANTS = ("written", "gauss-newton", "tau", "prior-stated", "prior-stated-tau", "per-channel", "run-jackknife")
+TRUTH = SHIP
+"""``--truth``: the ship config the true ship is drawn around (``esso_osaka_3m_crossflow``: a model-form
+mismatch, records of the cross-flow hull identified in the Kijima form)."""
 
 
 def silent(*_a, **_k):
@@ -213,7 +219,7 @@ def one_seed(seed: int, samples: int) -> dict:
 
     t0 = time.perf_counter()
     prior = mmg.load_ship(SHIP)
-    truth = true_ship(prior, seed)
+    truth = true_ship(mmg.load_ship(TRUTH), seed)
     runs = records(prior, truth, seed)
     ident = identify(prior, runs, say=silent, initial_state=INITIAL_STATE)
     t_fit = time.perf_counter() - t0
@@ -229,7 +235,11 @@ def one_seed(seed: int, samples: int) -> dict:
         return out
     covs = covariances(ident.fit, tau)
     covs["per-channel"] = per_channel_covariance(ident)
-    covs["written"] = np.asarray(identification_covariance(ident)["matrix"], float)
+    written, post, runs_cov = identification_covariance(ident, parts=True)
+    covs["written"] = np.asarray(written["matrix"], float)
+    shared = [i for i, f in enumerate(ident.fit.free) if f.record is None]
+    covs["run-jackknife"] = (_psd(runs_cov[np.ix_(shared, shared)]) if runs_cov is not None
+                             else np.full_like(covs["written"], np.nan))
     out["s2"], out["sd2"] = covs["s2"], covs["sd2"]
     for v in VARIANTS:
         c = {**cov, "matrix": covs[v]}
@@ -266,9 +276,13 @@ def main(argv=None) -> int:
                     help="each record's first sample without its noise (an oracle experiment on the cause)")
     ap.add_argument("--initial-state", default="fit", choices=("fit", "sample"),
                     help="identify's initial_state: each record's start state fitted (default) or its raw first sample")
+    ap.add_argument("--truth", default=SHIP, help="ship config the true ships are drawn around (default the prior's; "
+                                                  "esso_osaka_3m_crossflow: a model-form mismatch)")
+    ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=VARIANTS,
+                    help="the covariances to count (each costs one sampled IMO run per seed)")
     a = ap.parse_args(argv)
-    global EXACT_START, INITIAL_STATE
-    EXACT_START, INITIAL_STATE = a.exact_start, a.initial_state
+    global EXACT_START, INITIAL_STATE, TRUTH, VARIANTS
+    EXACT_START, INITIAL_STATE, TRUTH, VARIANTS = a.exact_start, a.initial_state, a.truth, tuple(a.variants)
     results = []
     t0 = time.perf_counter()
     for s in range(a.seed0, a.seed0 + a.seeds):

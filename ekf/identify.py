@@ -43,64 +43,22 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mmg.model import (P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_RUDDER_OFFSET, P_YP_ASTERN, POLY_WP0,
-                       PackedShip)
+from mmg.model import POLY_WP0, PackedShip
+from mmg.parameters import CONSTANTS, DIAGNOSIS_PRIOR_REL_STD, PRIOR_REL_STD, WIND_COLUMNS, parameter
 from mmg.replay import ReplayInputs, replay_states
 
 __all__ = ["Segmented", "Scales", "FreeParameter", "IdentifyResult", "free_parameters", "apply_parameters",
            "segment_resets", "identify_segments", "FitOptions", "SHIP_CONSTANTS", "record_weights",
-           "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled", "WIND_FACTORS",
+           "record_residual_rms", "RECORD_WEIGHTINGS", "effect_parameters", "effect_prior", "wind_scaled",
            "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "logged_residual", "record_effect_parameters", "effect_set_of",
            "predict_logged", "start_parameters", "record_residuals", "model_states", "StraightRun",
-           "straight_run_residual", "STRAIGHT_RUN_DRIFT_SD", "FAILED_RESIDUAL"]
+           "straight_run_residual", "STRAIGHT_RUN_DRIFT_SD", "FAILED_RESIDUAL", "run_jackknife_covariance"]
 
-RUDDER_CONSTANTS = {"gamma_R_pos": (P_GPOS, 0.0, 1.5), "gamma_R_neg": (P_GNEG, 0.0, 1.5),
-                    "l_R_prime": (P_LR, -2.0, 0.0)}
-"""Rudder constants (:class:`mmg.ship.Rudder` fields) :func:`free_parameters` can free: their index in
-the packed parameters and bounds (the flow-straightening coefficients gamma_R of the rudder's
-inflow angle, positive and negative beta_R, and the effective lever l_R' of the yaw rate in it)."""
-MASS_CONSTANTS = {"m_x": P_MX, "m_y": P_MY, "J_z": P_JZ}
-"""Added masses [kg] and added moment of inertia [kg m^2] :func:`free_parameters` can free (the
-config's primed ``m_x_prime``, ``m_y_prime``, ``J_z_prime`` times the mass / inertia scale)."""
-WIND_FACTORS = {"wind_sway_factor": ("sway_factor", 1), "wind_yaw_factor": ("yaw_factor", 2)}
-"""``mmg identify --free`` names of the wind effect's shape factors (:class:`mmg.effects.Wind`): the
-effect's parameter and the column of the records' external loads (X, Y, N) it multiplies, beside
-``wind_scale`` on all three.  Priors and bounds are the effect's (1, std
-:data:`mmg.effects.wind.SHAPE_SIGMA`, 0.2-3): a ship's wind loads are not the published regression's."""
-SHIP_CONSTANTS = (("w_P0", "epsilon", "kappa", "wind_scale", *WIND_FACTORS, "rudder_offset", "Y_P_astern")
-                  + tuple(RUDDER_CONSTANTS) + tuple(MASS_CONSTANTS))
-"""Ship constants besides the hull coefficients that :func:`free_parameters` can free (``"wind_scale"``
+SHIP_CONSTANTS = tuple(CONSTANTS)
+"""Ship constants besides the hull coefficients that :func:`free_parameters` can free: the names of the
+parameter table's constants (:data:`mmg.parameters.CONSTANTS`; ``"wind_scale"``, the wind's shape factors
 and ``"rudder_offset"`` are the ``wind`` and ``rudder_offset`` effects' parameters under their
 ``mmg identify --free`` names: their priors and bounds are the effects' own, :func:`effect_prior`)."""
-
-Y_P_ASTERN_PRIOR = (0.03, -0.3, 0.3)
-"""Prior std and bounds of the propeller's lateral force astern, Y_P / (rho n^2 D^4) (:func:`mmg.model.propeller_lateral`),
-absolute, about the config's value (0 unless given): a few per cent of the bollard thrust
-(K_T(0) about 0.3) is what single screws show; the bounds are the config's."""
-
-PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
-"""Prior std of a freed ship coefficient relative to its config value, per family: the one table of
-the ship coefficients' prior widths (identification's: the value is known to a factor of about 2
-either way).  Floors: 0.01 for a hull coefficient, 0.05 for a rudder constant; ``w_P0``: 0.15
-absolute.  Effect parameters carry their own prior (:class:`mmg.effects.Parameter`)."""
-
-DIAGNOSIS_PRIOR_REL_STD = {**PRIOR_REL_STD, "mass": 0.2, "hull": 0.15, "hull_nonlinear": 0.30, "resistance": 0.10,
-                           "w_P0": 0.20, "epsilon": 0.10, "hull_floor": 0.002, "rudder": 0.15}
-"""The diagnosis's policy (:func:`trials.measured.diagnose.diagnose`), beside :data:`PRIOR_REL_STD` in
-the one table of prior widths: what is known of a config's source, not identification's factor of
-2.  Linear sway/yaw derivatives (``hull``: the terms in beta, r, v) from captive tests or
-Kijima-type regressions are good to 10-15 %, their nonlinear terms (``hull_nonlinear``: r|r|) to
-about 30 %, the resistance (``resistance``: cos(beta)^2, u^2) to 10 %, the wake fraction w_P0
-(``w_P0``, relative here) to 20 %; the rudder's inflow ratio epsilon = (1 - w_R) / (1 - w_P) to 10 %
-(``epsilon``: the rudder normal force goes as epsilon^2, so its force to about 20 %, the spread of
-the rudder-wake regressions and of the rudder lift slope a config takes from Fujii's formula);
-``hull_floor`` is the smallest std of a primed hull coefficient.  The rudder's flow-straightening
-coefficients gamma_R (``rudder``, freed on zigzags) to 15 %, the spread of a ship's rudder constants
-about a config's (the floor of 0.05 of :func:`free_parameters` holds for small ones).
-The added masses at 20 %: the diagnosis frees them with every candidate effect, and an added mass
-a few % off leaves a residual (surge speed loss in the turn, sway and yaw lag) an effect would
-otherwise take; a wider prior would let them take an effect's residual instead.  Which term is in
-which family: :func:`trials.measured.diagnose._baseline_prior`."""
 
 
 @dataclass(frozen=True)
@@ -223,54 +181,34 @@ def effect_prior(effect, name: str, nm: str | None = None, kind: str = "effect",
 
 
 def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float | None = None,
-                    priors: dict | None = None) -> list[FreeParameter]:
-    """The :class:`FreeParameter` list for ``names`` (hull coefficient names or :data:`SHIP_CONSTANTS`).
+                    priors: dict | None = None, hull_terms=()) -> list[FreeParameter]:
+    """The :class:`FreeParameter` list for ``names`` (hull coefficient names or :data:`SHIP_CONSTANTS`), from
+    the parameter table (:mod:`mmg.parameters`).
 
     The prior std of a ship coefficient is its family's relative std (``priors``, default
-    :data:`PRIOR_REL_STD`) times its config value, with the table's floors; ``prior_rel_std``, when
-    given, is one relative std for every family instead.  ``"rudder_offset"`` and ``"wind_scale"``
-    take the effects' priors (:func:`effect_prior`)."""
+    :data:`PRIOR_REL_STD`) times its config value, with the entry's floor; ``prior_rel_std``, when
+    given, is one relative std for every family instead.  Effect parameters (``"rudder_offset"``,
+    ``"wind_scale"`` and the wind's shape factors) take the effects' priors (:func:`effect_prior`).
+    ``hull_terms`` (the hull model's term of each name) marks the straight-ahead resistance, bounded to
+    stay negative; without them a coefficient named ``X_uu`` is taken as it."""
     import mmg.effects as E
 
     rel = dict(priors or PRIOR_REL_STD)
     if prior_rel_std is not None:
         rel = {k: float(prior_rel_std) for k in rel}
+    terms = list(hull_terms) or ["cos(beta)^2" if n == "X_uu" else "" for n in hull_names]
     out = []
     for nm in names:
-        if nm in hull_names:
-            i = list(hull_names).index(nm)
-            v = float(packed.hull_coef[i])
-            lo, hi = (-np.inf, 0.0) if nm == "X_uu" else (-np.inf, np.inf)      # resistance stays a resistance
-            out.append(FreeParameter(nm, "hull", i, v, max(rel["hull"] * abs(v), 0.01), lo, hi))
-        elif nm == "w_P0":
-            v = float(packed.poly[POLY_WP0][0])
-            out.append(FreeParameter(nm, "w_P0", 0, v, 0.15, 0.0, 0.8))           # a wake fraction
-        elif nm == "epsilon":
-            v = float(packed.p[P_EPS])
-            out.append(FreeParameter(nm, "epsilon", P_EPS, v, rel["epsilon"] * v, 0.3, 3.0))
-        elif nm == "kappa":                              # a share of the slipstream's speed-up: [0, 1]
-            v = float(packed.p[P_KAPPA])
-            out.append(FreeParameter(nm, "kappa", P_KAPPA, v, rel["kappa"] * v, 0.0, 1.0))
-        elif nm in RUDDER_CONSTANTS:
-            i, lo, hi = RUDDER_CONSTANTS[nm]
-            v = float(packed.p[i])
-            out.append(FreeParameter(nm, "rudder", i, v, max(rel["rudder"] * abs(v), 0.05), lo, hi))
-        elif nm == "rudder_offset":      # the rudder_offset effect's offset [rad], prior at the config's
-            out.append(effect_prior(E.RudderOffset, "offset_deg", nm, "rudder", P_RUDDER_OFFSET, np.pi / 180.0,
-                                    float(packed.p[P_RUDDER_OFFSET])))
-        elif nm == "Y_P_astern":
-            sd, lo, hi = Y_P_ASTERN_PRIOR
-            out.append(FreeParameter(nm, "propeller", P_YP_ASTERN, float(packed.p[P_YP_ASTERN]), sd, lo, hi))
-        elif nm in MASS_CONSTANTS:
-            v = float(packed.p[MASS_CONSTANTS[nm]])
-            out.append(FreeParameter(nm, "mass", MASS_CONSTANTS[nm], v, rel["mass"] * v, 0.0, 3.0 * v))
-        elif nm == "wind_scale":         # the wind effect's scale on the records' external (wind) loads
-            out.append(replace(effect_prior(E.Wind, "scale", nm, "wind_scale"), sub=0))
-        elif nm in WIND_FACTORS:         # its shape factors on the sway force / yaw moment (sub: the column)
-            par, col = WIND_FACTORS[nm]
-            out.append(replace(effect_prior(E.Wind, par, nm, "wind_scale"), sub=col))
-        else:
-            raise KeyError(f"unknown parameter {nm!r}: not a hull coefficient of the ship nor one of {SHIP_CONSTANTS}")
+        spec = parameter(nm, hull_names, terms)
+        v = spec.config_value(packed)
+        if spec.effect is not None:
+            wind = spec.kind == "wind_scale"          # a factor on the records' loads (sub: their column)
+            f = effect_prior(E.get(spec.effect.effect), spec.effect.parameter, nm, spec.kind, 0 if wind else spec.slot,
+                             spec.effect.factor, None if wind else v)
+            out.append(replace(f, sub=spec.slot) if wind else f)
+            continue
+        lo, hi = spec.bounds(v)
+        out.append(FreeParameter(nm, spec.kind, spec.slot, v, spec.prior_std(v, rel), lo, hi))
     return out
 
 
@@ -492,6 +430,12 @@ class IdentifyResult:
     solution, unscaled; None where not computed."""
     ss_data: float | None = None
     """Sum of squares of the data rows' residuals at the solution (twice the cost without the prior's part)."""
+    record_scores: np.ndarray | None = None
+    """(n_records, n) each record's score J_k^T r_k at the solution: its data rows (its block and its
+    straight-run row) alone, in the fit's weighted units; None where not computed."""
+    record_info: np.ndarray | None = None
+    """(n_records, n, n) each record's J_k^T J_k at the solution, as :attr:`record_scores`; their sum is
+    :attr:`info_data`."""
 
     def warnings(self) -> list[str]:
         """What a reader of the values should not miss, one sentence each: a parameter on one of its
@@ -642,6 +586,12 @@ class _SegmentFit:
         self.longest_first = sorted(range(n), key=lambda k: -len(records[k].meas))   # the pool's order (see resid)
         self.count = 0
 
+    def record_rows(self) -> list[np.ndarray]:
+        """Each record's data rows in the residual vector: its block, then its straight-run row if any."""
+        s, end = self.start, self.start[-1]
+        return [np.r_[np.arange(s[k], s[k + 1]), [end + self.straight.index(k)] if k in self.straight else []]
+                .astype(int) for k in range(len(self.records))]
+
     def block(self, theta, k, pk=None, rec=None):
         """Record k's weighted residuals (of ``rec``, a part of it such as its first segment, when given)."""
         o = self.opts
@@ -710,8 +660,9 @@ class _SegmentFit:
         return np.column_stack([cols[j] for j in range(n)])
 
 
-def _result(free, sol, cost_initial: float) -> IdentifyResult:
-    """The fit with its Gauss-Newton covariance scaled by the residual variance per degree of freedom."""
+def _result(free, sol, cost_initial: float, record_rows=None) -> IdentifyResult:
+    """The fit with its Gauss-Newton covariance scaled by the residual variance per degree of freedom;
+    with ``record_rows`` (one index array per record: its data rows) each record's score and information."""
     J = sol.jac
     n = len(free)
     dof = max(len(sol.fun) - n, 1)
@@ -724,10 +675,63 @@ def _result(free, sol, cost_initial: float) -> IdentifyResult:
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(std, std)
     Jd, fd = np.asarray(J)[:-n], sol.fun[:-n]                # the prior's rows are the last n
+    scores = info = None
+    if record_rows is not None:
+        scores = np.array([Jd[i].T @ fd[i] for i in record_rows]).reshape(len(record_rows), n)
+        info = np.array([Jd[i].T @ Jd[i] for i in record_rows]).reshape(len(record_rows), n, n)
     return IdentifyResult(free=free, theta=sol.x, std=std, corr=corr, cost_initial=cost_initial,
                           cost_final=float(sol.cost), n_residuals=len(sol.fun), iterations=int(sol.nfev),
                           message=str(sol.message), status=int(sol.status), info_data=Jd.T @ Jd,
-                          ss_data=float(fd @ fd))
+                          ss_data=float(fd @ fd), record_scores=scores, record_info=info)
+
+
+def run_jackknife_covariance(result: IdentifyResult, groups) -> np.ndarray:
+    """Delete-one-group jackknife covariance of a fit's parameters over its independent records.
+
+    For each group g of records (a run and its cut copies: one group), the fit without it is taken
+    one Gauss-Newton step from the solution: ``delta_g = (H - H_g)^-1 s_g``, H the fit's information
+    (data rows' J^T J plus the prior's diag(1 / sigma^2)), H_g and s_g the group's own J^T J and
+    score J^T r (:attr:`IdentifyResult.record_info`, :attr:`IdentifyResult.record_scores`).  The
+    covariance is ``(G - 1) / G * sum_g (delta_g - mean)(delta_g - mean)^T``: how far the estimate
+    moves from one group of records to the next, whatever the residuals' correlation within a record
+    or a model form the records share.  The prior does not move with the records, so a parameter the
+    records do not inform gets none of its variance here.
+
+    Parameters
+    ----------
+    result : IdentifyResult
+        A fit made by :func:`identify_segments` (its per-record scores and information).
+    groups : sequence of int
+        Each record's group label, in the fit's record order.
+
+    Returns
+    -------
+    ndarray
+        (n, n) over every free parameter (a record's own ones included).
+
+    Raises
+    ------
+    ValueError
+        Without per-record scores, a label per record, or with fewer than two groups.
+    """
+    if result.record_scores is None or result.record_info is None:
+        raise ValueError("run jackknife: the fit carries no per-record scores (made by identify_segments?)")
+    groups = np.asarray(groups)
+    if len(groups) != len(result.record_scores):
+        raise ValueError(f"run jackknife: {len(groups)} group labels for {len(result.record_scores)} records")
+    labels = list(dict.fromkeys(groups.tolist()))
+    if len(labels) < 2:
+        raise ValueError(f"run jackknife: needs two or more independent groups of records, got {len(labels)}")
+    sig = np.array([f.sigma for f in result.free], float)
+    H = result.record_info.sum(axis=0) + np.diag(1.0 / sig ** 2)
+    deltas = []
+    for g in labels:
+        m = groups == g
+        deltas.append(np.linalg.solve(H - result.record_info[m].sum(axis=0), result.record_scores[m].sum(axis=0)))
+    d = np.array(deltas)
+    d -= d.mean(axis=0)
+    G = len(labels)
+    return (G - 1) / G * d.T @ d
 
 
 def identify_segments(packed: PackedShip, records: list[Segmented], free: list[FreeParameter], scales: Scales,
@@ -764,4 +768,4 @@ def identify_segments(packed: PackedShip, records: list[Segmented], free: list[F
                             max_nfev=o.max_nfev, bounds=(lo, hi), loss=o.loss, f_scale=o.f_scale)
     finally:
         pool.shutdown()
-    return _result(free, sol, 0.5 * float(r_init @ r_init))
+    return _result(free, sol, 0.5 * float(r_init @ r_init), fit.record_rows())

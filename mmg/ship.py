@@ -230,6 +230,8 @@ class ParameterCovariance:
         The covariance, in the products of ``units``; symmetric, positive semi-definite.
     source : str
         How it was obtained.
+    method : str
+        The method's short name (e.g. ``"posterior+run-jackknife"``); empty where the file gives none.
     """
 
     names: tuple
@@ -237,6 +239,7 @@ class ParameterCovariance:
     values: tuple
     matrix: tuple
     source: str = ""
+    method: str = ""
 
     def std(self) -> tuple:
         """Standard deviation of each parameter (the square roots of the diagonal), in ``units``."""
@@ -457,6 +460,7 @@ class _Covariance(_Strict):
     values: list[float]
     matrix: list[list[float]]
     source: str = ""
+    method: str = ""
 
 
 class _RunSpread(_Strict):
@@ -783,7 +787,7 @@ def _covariance(f: _ShipFile, src: str) -> ParameterCovariance | None:
     if float(np.linalg.eigvalsh(np.asarray(c.matrix, dtype=float)).min()) < -1e-9 * big:
         raise InputError(src, "covariance.matrix", "not positive semi-definite (a negative eigenvalue): not a covariance")
     return ParameterCovariance(tuple(c.names), tuple(c.units), tuple(float(v) for v in c.values),
-                               tuple(tuple(float(x) for x in row) for row in c.matrix), c.source)
+                               tuple(tuple(float(x) for x in row) for row in c.matrix), c.source, c.method)
 
 
 def _effects(f: _ShipFile, wind: Wind | None, src: str):

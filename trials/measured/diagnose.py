@@ -282,7 +282,8 @@ def _ship_free(ship: Ship, packed, names=None, kind: str = "zigzag", drift: bool
     else:
         mass = [n for n in names if n in MASS_FREE]
         names = [n for n in names if n not in MASS_FREE]
-    free = free_parameters(packed, ship.hull.names, names + mass, priors=DIAGNOSIS_PRIOR_REL_STD)
+    free = free_parameters(packed, ship.hull.names, names + mass, priors=DIAGNOSIS_PRIOR_REL_STD,
+                           hull_terms=ship.hull.terms)
     terms = dict(zip(ship.hull.names, ship.hull.terms))
     return [_baseline_prior(f, terms.get(f.name)) for f in free]
 

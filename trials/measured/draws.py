@@ -13,41 +13,27 @@ from collections.abc import Mapping
 import numpy as np
 
 from mmg.errors import InputError
+from mmg.parameters import WIND_COLUMNS
 from mmg.ship import ParameterCovariance, Ship
 
 __all__ = ["parameter_covariance", "ship_values", "draw", "WIND_FACTOR_NAMES"]
 
-WIND_FACTOR_NAMES = ("wind_scale", "wind_sway_factor", "wind_yaw_factor")
+WIND_FACTOR_NAMES = tuple(WIND_COLUMNS)
 """Parameters of a covariance that are factors on the records' wind loads (1: the ship as it is)."""
 
 
 def ship_values(ship: Ship, names) -> np.ndarray:
-    """The ship's own values of the parameters ``names`` (in the fit's units), for a covariance without values."""
-    from mmg.nondim import inertia_scale, mass_scale
+    """The ship's own values of the parameters ``names`` (in the fit's units, :mod:`mmg.parameters`), for a
+    covariance without values; a wind factor is 1 (the ship as it is)."""
+    from mmg.parameters import CONSTANTS, ship_value
 
-    pa, out = ship.particulars, []
+    out = []
     for n in names:
-        if n in ship.hull.names:
-            out.append(ship.hull.value(n))
-        elif n == "w_P0":
-            out.append(ship.propeller.w_P0[0])
-        elif n == "Y_P_astern":
-            out.append(ship.propeller.Y_P_astern)
-        elif n in ("m_x", "m_y"):
-            out.append(getattr(ship.mass, f"{n}_prime") * mass_scale(pa.rho, pa.L, pa.T))
-        elif n == "J_z":
-            out.append(ship.mass.J_z_prime * inertia_scale(pa.rho, pa.L, pa.T))
-        elif n == "rudder_offset":
-            off = ship.effect_set().get("rudder_offset")
-            out.append(np.radians(off["offset_deg"]) if off else 0.0)
-        elif n in WIND_FACTOR_NAMES:     # factors on the records' wind loads: 1 is the ship as it is
-            out.append(1.0)
-        elif hasattr(ship.rudder, n):
-            out.append(getattr(ship.rudder, n))
-        else:
+        try:
+            out.append(ship_value(ship, n))
+        except KeyError:
             raise InputError("covariance", n, f"not a parameter of {ship.name} (a hull coefficient or one of "
-                                              f"w_P0, epsilon, kappa, gamma_R_pos, gamma_R_neg, l_R_prime, "
-                                              f"rudder_offset, Y_P_astern, m_x, m_y, J_z)")
+                                              f"{', '.join(CONSTANTS)})") from None
     return np.asarray(out, dtype=float)
 
 

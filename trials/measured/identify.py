@@ -51,13 +51,17 @@ record starts with the rudder going over (a zigzag); the fit uses the whole reco
 model, and its covariance accounts for the offsets (the shared parameters' block of the joint
 inverse is their marginal).  ``initial_state="sample"`` replays from the raw first sample as before.
 
-The covariance written into ship.yaml (:func:`identification_covariance`): the linearised posterior
-cov = (J_d^T J_d / (s_d^2 tau) + diag(1 / sigma_prior^2))^-1, the data rows' information scaled by
-their own residual variance s_d^2 and the prior's kept at its stated std (:func:`ekf.identify._result`
-scales the whole inverse, prior rows included, by s^2, so a good fit shrank the prior's std too),
-inflated by the fit's residuals' integrated autocorrelation time tau where it is above 1 (N
-correlated residuals carry about N / tau independent ones; tau as ``mmg diagnose`` takes it: the
-mean over u, v, r, heading of the median over the records).
+The covariance written into ship.yaml (:func:`identification_covariance`) is the sum of two parts.
+The linearised posterior cov = (J_d^T J_d / (s_d^2 tau) + diag(1 / sigma_prior^2))^-1: the data rows'
+information scaled by their own residual variance s_d^2 and the prior's kept at its stated std
+(:func:`ekf.identify._result` scales the whole inverse, prior rows included, by s^2, so a good fit
+would shrink the prior's std too), inflated by the fit's residuals' integrated autocorrelation time tau
+where it is above 1 (N correlated residuals carry about N / tau independent ones; tau as ``mmg
+diagnose`` takes it: the mean over u, v, r, heading of the median over the records).  And the
+run-to-run part: the delete-one-run jackknife over the independent runs
+(:func:`ekf.identify.run_jackknife_covariance`), which counts how far the fit moves from one group of
+records to the next; on real records (a model form that is not the ship's, a rudder zero or a drift
+that differs from run to run) it is many times the posterior.
 """
 from __future__ import annotations
 
@@ -70,16 +74,18 @@ import numpy as np
 
 from mmg.errors import InputError
 from mmg.model import pack
+from mmg.parameters import unit_of
 from mmg.ship import Ship
 
 from .predict import MeasuredRun, measured_run, replay_record
 
 __all__ = ["identify", "IdentifyOptions",
            "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
-           "fit_covariance", "ship_with_values", "PARAMETER_UNITS",
+           "fit_covariance", "ship_with_values",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
-           "stage_description", "identification_covariance", "start_noise", "DEFAULT_INITIAL_STATE",
-           "INITIAL_STATES", "run_spread", "START_UNITS", "fold_of", "manoeuvre_class", "goes_astern", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
+           "stage_description", "identification_covariance", "run_covariance", "fold_spread_json",
+           "COVARIANCE_METHOD", "start_noise", "DEFAULT_INITIAL_STATE", "run_spread", "START_UNITS",
+           "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale", "Y_P_astern")
 DEFAULT_MAX_NFEV = 30
@@ -285,53 +291,25 @@ def with_fitted_wind(run: MeasuredRun, values: dict) -> MeasuredRun:
 
 def ship_with_values(ship: Ship, values: dict) -> Ship:
     """``ship`` with fitted parameter values (by their ``mmg identify --free`` names, in the fit's units:
-    :data:`PARAMETER_UNITS`) written in; ``wind_scale`` multiplies the ship's wind scale."""
-    from dataclasses import replace
+    :func:`mmg.parameters.unit_of`) written in through the parameter table (:mod:`mmg.parameters`); a wind
+    value multiplies the ship's; names not in the table (a record's own nuisances) are left out."""
+    from mmg.parameters import with_value
 
     hull = {k: v for k, v in values.items() if k in ship.hull.names}
-    s = ship.with_hull(hull) if hull else ship
-    if "w_P0" in values:
-        w = list(s.propeller.w_P0)
-        w[0] = values["w_P0"]
-        s = replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
-    if "Y_P_astern" in values:
-        s = replace(s, propeller=replace(s.propeller, Y_P_astern=float(values["Y_P_astern"])))
-    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
-    from mmg.nondim import inertia_scale, mass_scale
-
-    pa = s.particulars
-    mass = {f"{k}_prime": values[k] / (inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T))
-            for k in MASS_CONSTANTS if k in values}
-    if mass:
-        s = replace(s, mass=replace(s.mass, **mass))
-    rud = {k: values[k] for k in ("epsilon", "kappa", *RUDDER_CONSTANTS) if k in values}
-    if rud:
-        s = replace(s, rudder=replace(s.rudder, **rud))
-    if "rudder_offset" in values:                 # the rudder_offset effect of mmg.effects, in degrees
-        import mmg.effects as E
-
-        s = replace(s, effects=s.effect_set().merged(
-            E.effect_set({"rudder_offset": {"offset_deg": float(np.degrees(values["rudder_offset"]))}})))
-    wind = {k: values[name] for name, k in _wind_keys().items() if name in values}
-    if wind and s.wind is not None:
-        new = {k: getattr(s.wind, k) * v for k, v in wind.items()}
-        s = replace(s, wind=replace(s.wind, **new))
-        w = s.effect_set().get("wind")
-        if w is not None:
-            import mmg.effects as E
-
-            new = {k: float(w.get(k, 1.0)) * v for k, v in wind.items()}
-            s = replace(s, effects=s.effect_set().merged(E.effect_set({"wind": {**w, **new}})))
+    s = ship.with_hull(hull) if hull else ship                # the hull in one step
+    for k, v in values.items():
+        if k not in hull:
+            s = with_value(s, k, v)
     return s
 
 
 def _wind_keys() -> dict:
     """``mmg identify --free`` name of a fitted wind value -> the key of the ship's ``wind:`` section (and of
-    its ``wind`` effect) it multiplies (``wind_scale`` and :data:`ekf.identify.WIND_FACTORS`): the records'
-    loads were computed with the ship's values, so the fitted ones are factors on them."""
-    from ekf.identify import WIND_FACTORS
+    its ``wind`` effect) it multiplies (:data:`mmg.parameters.WIND_COLUMNS`): the records' loads were computed
+    with the ship's values, so the fitted ones are factors on them."""
+    from mmg.parameters import WIND_COLUMNS
 
-    return {"wind_scale": "scale", **{k: par for k, (par, _) in WIND_FACTORS.items()}}
+    return {k: key for k, (key, _) in WIND_COLUMNS.items()}
 
 
 _ship_with = ship_with_values
@@ -461,7 +439,8 @@ def _free_of(ship: Ship, packed, runs, free, o: IdentifyOptions):
     if "Y_P_astern" in names and not any(goes_astern(r) for r in runs):
         names = [n for n in names if n != "Y_P_astern"]       # nothing to fit it on: it stays the config's
         o.say(f"Y_P_astern not fitted: no record runs its propeller astern on {ASTERN_SHARE:.0%} of its samples")
-    fp = _bounded_wind(ship, free_parameters(packed, ship.hull.names, names, o.prior_rel_std))
+    fp = _bounded_wind(ship, free_parameters(packed, ship.hull.names, names, o.prior_rel_std,
+                                                  hull_terms=ship.hull.terms))
     if o.initial_state == "fit":
         from ekf.identify import start_parameters
 
@@ -756,11 +735,8 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     return [r for part in parts for r in part]
 
 
-PARAMETER_UNITS = {"rudder_offset": "rad", "m_x": "kg", "m_y": "kg", "J_z": "kg m^2"}
-"""The unit of a fitted parameter where it is not non-dimensional (``"1"``): the fit's own (SI)."""
 
-
-def _covariance_section(fit, cov: np.ndarray, note: str) -> dict | None:
+def _covariance_section(fit, cov: np.ndarray, note: str, method: str = "") -> dict | None:
     """The ``covariance:`` section of the shared parameters (a record's own nuisance left out: the block
     of the joint covariance is their marginal); None when it is not finite."""
     keep = [i for i, f in enumerate(fit.free) if f.record is None]
@@ -769,15 +745,16 @@ def _covariance_section(fit, cov: np.ndarray, note: str) -> dict | None:
         return None
     cov = 0.5 * (cov + cov.T)
     names = [fit.free[i].name for i in keep]
-    return {"names": names, "units": [PARAMETER_UNITS.get(n, "1") for n in names],
+    return {"names": names, "units": [unit_of(n) for n in names],
             "values": [float(f"{fit.theta[i]:.10g}") for i in keep],
-            "matrix": [[float(f"{x:.10g}") for x in row] for row in cov], "source": note}
+            "matrix": [[float(f"{x:.10g}") for x in row] for row in cov], "source": note,
+            **({"method": method} if method else {})}
 
 
 def fit_covariance(fit, note: str = "") -> dict | None:
     """The ``covariance:`` section of a ship YAML from a fit (:class:`ekf.identify.IdentifyResult`) with
     its own Gauss-Newton covariance (``corr * std std^T``: the whole inverse J^T J, prior rows included,
-    times the residual variance): its shared parameters' names, units (:data:`PARAMETER_UNITS`), fitted
+    times the residual variance): its shared parameters' names, units (:func:`mmg.parameters.unit_of`), fitted
     values and covariance; None when it is not finite (a singular fit).  What ``mmg identify`` writes is
     :func:`identification_covariance`'s."""
     std = np.asarray(fit.std, dtype=float)
@@ -803,18 +780,64 @@ def posterior_covariance(fit, tau: float = 1.0) -> np.ndarray:
         return np.full((n, n), np.nan)
 
 
-def identification_covariance(ident: Identification) -> dict | None:
-    """The ``covariance:`` section ``mmg identify`` writes into ship.yaml: :func:`posterior_covariance`
-    with the fit's residual correlation time (:attr:`Identification.tau`), the shared parameters' block
-    (module docstring); None when it is not finite."""
+COVARIANCE_METHOD = "posterior+run-jackknife"
+"""The ``method`` of the covariance ``mmg identify`` writes (:func:`identification_covariance`)."""
+
+
+def run_covariance(ident: Identification) -> np.ndarray | None:
+    """The run-to-run part of the written covariance: :func:`ekf.identify.run_jackknife_covariance` over
+    the training records' independent runs (:func:`same_run_groups`: a record and its cuts are one run),
+    over every free parameter; None with fewer than two runs or a fit without per-record scores."""
+    from ekf.identify import run_jackknife_covariance
+
+    try:
+        return run_jackknife_covariance(ident.fit, same_run_groups(ident.runs))
+    except ValueError:
+        return None
+
+
+def identification_covariance(ident: Identification, parts: bool = False):
+    """The ``covariance:`` section ``mmg identify`` writes into ship.yaml (module docstring).
+
+    The sum of two parts over the shared parameters' block: the linearised posterior
+    (:func:`posterior_covariance` with the fit's residual correlation time :attr:`Identification.tau`:
+    the residuals' noise and the prior at its stated std, which alone speaks for a parameter the records
+    do not inform) and the run-to-run jackknife (:func:`run_covariance`: how far the fit moves when one
+    independent run is left out, which counts what the records disagree on: a model form that is not
+    the ship's, a disturbance that differs from run to run).  Where the model is right and the runs
+    agree, the two count the same noise and the sum overstates the variance by up to 2 (standard errors
+    by up to 1.41); on real records the run-to-run part dominates.
+
+    Parameters
+    ----------
+    ident : Identification
+    parts : bool
+        Also return the two parts' full matrices (every free parameter): ``(section, posterior, runs)``.
+
+    Returns
+    -------
+    dict or None
+        The section (``names``, ``units``, ``values``, ``matrix``, ``source``, ``method``); None when it
+        is not finite.  With ``parts``, a tuple as above (``runs`` None where it could not be made).
+    """
     tau = max(float(ident.tau), 1.0)
     start = ("each record's start state fitted as a nuisance" if ident.initial_state == "fit"
              else "each record replayed from its first sample")
+    post = posterior_covariance(ident.fit, tau)
+    runs = run_covariance(ident)
+    n_runs = len(set(same_run_groups(ident.runs)))
     note = (f"linearised posterior of mmg identify's fit ({start}): (J_d^T J_d / (s_d^2 tau) + "
             f"diag(1 / sigma_prior^2))^-1, the prior at its stated std, the data's information divided by the "
             f"residuals' integrated autocorrelation time tau = {tau:.3g} samples"
             + (" (inflated)" if tau > 1.0 else " (not inflated: white residuals)"))
-    return _covariance_section(ident.fit, posterior_covariance(ident.fit, tau), note)
+    if runs is not None:
+        note += (f"; plus the delete-one-run jackknife over the {n_runs} independent runs (one Gauss-Newton step "
+                 f"from the fit without each run): the spread from run to run")
+        section = _covariance_section(ident.fit, post + runs, note, COVARIANCE_METHOD)
+    else:
+        note += f"; no run-to-run part ({n_runs} independent run: the jackknife needs two or more)"
+        section = _covariance_section(ident.fit, post, note, "posterior")
+    return (section, post, runs) if parts else section
 
 
 START_UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "psi": "rad"}
@@ -906,41 +929,11 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
     its ``run_spread:`` section (else none, as the covariance)."""
     import yaml
 
-    from ekf.identify import MASS_CONSTANTS, RUDDER_CONSTANTS
-    from mmg.nondim import inertia_scale, mass_scale
+    from mmg.parameters import write_yaml_value
 
-    wind_keys = _wind_keys()
     data = yaml.safe_load(Path(ship_path).read_text())
-    ship = None
     for k, v in values.items():
-        if k in data["hull"]["coefficients"]:
-            data["hull"]["coefficients"][k]["value"] = float(f"{v:.6g}")
-        elif k == "w_P0":
-            data["propeller"]["w_P0"][0] = float(f"{v:.6g}")
-        elif k == "Y_P_astern":
-            data["propeller"]["Y_P_astern"] = float(f"{v:.6g}")
-        elif k in ("epsilon", "kappa", *RUDDER_CONSTANTS):
-            data["rudder"][k] = float(f"{v:.6g}")
-        elif k in MASS_CONSTANTS:
-            if ship is None:
-                from mmg.ship import load_ship
-
-                ship = load_ship(ship_path)
-            pa = ship.particulars
-            sc = inertia_scale(pa.rho, pa.L, pa.T) if k == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
-            data["mass"][f"{k}_prime"] = float(f"{v / sc:.6g}")
-        elif k == "rudder_offset":
-            data.setdefault("effects", {})
-            data["effects"] = dict(data["effects"] or {})
-            data["effects"]["rudder_offset"] = {"offset_deg": float(f"{np.degrees(v):.6g}")}
-        elif k in wind_keys and "wind" in data:
-            key = wind_keys[k]
-            eff = (data.get("effects") or {}).get("wind")
-            if isinstance(eff, dict) and key in eff:               # the value given in the effects section
-                eff[key] = float(f"{float(eff[key]) * v:.6g}")
-                data["wind"].pop(key, None)
-            else:
-                data["wind"][key] = float(f"{float(data['wind'].get(key, 1.0)) * v:.6g}")
+        write_yaml_value(data, k, v, ship_path)
     data.pop("covariance", None)
     if covariance is not None:
         data["covariance"] = covariance
@@ -988,9 +981,11 @@ def _report_fit(ident: Identification, cov: dict | None) -> list:
              f"records weighted {ident.record_weighting!r}; velocity residuals weighted {ident.velocity_weight:g} "
              f"beside the heading's.", "", *_stage_lines(ident), "",
              "## Values and standard errors", "",
-             "Standard errors from the covariance written into ship.yaml (the linearised posterior, the prior at "
+             "Standard errors from the covariance written into ship.yaml "
+             f"(method `{(cov or {}).get('method', 'none')}`: the linearised posterior, the prior at "
              f"its stated std, the data's information divided by the residuals' correlation time tau = "
-             f"{max(ident.tau, 1.0):.3g} samples; :func:`identification_covariance`); where it is singular, the "
+             f"{max(ident.tau, 1.0):.3g} samples, plus the delete-one-run jackknife over the independent runs where "
+             "there are two or more; :func:`identification_covariance`); where it is singular, the "
              "fit's own Gauss-Newton ones.", "",
              "| parameter | config | identified | std | change |", "|---|---|---|---|---|"]
     std = _cov_std(cov)
@@ -1074,36 +1069,81 @@ def _report_test(ident: Identification, test_runs) -> list:
     return lines
 
 
-def _report_spread(cv: list, ident: Identification, cov: dict | None) -> list:
-    """The report's check of the written standard errors (``cov``, ship.yaml's covariance section) against
-    the folds' spread (:mod:`trials.measured.foldspread`); nothing where the folds carry no values."""
+def _comparable_spread(cv: list, ident: Identification, cov: dict | None):
+    """(:class:`~trials.measured.foldspread.FoldSpread` of ``cv`` against ``cov``'s standard errors, the shared
+    parameters not in every fold) where the folds fitted the model written; else (None, the reason)."""
     from .foldspread import fold_spread
 
-    if not all("values" in c for c in cv):
-        return []
     if cov is None:
-        return ["", "No covariance was written (singular fit): the folds' spread is not compared."]
+        return None, "No covariance was written (singular fit): the folds' spread is not compared."
     sp = fold_spread(cv, _cov_std(cov))
     shared = {n for n in ident.fit.values() if "[" not in n}
     left = sorted(shared - set(sp.names))
     droppable = {"Y_P_astern", *_wind_keys()}          # left out of a fold whose records cannot fit them (_free_of)
     if not sp.same_choice or not set(sp.names) <= shared or not set(left) <= droppable:
-        return ["", "The folds fitted another model than the one written (another hull form or free set): "
-                    "no fold spread (it compares fits of one model)."]
+        return None, ("The folds fitted another model than the one written (another hull form or free set): "
+                      "no fold spread (it compares fits of one model).")
+    return sp, left
+
+
+def fold_spread_json(cv: list, ident: Identification, cov: dict | None, posterior=None) -> dict | None:
+    """What ``mmg identify --cv`` writes to ``DIR/fold_spread.json``: the written standard errors against the
+    folds' jackknife (:mod:`trials.measured.foldspread`).
+
+    Returns
+    -------
+    dict or None
+        ``{"median_ratio", "folds", "method", "parameters": [{"name", "stated_se", "jackknife_se", "ratio",
+        "posterior_se"}, ...]}`` (ratio: jackknife over stated; ``posterior_se`` the linearised posterior's
+        alone, from ``posterior``, the full matrix over the fit's free parameters, where given) with
+        ``median_ratio_posterior`` beside it; ``{"median_ratio": None, "note": ...}`` where the folds
+        cannot be compared; None where the folds carry no values.
+    """
+    if not all("values" in c for c in cv):
+        return None
+    sp, left = _comparable_spread(cv, ident, cov)
+    if sp is None:
+        return {"median_ratio": None, "note": left, "parameters": []}
+    post = {}
+    if posterior is not None:
+        d = np.sqrt(np.abs(np.diag(np.asarray(posterior, float))))
+        post = {f.name: float(x) for f, x in zip(ident.fit.free, d)}
+
+    def num(x):
+        return float(x) if np.isfinite(x) else None
+
+    params = [{"name": n, "stated_se": num(sp.stated[j]), "jackknife_se": num(sp.jackknife[j]),
+               "ratio": num(sp.ratio[j]), "posterior_se": post.get(n)} for j, n in enumerate(sp.names)]
+    rp = [p["jackknife_se"] / p["posterior_se"] for p in params
+          if p["jackknife_se"] is not None and p["posterior_se"]]
+    return {"median_ratio": num(sp.median_ratio()), "folds": len(sp.values), "method": cov.get("method", ""),
+            "median_ratio_posterior": float(np.median(rp)) if rp else None, "not_in_every_fold": left,
+            "parameters": params}
+
+
+def _report_spread(cv: list, ident: Identification, cov: dict | None) -> list:
+    """The report's check of the written standard errors (``cov``, ship.yaml's covariance section) against
+    the folds' spread (:mod:`trials.measured.foldspread`); nothing where the folds carry no values."""
+    if not all("values" in c for c in cv):
+        return []
+    sp, left = _comparable_spread(cv, ident, cov)
+    if sp is None:
+        return ["", left]
     lines = ["", "## The written standard errors against the folds' spread", "",
              "Each fold fitted the model without its kept-out records.  The jackknife standard error over the "
              f"{len(sp.values)} folds counts how the fit moves when a group of records is left out; the written one "
-             "(ship.yaml's covariance) counts the noise of one model fitted to all of them.  A ratio well above 1 "
-             "says the records differ from one another in ways the model does not carry (or that the fits stopped "
-             "short of their optimum: the report's stages), and the covariance (and `mmg imo --samples`, which "
-             "draws from it) is too sure by about that factor.", "",
+             "(ship.yaml's covariance) is meant to count the same: its run-to-run part is a jackknife over single "
+             "runs of the fit on all the records.  A ratio well above 1 says the written covariance (and "
+             "`mmg imo --samples`, which draws from it) is too sure by about that factor; well below 1, too cautious "
+             "(or that the folds' fits stopped short of their optimum: the report's stages).  "
+             "`DIR/fold_spread.json` has the same figures.", "",
              "| parameter | identified | written std | jackknife std | ratio | folds' signs differ |",
              "|---|---|---|---|---|---|"]
     fitted = ident.fit.values()
     for j, n in enumerate(sp.names):
         lines.append(f"| {n} | {fitted.get(n, np.nan):.5g} | {sp.stated[j]:.2g} | {sp.jackknife[j]:.2g} | "
                      f"{sp.ratio[j]:.1f} | {'yes' if sp.sign_differs[j] else ''} |")
-    lines += ["", f"Median ratio {sp.median_ratio():.1f} over {int(np.isfinite(sp.ratio).sum())} parameters "
+    lines += ["", f"Median ratio {sp.median_ratio():.2f} over {int(np.isfinite(sp.ratio).sum())} parameters "
                   f"({len(sp.values)} folds: a rough figure)."]
     if left:
         lines += [f"Not in every fold's fit (no record to fit it on there): {', '.join(left)}."]
@@ -1141,12 +1181,19 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
     fit = ident.fit
     note = (f"segment-wise output error over {len(ident.runs)} records "
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
-    cov = identification_covariance(ident)
+    cov, post, _ = identification_covariance(ident, parts=True)
     (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, spread=run_spread(ident)))
     lines = _report_fit(ident, cov) + _report_physical(ident.physical_check()) + _report_training(ident)
     if test_runs:
         lines += _report_test(ident, test_runs)
+    written = {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
     if cv:
         lines += _report_cv(cv) + _report_spread(cv, ident, cov)
+        spread = fold_spread_json(cv, ident, cov, post)
+        if spread is not None:
+            import json
+
+            (out_dir / "fold_spread.json").write_text(json.dumps(spread, indent=1) + "\n")
+            written["fold_spread"] = out_dir / "fold_spread.json"
     (out_dir / "report.md").write_text("\n".join(lines) + "\n")
-    return {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
+    return written

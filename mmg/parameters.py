@@ -1,0 +1,327 @@
+"""The ship's parameters an estimator can free: one table.
+
+Each entry (:class:`ShipParameter`) says, for one parameter under its fit name (``mmg identify --free``):
+its unit in a fit (SI; ``"1"``: non-dimensional), its prior family (the key of a relative-std table such as
+:data:`PRIOR_REL_STD`) and how its prior std, floor and hard bounds follow from the config value, how a fit
+applies it to the packed ship (``kind`` and ``slot``, :func:`ekf.identify.apply_parameters`), how it is read
+from and written into a :class:`mmg.ship.Ship`, and where a ship YAML holds it.  The hull coefficients are
+the ship's own (:func:`hull_parameter`, one entry per name of its hull model); the rest are the constants
+of :data:`CONSTANTS`.  Estimators, the writers of ship configs and the samplers loop over this table.
+
+The wind's scale and shape factors and the rudder offset are :mod:`mmg.effects` parameters: their priors
+and bounds are the effects' own (:func:`effect_prior_of`); a fitted wind value is a factor on the loads
+the ship's wind section gives.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Callable
+
+import numpy as np
+
+from .model import (P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_RUDDER_OFFSET, P_YP_ASTERN, POLY_WP0,
+                    PackedShip)
+from .nondim import inertia_scale, mass_scale
+
+__all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "RESISTANCE_TERMS",
+           "hull_parameter", "parameter", "ship_value", "with_value", "write_yaml_value", "unit_of", "is_resistance",
+           "EffectPrior", "WIND_COLUMNS"]
+
+PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
+"""Prior std of a freed ship coefficient relative to its config value, per family (identification's: the
+value is known to a factor of about 2 either way).  Floors are the entries' own (:class:`ShipParameter`);
+``w_P0`` and ``Y_P_astern`` take absolute stds; effect parameters carry their own prior
+(:class:`mmg.effects.Parameter`)."""
+
+DIAGNOSIS_PRIOR_REL_STD = {**PRIOR_REL_STD, "mass": 0.2, "hull": 0.15, "hull_nonlinear": 0.30, "resistance": 0.10,
+                           "w_P0": 0.20, "epsilon": 0.10, "hull_floor": 0.002, "rudder": 0.15}
+"""The diagnosis's prior widths: what is known of a config's source, not identification's factor of 2.
+Linear sway/yaw derivatives (``hull``: the terms in beta, r, v) from captive tests or Kijima-type
+regressions are good to 10-15 %, their nonlinear terms (``hull_nonlinear``: r|r|) to about 30 %, the
+resistance (``resistance``: cos(beta)^2, u^2) to 10 %, the wake fraction w_P0 (``w_P0``, relative here) to
+20 %; the rudder's inflow ratio epsilon = (1 - w_R) / (1 - w_P) to 10 % (the rudder normal force goes as
+epsilon^2, so its force to about 20 %, the spread of the rudder-wake regressions and of the rudder lift slope
+a config takes from Fujii's formula); ``hull_floor`` is the smallest std of a primed hull coefficient.  The
+rudder's flow-straightening coefficients gamma_R (``rudder``, freed on zigzags) to 15 %, the spread of a
+ship's rudder constants about a config's.  The added masses at 20 %: the diagnosis frees them with every
+candidate effect, and an added mass a few % off leaves a residual (surge speed loss in the turn, sway and yaw
+lag) an effect would otherwise take; a wider prior would let them take an effect's residual instead."""
+
+RESISTANCE_TERMS = ("1", "cos(beta)^2", "u^2")
+"""Terms of the surge equation whose coefficient is the ship's straight-ahead resistance (non-dimensional by
+U^2: ``X_0`` of a polynomial MMG hull, ``X_uu`` of the Kijima form): it stays a resistance (negative)."""
+
+WIND_COLUMNS = {"wind_scale": ("scale", 0), "wind_sway_factor": ("sway_factor", 1), "wind_yaw_factor": ("yaw_factor", 2)}
+"""Fit name of a wind value -> (the wind effect's parameter and the ship's ``wind:`` key it multiplies, the
+column of the records' external loads X, Y, N it multiplies; 0: all three)."""
+
+
+def is_resistance(name: str, term: str) -> bool:
+    """Whether hull coefficient ``name`` with term ``term`` is the straight-ahead resistance (:data:`RESISTANCE_TERMS`)."""
+    return name.startswith("X_") and term in RESISTANCE_TERMS
+
+
+@dataclass(frozen=True)
+class EffectPrior:
+    """Where an effect parameter's prior comes from: the effect's (registered) name, its parameter, and the
+    factor from the effect's units to the fit's (degrees to radians for the rudder offset)."""
+
+    effect: str
+    parameter: str
+    factor: float = 1.0
+
+
+@dataclass(frozen=True)
+class ShipParameter:
+    """One freeable parameter of a ship (module docstring).
+
+    Attributes
+    ----------
+    name : str
+        The fit name (``mmg identify --free``).
+    unit : str
+        Its unit in a fit, SI (``"1"``: non-dimensional).
+    family : str
+        The key of its relative prior std in a family table (:data:`PRIOR_REL_STD`), or ``""`` for an absolute
+        std (``abs_std``) or an effect's own prior (``effect``).
+    kind : str
+        How a fit applies it (:attr:`ekf.identify.FreeParameter.kind`): ``"hull"``, ``"w_P0"``, ``"epsilon"``,
+        ``"kappa"``, ``"rudder"``, ``"propeller"``, ``"mass"``, ``"wind_scale"``.
+    slot : int
+        Its index in :attr:`mmg.model.PackedShip.p` (a hull coefficient's in ``hull_coef``; the wind's: the
+        loads' column, :data:`WIND_COLUMNS`).
+    yaml : str
+        Where a ship YAML holds it (documentation; :func:`write_yaml_value` writes it).
+    floor : float
+        Smallest prior std (a relative std of a small value would pin it).
+    abs_std : float
+        An absolute prior std (``family`` empty), 0 where none.
+    bounds : callable
+        ``bounds(config_value) -> (lower, upper)``: hard bounds.
+    effect : EffectPrior or None
+        For an :mod:`mmg.effects` parameter: where its prior comes from.
+    """
+
+    name: str
+    unit: str
+    family: str
+    kind: str
+    slot: int
+    yaml: str
+    read: Callable
+    write: Callable
+    write_yaml: Callable
+    packed: Callable
+    floor: float = 0.0
+    abs_std: float = 0.0
+    bounds: Callable = lambda v: (-np.inf, np.inf)
+    effect: EffectPrior | None = None
+
+    def config_value(self, packed: PackedShip) -> float:
+        """The value the packed ship carries (the prior's centre), in the fit's unit."""
+        return float(self.packed(packed))
+
+    def prior_std(self, value: float, rel: dict) -> float:
+        """The prior std about ``value`` from the family table ``rel`` (its floor kept), or the absolute one."""
+        if not self.family:
+            return self.abs_std
+        s = rel[self.family] * (abs(value) if self.floor > 0 else value)
+        return max(s, self.floor) if self.floor > 0 else s
+
+
+def _mass_scale(ship, name: str) -> float:
+    pa = ship.particulars
+    return inertia_scale(pa.rho, pa.L, pa.T) if name == "J_z" else mass_scale(pa.rho, pa.L, pa.T)
+
+
+def _load_ship(ship_path):
+    from .ship import load_ship
+
+    return load_ship(ship_path)
+
+
+def _rudder(name: str, slot: int, family: str, lo: float, hi: float, floor: float = 0.0) -> ShipParameter:
+    """A constant of :class:`mmg.ship.Rudder`."""
+    return ShipParameter(
+        name, "1", family, family if family in ("epsilon", "kappa") else "rudder", slot, f"rudder.{name}",
+        read=lambda s: float(getattr(s.rudder, name)),
+        write=lambda s, v: replace(s, rudder=replace(s.rudder, **{name: float(v)})),
+        write_yaml=lambda d, v, path: d["rudder"].__setitem__(name, float(f"{v:.6g}")),
+        packed=lambda p: p.p[slot], floor=floor, bounds=lambda v: (lo, hi))
+
+
+def _mass(name: str, slot: int, unit: str) -> ShipParameter:
+    """An added mass [kg] or added moment of inertia [kg m^2]: the config's primed value times its scale."""
+    def write_yaml(d, v, path):
+        d["mass"][f"{name}_prime"] = float(f"{v / _mass_scale(_load_ship(path), name):.6g}")
+
+    return ShipParameter(
+        name, unit, "mass", "mass", slot, f"mass.{name}_prime",
+        read=lambda s: getattr(s.mass, f"{name}_prime") * _mass_scale(s, name),
+        write=lambda s, v: replace(s, mass=replace(s.mass, **{f"{name}_prime": v / _mass_scale(s, name)})),
+        write_yaml=write_yaml, packed=lambda p: p.p[slot], bounds=lambda v: (0.0, 3.0 * v))
+
+
+def _with_w_P0(s, v):
+    w = list(s.propeller.w_P0)
+    w[0] = v
+    return replace(s, propeller=replace(s.propeller, w_P0=tuple(w)))
+
+
+def _with_offset(s, v):
+    import mmg.effects as E
+
+    return replace(s, effects=s.effect_set().merged(E.effect_set({"rudder_offset": {"offset_deg": float(np.degrees(v))}})))
+
+
+def _offset_of(s) -> float:
+    off = s.effect_set().get("rudder_offset")
+    return float(np.radians(off["offset_deg"])) if off else 0.0
+
+
+def _offset_yaml(d, v, path):
+    d["effects"] = dict(d.get("effects") or {})
+    d["effects"]["rudder_offset"] = {"offset_deg": float(f"{np.degrees(v):.6g}")}
+
+
+def _with_wind(key: str):
+    """Write a fitted wind factor: multiplies the ship's ``wind:`` value and its ``wind`` effect's."""
+    def write(s, v):
+        if s.wind is None:
+            return s
+        s = replace(s, wind=replace(s.wind, **{key: getattr(s.wind, key) * v}))
+        w = s.effect_set().get("wind")
+        if w is not None:
+            import mmg.effects as E
+
+            s = replace(s, effects=s.effect_set().merged(E.effect_set({"wind": {**w, key: float(w.get(key, 1.0)) * v}})))
+        return s
+    return write
+
+
+def _wind_yaml(key: str):
+    def write_yaml(d, v, path):
+        if "wind" not in d:
+            return
+        eff = (d.get("effects") or {}).get("wind")
+        if isinstance(eff, dict) and key in eff:               # the value given in the effects section
+            eff[key] = float(f"{float(eff[key]) * v:.6g}")
+            d["wind"].pop(key, None)
+        else:
+            d["wind"][key] = float(f"{float(d['wind'].get(key, 1.0)) * v:.6g}")
+    return write_yaml
+
+
+def _wind(name: str) -> ShipParameter:
+    key, col = WIND_COLUMNS[name]
+    return ShipParameter(name, "1", "", "wind_scale", col, f"wind.{key}", read=lambda s: 1.0, write=_with_wind(key),
+                         write_yaml=_wind_yaml(key), packed=lambda p: 1.0, effect=EffectPrior("wind", key))
+
+
+def _constants() -> dict:
+    def set_yaml(section, key, index=None):
+        def w(d, v, path):
+            if index is None:
+                d[section][key] = float(f"{v:.6g}")
+            else:
+                d[section][key][index] = float(f"{v:.6g}")
+        return w
+
+    out = [
+        ShipParameter("w_P0", "1", "", "w_P0", 0, "propeller.w_P0[0]", read=lambda s: s.propeller.w_P0[0],
+                      write=_with_w_P0, write_yaml=set_yaml("propeller", "w_P0", 0),
+                      packed=lambda p: p.poly[POLY_WP0][0], abs_std=0.15, bounds=lambda v: (0.0, 0.8)),
+        _rudder("epsilon", P_EPS, "epsilon", 0.3, 3.0),
+        _rudder("kappa", P_KAPPA, "kappa", 0.0, 1.0),
+        _wind("wind_scale"), _wind("wind_sway_factor"), _wind("wind_yaw_factor"),
+        ShipParameter("rudder_offset", "rad", "", "rudder", P_RUDDER_OFFSET, "effects.rudder_offset.offset_deg",
+                      read=_offset_of, write=_with_offset, write_yaml=_offset_yaml,
+                      packed=lambda p: p.p[P_RUDDER_OFFSET], effect=EffectPrior("rudder_offset", "offset_deg", np.pi / 180.0)),
+        ShipParameter("Y_P_astern", "1", "", "propeller", P_YP_ASTERN, "propeller.Y_P_astern",
+                      read=lambda s: s.propeller.Y_P_astern,
+                      write=lambda s, v: replace(s, propeller=replace(s.propeller, Y_P_astern=float(v))),
+                      write_yaml=set_yaml("propeller", "Y_P_astern"), packed=lambda p: p.p[P_YP_ASTERN],
+                      abs_std=0.03, bounds=lambda v: (-0.3, 0.3)),
+        _rudder("gamma_R_pos", P_GPOS, "rudder", 0.0, 1.5, 0.05),
+        _rudder("gamma_R_neg", P_GNEG, "rudder", 0.0, 1.5, 0.05),
+        _rudder("l_R_prime", P_LR, "rudder", -2.0, 0.0, 0.05),
+        _mass("m_x", P_MX, "kg"), _mass("m_y", P_MY, "kg"), _mass("J_z", P_JZ, "kg m^2"),
+    ]
+    return {p.name: p for p in out}
+
+
+CONSTANTS = _constants()
+"""The ship constants besides the hull coefficients, by fit name (module docstring).  ``Y_P_astern``: the
+propeller's lateral force astern, Y_P / (rho n^2 D^4) (:func:`mmg.model.propeller_lateral`), absolute std 0.03
+about the config's value (a few per cent of the bollard thrust, K_T(0) about 0.3, is what single screws show);
+``w_P0``: the constant term of the wake polynomial (the model-scale wake), absolute std 0.15; the rudder's
+flow-straightening coefficients gamma_R of the inflow angle (positive and negative beta_R) and the effective
+lever l_R' of the yaw rate in it; the added masses and moment of inertia."""
+
+
+def hull_parameter(name: str, index: int, term: str = "") -> ShipParameter:
+    """The entry of hull coefficient ``name`` (primed, non-dimensional), at ``index`` of the ship's hull model;
+    the straight-ahead resistance (:func:`is_resistance`) bounded to stay negative."""
+    bounds = (lambda v: (-np.inf, 0.0)) if is_resistance(name, term) else (lambda v: (-np.inf, np.inf))
+
+    def write_yaml(d, v, path):
+        d["hull"]["coefficients"][name]["value"] = float(f"{v:.6g}")
+
+    return ShipParameter(name, "1", "hull", "hull", index, f"hull.coefficients.{name}.value",
+                         read=lambda s: s.hull.value(name), write=lambda s, v: s.with_hull({name: float(v)}),
+                         write_yaml=write_yaml, packed=lambda p: p.hull_coef[index], floor=0.01, bounds=bounds)
+
+
+def parameter(name: str, hull_names=(), hull_terms=()) -> ShipParameter:
+    """The table's entry for ``name``: a hull coefficient of ``hull_names`` (its term from ``hull_terms``,
+    same order) or a constant of :data:`CONSTANTS`.
+
+    Raises
+    ------
+    KeyError
+        Neither.
+    """
+    hull_names = list(hull_names)
+    if name in hull_names:
+        i = hull_names.index(name)
+        return hull_parameter(name, i, hull_terms[i] if i < len(hull_terms) else "")
+    if name in CONSTANTS:
+        return CONSTANTS[name]
+    raise KeyError(f"unknown parameter {name!r}: not a hull coefficient of the ship nor one of {tuple(CONSTANTS)}")
+
+
+def _of_ship(ship, name: str) -> ShipParameter:
+    return parameter(name, ship.hull.names, ship.hull.terms)
+
+
+def ship_value(ship, name: str) -> float:
+    """The ship's own value of parameter ``name``, in the fit's unit (KeyError for an unknown name)."""
+    return float(_of_ship(ship, name).read(ship))
+
+
+def with_value(ship, name: str, value: float):
+    """``ship`` with parameter ``name`` set to ``value`` (the fit's unit; a wind value is a factor on the
+    ship's); an unknown name (a record's own nuisance, an effect's) leaves the ship as it is."""
+    try:
+        p = _of_ship(ship, name)
+    except KeyError:
+        return ship
+    return p.write(ship, value)
+
+
+def write_yaml_value(data: dict, name: str, value: float, ship_path) -> None:
+    """Write parameter ``name``'s fitted ``value`` into ``data``, a ship YAML's mapping (of the file
+    ``ship_path``); an unknown name is left out."""
+    hull = (data.get("hull") or {}).get("coefficients") or {}
+    if name in hull:
+        p = hull_parameter(name, 0)
+    elif name in CONSTANTS:
+        p = CONSTANTS[name]
+    else:
+        return
+    p.write_yaml(data, value, ship_path)
+
+
+def unit_of(name: str) -> str:
+    """A fitted parameter's unit (``"1"`` for a hull coefficient and any name not in the table)."""
+    return CONSTANTS[name].unit if name in CONSTANTS else "1"
