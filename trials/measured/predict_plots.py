@@ -82,7 +82,7 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
                         label=f"{lab} (to scale), every {every:.0f} s" if first else None)
         first = False
     if bands is not None:
-        _track_bands(ax, view, bands, L, t, every)
+        _track_bands(ax, view, bands, L, t, every, shown[:, 3:5])
     if t_div is not None:
         hlim, vlim = view.hv(keep_measured_range(m[:, 3] / L), keep_measured_range(m[:, 4] / L))
         ax.set_xlim(*hlim)
@@ -131,18 +131,28 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
     return fig
 
 
-def _track_bands(ax, view, bands, L: float, t, every: float) -> None:
-    """A few drawn tracks and the 90 % position band (circles of its radius about the median track) on the track."""
+def _track_bands(ax, view, bands, L: float, t, every: float, shown) -> None:
+    """A few drawn tracks and the 90 % position band (circles of its radius about the median track) on the track,
+    both cut where they leave the box of the ``shown`` positions [m] widened by its span on each side (a
+    diverging draw runs off to 1e14 m: it would squash the record to a point)."""
+    lo, hi = np.nanmin(shown, axis=0), np.nanmax(shown, axis=0)
+    pad = np.maximum(hi - lo, L)
+
+    def cut(x, y):
+        out = (x < lo[0] - pad[0]) | (x > hi[0] + pad[0]) | (y < lo[1] - pad[1]) | (y > hi[1] + pad[1])
+        return np.where(out, np.nan, x) / L, np.where(out, np.nan, y) / L
+
     for k, tr in enumerate(bands.tracks):
-        ax.plot(*view.hv(tr[:, 0] / L, tr[:, 1] / L), "-", color="tab:blue", lw=0.5, alpha=0.5,
-                label=f"drawn tracks ({len(bands.tracks)} of {bands.draws})" if k == 0 else None)
+        ax.plot(*view.hv(*cut(tr[:, 0], tr[:, 1])), "-", color="tab:blue", lw=0.5, alpha=0.5,
+                label=f"drawn tracks ({len(bands.tracks)} of {bands.draws}; cut at the box of the record)" if k == 0
+                else None)
     ang = np.linspace(0.0, 2 * np.pi, 49)
     first = True
     for tk in np.arange(t[0] + every, t[-1] + 1e-9, every):
         i = min(int(np.searchsorted(t, tk)), len(t) - 1)
         r, xm, ym = bands.radius[i], bands.x_median[i], bands.y_median[i]
         if np.isfinite(r) and np.isfinite(xm) and np.isfinite(ym):
-            ax.plot(*view.hv((xm + r * np.cos(ang)) / L, (ym + r * np.sin(ang)) / L), "-", color="tab:purple",
+            ax.plot(*view.hv(*cut(xm + r * np.cos(ang), ym + r * np.sin(ang))), "-", color="tab:purple",
                     lw=0.9, label="90 % position band about the median track" if first else None)
             first = False
 
