@@ -128,6 +128,7 @@ def test_coverage_counted_by_hand():
     assert b.position_coverage90 == pytest.approx(3 / 5)         # |(3,4)| = 5 <= 5 in; 1 > 0.5 out; 2 > 1 out
     assert b.median_width_deg == pytest.approx(2.0)               # widths 1, 1, 2, inf, 2: sorted, the third
     assert b.unbounded_share == pytest.approx(1 / 5)
+    assert b.coverage90_where_bounded == pytest.approx(2 / 4)    # the unbounded fourth left out
     assert b.to_json()["heading_band_median_width_deg"] == pytest.approx(2.0)
 
 
@@ -216,6 +217,7 @@ def test_cli_predict_samples_json_keys_and_plots(tmp_path, capsys):
     run = doc["runs"][0]
     assert list(run)[-len(BAND_KEYS):] == ["draws", "diverged_draws", "heading_band_deg", "coverage90",
                                            "heading_band_median_width_deg", "heading_band_unbounded_share",
+                                           "coverage90_where_bounded",
                                            "position_band_m", "position_coverage90",
                                            "position_band_median_radius_m"]
     assert list(run["heading_band_deg"]) == ["t_s", "lo", "hi"]

@@ -99,8 +99,8 @@ def _print_bands(bands) -> None:
         print(f"{b.nominal.run.name}: 90 % band from {b.draws} draws ({b.diverged} diverged): heading coverage "
               f"{100 * b.coverage90:.0f} % of samples, median width {num(b.median_width_deg, 'deg')}; position "
               f"coverage {100 * b.position_coverage90:.0f} %, median radius {num(b.median_radius_m, 'm')}"
-              + (f"; heading band unbounded on {100 * b.unbounded_share:.0f} % of samples (inside there)"
-                 if b.unbounded_share else ""))
+              + (f"; heading band unbounded on {100 * b.unbounded_share:.0f} % of samples (inside there; "
+                 f"coverage {100 * b.coverage90_where_bounded:.0f} % over the others)" if b.unbounded_share else ""))
     for n in sorted({n for b in bands or () for n in b.notes}):
         print(f"note: {n}")
 

@@ -54,7 +54,7 @@ POSITION_QUANTILE = 0.90
 SAMPLE_TRACKS = 12
 """How many of the drawn tracks a :class:`Bands` keeps for its figure."""
 BAND_KEYS = ("draws", "diverged_draws", "heading_band_deg", "coverage90", "heading_band_median_width_deg",
-             "heading_band_unbounded_share", "position_band_m", "position_coverage90", "position_band_median_radius_m")
+             "heading_band_unbounded_share", "coverage90_where_bounded", "position_band_m", "position_coverage90", "position_band_median_radius_m")
 """The keys :meth:`Bands.to_json` gives (``mmg predict --samples`` adds them to each run)."""
 
 
@@ -122,6 +122,13 @@ class Bands:
         return float(np.mean(~(np.isfinite(self.lo) & np.isfinite(self.hi))))
 
     @property
+    def coverage90_where_bounded(self) -> float:
+        """:attr:`coverage90` over the samples where the heading band is bounded alone (NaN where it is nowhere)."""
+        ok = np.isfinite(self.lo) & np.isfinite(self.hi)
+        h = self.heading_deg[ok]
+        return float(np.mean((h >= self.lo[ok]) & (h <= self.hi[ok]))) if ok.any() else float("nan")
+
+    @property
     def median_width_deg(self) -> float:
         """The median over the samples of the heading band's width hi - lo [deg] (inf where unbounded)."""
         return float(np.median(self.hi - self.lo))
@@ -134,7 +141,8 @@ class Bands:
     def to_json(self) -> dict:
         """The run's band keys (:data:`BAND_KEYS`): ``heading_band_deg`` ``{"t_s", "lo", "hi"}``,
         ``position_band_m`` ``{"t_s", "x_median", "y_median", "radius"}`` at every sample, the coverages,
-        median width [deg] and radius [m], the share of samples where the heading band is unbounded, the
+        median width [deg] and radius [m], the share of samples where the heading band is unbounded and the
+        coverage over the others, the
         draws and how many diverged (unbounded values: null)."""
         lst = lambda a: [float(x) for x in a]          # noqa: E731
         t = lst(self.t)
@@ -142,6 +150,7 @@ class Bands:
                 "heading_band_deg": {"t_s": t, "lo": lst(self.lo), "hi": lst(self.hi)},
                 "coverage90": self.coverage90, "heading_band_median_width_deg": self.median_width_deg,
                 "heading_band_unbounded_share": self.unbounded_share,
+                "coverage90_where_bounded": self.coverage90_where_bounded,
                 "position_band_m": {"t_s": t, "x_median": lst(self.x_median), "y_median": lst(self.y_median),
                                     "radius": lst(self.radius)},
                 "position_coverage90": self.position_coverage90,
