@@ -110,7 +110,8 @@ def _add_band_arguments(p) -> None:
                    help="also a 90 %% band of heading and position per run from N replays, each with a ship drawn from "
                         "the YAML's covariance: and the start state offset by a draw from its run_spread: "
                         "(JSON keys heading_band_deg, coverage90, position_band_m, ...; bands drawn in the plots)")
-    p.add_argument("--seed", type=_whole(0, "--seed"), default=0, metavar="S", help="seed of the --samples draws (default 0)")
+    p.add_argument("--seed", type=_whole(0, "--seed"), default=0, metavar="S",
+                   help="seed of the --samples draws (default 0)")
 
 
 def _first_text(r, horizon) -> str:

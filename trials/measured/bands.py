@@ -54,7 +54,8 @@ POSITION_QUANTILE = 0.90
 SAMPLE_TRACKS = 12
 """How many of the drawn tracks a :class:`Bands` keeps for its figure."""
 BAND_KEYS = ("draws", "diverged_draws", "heading_band_deg", "coverage90", "heading_band_median_width_deg",
-             "heading_band_unbounded_share", "coverage90_where_bounded", "position_band_m", "position_coverage90", "position_band_median_radius_m")
+             "heading_band_unbounded_share", "coverage90_where_bounded", "position_band_m", "position_coverage90",
+             "position_band_median_radius_m")
 """The keys :meth:`Bands.to_json` gives (``mmg predict --samples`` adds them to each run)."""
 
 

@@ -904,8 +904,9 @@ def run_spread(ident: Identification) -> dict | None:
                 names.append(f"start.{STATE[j]}")
                 units.append(START_UNITS[STATE[j]])
                 std.append(float(np.sqrt(np.mean(col ** 2))))
-        source = (f"no per-record nuisance fitted on two or more records: the measured start-state noise (start_noise, the RMS over the "
-                  f"{n} training records of each channel's noise std), the std of a first sample's error")
+        source = (f"no per-record nuisance fitted on two or more records: the measured start-state noise "
+                  f"(start_noise, the RMS over the {n} training records of each channel's noise std), the std of "
+                  f"a first sample's error")
     keep = [i for i, s in enumerate(std) if np.isfinite(s)]
     if not keep:
         return None
