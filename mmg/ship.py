@@ -285,6 +285,36 @@ class IdentificationNotes:
 
 
 @dataclass(frozen=True)
+class RunSpread:
+    """How much a run's own disturbance varies from one run to the next: the ``run_spread:`` section.
+
+    ``mmg identify`` writes it (:func:`trials.measured.identify.run_spread`) from the spread of the
+    per-record nuisances it fitted over the training records; ``mmg predict --samples`` offsets each
+    replay's start state (and a per-record effect) by a zero-mean normal draw of these standard deviations.
+
+    Attributes
+    ----------
+    names : tuple of str
+        ``start.u``, ``start.v``, ``start.r``, ``start.psi`` (the start state's offsets) or
+        ``<effect>.<parameter>`` (a per-record effect's fit parameter, ``..._rad`` for one in degrees).
+    units : tuple of str
+        The SI unit of each (``m/s``, ``rad/s``, ``rad``).
+    std : tuple of float
+        The standard deviation of each between runs, in ``units``.
+    records : int
+        The training records it was computed over.
+    source : str
+        How it was computed.
+    """
+
+    names: tuple
+    units: tuple
+    std: tuple
+    records: int = 0
+    source: str = ""
+
+
+@dataclass(frozen=True)
 class Ship:
     """A ship: everything the simulator needs, in SI and primes."""
 
@@ -318,6 +348,8 @@ class Ship:
         """lambda = L of the full-scale ship / L of this one (1 for a full-scale ship): times scale as
         sqrt(lambda) between the two."""
         return 1.0 if self.full_scale is None else self.full_scale.L / self.particulars.L
+    run_spread: RunSpread | None = field(default=None, compare=False, repr=False)
+    """The spread of a run's own disturbance between runs (the ``run_spread:`` section), or None."""
 
     def effect_set(self):
         """:attr:`effects` as an :class:`mmg.effects.EffectSet` (an empty one when None)."""
@@ -495,6 +527,14 @@ class _Identification(_Strict):
     training_replays_worse: list[str] = []
 
 
+class _RunSpread(_Strict):
+    names: list[str]
+    units: list[str]
+    std: list[float]
+    records: int = 0
+    source: str = ""
+
+
 class _ShipFile(_Strict):
     name: str = Field(min_length=1)
     source: str = ""
@@ -510,6 +550,7 @@ class _ShipFile(_Strict):
     covariance: Optional[_Covariance] = None
     full_scale: Optional[_FullScale] = None
     identification: Optional[_Identification] = None
+    run_spread: Optional[_RunSpread] = None
 
 
 _UNIT_HINT = {"L": "m", "B": "m", "T": "m", "S_wetted": "m^2", "x_G": "m", "rho": "kg/m^3", "D": "m", "P": "m",
@@ -765,7 +806,7 @@ def _build(f: _ShipFile, src: str) -> Ship:
     return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
                 steering=steering, engine=engine, source=f.source, wind=wind, effects=effects, stated=stated,
                 covariance=_covariance(f, src), full_scale=_full_scale(f, src, particulars),
-                identification=_identification(f))
+                identification=_identification(f), run_spread=_run_spread(f, src))
 
 
 def _full_scale(f: _ShipFile, src: str, pa: Particulars) -> FullScale | None:
@@ -784,6 +825,23 @@ def _identification(f: _ShipFile) -> IdentificationNotes | None:
     if c is None:
         return None
     return IdentificationNotes(c.converged, tuple(c.warnings), c.covariance_method, tuple(c.training_replays_worse))
+
+
+def _run_spread(f: _ShipFile, src: str) -> RunSpread | None:
+    """run_spread: one name, unit and non-negative standard deviation per quantity, each name once."""
+    c = f.run_spread
+    if c is None:
+        return None
+    n = len(c.names)
+    if len(set(c.names)) != n:
+        raise InputError(src, "run_spread.names", "a quantity is named twice")
+    for key in ("units", "std"):
+        if len(getattr(c, key)) != n:
+            raise InputError(src, f"run_spread.{key}", f"{len(getattr(c, key))} entries for {n} names")
+    for i, x in enumerate(c.std):
+        if x < 0:
+            raise InputError(src, f"run_spread.std.{i}", f"a negative standard deviation {x:g}")
+    return RunSpread(tuple(c.names), tuple(c.units), tuple(float(x) for x in c.std), int(c.records), c.source)
 
 
 def _covariance(f: _ShipFile, src: str) -> ParameterCovariance | None:

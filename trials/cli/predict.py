@@ -6,7 +6,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _finite_positive, _output_path, release_notes
+from .common import _finite_positive, _output_path, _whole, release_notes
 
 
 def cmd_predict(args) -> int:
@@ -33,12 +33,13 @@ def cmd_predict(args) -> int:
 
     pred = predict(ship, args.logs, start=args.start, wind=wind, progress=progress)   # runs named after their files
     pred = with_windows(ship, pred, args.window, args.every)
-    text = dumps_json(pred.to_json(horizon_s=args.horizon))
+    bands = _bands(args, ship, pred)
+    text = dumps_json(_with_bands(pred.to_json(horizon_s=args.horizon), bands, args))
     names = [f"{r.run.name}.png" for r in pred.runs]
     with StagedFile(args.json) as tmp:     # the files first (renamed last, after the plots), then the console
         with StagedOutput(args.plots) if args.plots is not None else nullcontext() as stage:
-            for r, name in zip(pred.runs, names if args.plots is not None else ()):
-                r.plot(pyplot=False).savefig(stage.path(name))
+            for k, (r, name) in enumerate(zip(pred.runs, names if args.plots is not None else ())):
+                (bands[k] if bands else r).plot(pyplot=False).savefig(stage.path(name))
         tmp.write_text(text)
     for r in pred.runs:
         s = r.scores()
@@ -61,9 +62,59 @@ def cmd_predict(args) -> int:
                 first = f"; over the first {args.horizon:g} s: heading {sum(f) / len(f):.4g} deg RMS"
             print(f"mean over {len(sc)} runs{f' ({left} diverged, left out)' if left else ''}: heading "
                   f"{mean('heading_rms_deg'):.4g} deg RMS, final position {mean('final_position_error_L'):.4g} L{first}")
+    _print_bands(bands)
     print(f"wrote {args.json}" + (f" and {len(names)} plot{'s' if len(names) != 1 else ''} to {args.plots}"
                                   if args.plots is not None else ""))
     return 0
+
+
+# --samples: prediction bands (trials.measured.bands); every piece of it here, together
+def _bands(args, ship, pred) -> list | None:
+    """Each run's :func:`trials.measured.bands.prediction_bands` with ``--samples``, ``--seed`` (None without)."""
+    if args.samples is None:
+        return None
+    from ..measured.bands import prediction_bands
+
+    out = []
+    for i, r in enumerate(pred.runs):
+        out.append(prediction_bands(ship, r.run, args.samples, seed=args.seed))
+        print(f"bands {i + 1}/{len(pred.runs)}: {r.run.name} ({args.samples} draws)", file=sys.stderr, flush=True)
+    return out
+
+
+def _with_bands(doc: dict, bands, args) -> dict:
+    """The JSON with each run's band keys (:data:`trials.measured.bands.BAND_KEYS`) and what was drawn (``bands``)."""
+    if bands is None:
+        return doc
+    for row, b in zip(doc["runs"], bands):
+        row.update(b.to_json())
+    notes = sorted({n for b in bands for n in b.notes})
+    doc["bands"] = {"samples": int(args.samples), "seed": int(args.seed), "notes": notes}
+    return doc
+
+
+def _print_bands(bands) -> None:
+    """One console line per run's bands, then what was not drawn."""
+    import numpy as np
+
+    num = lambda x, unit: f"{x:.3g} {unit}" if np.isfinite(x) else "unbounded (diverged draws)"   # noqa: E731
+    for b in bands or ():
+        print(f"{b.nominal.run.name}: 90 % band from {b.draws} draws ({b.diverged} diverged): heading coverage "
+              f"{100 * b.coverage90:.0f} % of samples, median width {num(b.median_width_deg, 'deg')}; position "
+              f"coverage {100 * b.position_coverage90:.0f} %, median radius {num(b.median_radius_m, 'm')}"
+              + (f"; heading band unbounded on {100 * b.unbounded_share:.0f} % of samples (inside there; "
+                 f"coverage {100 * b.coverage90_where_bounded:.0f} % over the others)" if b.unbounded_share else ""))
+    for n in sorted({n for b in bands or () for n in b.notes}):
+        print(f"note: {n}")
+
+
+def _add_band_arguments(p) -> None:
+    p.add_argument("--samples", type=_whole(1, "--samples"), default=None, metavar="N",
+                   help="also a 90 %% band of heading and position per run from N replays, each with a ship drawn from "
+                        "the YAML's covariance: and the start state offset by a draw from its run_spread: "
+                        "(JSON keys heading_band_deg, coverage90, position_band_m, ...; bands drawn in the plots)")
+    p.add_argument("--seed", type=_whole(0, "--seed"), default=0, metavar="S",
+                   help="seed of the --samples draws (default 0)")
 
 
 def _first_text(r, horizon) -> str:
@@ -116,4 +167,5 @@ def add_parser(sub) -> None:
                    help="also the scores over the first S seconds of each replay (JSON key 'first'; the short-"
                         "horizon figure of docs/benchmark_frt.md, 60 s there)")
     _add_window_options(p)
+    _add_band_arguments(p)
     p.set_defaults(func=cmd_predict)

@@ -20,14 +20,12 @@ probability is at least 0.95, ``"fail"`` when at most 0.05, ``"undecided"`` betw
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 import numpy as np
 
-from mmg.errors import InputError
-from mmg.parameters import WIND_COLUMNS
-from mmg.ship import ParameterCovariance, Ship
+from mmg.ship import Ship
 
+from ..measured.draws import WIND_FACTOR_NAMES, draw, parameter_covariance
+from ..measured.draws import ship_values as _ship_values  # noqa: F401  (bench/imo_coverage.py, tests)
 from .standard import Plan, criteria, criterion_values, run_manoeuvres
 
 __all__ = ["covariance_of", "draw", "sample_tasks", "run_samples", "local_executor", "summarise", "convergence",
@@ -39,72 +37,17 @@ FAIL_PROBABILITY = 0.05
 """Verdict ``"fail"``: the probability of meeting the limit is at most this."""
 INTERVAL = (5.0, 95.0)
 """The percentiles bounding the reported 90 % interval."""
-NOT_SAMPLED = tuple(WIND_COLUMNS)
+NOT_SAMPLED = WIND_FACTOR_NAMES
 """Parameters of a covariance left out of the sampling: the wind-load scale and shape factors do nothing
 in calm water."""
 
 
-def _ship_values(ship: Ship, names) -> np.ndarray:
-    """The ship's own values of the parameters ``names`` (in the fit's units, :mod:`mmg.parameters`), for a
-    covariance without values; a wind factor is 1 (the ship as it is)."""
-    from mmg.parameters import CONSTANTS, ship_value
-
-    out = []
-    for n in names:
-        try:
-            out.append(ship_value(ship, n))
-        except KeyError:
-            raise InputError("covariance", n, f"not a parameter of {ship.name} (a hull coefficient or one of "
-                                              f"{', '.join(CONSTANTS)})") from None
-    return np.asarray(out, dtype=float)
-
-
 def covariance_of(ship: Ship, cov=None) -> tuple[list[str], np.ndarray, np.ndarray, list[str]]:
-    """The parameters to sample: (names, mean, covariance, notes).
-
-    Parameters
-    ----------
-    ship : Ship
-    cov : ParameterCovariance, mapping or pandas.DataFrame, optional
-        Default the ship config's ``covariance:`` section.  A mapping has ``names`` and ``matrix``
-        (and optionally ``values``); a DataFrame is indexed and labelled by the names.  Without
-        values the mean is the ship's own.
-
-    Raises
-    ------
-    mmg.errors.InputError
-        No covariance, a matrix of the wrong shape, not symmetric or not positive semi-definite, a
-        name that is no parameter of the ship.
-    """
-    if cov is None:
-        cov = ship.covariance
-        if cov is None:
-            raise InputError("samples", ship.name, "the ship config has no covariance: section (mmg identify "
-                                                   "writes one into DIR/ship.yaml) and none was given")
-    if isinstance(cov, ParameterCovariance):
-        names, values, matrix = list(cov.names), cov.values, cov.matrix
-    elif isinstance(cov, Mapping):
-        names, values, matrix = list(cov["names"]), cov.get("values"), cov["matrix"]
-    else:                                                  # a DataFrame
-        names, values, matrix = [str(x) for x in cov.index], None, cov.to_numpy()
-    matrix = np.asarray(matrix, dtype=float)
-    n = len(names)
-    if matrix.shape != (n, n) or not np.all(np.isfinite(matrix)):
-        raise InputError("covariance", "matrix", f"expected a finite {n} x {n} matrix, got shape {matrix.shape}")
-    if not np.allclose(matrix, matrix.T, rtol=1e-9, atol=1e-12 * max(np.abs(matrix).max(), 1e-300)):
-        raise InputError("covariance", "matrix", "not symmetric")
-    if np.linalg.eigvalsh(matrix).min() < -1e-9 * max(np.abs(np.diag(matrix)).max(), 1e-300):
-        raise InputError("covariance", "matrix", "not positive semi-definite: not a covariance")
-    mean = _ship_values(ship, names) if values is None else np.asarray(values, dtype=float)
-    keep = [i for i, x in enumerate(names) if x not in NOT_SAMPLED]
-    notes = [f"{x} not sampled: no wind in the standard's calm-water manoeuvres" for x in names if x in NOT_SAMPLED]
-    return [names[i] for i in keep], mean[keep], matrix[np.ix_(keep, keep)], notes
-
-
-def draw(mean, matrix, n: int, seed: int | None = None) -> np.ndarray:
-    """``n`` samples (rows) of the normal with ``mean`` and covariance ``matrix`` (correlations kept)."""
-    rng = np.random.default_rng(seed)
-    return rng.multivariate_normal(np.asarray(mean, float), np.asarray(matrix, float), size=int(n), method="eigh")
+    """The parameters to sample: (names, mean, covariance, notes); :func:`trials.measured.draws.parameter_covariance`
+    (``cov``: default the ship config's ``covariance:`` section; a mapping with ``names``, ``matrix`` and
+    optionally ``values``; a DataFrame) with :data:`NOT_SAMPLED` left out, a note for each."""
+    names, mean, matrix, out = parameter_covariance(ship, cov, leave_out=NOT_SAMPLED)
+    return names, mean, matrix, [f"{x} not sampled: no wind in the standard's calm-water manoeuvres" for x in out]
 
 
 def _one_sample(p: Plan, names, row) -> dict:

@@ -1,5 +1,6 @@
 """Measured records against the model.  Replay of a record against its own rudder and revolutions
-(:mod:`.predict`, ``mmg predict``), identification of a ship model from records and its
+(:mod:`.predict`, ``mmg predict``; its 90 % bands from the identified ship's uncertainty, :mod:`.bands`, the
+ship drawn from its covariance by :mod:`.draws`), identification of a ship model from records and its
 cross-validation (:mod:`.identify`, ``mmg identify``; whether its stated uncertainty holds from one group
 of records to the next, :mod:`.foldspread`), the discrepancy workflow that names the
 effect the model is missing (:mod:`.diagnose`, ``mmg diagnose``; the effects themselves, and where

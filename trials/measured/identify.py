@@ -84,7 +84,8 @@ __all__ = ["identify", "IdentifyOptions",
            "fit_covariance", "ship_with_values",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description", "identification_covariance", "run_covariance", "fold_spread_json",
-           "COVARIANCE_METHOD", "identification_summary", "start_noise", "DEFAULT_INITIAL_STATE",
+           "COVARIANCE_METHOD", "identification_summary", "start_noise", "DEFAULT_INITIAL_STATE", "run_spread",
+           "START_UNITS",
            "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale", "Y_P_astern")
@@ -840,6 +841,80 @@ def identification_covariance(ident: Identification, parts: bool = False):
     return (section, post, runs) if parts else section
 
 
+START_UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "psi": "rad"}
+"""The SI unit of each fitted start-state offset (kind ``"start"``), by state name."""
+
+
+def _nuisance_groups(ident: Identification) -> dict:
+    """{quantity name: (SI unit, factor to SI, [fitted value of each record that has it])} of the fit's
+    per-record nuisances: start offsets as ``start.<state>``, effect parameters as ``<effect>.<parameter>``
+    (a parameter in degrees as ``..._rad``, in radians)."""
+    from mmg.replay import STATE
+
+    effects = _nuisance_effects(ident.record_nuisance)
+    out = {}
+    for f, v in zip(ident.fit.free, ident.fit.theta):
+        if f.record is None:
+            continue
+        if f.kind == "start":
+            name, unit, k = f"start.{STATE[f.sub]}", START_UNITS[STATE[f.sub]], 1.0
+        else:
+            q = effects[f.index].fit_parameters()[f.sub]
+            deg = q.unit == "deg"
+            name = f"{effects[f.index].name}.{q.name[:-4] + '_rad' if deg and q.name.endswith('_deg') else q.name}"
+            unit, k = ("rad", np.pi / 180.0) if deg else (q.unit, 1.0)
+        out.setdefault(name, (unit, k, []))[2].append(float(v))
+    order = {f"start.{x}": i for i, x in enumerate(STATE)}          # the start offsets in state order, first
+    return dict(sorted(out.items(), key=lambda kv: order.get(kv[0], len(order))))
+
+
+def run_spread(ident: Identification) -> dict | None:
+    """The ``run_spread:`` section of ship.yaml: how much each record's own disturbance varies between runs.
+
+    Where the fit has per-record nuisances (each record's start-state offsets, ``initial_state="fit"``;
+    the ``record_nuisance`` effects), each quantity's sample standard deviation (ddof 1) of its fitted
+    values across the training records that have it (two at least); otherwise (``initial_state="sample"``,
+    or a single record) the measured start-state noise (:func:`start_noise`: the std of a first sample's
+    error), the root mean square over the records, for u, v, r and the heading.
+
+    Returns
+    -------
+    dict or None
+        ``names`` (``start.u``, ``start.v``, ``start.r``, ``start.psi``, ``<effect>.<parameter>``), ``units``
+        (SI), ``std`` (in ``units``), ``records`` (the training records) and ``source`` (how it was
+        computed); None when there is nothing finite to write.
+    """
+    groups = {k: g for k, g in _nuisance_groups(ident).items() if len(g[2]) >= 2}
+    n = len(ident.runs)
+    if groups:
+        names = list(groups)
+        units = [groups[k][0] for k in names]
+        std = [groups[k][1] * float(np.std(groups[k][2], ddof=1)) for k in names]
+        counts = sorted({len(groups[k][2]) for k in names})
+        over = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
+        source = (f"sample standard deviation (ddof 1) of mmg identify's fitted per-record nuisances across "
+                  f"{over} of the {n} training records (a start offset is fitted only where the channel shows noise)")
+    else:
+        from mmg.replay import STATE
+
+        noise = np.array([start_noise(r) for r in ident.runs])
+        names, units, std = [], [], []
+        for j in (0, 1, 2, 5):
+            col = noise[:, j][np.isfinite(noise[:, j])]
+            if len(col):
+                names.append(f"start.{STATE[j]}")
+                units.append(START_UNITS[STATE[j]])
+                std.append(float(np.sqrt(np.mean(col ** 2))))
+        source = (f"no per-record nuisance fitted on two or more records: the measured start-state noise "
+                  f"(start_noise, the RMS over the {n} training records of each channel's noise std), the std of "
+                  f"a first sample's error")
+    keep = [i for i, s in enumerate(std) if np.isfinite(s)]
+    if not keep:
+        return None
+    return {"names": [names[i] for i in keep], "units": [units[i] for i in keep],
+            "std": [float(f"{std[i]:.6g}") for i in keep], "records": n, "source": source}
+
+
 def _change_text(pct: float) -> str:
     """A fitted value's change from its config value, in per cent; "-" where the config value is 0
     (a term the config does not have, e.g. ``Y_P_astern``: no relative change to give)."""
@@ -847,14 +922,14 @@ def _change_text(pct: float) -> str:
 
 
 def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None,
-              identification: dict | None = None) -> str:
+              identification: dict | None = None, spread: dict | None = None) -> str:
     """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
     ``w_P0`` constant term, ``Y_P_astern``, the rudder's ``epsilon``, ``kappa``, ``gamma_R_pos``,
     ``gamma_R_neg``, ``l_R_prime``, the added masses, a rudder offset and the wind factors) and ``note`` in its header and ``source``; with
     ``covariance`` (:func:`fit_covariance`) its ``covariance:`` section (else none: the initial
     ship's own section, if any, is about other values and is dropped); with ``identification``
-    (:func:`identification_summary`) its ``identification:`` section and its warnings as header comments
-    (else none, as the covariance)."""
+    (:func:`identification_summary`) its ``identification:`` section and its warnings as header comments,
+    with ``spread`` (:func:`run_spread`) its ``run_spread:`` section (else none of either, as the covariance)."""
     import yaml
 
     from mmg.parameters import write_yaml_value
@@ -868,6 +943,9 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
         data["covariance"] = covariance
     if identification is not None:
         data["identification"] = identification
+    data.pop("run_spread", None)
+    if spread is not None:
+        data["run_spread"] = spread
     data["name"] = f"{data['name']} (identified)"
     data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
     head = "".join(f"# {ln}\n" for ln in note.splitlines() + _warning_lines(identification))
@@ -1183,7 +1261,7 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
     cov, post, _ = identification_covariance(ident, parts=True)
     summary = identification_summary(ident, cov)
-    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, summary))
+    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, summary, spread=run_spread(ident)))
     lines = _report_fit(ident, cov, summary["warnings"]) + _report_physical(ident.physical_check()) + _report_training(ident)
     if test_runs:
         lines += _report_test(ident, test_runs)

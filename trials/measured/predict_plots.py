@@ -27,7 +27,7 @@ def replay_layout(north, east, pad: float = 0.6) -> tuple:
     return view, True, float(np.clip(13.0 / ratio, 2.8, 5.0))
 
 
-def replay_figure(rep, title: str | None = None, pyplot: bool = True):
+def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None):
     """Track with ship outlines (left, or across the top for a long track: :func:`replay_layout`) and
     heading, yaw rate, speed, rudder and revolutions of a :class:`trials.measured.predict.Replayed`, measured
     (black) against predicted (red).  The track is to scale, its start marked, the legend below it.
@@ -36,6 +36,10 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True):
     line at that time and in the titles, and every panel keeps the measured record's range (its span
     again on each side), so the run-away prediction leaves the axes instead of squashing the record
     to a flat line.
+
+    With ``bands`` (:class:`trials.measured.bands.Bands`) the heading panel shows the record's unwrapped
+    heading, the nominal prediction on its turn and the shaded 90 % band, and the track a few drawn tracks
+    and the 90 % position band's circles about the median track at the outlines' times.
 
     Returns
     -------
@@ -77,6 +81,8 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True):
                 ax.fill(*view.hv(px / L, py / L), fc="none", ec=ec, lw=0.6,
                         label=f"{lab} (to scale), every {every:.0f} s" if first else None)
         first = False
+    if bands is not None:
+        _track_bands(ax, view, bands, L, t, every, shown[:, 3:5])
     if t_div is not None:
         hlim, vlim = view.hv(keep_measured_range(m[:, 3] / L), keep_measured_range(m[:, 4] / L))
         ax.set_xlim(*hlim)
@@ -87,22 +93,30 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True):
         ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=8, frameon=False)
     else:                        # ... or below it, under the axis label
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=8, frameon=False)
-    rows = [("heading (deg)", np.degrees(m[:, 5]), np.degrees(p[:, 5])),
+    rows = [("heading (deg)", np.degrees(m[:, 5]), np.degrees(p[:, 5])) if bands is None else
+            ("heading (deg)\nunwrapped", bands.heading_deg, bands.nominal_deg),
             ("yaw rate (deg/s)", np.degrees(m[:, 2]), np.degrees(p[:, 2])),
             ("speed (m/s)", np.hypot(m[:, 0], m[:, 1]), np.hypot(p[:, 0], p[:, 1])),
             ("sway v (m/s)", m[:, 1], p[:, 1])]
     axs = []
     for k, (lab, a, b) in enumerate(rows):
         a_ = fig.add_subplot(cell(k), sharex=axs[0] if axs else None)
+        if k == 0 and bands is not None:
+            _heading_band(a_, t, bands)
         a_.plot(t, a, "k-", lw=1, label="measured")
-        a_.plot(t, b, "r--", lw=1, label="predicted")
+        a_.plot(t, b, "r--", lw=1, label="predicted" if bands is None else "predicted, nominal ship and start")
         if t_div is not None:
             a_.axvline(t_div, color="r", ls=":", lw=1.2, label=f"replay diverged (t = {t_div:.1f} s)")
             a_.set_ylim(*keep_measured_range(a))
         a_.set_ylabel(lab)
         a_.grid(True, alpha=0.3)
         axs.append(a_)
-    axs[0].legend(loc="best", fontsize=8)
+    if bands is not None:        # room above the data for the legend
+        lo, hi = axs[0].get_ylim()
+        axs[0].set_ylim(lo, hi + 0.7 * (hi - lo))
+        axs[0].legend(loc="upper left", fontsize=7, ncol=2)
+    else:
+        axs[0].legend(loc="best", fontsize=8)
     axs[0].set_title(f"{title}: time histories{div}")
     a_ = fig.add_subplot(cell(4), sharex=axs[0])
     a_.plot(t, np.degrees(run.inputs.delta), "b-", lw=1, label="rudder (deg)")
@@ -115,3 +129,41 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True):
         a.tick_params(labelbottom=False)
     fig.tight_layout()
     return fig
+
+
+def _track_bands(ax, view, bands, L: float, t, every: float, shown) -> None:
+    """A few drawn tracks and the 90 % position band (circles of its radius about the median track) on the track,
+    both cut where they leave the box of the ``shown`` positions [m] widened by its span on each side (a
+    diverging draw runs off to 1e14 m: it would squash the record to a point)."""
+    lo, hi = np.nanmin(shown, axis=0), np.nanmax(shown, axis=0)
+    pad = np.maximum(hi - lo, L)
+
+    def cut(x, y):
+        out = (x < lo[0] - pad[0]) | (x > hi[0] + pad[0]) | (y < lo[1] - pad[1]) | (y > hi[1] + pad[1])
+        return np.where(out, np.nan, x) / L, np.where(out, np.nan, y) / L
+
+    for k, tr in enumerate(bands.tracks):
+        ax.plot(*view.hv(*cut(tr[:, 0], tr[:, 1])), "-", color="tab:blue", lw=0.5, alpha=0.5,
+                label=f"drawn tracks ({len(bands.tracks)} of {bands.draws}; cut at the box of the record)" if k == 0
+                else None)
+    ang = np.linspace(0.0, 2 * np.pi, 49)
+    first = True
+    for tk in np.arange(t[0] + every, t[-1] + 1e-9, every):
+        i = min(int(np.searchsorted(t, tk)), len(t) - 1)
+        r, xm, ym = bands.radius[i], bands.x_median[i], bands.y_median[i]
+        if np.isfinite(r) and np.isfinite(xm) and np.isfinite(ym):
+            ax.plot(*view.hv(*cut(xm + r * np.cos(ang), ym + r * np.sin(ang))), "-", color="tab:purple",
+                    lw=0.9, label="90 % position band about the median track" if first else None)
+            first = False
+
+
+def _heading_band(ax, t, bands) -> None:
+    """The shaded 90 % heading band, and where diverged draws leave it unbounded, hatched over the panel's height."""
+    ok = np.isfinite(bands.lo) & np.isfinite(bands.hi)
+    ax.fill_between(t, np.where(ok, bands.lo, np.nan), np.where(ok, bands.hi, np.nan), color="tab:blue", alpha=0.25,
+                    lw=0, label=f"90 % band, {bands.draws} draws ({bands.diverged} diverged); "
+                                f"record inside {100 * bands.coverage90:.0f} % of samples")
+    if not ok.all():
+        ax.fill_between(t, 0, 1, where=~ok, transform=ax.get_xaxis_transform(), facecolor="none",
+                        edgecolor="tab:blue", hatch="//", lw=0, alpha=0.5,
+                        label="band unbounded there (over 5 % of the draws diverged)")

@@ -1,0 +1,346 @@
+"""Prediction bands of a replayed record: heading and position, 90 %, from the ship's and the run's uncertainty.
+
+:func:`prediction_bands` replays one record (:func:`trials.measured.predict.replay_record`) ``samples``
+times, each replay with
+
+* a ship drawn from the covariance of its identified parameters (the ship config's ``covariance:``
+  section, :func:`trials.measured.draws.parameter_covariance`, written in by name with
+  :func:`trials.measured.identify.ship_with_values`; a wind-load factor scales the record's measured
+  wind loads, relative to the covariance's own value), and
+* the record's start state (and a per-record effect) offset by a zero-mean normal draw of the
+  between-run spread of a run's own disturbance (the ``run_spread:`` section, :class:`mmg.ship.RunSpread`,
+  written by ``mmg identify``: ``start.u``, ``start.v``, ``start.r``, ``start.psi`` added to the first
+  logged state; ``<effect>.<parameter>`` a per-record effect the run does not already have).
+
+At every sample of the record the band is the 5 % and 95 % quantiles over the draws (numpy's default
+linear interpolation) of
+
+* the heading, unwrapped (:func:`numpy.unwrap`) and put on the same turn as the record's unwrapped
+  logged heading at the first sample, in degrees: directly comparable with the unwrapped record
+  sample by sample (:attr:`Bands.coverage90`: the share of the record's samples inside the band);
+* the distance of the predicted position from the draws' median track (the per-sample median of x and
+  of y): ``radius`` is its 90 % quantile, a disc about the median track that holds 90 % of the draws
+  (:attr:`Bands.position_coverage90`: the share of samples whose logged position lies inside it).
+
+A draw whose replay diverges still counts: from its divergence on its heading is taken as -inf for the
+lower and +inf for the upper quantile, and its distance from the median track as +inf, so divergences
+widen the band (to unbounded where more than 5 % of the draws, 10 % for the position, have diverged),
+never narrow it.  The draws are made from ``seed`` alone (the ship's and the run's from two streams),
+and the replays run on threads (the compiled replay releases the GIL): the same numbers for any
+number of threads.
+"""
+from __future__ import annotations
+
+import os
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from mmg.errors import InputError
+from mmg.replay import STATE
+from mmg.ship import RunSpread, Ship
+
+from .draws import WIND_FACTOR_NAMES, draw, parameter_covariance
+from .predict import MeasuredRun, Replayed, measured_run, replay_record
+
+__all__ = ["Bands", "prediction_bands", "BAND_KEYS", "QUANTILES", "SAMPLE_TRACKS"]
+
+QUANTILES = (0.05, 0.95)
+"""The quantiles bounding the 90 % heading band."""
+POSITION_QUANTILE = 0.90
+"""The quantile of the distance from the median track that bounds the position band."""
+SAMPLE_TRACKS = 12
+"""How many of the drawn tracks a :class:`Bands` keeps for its figure."""
+BAND_KEYS = ("draws", "diverged_draws", "heading_band_deg", "coverage90", "heading_band_median_width_deg",
+             "heading_band_unbounded_share", "coverage90_where_bounded", "position_band_m", "position_coverage90",
+             "position_band_median_radius_m")
+"""The keys :meth:`Bands.to_json` gives (``mmg predict --samples`` adds them to each run)."""
+
+
+@dataclass(frozen=True)
+class Bands:
+    """The 90 % bands of one record's prediction (module docstring); angles in degrees, lengths in metres.
+
+    Attributes
+    ----------
+    nominal : Replayed
+        The replay with the ship as given and the record's own start state (the band's centre line).
+    t : ndarray (N,)
+        The record's sample times [s].
+    heading_deg : ndarray (N,)
+        The record's logged heading, unwrapped [deg].
+    lo, hi : ndarray (N,)
+        The band's 5 % and 95 % quantiles of the predicted heading [deg] (``-inf``/``inf`` where
+        diverged draws leave it unbounded), on the record's turn.
+    nominal_deg : ndarray (N,)
+        The nominal replay's heading on the record's turn [deg].
+    x_median, y_median : ndarray (N,)
+        The draws' median track [m] (over the draws still finite there).
+    radius : ndarray (N,)
+        The 90 % quantile of the draws' distance from the median track [m].
+    tracks : ndarray (k, N, 2)
+        The first :data:`SAMPLE_TRACKS` drawn tracks, x and y [m] (for the figure).
+    draws, diverged : int
+        Replays made, and how many of them diverged somewhere in the record.
+    notes : tuple of str
+        What was and was not drawn (no covariance, no run spread, an effect not applied).
+    """
+
+    nominal: Replayed
+    t: np.ndarray
+    heading_deg: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    nominal_deg: np.ndarray
+    x_median: np.ndarray
+    y_median: np.ndarray
+    radius: np.ndarray
+    tracks: np.ndarray
+    draws: int
+    diverged: int
+    notes: tuple = ()
+
+    @property
+    def coverage90(self) -> float:
+        """The share of the record's samples whose unwrapped logged heading lies in [lo, hi]."""
+        return float(np.mean((self.heading_deg >= self.lo) & (self.heading_deg <= self.hi)))
+
+    @property
+    def position_coverage90(self) -> float:
+        """The share of the record's samples whose logged position lies within ``radius`` of the median track
+        (inside where the band is unbounded)."""
+        m = self.nominal.run.meas
+        with np.errstate(invalid="ignore"):
+            inside = np.hypot(m[:, 3] - self.x_median, m[:, 4] - self.y_median) <= self.radius
+        return float(np.mean(inside | (self.radius == np.inf)))        # unbounded: every draw diverged there too
+
+    @property
+    def unbounded_share(self) -> float:
+        """The share of the record's samples where diverged draws leave the heading band unbounded (inside
+        it, whatever the record does: read :attr:`coverage90` with this)."""
+        return float(np.mean(~(np.isfinite(self.lo) & np.isfinite(self.hi))))
+
+    @property
+    def coverage90_where_bounded(self) -> float:
+        """:attr:`coverage90` over the samples where the heading band is bounded alone (NaN where it is nowhere)."""
+        ok = np.isfinite(self.lo) & np.isfinite(self.hi)
+        h = self.heading_deg[ok]
+        return float(np.mean((h >= self.lo[ok]) & (h <= self.hi[ok]))) if ok.any() else float("nan")
+
+    @property
+    def median_width_deg(self) -> float:
+        """The median over the samples of the heading band's width hi - lo [deg] (inf where unbounded)."""
+        return float(np.median(self.hi - self.lo))
+
+    @property
+    def median_radius_m(self) -> float:
+        """The median over the samples of the position band's radius [m]."""
+        return float(np.median(self.radius))
+
+    def to_json(self) -> dict:
+        """The run's band keys (:data:`BAND_KEYS`): ``heading_band_deg`` ``{"t_s", "lo", "hi"}``,
+        ``position_band_m`` ``{"t_s", "x_median", "y_median", "radius"}`` at every sample, the coverages,
+        median width [deg] and radius [m], the share of samples where the heading band is unbounded and the
+        coverage over the others, the
+        draws and how many diverged (unbounded values: null)."""
+        lst = lambda a: [float(x) for x in a]          # noqa: E731
+        t = lst(self.t)
+        return {"draws": int(self.draws), "diverged_draws": int(self.diverged),
+                "heading_band_deg": {"t_s": t, "lo": lst(self.lo), "hi": lst(self.hi)},
+                "coverage90": self.coverage90, "heading_band_median_width_deg": self.median_width_deg,
+                "heading_band_unbounded_share": self.unbounded_share,
+                "coverage90_where_bounded": self.coverage90_where_bounded,
+                "position_band_m": {"t_s": t, "x_median": lst(self.x_median), "y_median": lst(self.y_median),
+                                    "radius": lst(self.radius)},
+                "position_coverage90": self.position_coverage90,
+                "position_band_median_radius_m": self.median_radius_m}
+
+    def to_pandas(self):
+        """Per sample (index ``t`` [s]): ``heading_deg`` (the record, unwrapped), ``nominal_deg``, ``lo_deg``,
+        ``hi_deg``, ``x_median_m``, ``y_median_m``, ``radius_m``."""
+        import pandas as pd
+
+        return pd.DataFrame({"heading_deg": self.heading_deg, "nominal_deg": self.nominal_deg, "lo_deg": self.lo,
+                             "hi_deg": self.hi, "x_median_m": self.x_median, "y_median_m": self.y_median,
+                             "radius_m": self.radius}, index=pd.Index(self.t, name="t"))
+
+    def plot(self, pyplot: bool = True):
+        """The replay figure (:func:`trials.measured.predict_plots.replay_figure`) with the bands drawn in."""
+        from .predict_plots import replay_figure
+
+        return replay_figure(self.nominal, pyplot=pyplot, bands=self)
+
+
+def _spread_of(spread, src: str) -> tuple[list[str], np.ndarray]:
+    """(names, std) of a ``run_spread`` (:class:`mmg.ship.RunSpread` or a mapping with ``names``, ``std``),
+    each name checked (``start.<u|v|r|psi>`` or ``<effect>.<fit parameter>``)."""
+    import mmg.effects as E
+
+    if isinstance(spread, RunSpread):
+        names, std = list(spread.names), np.asarray(spread.std, float)
+    else:
+        names, std = list(spread["names"]), np.asarray(spread["std"], float)
+    if std.shape != (len(names),) or not np.all(np.isfinite(std)) or np.any(std < 0):
+        raise InputError(src, "run_spread.std", f"expected {len(names)} finite non-negative standard deviations")
+    for i, n in enumerate(names):
+        kind, _, q = n.partition(".")
+        ok = q in ("u", "v", "r", "psi") if kind == "start" else False
+        if kind != "start":
+            try:
+                ok = _effect_slot(E.get(kind, "run_spread"), q) is not None
+            except InputError:
+                ok = False
+        if not ok:
+            raise InputError(src, f"run_spread.names.{i}", f"{n!r} is not start.<u|v|r|psi> nor <effect>.<parameter>")
+    return names, std
+
+
+def _effect_slot(effect, q: str):
+    """(position in ``effect``'s fit parameters, factor from SI to its unit) of quantity ``q`` (``..._rad`` for
+    a parameter in degrees), or None."""
+    for j, p in enumerate(effect.fit_parameters()):
+        if p.name == q:
+            return j, 1.0
+        if p.unit == "deg" and p.name.endswith("_deg") and q == p.name[:-4] + "_rad":
+            return j, 180.0 / np.pi
+    return None
+
+
+def _disturbed(run: MeasuredRun, names, row, notes: set) -> MeasuredRun:
+    """``run`` with its first logged state offset by the ``start.*`` draws and the drawn per-record effects
+    added (one the run already has is left as it is, noted in ``notes``)."""
+    import mmg.effects as E
+
+    off, eff = np.zeros(6), {}
+    for n, v in zip(names, row):
+        kind, _, q = n.partition(".")
+        if kind == "start":
+            off[STATE.index(q)] += v
+        else:
+            eff.setdefault(kind, []).append((q, v))
+    meas = run.meas
+    if np.any(off):
+        meas = meas.copy()
+        meas[0] += off
+    es = run.effects
+    for name, qs in eff.items():
+        if es is not None and es.get(name) is not None:
+            notes.add(f"{name} not drawn: the ship config has it already")
+            continue
+        e = E.get(name, "run_spread")
+        vec = [p.default for p in e.fit_parameters()]
+        for q, v in qs:
+            j, k = _effect_slot(e, q)
+            vec[j] += k * v
+        add = E.EffectSet(((e, e.from_fit(vec)),))
+        es = add if es is None else es.merged(add)
+    return replace(run, meas=meas, effects=es)
+
+
+def _ship_draws(ship: Ship, covariance, samples: int, seed: int, notes: list):
+    """(names, rows (samples, k), mean) of the ship's parameter draws; no names where there is no covariance."""
+    cov = ship.covariance if covariance is None else covariance
+    if cov is None:
+        notes.append("ship not drawn: the ship config has no covariance: section (the band is the run spread's alone)")
+        return [], np.zeros((samples, 0)), np.zeros(0)
+    names, mean, matrix, _ = parameter_covariance(ship, cov)
+    return names, draw(mean, matrix, samples, seed), mean
+
+
+def _one_replay(ship: Ship, run: MeasuredRun, names, row, mean, sp_names, sp_row, notes: set) -> np.ndarray:
+    """The predicted x, y [m] and heading [rad] (N, 3) of one draw: the ship's parameters ``row`` (``names``), the
+    run spread's ``sp_row``."""
+    from .identify import ship_with_values, with_fitted_wind, with_ship_effects
+
+    values = {n: float(v) for n, v in zip(names, row)}
+    wind = {n: values.pop(n) / m for n, m in zip(names, mean) if n in WIND_FACTOR_NAMES and m != 0}
+    s = ship_with_values(ship, values) if values else ship
+    r = with_fitted_wind(run, wind) if wind else run
+    r = with_ship_effects(r, s) if "rudder_offset" in values else r
+    r = _disturbed(r, sp_names, sp_row, notes) if len(sp_names) else r
+    return replay_record(s, r).pred[:, 3:6]
+
+
+def _unwrapped_deg(psi: np.ndarray, first: float) -> np.ndarray:
+    """Headings (..., N) [rad] unwrapped along the last axis, put on the turn of ``first`` [rad], in degrees."""
+    u = np.unwrap(psi, axis=-1)
+    k = np.round((first - u[..., :1]) / (2 * np.pi))
+    return np.degrees(u + 2 * np.pi * np.nan_to_num(k))
+
+
+def _quantile_bounds(x: np.ndarray, q=QUANTILES) -> tuple[np.ndarray, np.ndarray]:
+    """Per column of ``x`` (draws, N): the ``q`` quantiles with a NaN (a diverged draw) as -inf for the
+    lower and +inf for the upper one."""
+    with np.errstate(invalid="ignore"):
+        lo = np.quantile(np.where(np.isnan(x), -np.inf, x), q[0], axis=0)
+        hi = np.quantile(np.where(np.isnan(x), np.inf, x), q[1], axis=0)
+    return np.where(np.isnan(lo), -np.inf, lo), np.where(np.isnan(hi), np.inf, hi)   # inf - inf in the interpolation
+
+
+def _position_band(xy: np.ndarray):
+    """(x median, y median, radius) per sample of the drawn tracks ``xy`` (draws, N, 2) (module docstring)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)        # a sample where every draw diverged: NaN
+        xm, ym = np.nanmedian(xy[:, :, 0], axis=0), np.nanmedian(xy[:, :, 1], axis=0)
+    d = np.hypot(xy[:, :, 0] - xm, xy[:, :, 1] - ym)
+    with np.errstate(invalid="ignore"):
+        r = np.quantile(np.where(np.isnan(d), np.inf, d), POSITION_QUANTILE, axis=0)
+    return xm, ym, np.where(np.isnan(r), np.inf, r)
+
+
+def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=None, run_spread=None,
+                     jobs: int | None = None) -> Bands:
+    """The 90 % heading and position bands of one record's prediction (module docstring).
+
+    Parameters
+    ----------
+    ship : Ship
+        The (identified) ship; its ``covariance:`` and ``run_spread:`` sections are the defaults.
+    run : MeasuredRun or TrialRecord
+        The record (a :class:`~trials.files.records.TrialRecord` is made ready with :func:`measured_run`).
+    samples : int
+        Replays to draw (1 or more).
+    seed : int
+        Seed of the draws.
+    covariance : ParameterCovariance, mapping or DataFrame, optional
+        The parameters' covariance (:func:`trials.measured.draws.parameter_covariance`); default the
+        ship's; the ship is not drawn where neither is (said in :attr:`Bands.notes`).
+    run_spread : RunSpread or mapping, optional
+        ``names`` and ``std`` of the run's own disturbance; default the ship's; none drawn where
+        neither is.
+    jobs : int, optional
+        Threads (default every core).
+
+    Returns
+    -------
+    Bands
+    """
+    if isinstance(samples, bool) or int(samples) != samples or samples < 1:
+        raise InputError("samples", "", f"must be a whole number of 1 or more, got {samples!r}")
+    samples = int(samples)
+    run = run if isinstance(run, MeasuredRun) else measured_run(ship, run)
+    src = ship.source or ship.name
+    notes: list = []
+    names, rows, mean = _ship_draws(ship, covariance, samples, seed, notes)
+    spread = ship.run_spread if run_spread is None else run_spread
+    if spread is None:
+        notes.append("start state not drawn: the ship config has no run_spread: section")
+        sp_names, sp_rows = [], np.zeros((samples, 0))
+    else:
+        sp_names, std = _spread_of(spread, src)
+        sp_rows = np.random.default_rng([int(seed), 1]).normal(0.0, 1.0, (samples, len(std))) * std
+    seen: set = set()
+    with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
+        preds = list(pool.map(lambda k: _one_replay(ship, run, names, rows[k], mean, sp_names, sp_rows[k], seen),
+                              range(samples)))
+    P = np.stack(preds)                                              # (draws, N, 3): x, y, psi
+    nominal = replay_record(ship, run)
+    first = float(np.unwrap(run.meas[:, 5])[0])
+    lo, hi = _quantile_bounds(_unwrapped_deg(P[:, :, 2], first))
+    xm, ym, radius = _position_band(P[:, :, :2])
+    return Bands(nominal=nominal, t=np.asarray(run.t, float), heading_deg=np.degrees(np.unwrap(run.meas[:, 5])),
+                 lo=lo, hi=hi, nominal_deg=_unwrapped_deg(nominal.pred[:, 5], first), x_median=xm, y_median=ym,
+                 radius=radius, tracks=P[:SAMPLE_TRACKS, :, :2].copy(), draws=samples,
+                 diverged=int(np.sum(~np.isfinite(P).all(axis=(1, 2)))), notes=tuple(notes + sorted(seen)))
