@@ -91,6 +91,9 @@ def _args(argv=None):
                          "candidate of the inner choice beside the hull forms; default its default, "
                          "'fit'; docs/benchmark_frt.md's figures: 'sample')")
     ap.add_argument("--horizon", type=float, default=60.0, help="the short-horizon window [s] (default 60)")
+    ap.add_argument("--bands", type=int, default=0, metavar="N",
+                    help="each kept-out record's 90 %% heading band from N draws of its fold's model (ship from the "
+                         "written covariance, start from the run-to-run spread); pooled coverage and median width")
     ap.add_argument("--backend", choices=("serial", "loky"), default="loky")
     ap.add_argument("--jobs", type=int, default=2, help="local workers of the loky backend (default 2)")
     ap.add_argument("--markdown", action="store_true", help="print the tables as Markdown")
@@ -236,6 +239,10 @@ def summary_lines(res) -> list[str]:
     out = [f"whole record: mean heading RMS scaled {s['mean_scaled']:.2f} deg, identified {s['mean_identified']:.2f} deg, "
            f"ratio scaled/identified {s['ratio']:.2f} (over the {s['n_both_finite']} records both replays kept finite); "
            f"identified better on {s['better']} of {s['n']}"]
+    if "band_coverage90" in s:
+        out.append(f"90 % heading bands of the kept-out records ({s['band_records']} records): "
+                   f"{100 * s['band_coverage90']:.1f} % of their samples inside; median width "
+                   f"{s['band_median_width_deg']:.3g} deg (median over the records)")
     for key, words in (("heading_rms_deg", "heading RMS [deg]"), ("yaw_rate_rms_degps", "yaw-rate RMS [deg/s]"),
                        ("speed_rms_mps", "speed RMS [m/s]"), ("final_position_error_L", "final position error [L]")):
         spans = ((key, "whole record"), (key + tag, f"first {res.horizon_s:g} s"), ("window_" + key, "60 s windows"))
@@ -288,7 +295,8 @@ def main(argv=None) -> None:
           f"weighting {a.weighting or 'default'}; folds by {a.folds_by}; backend {a.backend} ({a.jobs} jobs)", flush=True)
     t0 = time.perf_counter()
     res = nested_cross_validate(cands, runs, folds=a.folds, inner_folds=a.inner_folds, initial=initial,
-                                folds_by=a.folds_by, backend=a.backend, n_jobs=a.jobs, horizon_s=a.horizon, **opts)
+                                folds_by=a.folds_by, backend=a.backend, n_jobs=a.jobs, horizon_s=a.horizon,
+                                band_samples=a.bands, **opts)
     print(f"\n{time.perf_counter() - t0:.0f} s wall\n")
     print("Per kept-out record (s: scaled esso_osaka_3m, i: identified without it; 'div.': the replay diverged):\n")
     print("\n".join(record_table(res, a.markdown)))

@@ -117,3 +117,30 @@ def test_a_fits_per_record_parts_add_up_and_the_written_covariance_holds_both_pa
                                           tuple(section["values"]), tuple(map(tuple, section["matrix"])),
                                           section["source"], section["method"])
     assert loaded.method == "posterior+run-jackknife"
+
+
+def test_kept_out_bands_pool_samples_inside_over_all_samples():
+    """The nested cross-validation's pooled band figures by hand: coverage is samples inside over samples (a
+    long record counts by its length), the width the median over the records of their medians."""
+    from trials.measured.nested import band_summary
+
+    recs = [{"band": {"samples": 100, "inside": 90, "median_width_deg": 4.0}},
+            {"band": {"samples": 300, "inside": 150, "median_width_deg": 10.0}},
+            {"band": {"samples": 50, "inside": 50, "median_width_deg": 2.0}}, {"name": "no band"}]
+    s = band_summary(recs)
+    assert s["band_coverage90"] == pytest.approx(290 / 450) and s["band_median_width_deg"] == 4.0
+    assert s["band_records"] == 3 and band_summary([{"name": "x"}]) == {}
+
+
+def test_a_folds_band_of_a_kept_out_record_draws_from_its_fit():
+    """band_scores of a record the fit did not see: the ship drawn from the fit's written covariance and the
+    start from its run-to-run spread, so the band has width; its inside count is its coverage times its samples."""
+    from trials.measured.nested import band_scores
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    _, runs = _records(ship, n_rec=4)
+    ident = identify(ship, runs[:3], free=["kappa", "epsilon"], segment_s=(np.inf,), say=lambda m: None, max_nfev=4)
+    b = band_scores(ident, runs[3], 16)
+    assert b["samples"] == len(runs[3].meas) and b["draws"] == 16
+    assert b["median_width_deg"] > 0.0 and 0.0 <= b["coverage90"] <= 1.0
+    assert b["inside"] == round(b["coverage90"] * b["samples"])

@@ -138,15 +138,48 @@ def _inner_task(task) -> list[dict]:
     return out
 
 
+def band_scores(ident, run, samples: int, seed: int = 0) -> dict:
+    """The 90 % heading band of ``run`` predicted by the identified model ``ident`` (its ship drawn from the
+    covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
+    :func:`trials.measured.bands.prediction_bands`): ``samples`` (the record's), ``inside`` (of them in the
+    band), ``coverage90``, ``median_width_deg``, ``unbounded_share``, ``draws``, ``diverged_draws``."""
+    from .bands import prediction_bands
+    from .identify import identification_covariance, run_spread
+
+    cov = identification_covariance(ident)
+    b = prediction_bands(ident.ship, run, samples, seed, covariance=cov if cov is not None else {"names": [], "matrix": []},
+                         run_spread=run_spread(ident), jobs=1)
+    n = len(b.t)
+    return {"samples": n, "inside": int(round(b.coverage90 * n)), "coverage90": b.coverage90,
+            "median_width_deg": b.median_width_deg, "unbounded_share": b.unbounded_share,
+            "draws": b.draws, "diverged_draws": b.diverged}
+
+
+def band_summary(records: list[dict]) -> dict:
+    """The kept-out records' 90 % heading bands pooled (where the records carry them, :func:`band_scores`):
+    ``band_coverage90`` (samples inside over all samples), ``band_median_width_deg`` (the median over the
+    records of each record's median width), ``band_records``; {} where none carries a band."""
+    b = [r["band"] for r in records if r.get("band")]
+    if not b:
+        return {}
+    return {"band_coverage90": sum(x["inside"] for x in b) / sum(x["samples"] for x in b),
+            "band_median_width_deg": float(np.median([x["median_width_deg"] for x in b])), "band_records": len(b)}
+
+
 def _outer_task(task) -> list[dict]:
-    """One outer fit: the fold's choice fitted on the whole outer training set, the kept-out records scored."""
-    outer, cand, train, tests, initial, kw, horizon_s = task
+    """One outer fit: the fold's choice fitted on the whole outer training set, the kept-out records scored
+    (with ``band_samples`` > 0 also their 90 % heading bands, :func:`band_scores`)."""
+    outer, cand, train, tests, initial, kw, horizon_s, band_samples = task
     ident = fit_model(cand.ship, train, initial=initial, **{**kw, **cand.options})
     values = {k: float(v) for k, v in ident.fit.values().items()}
-    return [{"name": r.name, "fold": outer, "choice": cand.name,
-             "scaled": replay_scores(replay_record(initial, r), horizon_s, initial),
-             "identified": replay_scores(ident.replay(r), horizon_s, ident.ship), "ship": ident.ship, "values": values}
-            for r in tests]
+    out = [{"name": r.name, "fold": outer, "choice": cand.name,
+            "scaled": replay_scores(replay_record(initial, r), horizon_s, initial),
+            "identified": replay_scores(ident.replay(r), horizon_s, ident.ship), "ship": ident.ship, "values": values}
+           for r in tests]
+    if band_samples:
+        for rec, r in zip(out, tests):
+            rec["band"] = band_scores(ident, r, band_samples, seed=outer)
+    return out
 
 
 def choose(rows: list[dict], names) -> tuple[str, dict]:
@@ -246,7 +279,8 @@ def _initial(candidates: dict, initial: Ship | None) -> Ship:
 
 def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int = 4, inner_folds: int = 3,
                           initial: Ship | None = None, folds_by: str = "order", backend: str = "serial",
-                          client=None, n_jobs=None, horizon_s: float = HORIZON_S, **kw) -> NestedCV:
+                          client=None, n_jobs=None, horizon_s: float = HORIZON_S, band_samples: int = 0,
+                          **kw) -> NestedCV:
     """Nested cross-validation (module docstring) of the procedure "choose among ``candidates`` by an
     inner ``inner_folds``-fold cross-validation, then fit the choice".
 
@@ -268,6 +302,9 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
         in one sweep, then the outer fits in another; the same numbers on every backend.
     horizon_s : float
         The short-horizon window [s] of the scores.
+    band_samples : int
+        With > 0, each kept-out record's 90 % heading band from that many draws of its fold's model
+        (:func:`band_scores`; records' ``band``).
     **kw
         :func:`~trials.measured.identify.identify`'s options common to every candidate.
     """
@@ -284,7 +321,8 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
             choices[k], tables[k] = choose([r for r in inner_rows if r["outer"] == k], list(candidates))
     else:
         choices = dict.fromkeys(range(n_out), next(iter(candidates)))
-    tasks = [(k, candidates[choices[k]], tr, te, initial, kw, horizon_s) for k, (tr, te) in enumerate(splits)]
+    tasks = [(k, candidates[choices[k]], tr, te, initial, kw, horizon_s, band_samples)
+             for k, (tr, te) in enumerate(splits)]
     parts = _sweep(_outer_task, tasks, [f"outer fold {k + 1}/{n_out}: fit {choices[k]} on {len(t[2])} records"
                                         for k, t in enumerate(tasks)], backend, client, n_jobs)
     folds_info = [{"fold": k, "choice": choices[k], "inner": tables.get(k, {}),
@@ -335,7 +373,8 @@ class NestedCV:
         x = float(np.mean([p[0] for p in both])) if both else float("nan")
         y = float(np.mean([p[1] for p in both])) if both else float("nan")
         return {"mean_scaled": x, "mean_identified": y, "ratio": x / y if both else float("nan"),
-                "better": better, "n": len(self.records), "n_both_finite": len(both), "diverged": div}
+                "better": better, "n": len(self.records), "n_both_finite": len(both), "diverged": div,
+                **band_summary(self.records)}
 
     def to_pandas(self):
         """One row per kept-out record: ``fold``, ``choice``, ``scaled_<score>`` and ``identified_<score>``
