@@ -766,7 +766,9 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
     src = rec.source or rec.name or "record"
     L = _record_length(rec, length, src)
     if rec.psi is None:
-        raise InputError(src, "heading", "the record has no heading channel")
+        from trials.files.logio import missing_channel
+
+        raise missing_channel(rec, "psi", "manoeuvre metrics need the heading")
     notes = list(rec.meta.get("notes", []))
     psi = np.asarray(rec.psi, dtype=float)
     order = rec.meta.get("delta_order")
@@ -813,7 +815,9 @@ def _record_turning(rec, psi, U, L: float, ctx) -> dict:
     order = rec.meta.get("delta_order")
     rudder = order if order is not None else rec.delta
     if rec.x is None or rec.y is None:
-        raise InputError(src, "lat_deg", "turning metrics need the track (positions)")
+        from trials.files.logio import missing_channel
+
+        raise missing_channel(rec, "x" if rec.x is None else "y", "turning metrics need the track (positions)")
     te = rec.meta.get("execute_s") if rudder is None else None
     m = turning_metrics(rec.t, rec.x, rec.y, psi, U, L, t_execute=te,
                         delta=None if order is not None else rec.delta, order=order, n=rec.n)
@@ -846,14 +850,19 @@ def _record_zigzag(rec, psi, speed_length, kind: str, angle, ctx) -> dict:
         if kind == "stype":
             a = _header_angle(rec, "switch_heading_deg") if angle is None else angle
             if a is None:
-                raise InputError(src, "switch_heading_deg", "an S-type log without rudder needs the switching heading "
-                                                            "in its header")
+                from trials.files.logio import missing_channel
+
+                raise missing_channel(rec, "delta", "an S-type trial without its rudder needs the switching "
+                                                    "heading (switch_heading_deg) in its header")
             first = 1 if first is None else first
             levels = (a, 0.0) if first > 0 else (0.0, -a)
         else:
             a = angle if angle is not None else _header_angle(rec, "heading_deg")
             if a is None:
-                raise InputError(src, "heading_deg", "a zigzag log without rudder needs --zigzag-angle")
+                from trials.files.logio import missing_channel
+
+                raise missing_channel(rec, "delta", "a zigzag without its rudder needs --zigzag-angle (or "
+                                                    "heading_deg in a log's header)")
             levels = (a, -a)
         m = zigzag_metrics(rec.t, psi, first=first, U=U, L=L, levels=levels, t_execute=rec.meta.get("execute_s"),
                            r=rec.r)
