@@ -7,6 +7,9 @@ import numpy as np
 
 from mmg.errors import InputError
 
+CHANNELS = ("psi", "delta", "r", "U", "u", "v")
+"""The channels the Nomoto identification reads: heading, rudder, yaw rate, speed (never ``n``)."""
+
 
 def _f(v, fmt="{:.4g}"):
     return "n/a" if v is None or not np.isfinite(v) else fmt.format(v)
@@ -81,10 +84,10 @@ def identify_log(path, length: float, speed: float | None = None, output_error: 
         raise InputError("--speed", "", f"speed must be a positive number of m/s, got {speed}")
     from trials.files.shipcheck import check_speed_option, read_for_ship
 
-    rec = read_for_ship(path, length)        # a length the record contradicts is refused
+    rec = read_for_ship(path, length, channels=CHANNELS)        # a length the record contradicts is refused
     if speed is not None:
         check_speed_option(rec, speed, length)
-    require_finite(rec, ("psi", "delta", "r", "U", "u", "v"), "mmg nomoto")   # heading, rudder, yaw rate, speed
+    require_finite(rec, CHANNELS, "mmg nomoto")
     note = None
     if rec.delta is None and rec.meta.get("format") == "log":
         from trials.files.rudder import with_rebuilt_rudder
