@@ -50,3 +50,30 @@ def test_rebuilt_rudder_of_a_log_without_kind_names_the_rudder_column():
     with pytest.raises(InputError) as e:
         manoeuvre_from_meta({}, "log.csv")
     assert e.value.field == "rudder_deg"
+
+
+@needs_frt()
+@pytest.mark.parametrize("column, channel, instead", [("r_angvelo [rad/s]", "r", "differentiated from the logged heading"),
+                                                     ("vm_velo [m/s]", "v", "")], ids=["r", "v"])
+def test_diagnose_says_a_channel_was_not_logged(tmp_path, column, channel, instead):
+    """A record without its yaw rate (sway) column: the diagnosis says in its JSON and console lines that the
+    channel was not logged, by its column, and what its residual compared instead; a channel compared with
+    nothing (v) has no residual RMS (None), not the 0 of a residual never formed."""
+    from mmg.resources import ship_path
+    from mmg.ship import load_ship
+    from trials.measured.diagnose import diagnose, prepare
+
+    ship = load_ship(ship_path("esso_osaka_3m"))
+    recs = prepare(ship, [_without(tmp_path, column)])
+    d = diagnose(ship, recs, candidates=["heading_bias"], max_nfev=2, screen_nfev=1)
+    js = d.to_json()
+    entry = next(e for e in js["absent_channels"] if e["channel"] == channel)
+    assert entry["column"] == column and entry["record"] == recs[0].name
+    assert (instead in entry["compared_instead"]) if instead else entry["compared_instead"] == ""
+    line = next(ln for ln in d.summary_lines() if ln.strip().startswith(f"{channel} not logged by"))
+    assert column in line and (instead in line if instead else "no residual" in line)
+    if not instead:
+        assert js["rms_after"][channel] is None and js["rms_config"][channel] is None
+    else:
+        assert js["rms_after"][channel] > 0
+    assert set(recs[0].absent) >= {channel}

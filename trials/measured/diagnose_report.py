@@ -312,11 +312,26 @@ def summary_lines(diag) -> list[str]:
         u = CHANNEL_UNITS.get(c, "")
         lines.append(f"  {c + ' [' + u + ']':<26}{fmt3(diag.rms_config.get(c)):>10}{fmt3(diag.rms_before.get(c)):>13}"
                      f"{fmt3(diag.rms_after.get(c)):>10}")
+    lines += absent_lines(getattr(diag, "absent_channels", None) or [])
     if diag.unexplained:
         lines.append(f"unexplained: {diag.unexplained_description}")
     for r in diag.runs or []:
         lines.append(f"  record {r.records[0].name}: " + ("; ".join(
             f"{e} {format_values(e, r.parameters.get(e, {}))}" for e in r.named) or "nothing named"))
+    return lines
+
+
+def absent_lines(table) -> list:
+    """A line per channel some record does not log (``  r not logged by a, b (column r_angvelo [rad/s]): its
+    residual compares ...``), from :func:`trials.measured.diagnose.absent_table`."""
+    by = {}
+    for e in table:
+        by.setdefault((e["channel"], e["column"], e["compared_instead"]), []).append(e["record"])
+    lines = []
+    for (c, col, what), names in by.items():
+        where = f"column {col}" if col else "no column for it in the layout"
+        then = f"its residual compares {what}" if what else "left out of the fit; no residual reported from it"
+        lines.append(f"  {c} not logged by {', '.join(names)} ({where}): {then}")
     return lines
 
 
