@@ -736,6 +736,38 @@ def check_turning_diameters(m: dict, L: float, src: str) -> None:
                                               f"(this turn is of a ship of at most {d * L / MIN_TURN_DIAMETER_L:.3g} m)")
 
 
+TRIAL_DEFINED = {"rudder_deg": "rudder_deg"}
+"""Metrics a trial defines, by the trial header's key they are filled from when the record cannot give them
+(:func:`fill_from_trial`): the rudder angle of a turn, the rudder amplitude of a zigzag or S-type."""
+
+
+def fill_from_trial(m: dict, trial: dict, notes: list | None = None) -> dict:
+    """Fill the metrics of :data:`TRIAL_DEFINED` that ``m`` leaves None (a record without its rudder
+    channel, a turn whose execute the trial set) from the trial's definition.
+
+    Parameters
+    ----------
+    m : dict
+        Metrics (:func:`turning_metrics`, :func:`zigzag_metrics`); filled in place.
+    trial : dict
+        The trial's header values (``rudder_deg``: the commanded rudder [deg], signed for a turn, the
+        amplitude for a zigzag or S-type, as in :meth:`trials.runs.trial.Trial.summary`).
+    notes : list, optional
+        Gets a line per metric filled.
+
+    Returns
+    -------
+    dict
+        ``m``.
+    """
+    for key, src in TRIAL_DEFINED.items():
+        if key in m and m[key] is None and trial.get(src) is not None:
+            m[key] = float(trial[src])
+            if notes is not None:
+                notes.append(f"{key} is the trial's commanded {src} (the record has no rudder channel)")
+    return m
+
+
 def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
     """Metrics of a read record, refusing one that is not the manoeuvre asked for.
 
@@ -777,6 +809,9 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
     asked = kind
     kind = kind or rec.meta.get("kind")
     if kind not in ("turning", "zigzag", "stype"):
+        if kind and not asked:
+            raise InputError(src, "kind", f"the header's trial kind is {kind}: mmg metrics measures turning, zigzag "
+                                          f"and S-type trials (pass --kind to read the record as one)")
         kind = _guess_kind(rec, psi, rudder, order is None, src)
     out = {"record": rec.name, "source": rec.source, "kind": kind, "length_m": L}
     ctx = (src, f"--kind {asked}" if asked else "kind", notes)
@@ -784,6 +819,8 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
         out.update(_record_turning(rec, psi, U, L, ctx))
     else:
         out.update(_record_zigzag(rec, psi, (U, L), kind, angle, ctx))
+    if rec.meta.get("kind") == kind:                     # the header describes this trial
+        fill_from_trial(out, rec.meta, notes)
     out["execute_s"] = out.get("execute_s", out.get("execute_times_s", [None])[0])
     te, U0 = out["execute_s"], out.get("approach_speed_mps")
     if te is not None and U0 and te - 10.0 >= rec.t[0]:
