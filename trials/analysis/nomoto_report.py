@@ -50,20 +50,18 @@ def _rms_text(v) -> str:
 
 def _fit_table(ident) -> list:
     """The fits' parameters, dimensionless [-] and in seconds, with heading RMS [deg] and usability."""
+    from trials.files.tables import text_table
+
     z = ident.zigzag
-    w = max(len(label) for label, _, _ in ident.fits().values()) + 2
-    head = ("K' [-]", "T1' [-]", "T2' [-]", "T3' [-]", "K [1/s]", "T1 [s]", "T2 [s]", "T3 [s]", "psi RMS [deg]")
-    lines = [f"fits (K' = K L/U, T' = T U/L; L = {z.L:g} m, U = {z.U:.4g} m/s):",
-             f"{'method':{w}s}" + "".join(f" {h:>10s}" for h in head) + "  fit"]
-    for _, r in ident.to_pandas().iterrows():
-        key = next(k for k, (lab, _, _) in ident.fits().items() if lab == r["method"])
+    head = ("method", "K' [-]", "T1' [-]", "T2' [-]", "T3' [-]", "K [1/s]", "T1 [s]", "T2 [s]", "T3 [s]",
+            "psi RMS [deg]", "fit")
+    rows = []
+    for (key, _), (_, r) in zip(ident.fits().items(), ident.to_pandas().iterrows()):
         dim = ident.dimensional(key)
-        vals = [_f(r[c]) for c in ("K", "T1", "T2", "T3")]
-        vals += [_f(np.nan if dim.get(c) is None else dim[c]) for c in ("K_per_s", "T1_s", "T2_s", "T3_s")]
-        vals.append(_rms_text(r["rms_deg"]))
-        lines.append(f"{r['method']:{w}s}" + "".join(f" {v:>10s}" for v in vals)
-                     + ("  ok" if r["usable"] else "  UNUSABLE"))
-    return lines
+        rows.append([r["method"], *(_f(r[c]) for c in ("K", "T1", "T2", "T3")),
+                     *(_f(np.nan if dim.get(c) is None else dim[c]) for c in ("K_per_s", "T1_s", "T2_s", "T3_s")),
+                     _rms_text(r["rms_deg"]), "ok" if r["usable"] else "UNUSABLE"])
+    return [f"fits (K' = K L/U, T' = T U/L; L = {z.L:g} m, U = {z.U:.4g} m/s):"] + text_table(head, rows, "<" + ">" * 9 + "<")
 
 
 def identify_log(path, length: float, speed: float | None = None, output_error: bool = True):
