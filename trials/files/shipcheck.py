@@ -251,7 +251,7 @@ def check_speed_option(rec, speed: float, L: float, src: str | None = None, opti
     src = src or rec.source or rec.name or "record"
     fn = speed / math.sqrt(G * L)
     if fn > FROUDE_MAX:
-        raise InputError(option, f"{speed:g}", f"is Froude number {fn:.3g} for a {L:g} m ship (at most {FROUDE_MAX:g})")
+        raise InputError(option, f"{speed:.4g} m/s", f"is Froude number {fn:.3g} for a {L:g} m ship (at most {FROUDE_MAX:g})")
     try:
         U = np.abs(np.asarray(rec.speed(), dtype=float))
     except ValueError:
@@ -261,7 +261,7 @@ def check_speed_option(rec, speed: float, L: float, src: str | None = None, opti
         return
     mid = float(np.median(U[U >= MOVING_FRACTION * np.percentile(U, 95)]))
     if mid > 0 and not 0.5 <= speed / mid <= 2.0:
-        raise InputError(option, f"{speed:g}", f"the record {src} runs at {mid:.3g} m/s (median): the speed given is "
+        raise InputError(option, f"{speed:.4g} m/s", f"the record {src} runs at {mid:.3g} m/s (median): the speed given is "
                                                f"{speed / mid:.3g} times that")
 
 
