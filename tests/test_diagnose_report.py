@@ -291,3 +291,42 @@ def test_negative_interval_reads_as_a_range():
                      {"delta_bic": 61.04, "z": 30.2, "false_alarm_probability": 0.0031})
     assert "bias -1.52 deg" in ln and "-1.62 to -1.42 deg" in ln and "false-alarm p 0.00310" in ln
     _check_plain([ln])
+
+
+# --------------------------------------------------------------------------- tables that never run together
+
+
+def _cells(line):
+    return re.split(r"\s{2,}", line.strip())
+
+
+@pytest.mark.parametrize("ev", [{"delta_bic": 886.0, "z": 62.0, "false_alarm_probability": 0.00671},
+                                {"delta_bic": -1.234e+300, "z": -9.87e-300, "false_alarm_probability": 1e-300}],
+                         ids=["reported", "extreme"])
+def test_evidence_panel_and_rms_table_keep_columns_apart(ev):
+    """The figure's evidence table and the console's RMS table: every cell stays a cell (two spaces at least
+    between columns) for any value, the extreme ones included; the parameter panel's title names the effect in
+    words ("heading bias = -2.00 deg"), not the parameter's key."""
+    from matplotlib.figure import Figure
+
+    from trials.measured.diagnose_plots import _evidence_lines, _interval_panels
+    from trials.measured.diagnose_report import fmt3, summary_lines
+
+    rms = {"u": 1.5e+300, "v": -2.5e-300, "r": 123456.0, "heading": 0.00671, "position": None}
+    diag = NS(named=["heading_bias"], evidence={"heading_bias": ev}, not_identifiable=[],
+              parameters={"heading_bias": {"bias_deg": -2.0}}, intervals_95={"heading_bias": {"bias_deg": [-2.5, -1.5]}},
+              rounds=[], unexplained=False, model_form_mismatch={}, straight_runs=[], runs=[], absent_channels=[],
+              rms_config=rms, rms_before=rms, rms_after=rms)
+    lines = _evidence_lines(diag)
+    assert _cells(lines[0]) == ["effect", "dBIC", "z", "p"]
+    assert _cells(lines[1]) == ["heading_bias", fmt3(ev["delta_bic"]), fmt3(ev["z"]), fmt3(ev["false_alarm_probability"])]
+    text = summary_lines(diag)
+    head = next(i for i, ln in enumerate(text) if ln.startswith("residual RMS"))
+    assert _cells(text[head]) == ["residual RMS (replay - log)", "config", "ship fitted", "+ named"]
+    for c, ln in zip(rms, text[head + 1:head + 6]):
+        assert _cells(ln)[1:] == [fmt3(rms[c])] * 3, ln
+    fig = Figure()
+    _interval_panels(fig, fig.add_gridspec(7, 1), 0, diag)
+    titles = [ax.get_title() for ax in fig.axes]
+    assert any(t.startswith("heading bias = -2.00 deg") for t in titles), titles
+    assert not any("bias_deg" in t for t in titles)

@@ -122,3 +122,22 @@ def test_identify_without_effects_unchanged():
     assert [f.name for f in fp] == ["current.north_mps", "current.east_mps", "rudder_offset.offset_deg"]
     assert [f.index for f in fp] == [0, 0, 1] and [f.sub for f in fp] == [0, 1, 0]
     assert FreeParameter("Y_r", "hull", 0, 1.0, 0.1).sub == 0
+
+
+@pytest.mark.parametrize("ship_name, resistance", [("esso_osaka", "X_uu"), ("kvlcc2_l7", "X_0")])
+def test_shallow_water_scales_every_hulls_resistance(ship_name, resistance):
+    """The resistance correction reaches the hull's own resistance coefficient whatever its name (X_uu of the
+    Kijima form, X_0 of the MMG standard method): at H/T = 1.5 it is multiplied by Furukawa et al.'s (2016)
+    1 + 0.388 (T/H)^2, computed here by hand; no other X coefficient moves."""
+    from mmg.model import pack
+    from mmg.ship import load_ship
+
+    ship = load_ship(ship_name)
+    pk0 = pack(ship)
+    sh = E.ShallowWater.pack(pk0, {"depth_to_draft": 1.5}, ship)
+    ratio = {n: sh.hull_coef[i] / pk0.hull_coef[i] for i, n in enumerate(ship.hull.names)
+             if ship.hull.axes[i] == "X" and pk0.hull_coef[i] != 0}
+    assert ratio[resistance] == pytest.approx(1 + 0.388 * (1 / 1.5) ** 2, rel=1e-12)
+    assert all(r == 1.0 for n, r in ratio.items() if n != resistance)
+    assert resistance in E.ShallowWater.changed_coefficients(ship)
+    assert ship.hull.resistance_names() == (resistance,)

@@ -37,7 +37,7 @@ def test_full_scale_propeller_speed_in_another_unit_refused(tmp_path, factor, un
         p = _scaled(src, tmp_path / src.name, "n_prop [rps]", factor)
         with pytest.raises(sc.ShipMismatch, match=f"tip speed.*{unit}") as e:
             sc.read_for_ship(p, esso)
-        assert e.value.field == "n_prop"
+        assert e.value.field == "n_prop [rps]"          # the column, by its exact header
         with pytest.raises(sc.ShipMismatch, match=unit):       # a length only (mmg metrics --length 325)
             sc.read_for_ship(p, 325.0)
 

@@ -123,7 +123,7 @@ def test_cli_writes_the_exact_schema(cli_run):
 
 @pytest.mark.parametrize("argv, names", [
     (["imo", "no_such_ship"], "no_such_ship"),
-    (["imo", "esso_osaka", "--speed", "10"], "--speed"),
+    (["imo", "esso_osaka", "--speed", "0"], "--speed"),
     (["imo", "esso_osaka", "--speed", "-2 kn"], "--speed"),
     (["imo", "esso_osaka_3m"], "--speed"),                    # no bundled trial gives its speed
     (["imo", "esso_osaka", "--samples", "4"], "--samples"),   # no covariance in the bundled ship

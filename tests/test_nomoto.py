@@ -268,3 +268,67 @@ def test_nomoto_paper_command_writes_tables(tmp_path):
 
     assert main(["nomoto-paper", "--out", str(tmp_path), "--fast"]) == 0
     assert (tmp_path / "artyszuk_tables.md").exists() and (tmp_path / "table8.csv").exists()
+
+
+# ---- a failed fit is labelled unusable, never shown as a result ------------------------------
+def test_fit_problem_names_non_physical_and_diverged_fits():
+    """Rules of :func:`fit_problem` on hand-made models: a positive, well replayed model passes; a
+    negative gain or time constant, a non-finite or worse-than-no-turn replay each fail, with the reason."""
+    good = nm.NomotoModel(2.0, 1.5, 0.2, 0.4)
+    assert nm.fit_problem(good, 1.0, 20.0) == ""
+    assert nm.fit_problem(nm.first_order(2.0, 1.0), 1.0, 20.0) == ""
+    assert "K = -2 not positive" in nm.fit_problem(nm.NomotoModel(-2.0, 1.5, 0.2, 0.4), 1.0, 20.0)
+    assert "T2 = -0.2 not positive" in nm.fit_problem(nm.NomotoModel(2.0, 1.5, -0.2, 0.4), 1.0, 20.0)
+    assert "diverged" in nm.fit_problem(good, float("inf"), 20.0)
+    assert "worse than no turn" in nm.fit_problem(good, 25.0, 20.0)
+    assert "not real" in nm.fit_problem(nm.NomotoModel(2.0, float("nan"), float("nan"), 0.4), float("nan"), 20.0)
+
+
+def test_simulated_zigzag_fits_are_all_usable(sim2):
+    ident = nm.identify(a.sim_record(sim2), 100.0, 5.0, output_error=False)
+    assert all(ident.usable(k) for k in ident.fits()), ident.problems
+    d = ident.to_dict()
+    # K [1/s] = K' U/L, T [s] = T' L/U (U = 5 m/s, L = 100 m)
+    dim = d["second_order_least_squares"]["dimensional"]
+    assert np.isclose(dim["K_per_s"], d["second_order_least_squares"]["K"] * 5.0 / 100.0)
+    assert np.isclose(dim["T1_s"], d["second_order_least_squares"]["T1"] * 100.0 / 5.0)
+
+
+@pytest.mark.skipif(not (DATA / "zigzag").is_dir(), reason="FRT-DS-ESSO data not present")
+def test_failed_four_point_fit_is_labelled_unusable_in_console_json_and_figure(tmp_path, monkeypatch):
+    """zigzag 14:03:39 (3 m model): the four-point fit has K, T1 < 0 and a heading replay that diverges.
+    The console, the JSON and the figure say it is unusable; its RMS is not printed as a result and its
+    heading is not drawn; every parameter column carries its unit."""
+    import matplotlib.pyplot as plt
+
+    from trials.analysis.nomoto_plot import plot_identification
+    from trials.analysis.nomoto_report import report
+    from trials.files.logio import read_record
+
+    ident = nm.identify(read_record(DATA / "zigzag" / "zigzag_31-Jul-2020_14_03_39.csv"), 3.0, output_error=False)
+    fp = ident.four_point
+    assert fp.K < 0 and fp.T1 < 0                      # the failure this test is about
+    assert not ident.usable("four_point") and ident.usable("least_squares")
+    d = ident.to_dict()
+    assert d["second_order_four_point"]["usable"] is False
+    assert "K = -0.0821" in d["second_order_four_point"]["unusable_because"]
+    assert d["second_order_least_squares"]["usable"] is True
+    text = report(ident)
+    row = next(ln for ln in text.splitlines() if ln.startswith("2nd order four-point"))
+    assert row.rstrip().endswith("UNUSABLE")
+    assert "33374483332172" not in text                 # no 14-digit RMS printed as if measured
+    assert any(ln.startswith("2nd order four-point: UNUSABLE, K = -0.0821") for ln in text.splitlines())
+    header = next(ln for ln in text.splitlines() if ln.startswith("method"))
+    for col in ("K' [-]", "T1' [-]", "K [1/s]", "T1 [s]", "T2 [s]", "T3 [s]", "psi RMS [deg]"):
+        assert col in header
+    figs = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: figs.append(fig))
+    plot_identification(ident, tmp_path / "n.png")
+    ax = figs[0].axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    fp_label = next(lb for lb in labels if lb.startswith("2nd order four-point"))
+    assert "UNUSABLE" in fp_label and "RMS 3" not in fp_label.split("\n")[0]
+    drawn = [ln.get_label() for ln in ax.get_lines() if len(ln.get_xdata())]
+    assert not any(lb.startswith("2nd order four-point") for lb in drawn)
+    monkeypatch.undo()
+    plt.close(figs[0])

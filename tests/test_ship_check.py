@@ -335,3 +335,33 @@ def test_nomoto_frt_layout_equals_project_format(full_frt, sims, tmp_path, capsy
     x, y = docs
     keys = [k for k in x if k not in ("record", "source", "name")]
     assert keys and {k: x[k] for k in keys} == {k: y[k] for k in keys}
+
+
+# --------------------------------------------------------------------------- checks judge only the channels used
+
+
+def test_plausibility_checks_judge_only_the_channels_a_command_uses(sims, tmp_path, capsys):
+    """ZZ20's log with its rpm column x 10 (a tip speed of ~190 m/s for the 325 m ship): ``mmg nomoto``, which
+    never reads the propeller, identifies it; ``mmg metrics``, which reads it, refuses it naming the column
+    `rpm`; check_record_ship with channels leaving out ``n`` accepts the record, with ``n`` refuses it."""
+    from trials.files.logio import read_record
+    from trials.files.shipcheck import ShipMismatch, check_record_ship, tip_speed
+
+    src = sims["zz20"][0]
+    lines = src.read_text().splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
+    assert lines[head].split(",")[5] == "rpm"
+    rows = [ln.split(",") for ln in lines[head + 1:]]
+    for r in rows:
+        r[5] = repr(float(r[5]) * 10)
+    bad = tmp_path / "zz20_rpm_x10.csv"
+    bad.write_text("\n".join(lines[:head + 1] + [",".join(r) for r in rows]) + "\n")
+    rec = read_record(bad)
+    assert tip_speed(np.percentile(rec.n, 99), 0.02 * 325.0) > 80.0          # the implausible channel
+    rc, out, err = _cli(["nomoto", bad, "--length", "325", "--no-output-error"], capsys)
+    assert rc == 0, err
+    rc, out, err = _cli(["metrics", bad], capsys)
+    assert rc == 2 and err.strip().startswith(f"error: {bad}: rpm: "), err
+    check_record_ship(rec, 325.0, channels=("psi", "delta", "r", "U", "u", "v"))
+    with pytest.raises(ShipMismatch):
+        check_record_ship(rec, 325.0, channels=("psi", "n"))

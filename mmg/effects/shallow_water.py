@@ -6,7 +6,9 @@ with the effective aspect ratio k_e(q) = k / (T/(2H) + ((pi T/(2H)) cot(pi T/(2H
 applied here as the *ratio* shallow/deep of those estimates to the ship's own derivatives
 (Y_v: q = 2.3, Y_r, N_r: q = 0.7, N_v: q = 1.7; the Kijima beta-derivatives take the factors of
 the v-derivatives: Y_beta = -Y_v, N_beta = -N_v); the nonlinear drift-yaw terms N_bbr, N_brr
-times 1 + 6 (T/H)^2.5 and the resistance X_uu times 1 + 0.388 (T/H)^2 (Furukawa et al. 2016);
+times 1 + 6 (T/H)^2.5 and the resistance (the hull's resistance coefficients,
+:meth:`mmg.ship.HullModel.resistance_names`: X_uu of the Kijima form, X_0 of the MMG standard
+method) times 1 + 0.388 (T/H)^2 (Furukawa et al. 2016);
 the added masses m_x, m_y and J_z times the factors ((H/T-1)^a + ...)/(H/T-1)^a of the same
 collection; the wake (1 - w_P0) times cos(1.4 C_b T/H).  Deep water is depth_to_draft -> inf.
 
@@ -34,7 +36,8 @@ def _ke(k, h, q):
 
 
 def factors(ship, h: float) -> dict:
-    """Multiplying factors of the corrected quantities at h = T / H (0 deep)."""
+    """Multiplying factors of the corrected quantities at h = T / H (0 deep), by hull coefficient name
+    (the resistance by the ship's own names of it), ``m_x``, ``m_y``, ``J_z`` and ``one_minus_w``."""
     pa = ship.particulars
     L, B, T, Cb = pa.L, pa.B, pa.T, pa.C_b
     k = 2.0 * T / L
@@ -51,7 +54,7 @@ def factors(ship, h: float) -> dict:
     jz = (c ** 0.82 + 0.413 + 0.0192 * B / T + 0.00554 * (B / T) ** 2) / c ** 0.82
     return {"Y_beta": yv, "Y_v": yv, "Y_r": yr, "N_beta": nv, "N_v": nv, "N_r": nr,
             "N_bbr": 1 + 6 * h ** 2.5, "N_brr": 1 + 6 * h ** 2.5, "N_vvr": 1 + 6 * h ** 2.5, "N_vrr": 1 + 6 * h ** 2.5,
-            "X_uu": 1 + 0.388 * h ** 2, "m_x": max(mx, 1.0), "m_y": my, "J_z": jz,
+            **dict.fromkeys(ship.hull.resistance_names(), 1 + 0.388 * h ** 2), "m_x": max(mx, 1.0), "m_y": my, "J_z": jz,
             "one_minus_w": math.cos(1.4 * Cb * h)}
 
 

@@ -736,6 +736,38 @@ def check_turning_diameters(m: dict, L: float, src: str) -> None:
                                               f"(this turn is of a ship of at most {d * L / MIN_TURN_DIAMETER_L:.3g} m)")
 
 
+TRIAL_DEFINED = {"rudder_deg": "rudder_deg"}
+"""Metrics a trial defines, by the trial header's key they are filled from when the record cannot give them
+(:func:`fill_from_trial`): the rudder angle of a turn, the rudder amplitude of a zigzag or S-type."""
+
+
+def fill_from_trial(m: dict, trial: dict, notes: list | None = None) -> dict:
+    """Fill the metrics of :data:`TRIAL_DEFINED` that ``m`` leaves None (a record without its rudder
+    channel, a turn whose execute the trial set) from the trial's definition.
+
+    Parameters
+    ----------
+    m : dict
+        Metrics (:func:`turning_metrics`, :func:`zigzag_metrics`); filled in place.
+    trial : dict
+        The trial's header values (``rudder_deg``: the commanded rudder [deg], signed for a turn, the
+        amplitude for a zigzag or S-type, as in :meth:`trials.runs.trial.Trial.summary`).
+    notes : list, optional
+        Gets a line per metric filled.
+
+    Returns
+    -------
+    dict
+        ``m``.
+    """
+    for key, src in TRIAL_DEFINED.items():
+        if key in m and m[key] is None and trial.get(src) is not None:
+            m[key] = float(trial[src])
+            if notes is not None:
+                notes.append(f"{key} is the trial's commanded {src} (the record has no rudder channel)")
+    return m
+
+
 def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
     """Metrics of a read record, refusing one that is not the manoeuvre asked for.
 
@@ -766,7 +798,9 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
     src = rec.source or rec.name or "record"
     L = _record_length(rec, length, src)
     if rec.psi is None:
-        raise InputError(src, "heading", "the record has no heading channel")
+        from trials.files.logio import missing_channel
+
+        raise missing_channel(rec, "psi", "manoeuvre metrics need the heading")
     notes = list(rec.meta.get("notes", []))
     psi = np.asarray(rec.psi, dtype=float)
     order = rec.meta.get("delta_order")
@@ -775,6 +809,9 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
     asked = kind
     kind = kind or rec.meta.get("kind")
     if kind not in ("turning", "zigzag", "stype"):
+        if kind and not asked:
+            raise InputError(src, "kind", f"the header's trial kind is {kind}: mmg metrics measures turning, zigzag "
+                                          f"and S-type trials (pass --kind to read the record as one)")
         kind = _guess_kind(rec, psi, rudder, order is None, src)
     out = {"record": rec.name, "source": rec.source, "kind": kind, "length_m": L}
     ctx = (src, f"--kind {asked}" if asked else "kind", notes)
@@ -782,6 +819,8 @@ def record_metrics(rec, kind=None, length=None, angle=None) -> dict:
         out.update(_record_turning(rec, psi, U, L, ctx))
     else:
         out.update(_record_zigzag(rec, psi, (U, L), kind, angle, ctx))
+    if rec.meta.get("kind") == kind:                     # the header describes this trial
+        fill_from_trial(out, rec.meta, notes)
     out["execute_s"] = out.get("execute_s", out.get("execute_times_s", [None])[0])
     te, U0 = out["execute_s"], out.get("approach_speed_mps")
     if te is not None and U0 and te - 10.0 >= rec.t[0]:
@@ -813,7 +852,9 @@ def _record_turning(rec, psi, U, L: float, ctx) -> dict:
     order = rec.meta.get("delta_order")
     rudder = order if order is not None else rec.delta
     if rec.x is None or rec.y is None:
-        raise InputError(src, "lat_deg", "turning metrics need the track (positions)")
+        from trials.files.logio import missing_channel
+
+        raise missing_channel(rec, "x" if rec.x is None else "y", "turning metrics need the track (positions)")
     te = rec.meta.get("execute_s") if rudder is None else None
     m = turning_metrics(rec.t, rec.x, rec.y, psi, U, L, t_execute=te,
                         delta=None if order is not None else rec.delta, order=order, n=rec.n)
@@ -846,14 +887,19 @@ def _record_zigzag(rec, psi, speed_length, kind: str, angle, ctx) -> dict:
         if kind == "stype":
             a = _header_angle(rec, "switch_heading_deg") if angle is None else angle
             if a is None:
-                raise InputError(src, "switch_heading_deg", "an S-type log without rudder needs the switching heading "
-                                                            "in its header")
+                from trials.files.logio import missing_channel
+
+                raise missing_channel(rec, "delta", "an S-type trial without its rudder needs the switching "
+                                                    "heading (switch_heading_deg) in its header")
             first = 1 if first is None else first
             levels = (a, 0.0) if first > 0 else (0.0, -a)
         else:
             a = angle if angle is not None else _header_angle(rec, "heading_deg")
             if a is None:
-                raise InputError(src, "heading_deg", "a zigzag log without rudder needs --zigzag-angle")
+                from trials.files.logio import missing_channel
+
+                raise missing_channel(rec, "delta", "a zigzag without its rudder needs --zigzag-angle (or "
+                                                    "heading_deg in a log's header)")
             levels = (a, -a)
         m = zigzag_metrics(rec.t, psi, first=first, U=U, L=L, levels=levels, t_execute=rec.meta.get("execute_s"),
                            r=rec.r)

@@ -14,7 +14,9 @@ def plot_identification(ident: "nm.NomotoIdentification", path) -> Path:
     Upper panel: heading and rudder [deg] against s' = t U/L [-] (top axis time
     after the execute [s]); CR1, OS1, CR2, OS2 marked; the headings simulated
     from the execute with the recorded rudder by the classical 1st-order model,
-    the four-point, least-squares and output-error 2nd-order models.  Lower
+    the four-point, least-squares and output-error 2nd-order models; a fit that
+    is unusable (:func:`trials.analysis.nomoto.fit_problem`) is not drawn, its
+    legend entry says why.  Lower
     panel: omega' and eps' used by the point methods.
 
     Parameters
@@ -24,6 +26,8 @@ def plot_identification(ident: "nm.NomotoIdentification", path) -> Path:
     path : str or Path
         PNG file to write.
     """
+    import textwrap
+
     import matplotlib
 
     matplotlib.use("Agg")
@@ -31,27 +35,25 @@ def plot_identification(ident: "nm.NomotoIdentification", path) -> Path:
 
     z = ident.zigzag
     path = Path(path)
-    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(10, 7.5), sharex=True, gridspec_kw={"height_ratios": [3, 1.4]})
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(14, 7.5), sharex=True, gridspec_kw={"height_ratios": [3, 1.4]})
     sign = z.sign
     psi_rec = z.psi if z.psi_raw is None else z.psi_raw
     ax.plot(z.s, np.degrees(psi_rec), color="k", lw=2.2, label="heading, measured")
     ax.plot(z.s, np.degrees(z.delta + z.delta_e), color="0.55", lw=1.2, ls="-", label="rudder, measured")
-    models = [("1st order, classical", ident.classical.model, 0.0, "tab:orange"),
-              ("2nd order, four-point", ident.four_point.model, 0.0, "tab:blue"),
-              ("2nd order, least squares", ident.least_squares.model, ident.least_squares.delta_bias, "tab:green")]
-    if ident.output_error is not None:
-        models.append(("2nd order, output error", ident.output_error.model, ident.output_error.delta_bias, "tab:red"))
+    colours = {"first_order": "tab:orange", "four_point": "tab:blue", "least_squares": "tab:green",
+               "output_error": "tab:red"}
     lim = float(np.max(np.abs(np.degrees(psi_rec))))
-    for label, m, db, c in models:
-        if not np.isfinite(nm.heading_rms(m, z, db)):
-            ax.plot([], [], color=c, ls="--", label=f"{label}: not simulated (T1, T2 not real)")
+    for key, (label, m, db) in ident.fits().items():
+        c = colours[key]
+        if not ident.usable(key):                 # a failed fit is named, not drawn as a result
+            why = textwrap.fill(ident.problems[key], 48, initial_indent="  ", subsequent_indent="  ")
+            ax.plot([], [], color=c, ls=":", label=f"{label}: UNUSABLE, not drawn\n{why}")
             continue
-        init = getattr(ident.output_error, "initial_state", None) if label.endswith("output error") else None
+        init = getattr(ident.output_error, "initial_state", None) if key == "output_error" else None
         psi0, w0, e0 = init if init is not None else (0.0, z.omega_e, z.eps_e)
         psi = nm.simulate_response(m, z.s, z.delta + z.delta_e, psi0, w0, e0, db)
         rms = np.degrees(np.sqrt(np.mean((psi - psi_rec) ** 2)))
-        ax.plot(z.s, np.clip(np.degrees(psi), -3 * lim, 3 * lim), color=c, ls="--", lw=1.3,
-                label=f"{label} (RMS {rms:.2f} deg)")
+        ax.plot(z.s, np.degrees(psi), color=c, ls="--", lw=1.3, label=f"{label} (RMS {rms:.2f} deg)")
     p = ident.points
     ax.plot(p.s, np.degrees(p.psi), "o", ms=8, mfc="none", mec="m", mew=2, label="four points")
     for nmn, s_, ps in zip(p.names, p.s, p.psi):
@@ -61,7 +63,7 @@ def plot_identification(ident: "nm.NomotoIdentification", path) -> Path:
     flip = "" if sign > 0 else " (signs flipped: first execute to port)"
     ax.set_ylabel("heading change, rudder [deg]" + flip)
     ax.set_title(f"{z.name}: zigzag, Nomoto identification (L = {z.L:g} m, U = {z.U:.3g} m/s)")
-    ax.legend(fontsize=8, loc="best")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.grid(alpha=0.3)
     ax2.plot(z.s, z.omega, label="omega' [-]")
     ax2.plot(z.s, z.eps, label="eps' [-]")

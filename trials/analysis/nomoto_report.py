@@ -7,6 +7,9 @@ import numpy as np
 
 from mmg.errors import InputError
 
+CHANNELS = ("psi", "delta", "r", "U", "u", "v")
+"""The channels the Nomoto identification reads: heading, rudder, yaw rate, speed (never ``n``)."""
+
 
 def _f(v, fmt="{:.4g}"):
     return "n/a" if v is None or not np.isfinite(v) else fmt.format(v)
@@ -23,14 +26,11 @@ def report(ident) -> str:
         lines.append(f"  {nm_:4s} {v['s']:8.4f} {v['eps']:9.5f} {v['omega']:9.5f} {v['Delta']:9.5f} "
                      f"{v['delta']:9.5f} {v['psi_deg']:9.3f}")
     lines.append("")
-    lines.append(f"{'method':34s} {'K':>8s} {'T / T1':>8s} {'T2':>8s} {'T3':>8s} {'psi RMS [deg]':>14s}")
-    for _, r in ident.to_pandas().iterrows():
-        lines.append(f"{r['method']:34s} {_f(r['K']):>8s} {_f(r['T1']):>8s} {_f(r['T2']):>8s} {_f(r['T3']):>8s} "
-                     f"{_f(r['rms_deg'], '{:.3f}'):>14s}")
+    lines += _fit_table(ident)
     for fit in (ident.least_squares, ident.output_error):
         if fit is None:
             continue
-        ci = "  ".join(f"{k} [{_f(lo)}, {_f(hi)}]" for k, (lo, hi) in fit.ci95.items() if k != "delta_bias")
+        ci = "  ".join(f"{k}' [{_f(lo)}, {_f(hi)}] [-]" for k, (lo, hi) in fit.ci95.items() if k != "delta_bias")
         lines.append(f"95 % intervals, {fit.method.replace('_', ' ')}: {ci}")
     note = ident.four_point.note()
     if note:
@@ -38,7 +38,30 @@ def report(ident) -> str:
     for fit in (ident.least_squares, ident.output_error):
         if fit is not None and fit.note:
             lines.append(f"{fit.method}: {fit.note}")
+    for key, (label, _, _) in ident.fits().items():
+        if not ident.usable(key):
+            lines.append(f"{label}: UNUSABLE, {ident.problems[key]}")
     return "\n".join(lines)
+
+
+def _rms_text(v) -> str:
+    return "n/a" if v is None or not np.isfinite(v) else ("{:.3f}" if abs(v) < 1e4 else "{:.3g}").format(v)
+
+
+def _fit_table(ident) -> list:
+    """The fits' parameters, dimensionless [-] and in seconds, with heading RMS [deg] and usability."""
+    from trials.files.tables import text_table
+
+    z = ident.zigzag
+    head = ("method", "K' [-]", "T1' [-]", "T2' [-]", "T3' [-]", "K [1/s]", "T1 [s]", "T2 [s]", "T3 [s]",
+            "psi RMS [deg]", "fit")
+    rows = []
+    for (key, _), (_, r) in zip(ident.fits().items(), ident.to_pandas().iterrows()):
+        dim = ident.dimensional(key)
+        rows.append([r["method"], *(_f(r[c]) for c in ("K", "T1", "T2", "T3")),
+                     *(_f(np.nan if dim.get(c) is None else dim[c]) for c in ("K_per_s", "T1_s", "T2_s", "T3_s")),
+                     _rms_text(r["rms_deg"]), "ok" if r["usable"] else "UNUSABLE"])
+    return [f"fits (K' = K L/U, T' = T U/L; L = {z.L:g} m, U = {z.U:.4g} m/s):"] + text_table(head, rows, "<" + ">" * 9 + "<")
 
 
 def identify_log(path, length: float, speed: float | None = None, output_error: bool = True):
@@ -59,10 +82,10 @@ def identify_log(path, length: float, speed: float | None = None, output_error: 
         raise InputError("--speed", "", f"speed must be a positive number of m/s, got {speed}")
     from trials.files.shipcheck import check_speed_option, read_for_ship
 
-    rec = read_for_ship(path, length)        # a length the record contradicts is refused
+    rec = read_for_ship(path, length, channels=CHANNELS)        # a length the record contradicts is refused
     if speed is not None:
         check_speed_option(rec, speed, length)
-    require_finite(rec, ("psi", "delta", "r", "U", "u", "v"), "mmg nomoto")   # heading, rudder, yaw rate, speed
+    require_finite(rec, CHANNELS, "mmg nomoto")
     note = None
     if rec.delta is None and rec.meta.get("format") == "log":
         from trials.files.rudder import with_rebuilt_rudder

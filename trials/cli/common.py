@@ -1,6 +1,8 @@
 """What the command modules share: the argument types of their options (one-line refusals of an
-empty output path, a non-positive number, ...), the metrics printout and the "wrote ..." listing.
-Imports only the standard library (and :mod:`trials.files.output` inside :func:`print_metrics`)."""
+empty output path, a non-positive number, ...; :func:`quantity` for every dimensional option), the
+metrics printout and the "wrote ..." listing.  Imports only the standard library at import time
+(:mod:`mmg.units` inside :func:`quantity`'s parser, :mod:`trials.files.output` inside
+:func:`print_metrics`)."""
 from __future__ import annotations
 
 import argparse
@@ -48,17 +50,51 @@ def _finite_positive(text: str) -> float:
     return v
 
 
+def quantity(dimension: str, bare: str, lo: float | None = None, hi: float | None = None, *,
+             lo_open: bool = False, words: dict | None = None):
+    """The argparse type of every dimensional option: the value in SI.
+
+    A value with its unit (``'3 m'``, ``'0.3 m/s'``, ``'10 kn'``, ``'20 deg'``) is read by
+    :func:`mmg.units.to_si` in any unit of ``dimension``; a bare number is in ``bare``, the unit the
+    option's help states (SI, or degrees for an angle).
+
+    Parameters
+    ----------
+    dimension : str
+        A key of :data:`mmg.units.UNITS` (``"length"``, ``"speed"``, ``"angle"``, ``"time"``, ...).
+    bare : str
+        The unit of a number given without one (a unit of ``dimension``).
+    lo, hi : float, optional
+        Bounds in SI (``lo_open``: ``lo`` itself refused), as :func:`mmg.units.to_si` takes them.
+    words : dict, optional
+        Words that stand for a value (``{"inf": math.inf}``), case-insensitive.
+
+    Returns
+    -------
+    callable
+        ``text -> float`` raising :class:`argparse.ArgumentTypeError` in one line.
+    """
+    def parse(text: str):
+        from mmg.units import to_si
+
+        t = text.strip()
+        if words and t.lower() in words:
+            return words[t.lower()]
+        try:
+            float(t)
+            t = f"{t} {bare}"                       # a bare number: in the unit the help states
+        except ValueError:
+            pass
+        try:
+            return to_si(t, dimension, lo, hi, lo_open=lo_open)
+        except ValueError as e:
+            raise argparse.ArgumentTypeError(f"{e} (a bare number is in {bare})") from None
+    return parse
+
+
 def _rudder_timing(text: str) -> float | None:
-    """--rudder-timing: a prior std [s] > 0, 'inf' (no prior) or 'none' (no timing nuisances)."""
-    if text.strip().lower() == "none":
-        return None
-    try:
-        v = float(text)
-    except ValueError:
-        v = float("nan")
-    if not v > 0:
-        raise argparse.ArgumentTypeError(f"expected a prior std in seconds > 0, 'inf' or 'none', got {text!r}")
-    return v
+    """--rudder-timing: a prior std > 0 (a time, bare number in s), 'inf' (no prior) or 'none' (no timing nuisances)."""
+    return quantity("time", "s", 0.0, lo_open=True, words={"none": None, "inf": float("inf")})(text)
 
 
 def print_metrics(m: dict, out=None) -> None:

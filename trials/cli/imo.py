@@ -71,6 +71,20 @@ def cmd_imo(args) -> int:
     return 0
 
 
+def _speed_text(text: str) -> str:
+    """``--speed`` as the standard's speed text: a value with its unit as given, a bare number in m/s (the one
+    rule of :func:`trials.cli.common.quantity`, which checks it)."""
+    from .common import quantity
+
+    quantity("speed", "m/s", 0.0, lo_open=True)(text)
+    t = text.strip()
+    try:
+        float(t)
+    except ValueError:
+        return t
+    return f"{t} m/s"
+
+
 def add_parser(sub) -> None:
     """The imo subcommand of ``mmg`` (its options, help and function)."""
     p = sub.add_parser("imo", help="check the IMO manoeuvring standards (MSC.137(76)) on a ship, with their "
@@ -79,8 +93,9 @@ def add_parser(sub) -> None:
     p.add_argument("ship", help="bundled ship name (esso_osaka) or ship YAML (mmg identify's DIR/ship.yaml)")
     p.add_argument("--out", required=True, metavar="DIR", type=_output_path,
                    help="output folder (imo.json, imo.md, tracks.png, zigzags.png, distributions.png)")
-    p.add_argument("--speed", default=None,
-                   help="approach speed with its unit, e.g. '10 kn' (default: the ship's bundled trials')")
+    p.add_argument("--speed", type=_speed_text, default=None,
+                   help="approach speed with its unit ('10 kn', '0.5 m/s') or a bare number in m/s (default: the "
+                        "ship's bundled trials')")
     p.add_argument("--samples", type=_whole(0, "--samples"), default=0, metavar="N",
                    help="parameter samples from the ship's covariance (default 0: its own parameters only)")
     p.add_argument("--scale-to", default=None, metavar="SHIP",

@@ -3,12 +3,10 @@ from __future__ import annotations
 
 import sys
 
-from .common import _finite_positive, _output_path, print_metrics
+from .common import _output_path, print_metrics, quantity
 
 
 def cmd_metrics(args) -> int:
-    import numpy as np
-
     from ..files.logio import read_record, require_finite
     from ..analysis.metrics import record_metrics
     from ..files.output import check_output_file, dump_json
@@ -27,8 +25,7 @@ def cmd_metrics(args) -> int:
             assumed = "model the FRT-DS-ESSO layout assumes when no --length is given"
             check_record_ship(rec, float(length), name=assumed if rec.meta.get("format") == "frt-ds-esso" else None)
     require_finite(rec, CHANNELS, "mmg metrics")      # the track, heading, speeds, rudder, rpm; not the wind
-    ang = None if args.zigzag_angle is None else np.radians(args.zigzag_angle)
-    m = record_metrics(rec, args.kind, args.length, ang)
+    m = record_metrics(rec, args.kind, args.length, args.zigzag_angle)
     if args.json is not None:
         dump_json(m, args.json)               # first (a temporary file beside it, renamed), then the console
     print(f"{rec.name} ({m['kind']}, {rec.source})")
@@ -43,8 +40,10 @@ def add_parser(sub) -> None:
     p = sub.add_parser("metrics", help="manoeuvre metrics from a log (project log, truth file or FRT-DS-ESSO CSV)")
     p.add_argument("log")
     p.add_argument("--kind", choices=["turning", "zigzag", "stype"], help="override the manoeuvre kind")
-    p.add_argument("--length", type=_finite_positive, help="ship length L [m] when the log does not say")
-    p.add_argument("--zigzag-angle", type=_finite_positive,
-                   help="switching heading [deg] for a zigzag log without rudder")
+    p.add_argument("--length", type=quantity("length", "m", 0.0, lo_open=True),
+                   help="ship length L with its unit ('3 m'), a bare number in m, when the log does not say")
+    p.add_argument("--zigzag-angle", type=quantity("angle", "deg", 0.0, lo_open=True),
+                   help="switching heading with its unit ('20 deg'), a bare number in deg, for a zigzag log "
+                        "without rudder")
     p.add_argument("--json", type=_output_path, help="also write the metrics to this JSON file")
     p.set_defaults(func=cmd_metrics)

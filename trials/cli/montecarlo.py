@@ -6,7 +6,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _finite_positive, _output_path, _positive_int, _seed, backend_client, check_backend_options
+from .common import _output_path, _positive_int, _seed, backend_client, check_backend_options, quantity
 
 
 def cmd_montecarlo(args) -> int:
@@ -92,8 +92,9 @@ def add_parser(sub) -> None:
     mc_common(p, "raw-log EKF")
     p.add_argument("--trials", nargs="*", default=None,
                    help="trial names (default ST35 ZZ10 ZZ20 'S-type 120') or turning/zigzag/S-type trial YAMLs")
-    p.add_argument("--sigma-tau", type=_finite_positive, default=None,
-                   help="prior std [s] of each rudder movement's timing (default 0.15, or 1e-4 with --true-rudder)")
+    p.add_argument("--sigma-tau", type=quantity("time", "s", 0.0, lo_open=True), default=None,
+                   help="prior std of each rudder movement's timing with its unit ('0.15 s'), a bare number in s "
+                        "(default 0.15 s, or 1e-4 s with --true-rudder)")
     p.add_argument("--true-rudder", action="store_true",
                    help="give the filter the truth file's rudder instead of the rebuilt one (a check against the CRB "
                         "with the rudder known)")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _output_path
+from .common import _output_path, quantity
 
 
 def cmd_nomoto(args) -> int:
@@ -57,8 +57,11 @@ def add_parser(sub) -> None:
     """The nomoto and nomoto-paper subcommands of ``mmg`` (its options, help and function)."""
     p = sub.add_parser("nomoto", help="identify 1st/2nd-order Nomoto K, T (T1, T2, T3) from a zigzag log")
     p.add_argument("log", help="zigzag record (project log/truth CSV or FRT-DS-ESSO CSV)")
-    p.add_argument("--length", type=float, required=True, help="ship length L [m]")
-    p.add_argument("--speed", type=float, help="speed U [m/s] for s' = tU/L (default: mean approach speed)")
+    p.add_argument("--length", type=quantity("length", "m", 0.0, lo_open=True), required=True,
+                   help="ship length L with its unit ('3 m'), a bare number in m")
+    p.add_argument("--speed", type=quantity("speed", "m/s", 0.0, lo_open=True),
+                   help="speed U for s' = tU/L with its unit ('0.3 m/s', '10 kn'), a bare number in m/s "
+                        "(default: mean approach speed)")
     p.add_argument("--json", type=_output_path, help="write results to this JSON file (plot PNG next to it)")
     p.add_argument("--no-output-error", action="store_true", help="skip the output-error fit")
     p.set_defaults(func=cmd_nomoto)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from mmg.errors import InputError
 
-from .common import _finite_positive, _output_path, _whole, release_notes
+from .common import _output_path, _whole, quantity, release_notes
 
 
 def cmd_predict(args) -> int:
@@ -142,10 +142,10 @@ def _add_window_options(p) -> None:
     """--window and --every: the short-horizon windows restarted from the measured state."""
     from ..measured.window import EVERY_S, WINDOW_S
 
-    p.add_argument("--window", type=_finite_positive, default=WINDOW_S, metavar="S",
+    p.add_argument("--window", type=quantity("time", "s", 0.0, lo_open=True), default=WINDOW_S, metavar="S",
                    help=f"length [s] of the windows each run is also predicted over from its measured state "
                         f"(JSON key 'window': mean heading RMS and final position error; default {WINDOW_S:g})")
-    p.add_argument("--every", type=_finite_positive, default=EVERY_S, metavar="S",
+    p.add_argument("--every", type=quantity("time", "s", 0.0, lo_open=True), default=EVERY_S, metavar="S",
                    help=f"interval [s] between the starts of those windows (default {EVERY_S:g})")
 
 
@@ -159,11 +159,12 @@ def add_parser(sub) -> None:
     p.add_argument("--plots", default=None, metavar="DIR", type=_output_path,
                    help="also one figure per run, DIR/<name>.png (<name>: the record's file name; two files of one "
                         "name told apart by their folders, DIR/<folder>/<name>.png)")
-    p.add_argument("--start", type=float, default=None, metavar="S",
-                   help="start time [s] of every replay (default: each record's first sample)")
+    p.add_argument("--start", type=quantity("time", "s"), default=None, metavar="S",
+                   help="start time [s] of every replay, with its unit or a bare number in s (default: each "
+                        "record's first sample)")
     p.add_argument("--wind", choices=("on", "off"), default=None,
                    help="wind loads from the measured relative wind (default: as the ship config says)")
-    p.add_argument("--horizon", type=_finite_positive, default=None, metavar="S",
+    p.add_argument("--horizon", type=quantity("time", "s", 0.0, lo_open=True), default=None, metavar="S",
                    help="also the scores over the first S seconds of each replay (JSON key 'first'; the short-"
                         "horizon figure of docs/benchmark_frt.md, 60 s there)")
     _add_window_options(p)

@@ -63,7 +63,8 @@ def add_parser(sub) -> None:
                         "several folders are pooled per trial")
     p.add_argument("--mc-seeds", type=_positive_int, default=20, help="seeds per trial when the Monte Carlo must be run")
     p.add_argument("--rudder-timing", type=_rudder_timing, default=0.15, metavar="SIGMA_S",
-                   help="with --crb-vs-mc or --design: prior std [s] of the per-movement rudder-timing nuisances of the "
+                   help="with --crb-vs-mc or --design: prior std (a time, '0.15 s'; a bare number in s) of the "
+                        "per-movement rudder-timing nuisances of the "
                         "second log bound (default 0.15, the raw-log EKF's; 'inf' no prior; 'none' leaves that bound out)")
     p.add_argument("--design", action="store_true", help="trial-design search (S-type psi_S, zigzag angles)")
     p.add_argument("--backend", choices=["serial", "loky", "threads", "dask"], default="loky",

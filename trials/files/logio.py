@@ -84,6 +84,66 @@ MAX_WIND_MPS = 60.0
 """Largest wind speed [m/s] a record may log (a hurricane; beyond it the column is in another unit)."""
 FRT_REQUIRED = ("t [s]", "x_position_mid [m]", "y_position_mid [m]", "psi_hat [rad]")
 
+LAYOUT_COLUMNS = {
+    "frt-ds-esso": {k: c for c, k in FRT_COLUMNS.items()},
+    "log": {"t": "time_s", "x": "lat_deg", "y": "lon_deg", "psi": "heading_deg", "U": "speed_kn", "n": "rpm",
+            "delta": "rudder_deg", "wind_speed_rel": "wind_rel_kn", "wind_dir_rel": "wind_rel_deg"},
+    "truth": {"t": "time_s", "x": "x_m", "y": "y_m", "psi": "psi_rad", "u": "u_mps", "v": "v_mps", "r": "r_radps",
+              "delta": "delta_rad", "n": "n_rps", "wind_speed_rel": "wind_rel_mps", "wind_dir_rel": "wind_rel_rad"},
+}
+"""The column each channel of a record is read from, per file layout (the record's ``meta["format"]``)."""
+
+LAYOUT_NAMES = {"frt-ds-esso": "FRT-DS-ESSO CSV", "log": "project log", "truth": "truth file"}
+
+
+def channel_column(rec: TrialRecord, channel: str) -> str:
+    """The exact header of ``channel`` in the layout ``rec`` was read from.
+
+    Parameters
+    ----------
+    rec : TrialRecord
+        A record; its ``meta["format"]`` names the layout.
+    channel : str
+        A channel name of :data:`trials.files.records.CHANNELS` (or ``t``, a wind channel).
+
+    Returns
+    -------
+    str
+        The column header (e.g. ``delta_rudder [rad]``); '' when the layout has no column for the
+        channel; the channel's own name for a record not read from a file.
+    """
+    fmt = rec.meta.get("format")
+    if fmt not in LAYOUT_COLUMNS:
+        return channel
+    return LAYOUT_COLUMNS[fmt].get(channel, "")
+
+
+def missing_channel(rec: TrialRecord, channel: str, need: str) -> InputError:
+    """The error for a channel a command needs and the record lacks, naming its column first.
+
+    Parameters
+    ----------
+    rec : TrialRecord
+        The record.
+    channel : str
+        The channel missing (see :func:`channel_column`).
+    need : str
+        What needs it, in plain words (e.g. "a zigzag analysis needs heading and rudder").
+
+    Returns
+    -------
+    InputError
+        Field = the column's exact header; when the layout has no such column, the channel's
+        name and the layout's.
+    """
+    col = channel_column(rec, channel)
+    src = rec.source or rec.name or "record"
+    if col:
+        return InputError(src, col, f"missing column; {need}")
+    layout = LAYOUT_NAMES.get(rec.meta.get("format"), str(rec.meta.get("format")))
+    return InputError(src, channel, f"the {layout} layout has no column for this channel; {need}")
+
+
 
 # --------------------------------------------------------------------------- writing
 # (the columns and their printing live in trials.files.logwrite, which needs no pandas)

@@ -22,8 +22,8 @@ def manoeuvre_from_meta(meta: dict, source: str = "log") -> tuple[str, dict]:
     """The trial kind and its rudder logic (SI) from a log header."""
     kind = str(meta.get("kind", ""))
     if kind not in REBUILT_KINDS:
-        raise InputError(source, "kind", f"the log has no rudder channel and its header gives no turning/zigzag/stype "
-                                         f"trial kind to rebuild it from (kind: {kind or 'missing'})")
+        raise InputError(source, "rudder_deg", f"missing column, and the log's header gives no turning/zigzag/stype "
+                                               f"trial kind to rebuild the rudder from (kind: {kind or 'missing'})")
     try:
         m = {"rudder": float(meta["rudder_deg"]) * DEG, "first": str(meta.get("first", "starboard"))}
         if kind == "zigzag":
@@ -56,9 +56,15 @@ def with_rebuilt_rudder(rec: TrialRecord, dt: float = 0.1) -> TrialRecord:
     """
     from scipy.interpolate import CubicSpline
 
+    from .logio import missing_channel
+
+    kind = str(rec.meta.get("kind", ""))
+    if kind not in REBUILT_KINDS:
+        raise missing_channel(rec, "delta", f"no rudder angle, and no turning/zigzag/stype trial kind in a header to "
+                                            f"rebuild it from (kind: {kind or 'missing'})")
     src = rec.source or "log"
     if rec.psi is None:
-        raise InputError(src, "heading_deg", "a rudder can only be rebuilt from a heading channel")
+        raise missing_channel(rec, "psi", "a rudder can only be rebuilt from a heading channel")
     kind, man = manoeuvre_from_meta(rec.meta, src)
     p = steering_from_meta(rec.meta, src)
     t = np.arange(rec.t[0], rec.t[-1] + 1e-9, dt)

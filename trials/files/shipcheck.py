@@ -128,8 +128,32 @@ def check_header(rec, ship_or_length, src: str | None = None, name: str | None =
         raise ShipMismatch(src, "length_m", f"the header says a {lm:g} m ship{hdr}, not {who}: {HINT}")
 
 
-def check_record_ship(rec, ship_or_length, src: str | None = None, name: str | None = None) -> dict:
+SPEED_CHANNELS = ("U", "u", "v", "x", "y")
+"""Channels a record's speed is taken from (:meth:`trials.files.records.TrialRecord.speed`)."""
+
+
+def _checks(channels) -> set:
+    """The plausibility checks that judge only channels in ``channels`` (all of them for None)."""
+    if channels is None:
+        return {"tip_speed", "froude", "turn_rate"}
+    used = set(channels)
+    out = set()
+    if "n" in used:
+        out.add("tip_speed")
+    if used & set(SPEED_CHANNELS):
+        out.add("froude")
+        if used & {"r", "psi"}:
+            out.add("turn_rate")
+    return out
+
+
+def check_record_ship(rec, ship_or_length, src: str | None = None, name: str | None = None,
+                      channels=None) -> dict:
     """Refuse a record that cannot be of the ship: header length, propeller tip speed, Froude number, turning rate.
+
+    Each check judges channels of the record; one the command does not use (``channels``) is not judged:
+    the tip speed needs ``n``, the Froude number a speed channel (:data:`SPEED_CHANNELS`), the turning
+    rate a speed channel and ``r`` or ``psi``.
 
     Parameters
     ----------
@@ -141,6 +165,8 @@ def check_record_ship(rec, ship_or_length, src: str | None = None, name: str | N
         The file named in the message (default ``rec.source``).
     name : str, optional
         Words naming a ship given by its length (e.g. "model the FRT-DS-ESSO layout assumes").
+    channels : iterable of str, optional
+        The channels the command uses (names of :data:`trials.files.records.CHANNELS`); None: all.
 
     Returns
     -------
@@ -156,10 +182,16 @@ def check_record_ship(rec, ship_or_length, src: str | None = None, name: str | N
     L, who = _ship_label(ship_or_length, name)
     check_header(rec, ship_or_length, src, name)
     s = record_statistics(rec, L)
-    check_tip_speed(s["rps"], propeller_diameter(ship_or_length), src, who)
-    if s["froude"] > FROUDE_MAX:
+    checks = _checks(channels)
+    if "tip_speed" in checks:
+        from .logio import channel_column
+
+        check_tip_speed(s["rps"], propeller_diameter(ship_or_length), src, who, channel_column(rec, "n") or "n")
+    if "froude" in checks and s["froude"] > FROUDE_MAX:
         raise ShipMismatch(src, "speed", f"speeds up to {s['speed']:.3g} m/s (99th percentile) are Froude number "
                                          f"{s['froude']:.3g} for {who} (at most {FROUDE_MAX:g}): {HINT}")
+    if "turn_rate" not in checks:
+        return s
     if s["turn_rate"] > TURN_RATE_MAX:
         raise ShipMismatch(src, "yaw rate", f"the record turns at r L / U = {s['turn_rate']:.3g} (99th percentile) for "
                                             f"{who}, on circles of {1 / s['turn_rate']:.2g} ship lengths (at most "
@@ -219,7 +251,7 @@ def check_speed_option(rec, speed: float, L: float, src: str | None = None, opti
     src = src or rec.source or rec.name or "record"
     fn = speed / math.sqrt(G * L)
     if fn > FROUDE_MAX:
-        raise InputError(option, f"{speed:g}", f"is Froude number {fn:.3g} for a {L:g} m ship (at most {FROUDE_MAX:g})")
+        raise InputError(option, f"{speed:.4g} m/s", f"is Froude number {fn:.3g} for a {L:g} m ship (at most {FROUDE_MAX:g})")
     try:
         U = np.abs(np.asarray(rec.speed(), dtype=float))
     except ValueError:
@@ -229,13 +261,14 @@ def check_speed_option(rec, speed: float, L: float, src: str | None = None, opti
         return
     mid = float(np.median(U[U >= MOVING_FRACTION * np.percentile(U, 95)]))
     if mid > 0 and not 0.5 <= speed / mid <= 2.0:
-        raise InputError(option, f"{speed:g}", f"the record {src} runs at {mid:.3g} m/s (median): the speed given is "
+        raise InputError(option, f"{speed:.4g} m/s", f"the record {src} runs at {mid:.3g} m/s (median): the speed given is "
                                                f"{speed / mid:.3g} times that")
 
 
-def read_for_ship(path, ship_or_length, name: str | None = None):
+def read_for_ship(path, ship_or_length, name: str | None = None, channels=None):
     """:func:`trials.files.logio.read_record` with the ship's length (for a layout that does not state one), then
-    :func:`check_record_ship`: the one way a command reads a record it analyses with a ship.
+    :func:`check_record_ship` of the ``channels`` the command uses (None: all): the one way a command reads
+    a record it analyses with a ship.
 
     A reader's refusal of speeds beyond Froude number 1 for this length (a full-scale record read
     as a model) is raised as a :class:`ShipMismatch` that also names the ship.
@@ -250,5 +283,5 @@ def read_for_ship(path, ship_or_length, name: str | None = None):
             raise ShipMismatch(e.source, e.field, f"{e.message}; or a record of another ship than {who}? give the "
                                                   f"record's own ship or length") from None
         raise
-    check_record_ship(rec, ship_or_length, name=name)
+    check_record_ship(rec, ship_or_length, name=name, channels=channels)
     return rec

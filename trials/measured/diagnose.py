@@ -160,13 +160,25 @@ def _diffs(pred: np.ndarray, seg) -> np.ndarray:
     return logged_residual(pred, seg)
 
 
-def _rms(diffs: list) -> dict:
+def _rms(diffs: list, recs=None) -> dict:
+    """Residual RMS per channel over the records (u, v [m/s], r [deg/s], heading [deg], position [m]); with
+    ``recs`` (their :class:`Prepared`), v only over the records that log it, None when none does."""
     D = np.vstack(diffs)
     ok = np.isfinite(D).all(axis=1)
     D = D[ok] if ok.any() else np.zeros((1, 6))
     m = lambda a: float(np.sqrt(np.mean(a * a)))  # noqa: E731
-    return {"u": m(D[:, 0]), "v": m(D[:, 1]), "r": math.degrees(m(D[:, 2])), "heading": math.degrees(m(D[:, 5])),
-            "position": float(np.sqrt(np.mean(D[:, 3] ** 2 + D[:, 4] ** 2)))}
+    out = {"u": m(D[:, 0]), "v": m(D[:, 1]), "r": math.degrees(m(D[:, 2])), "heading": math.degrees(m(D[:, 5])),
+           "position": float(np.sqrt(np.mean(D[:, 3] ** 2 + D[:, 4] ** 2)))}
+    if recs is not None:
+        v = [d[:, 1][np.isfinite(d).all(axis=1)] for d, r in zip(diffs, recs) if "v" not in r.absent]
+        out["v"] = m(np.concatenate(v)) if v and sum(map(len, v)) else None
+    return out
+
+
+def absent_table(recs) -> list:
+    """``[{"record", "channel", "column", "compared_instead"}]``: the residual channels each record does not log
+    (:func:`trials.measured.diagnose_records.absent_channels`)."""
+    return [{"record": r.name, "channel": c, **a} for r in recs for c, a in getattr(r, "absent", {}).items()]
 
 
 # --------------------------------------------------------------------------- fitting
@@ -478,6 +490,8 @@ class Diagnosis:
     """"fitted", or "config (the fit replayed worse)" when the baseline fit was not kept."""
     straight_runs: list = field(default_factory=list)
     """The records' leading straight runs the fit used (:func:`straight_run_table`)."""
+    absent_channels: list = field(default_factory=list)
+    """Residual channels a record does not log and what was compared instead (:func:`absent_table`)."""
 
     def summary_lines(self) -> list:
         """The console text (:func:`trials.measured.diagnose_report.summary_lines`)."""
@@ -499,7 +513,8 @@ class Diagnosis:
                "ship_coefficients": self.ship_values,
                "files": [r.source for r in self.records], "names": [r.name for r in self.records],
                "seconds": round(self.seconds, 2),
-               "identifiability": self.identifiability, "straight_runs": self.straight_runs}
+               "identifiability": self.identifiability, "straight_runs": self.straight_runs,
+               "absent_channels": self.absent_channels}
         if self.runs:
             out["runs"] = [dict(r.to_json(), name=r.records[0].name, file=r.records[0].source) for r in self.runs]
         return out
@@ -627,7 +642,7 @@ def _baseline(fitter, noise, say):
     if not kept:
         say("baseline: the fitted ship replays worse than the config: the config is kept")
         base = _config_model(fitter, d_config)
-    say(f"baseline (ship fitted, no effect): residual RMS {format_rms(_rms(base.diffs))}")
+    say(f"baseline (ship fitted, no effect): residual RMS {format_rms(_rms(base.diffs, fitter.recs))}")
     return d_config, base, kept
 
 
@@ -667,7 +682,7 @@ def _drift_terms(fitter, d_config, base, kept, o: DiagnoseOptions, say):
     fall = _rms(ref.diffs)["heading"] - _rms(m.diffs)["heading"]
     if better and fall > DRIFT_FALL_MIN:
         say(f"baseline: the drift terms freed (dBIC {fmt3(dbic)}, heading residual {fmt3(fall)} deg less): "
-            f"residual RMS {format_rms(_rms(m.diffs))}")
+            f"residual RMS {format_rms(_rms(m.diffs, fitter.recs))}")
         fitter.kind = DRIFT_KIND
         return m, True
     fitter.ship_free = free0
@@ -1230,11 +1245,11 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
     th_out = [f.prior if f.name in mfm else v for f, v in zip(current.free[:ns], current.theta[:ns])]
     fit_vals = {f.name: float(v) for f, v in zip(current.free[:ns], th_out)}   # mismatched: the config's, not written as fitted
     ship_vals = config_values(ship, fit_vals)
-    return Diagnosis(named=named, parameters=params, standard_errors=ses, rms_config=_rms(d_config),
-                     rms_before=_rms(base.diffs), rms_after=_rms(current.diffs), unexplained=unexpl,
+    return Diagnosis(named=named, parameters=params, standard_errors=ses, rms_config=_rms(d_config, recs),
+                     rms_before=_rms(base.diffs, recs), rms_after=_rms(current.diffs, recs), unexplained=unexpl,
                      unexplained_description=desc, candidates=cand_log, rounds=rounds, ship_values=ship_vals,
                      ship_fit_values=fit_vals, records=recs, pred_before=[r.seg.meas + d for r, d in zip(recs, base.diffs)],
                      pred_after=[r.seg.meas + d for r, d in zip(recs, current.diffs)],
                      seconds=0.0, effects=current.effects, intervals_95=ivs, evidence=effect_evidence(named, rounds),
                      model_form_mismatch=mfm, ship_fit=ship_fit_table(current.free[:ns], current.theta[:ns]),
-                     straight_runs=straight_run_table(recs, base, current))
+                     straight_runs=straight_run_table(recs, base, current), absent_channels=absent_table(recs))

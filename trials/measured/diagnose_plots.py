@@ -150,14 +150,17 @@ def _text_panel(ax, lines, title):
 
 
 def _evidence_lines(diag) -> list:
+    """The evidence panel: dBIC, z and the false-alarm p of each named effect (a table whose columns fit any
+    value), the effects that cannot be told apart, the legend."""
+    from ..files.tables import text_table
     from .diagnose_report import fmt3
 
     ev = diag.evidence or {}
-    out = [f"{'effect':<14}{'dBIC':>7}{'z':>7}{'p':>7}"]
+    rows = []
     for e in diag.named:
         d = ev.get(e, {})
-        p = d.get("false_alarm_probability")
-        out.append(f"{e:<14}{fmt3(d.get('delta_bic')):>7}{fmt3(d.get('z')):>7}{fmt3(p) if p is not None else 'n/a':>7}")
+        rows.append([e, fmt3(d.get("delta_bic")), fmt3(d.get("z")), fmt3(d.get("false_alarm_probability"))])
+    out = text_table(["effect", "dBIC", "z", "p"], rows)
     for ni in diag.not_identifiable or []:
         out.append(f"{ni.get('effect')}: not identifiable")
         out.append(f"  (with {', '.join(map(str, ni.get('confused_with') or []))})")
@@ -171,14 +174,16 @@ def _interval_panels(fig, gs, col: int, diag):
     the evidence below them; a text panel (the candidates' evidence) when nothing is named."""
     import mmg.effects as E
 
-    from .diagnose_report import fmt3
+    from ..files.tables import text_table
+    from .diagnose_report import fmt3, parameter_label
 
     n_rows = gs.get_geometry()[0]
     rows = [(e, k, v) for e in diag.named for k, v in diag.parameters.get(e, {}).items()]
     if not rows:
         last = (diag.rounds or [{}])[-1].get("candidates", [])
-        text = ["nothing named", "", "last round's candidates:", f"{'effect':<15}{'dBIC':>8}{'z':>7}"]
-        text += [f"{c['effect']:<15}{fmt3(c.get('delta_bic')):>8}{fmt3(c.get('z')):>7}" for c in last]
+        text = ["nothing named", "", "last round's candidates:"]
+        text += text_table(["effect", "dBIC", "z"], [[c["effect"], fmt3(c.get("delta_bic")), fmt3(c.get("z"))]
+                                                     for c in last])
         text += ["", "named when dBIC and z clear", "their thresholds (console legend)"]
         if diag.unexplained:
             text += ["", "unexplained residual: see the console"]
@@ -191,7 +196,8 @@ def _interval_panels(fig, gs, col: int, diag):
         p = {q.name: q for q in E.get(e).parameters}.get(k)
         unit = "" if p is None or p.unit == "1" else p.unit
         iv = (diag.intervals_95 or {}).get(e, {}).get(k)
-        title = f"{e}: {k} = {fmt3(v)}{' ' + unit if unit else ''}"
+        name = parameter_label(e, k, p.unit if p is not None else "1")
+        title = f"{name} = {fmt3(v)}{' ' + unit if unit else ''}"
         if iv == "any":
             ax.axvspan(0.0, 360.0, color="C0", alpha=0.15)
             ax.plot([v], [0], "o", color="C0")
@@ -209,9 +215,9 @@ def _interval_panels(fig, gs, col: int, diag):
             ax.plot([v], [0], "o", color="C0")
         if p is not None and np.isfinite(p.default) and unit != "deg":
             ax.axvline(p.default, color="0.4", ls="--", lw=0.8)
-            ax.set_xlabel(f"{k} [{unit or '-'}]  (dashed: no effect)", fontsize=8)
+            ax.set_xlabel(f"{name} [{unit or '-'}]  (dashed: no effect)", fontsize=8)
         else:
-            ax.set_xlabel(f"{k} [{unit or '-'}]", fontsize=8)
+            ax.set_xlabel(f"{name} [{unit or '-'}]", fontsize=8)
         ax.set_yticks([])
         ax.tick_params(labelsize=7)
         ax.set_title(title, fontsize=9)

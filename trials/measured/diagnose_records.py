@@ -12,8 +12,8 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
-__all__ = ["Prepared", "prepare", "synthetic_record", "write_frt_csv", "RESTART_SMOOTH", "leading_straight_run",
-           "noise_level"]
+__all__ = ["Prepared", "prepare", "absent_channels", "synthetic_record", "write_frt_csv", "RESTART_SMOOTH",
+           "leading_straight_run", "noise_level"]
 
 RESTART_SMOOTH = 6.0
 """Every segment restarts from the logged state smoothed over this many sqrt(L/g) (quadratic
@@ -44,12 +44,43 @@ at 10 kn gave 0.3-0.9 deg."""
 
 @dataclass
 class Prepared:
-    """One record made ready: the segmented record (with its effect context) and notes."""
+    """One record made ready: the segmented record (with its effect context), notes, and the residual
+    channels it does not log (:func:`absent_channels`)."""
 
     name: str
     source: str
     seg: object
     notes: list = field(default_factory=list)
+    absent: dict = field(default_factory=dict)
+
+
+def absent_channels(rec) -> dict:
+    """The residual channels (u, v, r) a record does not log, and what the replay is compared with instead.
+
+    Parameters
+    ----------
+    rec : TrialRecord
+        The record as read.
+
+    Returns
+    -------
+    dict
+        ``{channel: {"column": the layout's exact header ('' when the layout has none),
+        "compared_instead": what its residual compares ('' when nothing: the channel is left out)}}``.
+    """
+    from ..files.logio import channel_column
+
+    out = {}
+    if rec.r is None:
+        out["r"] = "the yaw rate differentiated from the logged heading"
+    if rec.u is None or rec.v is None:
+        sog = ("the logged speed over ground" if rec.U is not None else
+               "|u| as the speed over ground" if rec.u is not None else "the speed over ground from the track")
+        if rec.u is None:
+            out["u"] = f"the replayed speed over ground with {sog}"
+        if rec.v is None:
+            out["v"] = ""
+    return {c: {"column": channel_column(rec, c), "compared_instead": w} for c, w in out.items()}
 
 
 def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | None = None,
@@ -97,7 +128,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
                         start=_smoothed(run.t, run.meas, RESTART_SMOOTH * math.sqrt(L / 9.80665)),
                         fixed=run.effects, speed_only=run.speed_only,
                         straight=_straight(run, rec, ch, L) if straight_run else None)
-        out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes)))
+        out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes), absent_channels(rec)))
     return out
 
 

@@ -63,6 +63,14 @@ def _strip_unit(name: str, unit: str) -> str:
     return name
 
 
+def parameter_label(effect: str, name: str, unit: str = "1") -> str:
+    """An effect parameter's name in words: the effect's name, then the parameter's without its unit when it
+    adds to it (``heading bias`` for heading_bias bias_deg, ``current speed`` for current speed_mps)."""
+    words = effect.replace("_", " ")
+    p = _strip_unit(name, unit).replace("_", " ")
+    return words if words.split()[-1] == p else f"{words} {p}"
+
+
 def _unit(u: str) -> str:
     return "" if u in ("1", "") else f" {u}"
 
@@ -307,16 +315,31 @@ def summary_lines(diag) -> list[str]:
                      f"({fmt3(v['z'])} prior std away): not written to --out-ship")
     for st in getattr(diag, "straight_runs", None) or []:
         lines.append(straight_run_line(st))
-    lines.append(f"{'residual RMS (replay - log)':<28}{'config':>10}{'ship fitted':>13}{'+ named':>10}")
-    for c in diag.rms_after:
-        u = CHANNEL_UNITS.get(c, "")
-        lines.append(f"  {c + ' [' + u + ']':<26}{fmt3(diag.rms_config.get(c)):>10}{fmt3(diag.rms_before.get(c)):>13}"
-                     f"{fmt3(diag.rms_after.get(c)):>10}")
+    from ..files.tables import text_table
+
+    rows = [[f"  {c} [{CHANNEL_UNITS.get(c, '')}]", fmt3(diag.rms_config.get(c)), fmt3(diag.rms_before.get(c)),
+             fmt3(diag.rms_after.get(c))] for c in diag.rms_after]
+    lines += text_table(["residual RMS (replay - log)", "config", "ship fitted", "+ named"], rows)
+    lines += absent_lines(getattr(diag, "absent_channels", None) or [])
     if diag.unexplained:
         lines.append(f"unexplained: {diag.unexplained_description}")
     for r in diag.runs or []:
         lines.append(f"  record {r.records[0].name}: " + ("; ".join(
             f"{e} {format_values(e, r.parameters.get(e, {}))}" for e in r.named) or "nothing named"))
+    return lines
+
+
+def absent_lines(table) -> list:
+    """A line per channel some record does not log (``  r not logged by a, b (column r_angvelo [rad/s]): its
+    residual compares ...``), from :func:`trials.measured.diagnose.absent_table`."""
+    by = {}
+    for e in table:
+        by.setdefault((e["channel"], e["column"], e["compared_instead"]), []).append(e["record"])
+    lines = []
+    for (c, col, what), names in by.items():
+        where = f"column {col}" if col else "no column for it in the layout"
+        then = f"its residual compares {what}" if what else "left out of the fit; no residual reported from it"
+        lines.append(f"  {c} not logged by {', '.join(names)} ({where}): {then}")
     return lines
 
 

@@ -326,7 +326,7 @@ class TrialRun:
             out.update(MET.zigzag_metrics(r.t, r.psi, order=r.orders, U=r.U, L=L))
         elif tr.kind == "stopping":
             out.update(MET.stopping_metrics(r.t, r.x, r.y, r.psi, r.u, r.v, L, t_execute=tr.manoeuvre["execute"]))
-        return out
+        return MET.fill_from_trial(out, tr.summary())
 
 
 def prepare_trial(trial: Trial):

@@ -55,7 +55,7 @@ from __future__ import annotations
 
 from trials.analysis.nomoto.classical import ClassicalResult, classical_first_order
 from trials.analysis.nomoto.fourpoint import FourPointResult, four_point
-from trials.analysis.nomoto.identification import NomotoIdentification, heading_rms, identify
+from trials.analysis.nomoto.identification import NomotoIdentification, fit_problem, heading_rms, identify
 from trials.analysis.nomoto.least_squares import Z95, FitResult, fit_least_squares
 from trials.analysis.nomoto.models import NomotoModel, first_order, load_model, zigzag_spec
 from trials.analysis.nomoto.output_error import fit_output_error
@@ -76,5 +76,5 @@ __all__ = [
     # identification
     "FourPointResult", "four_point", "ClassicalResult", "classical_first_order",
     "Z95", "FitResult", "fit_least_squares", "fit_output_error",
-    "heading_rms", "NomotoIdentification", "identify",
+    "heading_rms", "fit_problem", "NomotoIdentification", "identify",
 ]

@@ -319,7 +319,9 @@ def zigzag_data(record: TrialRecord, L: float, U: Optional[float] = None, per_kn
         raise InputError("--length", "", f"ship length must be positive, got {L}")
     for c in ("psi", "delta"):
         if getattr(record, c) is None:
-            raise InputError(src, c, "channel missing; a zigzag analysis needs heading and rudder")
+            from trials.files.logio import missing_channel
+
+            raise missing_channel(record, c, "a zigzag analysis needs heading and rudder")
     _check_finite(record, ("t", "psi", "delta", "r"))
     t = np.asarray(record.t, float)
     if len(t) < 10 or np.any(np.diff(t) <= 0):
