@@ -23,7 +23,7 @@ from .model import (P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_RU
                     PackedShip)
 from .nondim import inertia_scale, mass_scale
 
-__all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD", "RESISTANCE_TERMS",
+__all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD",
            "hull_parameter", "parameter", "ship_value", "with_value", "write_yaml_value", "unit_of", "is_resistance",
            "EffectPrior", "WIND_COLUMNS", "config_values", "MASS_NAMES"]
 
@@ -47,18 +47,20 @@ ship's rudder constants about a config's.  The added masses at 20 %: the diagnos
 candidate effect, and an added mass a few % off leaves a residual (surge speed loss in the turn, sway and yaw
 lag) an effect would otherwise take; a wider prior would let them take an effect's residual instead."""
 
-RESISTANCE_TERMS = ("1", "cos(beta)^2", "u^2")
-"""Terms of the surge equation whose coefficient is the ship's straight-ahead resistance (non-dimensional by
-U^2: ``X_0`` of a polynomial MMG hull, ``X_uu`` of the Kijima form): it stays a resistance (negative)."""
-
 WIND_COLUMNS = {"wind_scale": ("scale", 0), "wind_sway_factor": ("sway_factor", 1), "wind_yaw_factor": ("yaw_factor", 2)}
 """Fit name of a wind value -> (the wind effect's parameter and the ship's ``wind:`` key it multiplies, the
 column of the records' external loads X, Y, N it multiplies; 0: all three)."""
 
 
-def is_resistance(name: str, term: str) -> bool:
-    """Whether hull coefficient ``name`` with term ``term`` is the straight-ahead resistance (:data:`RESISTANCE_TERMS`)."""
-    return name.startswith("X_") and term in RESISTANCE_TERMS
+def is_resistance(name: str, term: str, axis: str | None = None) -> bool:
+    """Whether hull coefficient ``name`` (of equation ``axis``, default the name's first letter) with term
+    ``term`` is a straight-ahead resistance: a surge (X) term not zero at beta = v' = r' = 0, e.g. ``X_uu``
+    (``cos(beta)^2``) of the Kijima form, ``X_0`` (``1``) of the MMG standard method; it stays negative."""
+    from .terms import term_id, term_value
+
+    if (axis or name[:1]) != "X" or not term:
+        return False
+    return float(term_value(term_id(term), 0.0, 0.0, 0.0)) != 0.0
 
 
 @dataclass(frozen=True)

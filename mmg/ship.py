@@ -101,10 +101,9 @@ class HullModel:
         """The resistance coefficients: the X coefficients whose term is not zero straight ahead
         (beta = v' = r' = 0), e.g. ``X_uu`` (``cos(beta)^2``) of the Kijima form, ``X_0`` (``1``) of the MMG
         standard method.  X' = sum of them straight ahead, -R' (the resistance)."""
-        from .terms import term_id, term_value
+        from .parameters import is_resistance
 
-        return tuple(n for n, ax, t in zip(self.names, self.axes, self.terms)
-                     if ax == "X" and float(term_value(term_id(t), 0.0, 0.0, 0.0)) != 0.0)
+        return tuple(n for n, ax, t in zip(self.names, self.axes, self.terms) if is_resistance(n, t, ax))
 
     def with_values(self, changes: dict[str, float]) -> "HullModel":
         """A copy with some coefficients changed."""

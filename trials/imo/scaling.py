@@ -154,10 +154,7 @@ def check_similar(model: Ship, full: Ship) -> float:
 
 def resistance_coefficient(ship: Ship) -> str:
     """The hull's resistance coefficient: its one X coefficient whose term is not zero at beta = r' = 0."""
-    from mmg.terms import term_id, term_value
-
-    names = [n for n, ax, t in zip(ship.hull.names, ship.hull.axes, ship.hull.terms)
-             if ax == "X" and term_value(term_id(t), 0.0, 0.0, 0.0) != 0.0]
+    names = list(ship.hull.resistance_names())
     if len(names) != 1:
         raise InputError("hull", ship.name, f"expected one resistance coefficient (an X term not zero at "
                                             f"beta = r' = 0), found {names or 'none'}")
