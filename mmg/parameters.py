@@ -22,6 +22,7 @@ import numpy as np
 from .model import (P_EPS, P_GNEG, P_GPOS, P_JZ, P_KAPPA, P_LR, P_MX, P_MY, P_RUDDER_OFFSET, P_YP_ASTERN, POLY_WP0,
                     PackedShip)
 from .nondim import inertia_scale, mass_scale
+from .terms import is_resistance
 
 __all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD",
            "hull_parameter", "parameter", "ship_value", "with_value", "write_yaml_value", "unit_of", "is_resistance",
@@ -50,17 +51,6 @@ lag) an effect would otherwise take; a wider prior would let them take an effect
 WIND_COLUMNS = {"wind_scale": ("scale", 0), "wind_sway_factor": ("sway_factor", 1), "wind_yaw_factor": ("yaw_factor", 2)}
 """Fit name of a wind value -> (the wind effect's parameter and the ship's ``wind:`` key it multiplies, the
 column of the records' external loads X, Y, N it multiplies; 0: all three)."""
-
-
-def is_resistance(name: str, term: str, axis: str | None = None) -> bool:
-    """Whether hull coefficient ``name`` (of equation ``axis``, default the name's first letter) with term
-    ``term`` is a straight-ahead resistance: a surge (X) term not zero at beta = v' = r' = 0, e.g. ``X_uu``
-    (``cos(beta)^2``) of the Kijima form, ``X_0`` (``1``) of the MMG standard method; it stays negative."""
-    from .terms import term_id, term_value
-
-    if (axis or name[:1]) != "X" or not term:
-        return False
-    return float(term_value(term_id(term), 0.0, 0.0, 0.0)) != 0.0
 
 
 @dataclass(frozen=True)

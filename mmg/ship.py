@@ -101,7 +101,7 @@ class HullModel:
         """The resistance coefficients: the X coefficients whose term is not zero straight ahead
         (beta = v' = r' = 0), e.g. ``X_uu`` (``cos(beta)^2``) of the Kijima form, ``X_0`` (``1``) of the MMG
         standard method.  X' = sum of them straight ahead, -R' (the resistance)."""
-        from .parameters import is_resistance
+        from .terms import is_resistance
 
         return tuple(n for n, ax, t in zip(self.names, self.axes, self.terms) if is_resistance(n, t, ax))
 

@@ -195,3 +195,12 @@ def latex_label(name: str) -> str:
     axis, _, sub = name.partition("_")
     sub = sub.replace("beta", "\\beta ").strip()
     return f"${axis}'_{{{sub}}}$" if sub else f"${axis}'$"
+
+
+def is_resistance(name: str, term: str, axis: str | None = None) -> bool:
+    """Whether hull coefficient ``name`` (of equation ``axis``, default the name's first letter) with term
+    ``term`` is a straight-ahead resistance: a surge (X) term not zero at beta = v' = r' = 0, e.g. ``X_uu``
+    (``cos(beta)^2``) of the Kijima form, ``X_0`` (``1``) of the MMG standard method; it stays negative."""
+    if (axis or name[:1]) != "X" or not term:
+        return False
+    return float(term_value(term_id(term), 0.0, 0.0, 0.0)) != 0.0
