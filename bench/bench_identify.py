@@ -9,7 +9,6 @@ Usage: ``python bench/bench_identify.py [--repeat 1] [--out DIR] [-- EXTRA mmg i
 from __future__ import annotations
 
 import argparse
-import os
 import subprocess
 import sys
 import tempfile
@@ -17,12 +16,9 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
 
-
-def frt_folder() -> Path:
-    """The FRT-DS-ESSO folder: ``MMG_FRT_DATA`` or ``../shared/data/frt-ds-esso`` beside the repository."""
-    env = os.environ.get("MMG_FRT_DATA")
-    return Path(env) if env else REPO.parent / "shared" / "data" / "frt-ds-esso"
+from trials.files.data import FRT_MISSING, frt_folder  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -31,9 +27,10 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=None, help="output folder (default a temporary one)")
     ap.add_argument("extra", nargs="*", help="more mmg identify options, after --")
     a = ap.parse_args(argv)
-    logs = sorted(str(p) for p in frt_folder().glob("*/*.csv"))
+    data = frt_folder()
+    logs = sorted(str(p) for p in data.glob("*/*.csv")) if data is not None else []
     if not logs:
-        print(f"bench_identify: no FRT-DS-ESSO records under {frt_folder()} (set MMG_FRT_DATA)", file=sys.stderr)
+        print(f"bench_identify: {FRT_MISSING}", file=sys.stderr)
         return 2
     walls = []
     with tempfile.TemporaryDirectory() as tmp:

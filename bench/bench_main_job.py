@@ -24,9 +24,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 TARGET_S = 60.0
 sys.path.insert(0, str(ROOT))
-from trials.papers.reproduce import frt_data_dir  # noqa: E402
+from trials.files.data import frt_folder  # noqa: E402
 
-FRT = frt_data_dir()
+FRT = frt_folder()
 
 _TIMING = re.compile(r"\(\d+(\.\d+)? s\)|\b\d+(\.\d+)? s\b|Total \d+(\.\d+)? s")
 

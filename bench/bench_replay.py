@@ -10,7 +10,6 @@ Prints the median of ``--repeat`` replays (7), the best, and the ratio to the ta
 """
 from __future__ import annotations
 
-import os
 import statistics
 import sys
 import time
@@ -27,8 +26,10 @@ SPAN_S = 600.0
 def _record(ship):
     from trials.files.records import TrialRecord
 
-    data = Path(os.environ.get("MMG_FRT_DATA") or REPO.parent / "shared" / "data" / "frt-ds-esso")
-    files = sorted(data.glob("*/*.csv")) if data.is_dir() else []
+    from trials.files.data import frt_folder
+
+    data = frt_folder()
+    files = sorted(data.glob("*/*.csv")) if data is not None else []
     if files:
         from trials.files.logio import read_record
 

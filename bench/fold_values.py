@@ -86,7 +86,7 @@ def refit(nested: dict, fold: int, max_nfev: int) -> list[str]:
     from trials.measured.foldspread import fold_spread
     from trials.measured.identify import identify, load_runs
     from trials.measured.nested import hull_candidates
-    from trials.papers.reproduce import frt_data_dir
+    from trials.files.data import frt_folder
 
     recs = nested["records"]
     choice = next(r["choice"] for r in recs if r["fold"] == fold)
@@ -94,9 +94,9 @@ def refit(nested: dict, fold: int, max_nfev: int) -> list[str]:
     if "," in choice:
         raise SystemExit(f"--refit: fold {fold} chose {choice!r}; only a plain hull form is refitted")
     kept = {r["name"] for r in recs if r["fold"] == fold}
-    if frt_data_dir() is None:
+    if frt_folder() is None:
         raise SystemExit("--refit: FRT-DS-ESSO data not found (set MMG_FRT_DATA)")
-    paths = [p for p in sorted(Path(frt_data_dir()).glob("*/*.csv")) if p.stem in {r["name"] for r in recs}]
+    paths = [p for p in sorted(Path(frt_folder()).glob("*/*.csv")) if p.stem in {r["name"] for r in recs}]
     ship = hull_candidates(SHIP, (form,))[form].ship
     runs = load_runs(ship, [p for p in paths if p.stem not in kept], say=lambda *_: None)
     ident = identify(ship, runs, initial=mmg.load_ship(SHIP), max_nfev=max_nfev,

@@ -89,7 +89,7 @@ def _summary(res: dict) -> list[str]:
 
 
 def main(argv=None) -> int:
-    from trials.papers.reproduce import frt_data_dir
+    from trials.files.data import frt_folder
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hull", nargs="+", choices=("kijima", "crossflow"), default=["kijima", "crossflow"])
@@ -101,7 +101,7 @@ def main(argv=None) -> int:
                     help="each record's start state in the fit (mmg identify --initial-state; default fit)")
     ap.add_argument("--json", default=None, metavar="FILE")
     a = ap.parse_args(argv)
-    data = frt_data_dir()
+    data = frt_folder()
     paths = [p for sub in a.records for p in sorted((Path(data) / sub).glob("*.csv"))]
     if not paths:
         print(f"no records under {data}")

@@ -49,7 +49,7 @@ from frt_gap import KINDS, kind_of  # noqa: E402  (the record kinds, defined onc
 import mmg  # noqa: E402
 from trials.measured.identify import load_runs  # noqa: E402
 from trials.measured.nested import HULL_FORMS, SCORE_NAMES, hull_candidates, nested_cross_validate  # noqa: E402
-from trials.papers.reproduce import frt_data_dir  # noqa: E402
+from trials.files.data import frt_folder  # noqa: E402
 
 SHIP = "esso_osaka_3m"
 """The ship whose hull forms are candidates (:func:`trials.measured.nested.hull_candidates`)."""
@@ -276,7 +276,7 @@ def choice_lines(res) -> list[str]:
 
 def main(argv=None) -> None:
     a = _args(argv)
-    d = frt_data_dir()
+    d = frt_folder()
     if d is None:
         sys.exit("FRT-DS-ESSO data not found (set MMG_FRT_DATA)")
     files = [p for s in a.records for p in sorted((d / s).glob("*.csv"))]

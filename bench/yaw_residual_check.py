@@ -116,7 +116,7 @@ def record_row(ship, path: Path, speed: float) -> dict | None:
 
 def main(argv=None) -> int:
     from mmg.ship import load_ship
-    from trials.papers.reproduce import frt_data_dir
+    from trials.files.data import frt_folder
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--ship", default="esso_osaka_3m")
@@ -125,7 +125,7 @@ def main(argv=None) -> int:
                     choices=("turning", "zigzag", "random", "berthing"))
     ap.add_argument("--speed", type=float, default=0.15, help="largest speed U [m/s] of the samples used")
     a = ap.parse_args(argv)
-    data = a.data or frt_data_dir()
+    data = a.data or frt_folder()
     files = [p for s in a.records for p in sorted((Path(data) / s).glob("*.csv"))] if data else []
     if not files:
         print(f"no records under {data}", file=sys.stderr)

@@ -15,7 +15,12 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
 
 REPO = Path(__file__).resolve().parents[1]
 CONFIGS = REPO / "configs"
-FRT = REPO.parent / "shared" / "data" / "frt-ds-esso"
+from trials.files.data import FRT_MISSING, frt_folder, frt_place  # noqa: E402
+
+FRT_FOUND = frt_folder()
+"""The FRT-DS-ESSO folder (:func:`trials.files.data.frt_folder`), None when no records are found."""
+FRT = frt_place()
+"""Where the records are (or would be): tests marked :func:`needs_frt` run only when they are found."""
 
 
 @pytest.fixture(scope="session")
@@ -26,7 +31,41 @@ def esso():
 
 
 def needs_frt():
-    return pytest.mark.skipif(not FRT.is_dir(), reason="FRT-DS-ESSO data folder ../shared/data/frt-ds-esso absent")
+    """The ``needs_frt`` marker: the test is skipped, naming how to point to the data, when
+    :func:`trials.files.data.frt_folder` finds no FRT-DS-ESSO records."""
+    return pytest.mark.needs_frt
+
+
+@pytest.fixture(scope="session")
+def frt():
+    """The FRT-DS-ESSO folder; the test is skipped when no records are found."""
+    if FRT_FOUND is None:
+        pytest.skip(FRT_MISSING)
+    return FRT_FOUND
+
+
+def pytest_collection_modifyitems(config, items):
+    if FRT_FOUND is not None:
+        return
+    skip = pytest.mark.skip(reason=FRT_MISSING)
+    for item in items:
+        if item.get_closest_marker("needs_frt") is not None:
+            item.add_marker(skip)
+
+
+def frt_skip_summary(reasons) -> str | None:
+    """The one summary line naming the tests skipped for want of the FRT-DS-ESSO records among the skip
+    ``reasons`` (one string per skipped test), None when there were none."""
+    n = sum(FRT_MISSING in str(r) for r in reasons)
+    return f"{n} test{'s' if n != 1 else ''} skipped: {FRT_MISSING}" if n else None
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    reasons = [rep.longrepr[2] if isinstance(rep.longrepr, tuple) else rep.longrepr
+               for rep in terminalreporter.stats.get("skipped", [])]
+    line = frt_skip_summary(reasons)
+    if line:
+        terminalreporter.write_line(line, yellow=True)
 
 
 # --------------------------------------------------------------------------- cold numba cache
@@ -42,6 +81,7 @@ _warmup = None
 
 def pytest_configure(config):
     global _warmup
+    config.addinivalue_line("markers", "needs_frt: runs only where the real FRT-DS-ESSO records are found (MMG_FRT_DATA)")
     if os.environ.get("MMG_TEST_WARMUP", "1") == "0" or config.option.collectonly:
         return
     from trials.cli.warmup import SUITE_GROUPS, filter_cache_cold

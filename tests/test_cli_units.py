@@ -7,7 +7,7 @@ import re
 
 import pytest
 
-from .conftest import FRT
+from .conftest import FRT, needs_frt
 
 KNOT = 1852.0 / 3600.0          # m/s, by definition of the knot and the nautical mile
 
@@ -89,7 +89,7 @@ def test_every_dimensional_option_of_every_command_takes_units():
     assert set(failing) == OWNED_ELSEWHERE & set(found), failing
 
 
-@pytest.mark.skipif(not (FRT / "zigzag").is_dir(), reason="FRT-DS-ESSO data not present")
+@needs_frt()
 def test_nomoto_with_units_on_the_command_line(capsys):
     """The trial's command: ``mmg nomoto LOG --length '3 m' --speed '0.3 m/s'`` runs (it failed with "invalid
     float value"), with L = 3 m and U = 0.3 m/s."""

@@ -13,7 +13,8 @@ from mmg.errors import InputError
 from trials.papers import artyszuk as a
 from trials.analysis import nomoto as nm
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "frt-ds-esso"
+from .conftest import FRT as DATA, needs_frt
+
 CONFIGS = Path(__file__).resolve().parents[1] / "configs" / "nomoto"
 
 
@@ -253,7 +254,7 @@ def test_cli_bad_input_exit_2(tmp_path, sim2, capsys):
 
 
 # ---- acceptance 5: real data ------------------------------------------------------------
-@pytest.mark.skipif(not (DATA / "zigzag").is_dir(), reason="FRT-DS-ESSO data not present")
+@needs_frt()
 def test_real_zigzag_identifies_without_error():
     logio = pytest.importorskip("trials.files.logio")
     f = sorted((DATA / "zigzag").glob("*13_04_24.csv"))[0]
@@ -294,7 +295,7 @@ def test_simulated_zigzag_fits_are_all_usable(sim2):
     assert np.isclose(dim["T1_s"], d["second_order_least_squares"]["T1"] * 100.0 / 5.0)
 
 
-@pytest.mark.skipif(not (DATA / "zigzag").is_dir(), reason="FRT-DS-ESSO data not present")
+@needs_frt()
 def test_failed_four_point_fit_is_labelled_unusable_in_console_json_and_figure(tmp_path, monkeypatch):
     """zigzag 14:03:39 (3 m model): the four-point fit has K, T1 < 0 and a heading replay that diverges.
     The console, the JSON and the figure say it is unusable; its RMS is not printed as a result and its

@@ -6,7 +6,7 @@
   end to end; a project sea-trial log (no rudder channel, the rudder rebuilt) to a justified
   tolerance.
 * ``mmg predict`` end to end on small slices of the real FRT-DS-ESSO files (``../shared``,
-  or ``$MMG_FRT_DATA``; skipped where absent): the JSON's keys exactly, the numbers the
+  or ``$MMG_FRT_DATA``: :func:`trials.files.data.frt_folder`; skipped where absent): the JSON's keys exactly, the numbers the
   library's, one line per run, the plots.
 * Bad records (acceptance 5): a dropout, a wrapped heading, a missing column, channels in the
   wrong unit, a ``--start`` outside the record: handled (the wrapped heading) or refused in one
@@ -17,17 +17,15 @@
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from .conftest import FRT as _FRT_BESIDE
+from .conftest import FRT, FRT_FOUND, FRT_MISSING
 
-FRT = Path(os.environ["MMG_FRT_DATA"]) if os.environ.get("MMG_FRT_DATA") else _FRT_BESIDE
-needs_frt = pytest.mark.skipif(not FRT.is_dir(), reason=f"FRT-DS-ESSO data folder {FRT} absent")
+needs_frt = pytest.mark.needs_frt
 
 ZIGZAG = "zigzag/zigzag_31-Jul-2020_13_04_24.csv"
 TURNING = "turning/turn_14-Sep-2020_13_39_32.csv"
@@ -136,8 +134,8 @@ def _slice(src: Path, dst: Path, rows: int = SLICE_ROWS, drop=None, edit=None, d
 
 @pytest.fixture()
 def slices(tmp_path):
-    if not FRT.is_dir():
-        pytest.skip(f"FRT-DS-ESSO data folder {FRT} absent")
+    if FRT_FOUND is None:
+        pytest.skip(FRT_MISSING)
     return [_slice(FRT / ZIGZAG, tmp_path / "zz_slice.csv"), _slice(FRT / TURNING, tmp_path / "turn_slice.csv")]
 
 

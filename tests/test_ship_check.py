@@ -26,7 +26,7 @@ import pytest
 from .conftest import FRT, REPO
 
 DEV = REPO.parent / "shared" / "data" / "diagnose-dev" / "data"
-needs_frt = pytest.mark.skipif(not FRT.is_dir(), reason=f"FRT-DS-ESSO data folder {FRT} absent")
+needs_frt = pytest.mark.needs_frt
 needs_dev = pytest.mark.skipif(not DEV.is_dir(), reason=f"diagnose-dev data folder {DEV} absent")
 FRT_ZIGZAG = FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv"
 

@@ -1,8 +1,6 @@
 """Wind forces (Fujiwara et al. 1998 regression) and the FRT-DS-ESSO wind conventions."""
 
 import glob
-import os
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,11 +18,9 @@ from mmg.wind import (
     wind_forces,
 )
 
+from .conftest import FRT_FOUND, FRT_MISSING
+
 DEG = np.pi / 180
-_FRT_DEFAULT = Path("/work/shared/data/frt-ds-esso")
-_FRT_BESIDE = Path(__file__).resolve().parents[2] / "shared" / "data" / "frt-ds-esso"  # CI clone layout
-FRT = Path(os.environ["MMG_FRT_DATA"]) if os.environ.get("MMG_FRT_DATA") else (
-    _FRT_DEFAULT if _FRT_DEFAULT.is_dir() else _FRT_BESIDE)
 
 
 # --------------------------------------------------------------------------- signs, symmetry
@@ -221,12 +217,9 @@ def test_mirror_property(V, g):
 # --------------------------------------------------------------------------- real data
 
 def _frt_files():
-    if not FRT.is_dir():
-        pytest.skip(f"FRT-DS-ESSO folder {FRT} absent (set MMG_FRT_DATA)")
-    files = sorted(glob.glob(str(FRT / "*" / "*.csv")))
-    if not files:
-        pytest.skip(f"no CSV files under {FRT}")
-    return files
+    if FRT_FOUND is None:
+        pytest.skip(FRT_MISSING)
+    return sorted(glob.glob(str(FRT_FOUND / "*" / "*.csv")))
 
 
 def _read(f):

@@ -89,14 +89,16 @@ def zigzags_figure(res, pyplot: bool = True):
 def stopping_figure(res, pyplot: bool = True):
     """The full-astern stopping test of ``res``: the track in ship lengths (x north, y east from the point
     of the astern order) with hull outlines every minute-scale interval and the 15 L / 20 L track-reach
-    limits; beside it the surge speed [kn] and the revolutions [rpm] against time."""
+    limits; beside it the surge speed [kn] and the revolutions [rpm] against time.  The track's axes span
+    the track and the 15 L line with a margin (:func:`_stopping_view`), to scale."""
     from mmg.units import KNOT
 
     run, m = res.runs[STOPPING_RUN]
     L, B = res.L, res.B
     t, x, y, psi = run.t, run.x / L, run.y / L, run.psi
-    fig = _figure((11.0, 6.5), pyplot)
-    ax = fig.add_subplot(1, 2, 1)
+    fig = _figure((10.0, 7.0), pyplot)
+    gs = fig.add_gridspec(2, 2, width_ratios=[1.0, 1.4])
+    ax = fig.add_subplot(gs[:, 0])
     tr = m.get("track_reach_L")
     label = ("track" if tr is None else f"track: track reach {tr:.2f} L, head reach {m['head_reach_L']:.2f} L, "
              f"lateral deviation {m['lateral_deviation_L']:+.2f} L")
@@ -107,30 +109,46 @@ def stopping_figure(res, pyplot: bool = True):
         ax.fill(py, px, facecolor="none", edgecolor="tab:blue", lw=0.8)
     ax.axhline(15.0, color="tab:red", ls="--", lw=0.8,
                label="15 L ahead of the order: the track-reach limit (MSC.137(76) 5.3.4)")
-    ax.axhline(20.0, color="tab:red", ls=":", lw=0.8,
-               label="20 L: the most the Administration may accept for large ships")
-    ax.set_aspect("equal", adjustable="datalim")
+    (e0, e1), (n0, n1) = _stopping_view(x, y)
+    if n1 >= 20.0:
+        ax.axhline(20.0, color="tab:red", ls=":", lw=0.8,
+                   label="20 L: the most the Administration may accept for large ships")
+    ax.set_xlim(e0, e1)
+    ax.set_ylim(n0, n1)
+    ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("y, east (L)")
     ax.set_ylabel("x, north (L)")
     ax.set_title(f"{res.ship}: full astern from {res.speed}, rudder midships", fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1))
-    a1 = fig.add_subplot(2, 2, 2)
+    a1 = fig.add_subplot(gs[0, 1])
     a1.plot(t / 60.0, run.u / KNOT, color="tab:blue")
     a1.set_ylabel("surge speed u (kn)")
     a1.set_title(f"stopped after {t[-1] / 60:.1f} min (u down to 1 % of V)", fontsize=9)
     a1.grid(True, alpha=0.3)
-    a2 = fig.add_subplot(2, 2, 4, sharex=a1)
+    a2 = fig.add_subplot(gs[1, 1], sharex=a1)
     a2.plot(t / 60.0, run.n * 60.0, color="tab:orange")
     a2.set_ylabel("revolutions (rpm)")
     a2.set_xlabel("time from the astern order (min)")
     a2.grid(True, alpha=0.3)
-    fig.subplots_adjust(bottom=0.2, wspace=0.35, hspace=0.3)
+    fig.set_layout_engine("constrained")
     return fig
 
 
+def _stopping_view(x, y, pad: float = 1.0, narrowest: float = 0.4) -> tuple:
+    """The stopping track's view in L: ``(east limits, north limits)``, the track and the 15 L limit line
+    with ``pad`` L about them, the east span widened about the track's middle to at least ``narrowest``
+    times the north span (equal scales: the box is then no thin strip)."""
+    n0, n1 = float(np.min(x)) - pad, max(float(np.max(x)), 15.0) + pad
+    e0, e1 = float(np.min(y)) - pad, float(np.max(y)) + pad
+    half = max(e1 - e0, narrowest * (n1 - n0)) / 2
+    mid = (e0 + e1) / 2
+    return (mid - half, mid + half), (n0, n1)
+
+
 def distributions_figure(res, pyplot: bool = True):
-    """A histogram per sampled criterion with its limit (red), the median and the 90 % interval."""
+    """A histogram per sampled criterion with its limit (red), the median and the 90 % interval, each panel
+    with its own legend (its limit's value)."""
     if res.samples is None:
         raise ValueError("no samples: imo(ship, samples=N) gives the distributions")
     crit = list(res.criteria)
@@ -155,8 +173,7 @@ def distributions_figure(res, pyplot: bool = True):
         ax.set_xlabel(f"{c.name.split(',')[0]} ({c.unit})", fontsize=8)
         ax.set_ylabel("samples", fontsize=8)
         ax.tick_params(labelsize=7)
-        if k == 0:
-            ax.legend(fontsize=6)
+        ax.legend(fontsize=6, loc="best")
     fig.suptitle(f"{res.ship}: IMO criteria over {res.n_samples} parameter samples at {res.speed}")
-    fig.subplots_adjust(hspace=0.9, wspace=0.35, top=0.88)
+    fig.set_layout_engine("constrained")
     return fig

@@ -30,7 +30,8 @@ def replay_layout(north, east, pad: float = 0.6) -> tuple:
 def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None):
     """Track with ship outlines (left, or across the top for a long track: :func:`replay_layout`) and
     heading, yaw rate, speed, rudder and revolutions of a :class:`trials.measured.predict.Replayed`, measured
-    (black) against predicted (red).  The track is to scale, its start marked, the legend below it.
+    (black) against predicted (red).  The track is to scale, its start marked, the legend below it; the
+    panels are packed by matplotlib's constrained layout, every legend on the canvas.
 
     A replay that diverged (:attr:`~trials.measured.predict.Replayed.diverged_at`) is marked by a dotted
     line at that time and in the titles, and every panel keeps the measured record's range (its span
@@ -89,10 +90,9 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
         ax.set_ylim(*vlim)
     view.finish(ax)
     ax.set_title(f"{title}: track (L = {L:g} m, wind {run.wind}){div}")
-    if wide:                     # the legend beside the track, off the data
-        ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=8, frameon=False)
-    else:                        # ... or below it, under the axis label
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=8, frameon=False)
+    # the legend below the track, 4.5 font sizes under it: clear of the ticks and the axis label
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.5, ncol=3 if wide else 2, fontsize=8,
+              frameon=False)
     rows = [("heading (deg)", np.degrees(m[:, 5]), np.degrees(p[:, 5])) if bands is None else
             ("heading (deg)\nunwrapped", bands.heading_deg, bands.nominal_deg),
             ("yaw rate (deg/s)", np.degrees(m[:, 2]), np.degrees(p[:, 2])),
@@ -127,7 +127,7 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
     a_.legend(loc="best", fontsize=8)
     for a in axs:
         a.tick_params(labelbottom=False)
-    fig.tight_layout()
+    fig.set_layout_engine("constrained", h_pad=0.02, hspace=0.0)
     return fig
 
 

@@ -9,8 +9,7 @@ path.  The report, in order:
 3. every default trial in ``configs/trials`` (log, truth, metrics, figures in DIR/trials/NAME);
 4. the plausibility table: our ST35, ZZ10, ZZ20 against the IMO criteria and the
    3 m Esso Osaka model's measured turning metrics (computed here from the
-   FRT-DS-ESSO files when that folder is found: ``MMG_FRT_DATA``, else ``../shared/data/frt-ds-esso``
-   beside the checkout or the working folder);
+   FRT-DS-ESSO files when :func:`trials.files.data.frt_folder` finds them);
 5. step convergence and port/starboard symmetry checks;
 6. the Nomoto models and their identification (Artyszuk 2018, Tables 1-8);
 7. the EKF reproduction (Rhee & Kim 1999, Tables 9-10);
@@ -35,6 +34,7 @@ from mmg.simulation import prepare, simulate
 from mmg.units import DEG, KNOT
 
 from ..analysis.metrics import imo_criteria, record_metrics, turning_metrics
+from ..files.data import frt_folder
 from ..files.output import StagedOutput, fmt, numerical_zeros, write_trial_outputs
 from ..runs.run import run_trial
 from ..runs.trial import load_trial
@@ -97,17 +97,6 @@ def demote(md: str, levels: int = 1, drop_title: bool = False) -> str:
             ln = "#" * levels + ln
         out.append(ln)
     return "\n".join(out)
-
-
-def frt_data_dir() -> Path | None:
-    """The FRT-DS-ESSO folder: ``MMG_FRT_DATA``, else ``../shared/data/frt-ds-esso`` beside the checkout or
-    the working folder; None when absent."""
-    cands = [os.environ.get("MMG_FRT_DATA"), Path(__file__).resolve().parents[2] / "shared" / "data" / "frt-ds-esso",
-             Path.cwd().parent / "shared" / "data" / "frt-ds-esso"]
-    for c in cands:
-        if c and Path(c).is_dir():
-            return Path(c)
-    return None
 
 
 def table(rows, cols, headers=None) -> str:
@@ -213,7 +202,7 @@ def plausibility_section(doc, runs, ship):
     st = runs["st35"][1]
     model_rows = [{"run": "ours, full scale, 10 kn, +35 deg", "U0": "10 kn", **{k: st.get(k) for k in
                    ("advance_L", "transfer_L", "tactical_diameter_L", "steady_diameter_L", "speed_loss")}}]
-    frt = frt_data_dir()
+    frt = frt_folder()
     if frt is not None:
         # the three 35 deg turns at n = 10 rps (FRT-DS-ESSO README)
         for f in [frt / "turning" / f"turn_14-Sep-2020_{s}.csv" for s in ("13_39_32", "13_51_45", "14_16_04")]:
