@@ -1,0 +1,53 @@
+"""What a user reads: error messages that say what to do with the command line that exists, speeds in the
+ship's own scale, counts and units said the same way everywhere."""
+from __future__ import annotations
+
+import math
+import re
+
+import pytest
+
+from mmg.errors import InputError
+from mmg.resources import ship_path
+from mmg.ship import load_ship
+
+KNOT = 1852.0 / 3600.0
+
+
+# ----------------------------------------------------------------- mmg imo
+
+
+def test_no_covariance_says_what_to_do_on_the_command_line():
+    from trials.measured.draws import parameter_covariance
+
+    with pytest.raises(InputError) as e:
+        parameter_covariance(load_ship(ship_path("esso_osaka")))
+    msg = e.value.message
+    assert "none was given" not in msg                 # no other way to give one exists on the command line
+    assert "mmg identify" in msg and "DIR/ship.yaml" in msg and "--samples" in msg
+
+
+def test_example_speed_is_in_the_ships_own_scale():
+    from trials.imo.standard import approach_speed, example_speed
+
+    model = load_ship(ship_path("esso_osaka_3m"))      # a 3 m model of the 325 m ship
+    ms = float(re.search(r"'([0-9.]+) m/s'", example_speed(model)).group(1))
+    assert ms == pytest.approx(10 * KNOT / math.sqrt(325.0 / 3.0), rel=0.02)     # 0.494 m/s, Froude-scaled
+    with pytest.raises(InputError) as e:
+        approach_speed(model)                          # no bundled trial gives its speed
+    assert "e.g. '10 kn'" not in e.value.message and f"'{ms:.2g} m/s'" in e.value.message
+    ship = load_ship(ship_path("esso_osaka"))          # no full_scale: section: Froude number 0.1
+    ms = float(re.search(r"'([0-9.]+) m/s'", example_speed(ship)).group(1))
+    assert ms == pytest.approx(0.1 * math.sqrt(9.80665 * 325.0), rel=0.02)
+
+
+@pytest.mark.parametrize("given, u0, expected", [
+    ("0.5 m/s", 0.5, "0.5 m/s"),
+    ("0.5m/s", 0.5, "0.5m/s"),
+    ("10 kn", 10 * KNOT, "10 kn (5.144 m/s)"),
+    ("2 knots", 2 * KNOT, "2 knots (1.029 m/s)"),
+])
+def test_speed_said_once_or_in_another_unit(given, u0, expected):
+    from trials.imo.standard import speed_label
+
+    assert speed_label(given, u0) == expected
