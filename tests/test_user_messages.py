@@ -51,3 +51,20 @@ def test_speed_said_once_or_in_another_unit(given, u0, expected):
     from trials.imo.standard import speed_label
 
     assert speed_label(given, u0) == expected
+
+
+# ----------------------------------------------------------------- mmg identify
+
+
+@pytest.mark.parametrize("kinds, expected", [
+    (["hull"] * 22 + ["start"] * 12, "22 model parameters and 12 start-state offsets (34 in all)"),
+    (["hull"] * 3 + ["wind_scale"], "4 model parameters"),
+    (["hull", "start"], "1 model parameter and 1 start-state offset (2 in all)"),
+])
+def test_free_parameters_counted_in_words(kinds, expected):
+    from types import SimpleNamespace
+
+    from trials.measured.identify import free_parameter_text
+
+    fit = SimpleNamespace(free=[SimpleNamespace(name=f"p{i}", kind=k) for i, k in enumerate(kinds)])
+    assert free_parameter_text(fit) == expected
