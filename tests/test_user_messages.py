@@ -68,3 +68,36 @@ def test_free_parameters_counted_in_words(kinds, expected):
 
     fit = SimpleNamespace(free=[SimpleNamespace(name=f"p{i}", kind=k) for i, k in enumerate(kinds)])
     assert free_parameter_text(fit) == expected
+
+
+# ----------------------------------------------------------------- mmg diagnose
+
+
+def test_sizes_relative_to_the_ship_said_in_si():
+    from trials.measured.diagnose_report import size_in_si, size_with_unit
+
+    L, T = 3.0, 0.2
+    assert size_in_si(0.1, "sqrt(gL)", L, T) == f"{0.1 * math.sqrt(9.80665 * 3.0):.3g} m/s"      # 0.542 m/s
+    assert size_with_unit(0.1, "sqrt(gL)", L, T) == "0.100 sqrt(gL) = 0.542 m/s"
+    assert size_with_unit(0.5, "T/H", L, T) == "0.500 T/H, H = 0.400 m"                           # H = T / (T/H)
+    assert size_with_unit(0.0, "T/H", L, T) == "0 T/H, H infinite"
+    assert size_with_unit(0.738, "deg", L, T) == "0.738 deg" and size_in_si(1.0, "deg", L, T) == ""
+
+
+def test_round_headers():
+    from trials.measured.diagnose_report import round_header
+
+    assert round_header(1, []) == "round 1: candidates against the ship alone"
+    assert round_header(3, ["current", "rudder_offset"]) == "round 3: after naming current, rudder_offset"
+
+
+def test_identifiability_line_has_units_and_the_depth():
+    from types import SimpleNamespace
+
+    from trials.measured.identifiability import identifiability_line
+
+    row = {"effect": "shallow_water", "std": 0.0074, "std_conditional": 0.00108, "detection_size": 0.5,
+           "confused_with": ["m_y", "J_z"]}
+    line = identifiability_line(row, 0.989, "T/H", "T/H", SimpleNamespace(L=3.0, T=0.2))
+    assert line == ("identifiability of shallow_water: R 0.989, sd 0.0074 T/H (alone 0.00108 T/H), "
+                    "detection size 0.500 T/H, H = 0.400 m, with m_y, J_z")
