@@ -148,10 +148,40 @@ def current_record(ship):
 
 
 @pytest.fixture(scope="module")
-def diag(ship, current_record):
+def diag_and_console(ship, current_record):
     from trials.measured.diagnose import diagnose
 
-    return diagnose(ship, [current_record])
+    said = []
+    return diagnose(ship, [current_record], say=said.append), said
+
+
+@pytest.fixture(scope="module")
+def diag(diag_and_console):
+    return diag_and_console[0]
+
+
+def test_console_rounds_have_headers_and_sizes_their_si_value(diag_and_console, ship):
+    """Each search round opens with its header; R, sd and detection size have a legend before the first
+    identifiability line and units; a size in sqrt(gL) has m/s beside it, one in T/H the depth in m."""
+    d, said = diag_and_console
+    heads = [i for i, ln in enumerate(said) if ln.startswith("round ")]
+    assert said[heads[0]] == "round 1: candidates against the ship alone"
+    assert len(heads) == len(d.rounds) >= 2 and said[heads[1]] == "round 2: after naming current"
+    assert all(said[i + 1].startswith("  ") for i in heads)              # the round's candidates follow it
+    ident = [i for i, ln in enumerate(said) if ln.startswith("identifiability of ")]
+    legend = [i for i, ln in enumerate(said) if "R, the multiple correlation" in ln]
+    assert len(legend) == 1 and legend[0] < ident[0] and "standard error" in said[legend[0]]
+    cur = next(ln for ln in said if ln.startswith("identifiability of current"))
+    assert re.search(r"sd [0-9.e-]+ m/s \(alone [0-9.e-]+ m/s\), detection size [0-9.e-]+ m/s", cur)
+    g = 9.80665
+    for ln in said:
+        for v, ms in re.findall(r"([0-9.e-]+) sqrt\(gL\) = ([0-9.e-]+) m/s", ln):
+            assert float(ms) == pytest.approx(float(v) * math.sqrt(g * ship.particulars.L), rel=0.01)
+        for v, h in re.findall(r"([0-9.e-]+) T/H, H = ([0-9.e-]+) m", ln):
+            assert float(h) == pytest.approx(ship.particulars.T / float(v), rel=0.01)
+        assert not re.search(r"sqrt\(gL\)(?! = [0-9.e-]+ m/s)", ln), ln
+        assert not re.search(r"(size|floor) [0-9.e-]+ T/H(?!, H = [0-9.e-]+ m|, H infinite)", ln), ln
+    assert any("T/H, H = " in ln for ln in said) and any("sqrt(gL) = " in ln for ln in said)
 
 
 def test_json_has_intervals_evidence_and_the_new_keys(diag):

@@ -3,6 +3,8 @@ takes (mmg simulate through a trial file naming it, mmg predict), and mmg predic
 the report's numbers (issue 11, acceptance 3)."""
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import re
 
@@ -28,9 +30,22 @@ def identified(tmp_path_factory):
     a = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv", d / "zz.csv", 90.0)
     b = _slice(FRT / "turning" / "turn_14-Sep-2020_13_51_45.csv", d / "turn.csv", 90.0)
     out = d / "out"
-    assert main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--out", str(out),
-                 "--wind", "on"]) == 0
+    console = io.StringIO()
+    with contextlib.redirect_stdout(console):
+        assert main(["identify", "--ship", "esso_osaka_3m", "--train", str(a), str(b), "--out", str(out),
+                     "--wind", "on"]) == 0
+    (d / "console.txt").write_text(console.getvalue())
     return d, out, (a, b)
+
+
+def test_console_and_report_count_the_fitted_parameters_alike(identified):
+    d, out, _ = identified
+    console = re.search(r"^identified (.+?) over \d+ records", (d / "console.txt").read_text(), re.M)
+    report = re.search(r"fitted: (.+?); residuals", (out / "report.md").read_text())
+    assert console and report and console.group(1) == report.group(1)
+    m = re.fullmatch(r"(\d+) model parameters and (\d+) start-state offsets \((\d+) in all\)", report.group(1))
+    assert m and int(m.group(1)) + int(m.group(2)) == int(m.group(3))
+    assert int(m.group(2)) > 0 and int(m.group(2)) % 2 == 0    # the same start states of each of the two records
 
 
 def test_report_and_ship_written(identified):

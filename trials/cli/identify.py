@@ -146,7 +146,9 @@ def _print_outcome(ident, runs, out: Path, nested, t0: float) -> None:
 
     a = np.mean([x["heading_rms_deg"] for x in ident.scores(model="initial")])
     b = np.mean([x["heading_rms_deg"] for x in ident.scores()])
-    print(f"identified {len(ident.fit.values())} parameters over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
+    from ..measured.identify import free_parameter_text
+
+    print(f"identified {free_parameter_text(ident.fit)} over {len(runs)} records in {time.perf_counter() - t0:.0f} s: "
           f"mean heading RMS {a:.2f} deg (initial) -> {b:.2f} deg (identified)")
     print(f"wrote {out / 'ship.yaml'} and {out / 'report.md'}")
     if nested is not None:

@@ -15,7 +15,7 @@ def cmd_imo(args) -> int:
     from ..imo.report import write_report
     from ..imo.result import imo
     from ..imo.sampling import covariance_of, local_executor
-    from ..imo.standard import approach_speed, plan
+    from ..imo.standard import approach_speed, plan, speed_label
 
     check_backend_options(args)
     check_output_dir(args.out)
@@ -49,7 +49,8 @@ def cmd_imo(args) -> int:
                   if args.scale_to is not None else None)
     with StagedOutput(args.out) as stage:
         names = write_report(res, stage.dir)
-    print(f"{res.ship} at {res.speed} (L/V = {res.L_over_V:.3g} s): wrote {', '.join(names)} to {args.out}")
+    print(f"{res.ship} at {speed_label(res.speed, res.u0)}, L/V = {res.L_over_V:.3g} s: "
+          f"wrote {', '.join(names)} to {args.out}")
     for w in res.warnings:
         print(f"warning: {w}")
     if res.doubts.reason:

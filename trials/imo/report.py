@@ -5,7 +5,7 @@ from pathlib import Path
 
 from ..analysis.metrics import IMO_STANDARD
 from .sampling import FAIL_PROBABILITY, PASS_PROBABILITY
-from .standard import STOPPING
+from .standard import STOPPING, speed_label
 
 __all__ = ["write_report", "report_lines", "FIGURES"]
 
@@ -117,7 +117,7 @@ def report_lines(res) -> list[str]:
     sampled = res.samples is not None
     lines = [f"# IMO manoeuvring standards: {res.ship}", "",
              f"Source of the criteria: {IMO_STANDARD}.", "",
-             f"Approach speed V = {res.speed} ({res.u0:.4g} m/s); L = {res.L:g} m; L/V = {res.L_over_V:.3g} s "
+             f"Approach speed V = {speed_label(res.speed, res.u0)}; L = {res.L:g} m; L/V = {res.L_over_V:.3g} s "
              f"(it sets the 10/10 overshoot limits: 10 / 20 / 5 + L/(2V) deg and 25 / 40 / 17.5 + 0.75 L/V deg "
              f"for L/V below 10 s, from 30 s, between).  A criterion's side is that of the turn or of a zigzag's "
              f"first rudder order; the initial-turning track reach is the distance run to the 10/10 zigzag's second "

@@ -40,14 +40,15 @@ from pathlib import Path
 
 from mmg.errors import InputError
 from mmg.ship import Ship, load_ship, read_yaml
-from mmg.units import DEG, MAX_SHIP_SPEED, to_si
+from mmg.model import G
+from mmg.units import _QUANTITY, DEG, KNOT, MAX_SHIP_SPEED, UNITS, to_si
 
 from ..analysis import metrics as MET
 from ..runs.run import prepare_trial, run_trial
 from ..runs.trial import Trial, stopping, turning, zigzag
 
 __all__ = ["Criterion", "Plan", "criteria", "plan", "run_manoeuvres", "criterion_values", "approach_speed",
-           "calm_water", "SIDES", "STOPPING", "STOPPING_RUN", "CALM_WATER_DROPS"]
+           "example_speed", "speed_label", "calm_water", "SIDES", "STOPPING", "STOPPING_RUN", "CALM_WATER_DROPS"]
 
 SIDES = ("starboard", "port")
 STOPPING = "stopping track reach"
@@ -269,9 +270,50 @@ def approach_speed(ship: Ship) -> tuple[str, list[str]]:
         return next(iter(speeds)), files
     if not speeds:
         raise InputError("speed", "", f"no bundled turning or zigzag trial of {ship.name!r} gives its approach speed: "
-                                      f"give it (mmg imo --speed, e.g. '10 kn')")
+                                      f"give it (mmg imo --speed, e.g. {example_speed(ship)})")
     raise InputError("speed", "", f"the bundled trials of {ship.name!r} approach at several speeds "
                                   f"({', '.join(speeds)}): give one (mmg imo --speed)")
+
+
+EXAMPLE_FULL_SCALE_SPEED = 10.0 * KNOT
+"""A full-scale ship's approach speed in the examples of the messages [m/s] (10 kn, the Esso Osaka's trials)."""
+EXAMPLE_FROUDE_NUMBER = 0.1
+"""Froude number V / sqrt(g L) of the example speed of a ship with no ``full_scale:`` section (approach
+speeds of large ships are Froude numbers 0.09-0.12)."""
+
+
+def example_speed(ship: Ship) -> str:
+    """An approach speed in ``ship``'s own scale, with where it comes from, for a message.
+
+    A model (its config's ``full_scale:`` section) gets 10 kn Froude-scaled from the full-scale ship,
+    10 kn / sqrt(lambda) (:attr:`mmg.ship.Ship.froude_scale`); any other ship the speed of Froude number
+    :data:`EXAMPLE_FROUDE_NUMBER`, 0.1 sqrt(g L).
+
+    Returns
+    -------
+    str
+        E.g. ``"'0.49 m/s' (10 kn Froude-scaled to this 2.98 m model, lambda = 109)"``.
+    """
+    L = ship.particulars.L
+    if ship.full_scale is not None:
+        lam = ship.froude_scale
+        u = EXAMPLE_FULL_SCALE_SPEED / math.sqrt(lam)
+        why = f"10 kn Froude-scaled to this {L:.3g} m model, lambda = {lam:.3g}"
+    else:
+        u = EXAMPLE_FROUDE_NUMBER * math.sqrt(G * L)
+        why = (f"Froude number {EXAMPLE_FROUDE_NUMBER:g} for L = {L:.3g} m, {EXAMPLE_FROUDE_NUMBER:g} sqrt(g L); "
+               f"0.09-0.12 is usual")
+    return f"'{u:.2g} m/s' ({why})"
+
+
+def speed_label(speed: str, u0: float) -> str:
+    """The approach speed as given, then in m/s when it was given in another unit: ``"10 kn (5.144 m/s)"``,
+    ``"0.5 m/s"`` (never the same speed twice)."""
+    text = str(speed).strip()
+    m = _QUANTITY.match(text)
+    if m and UNITS["speed"].get(m.group(2) or m.group(3)) == 1.0:
+        return text
+    return f"{text} ({u0:.4g} m/s)"
 
 
 _NAMES: dict = {}

@@ -86,7 +86,7 @@ from mmg.ship import Ship
 from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, WEAK_BIC, Z_THRESHOLD, calibration, clears_floor, evidence_short, floor,
                        floor_parts, magnitude, mean_heading, over_floor, record_kind, residual_floor)
 from .diagnose_records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
-from .diagnose_report import fmt3, format_rms, format_values
+from .diagnose_report import fmt3, format_rms, format_values, round_header, size_with_unit
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "straight_contradicts",
            "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
@@ -826,20 +826,22 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
     best that clears the thresholds and holds beside its rival (:func:`_best_standing`).  Returns
     (final fit, named effects, the rounds' log)."""
     current, named, rounds, remaining = base, [], [], list(cand)
+    lt = (fitter.ship.particulars.L, fitter.ship.particulars.T)
     while remaining:
         current = _polish(fitter, current, o)
         taus, inflate = _taus(current, o.stride)
         fitter.straight_weight = math.sqrt(taus[1])     # the v channel's: the straight run is a mean of v
         results, parts = [], []
+        say(round_header(len(rounds) + 1, named))
         for cls in remaining:
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
             dbic, _, _, _, vals, _, z, mag, _ = results[-1]
             parts.append(_parts(fitter, cls.name, vals))
             pt = parts[-1].get("parts")
-            size = (", ".join(f"{k} {fmt3(abs(a))} (floor {fmt3(f)})" for k, (a, f) in pt.items()) if pt else
-                    f"{fmt3(mag)} (floor {fmt3(floor(cls.name, fitter.kind))})")
-            say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}, size {size} "
-                f"{MAGNITUDE_UNITS.get(cls.name, '')}")
+            sz = lambda x: size_with_unit(x, MAGNITUDE_UNITS.get(cls.name, ''), *lt)     # noqa: E731
+            size = (", ".join(f"{k} {sz(abs(a))} (floor {sz(f)})" for k, (a, f) in pt.items()) if pt else
+                    f"{sz(mag)} (floor {sz(floor(cls.name, fitter.kind))})")
+            say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}, size {size}")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
                        "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
                        "kind": fitter.kind, "heading_deg": round(math.degrees(fitter.heading), 2),

@@ -23,7 +23,7 @@ from .decision import false_alarm_probability  # noqa: F401  (re-exported: the r
 
 __all__ = ["Z95", "effect_estimate", "effect_intervals", "polar_interval", "effect_evidence",
            "summary_lines", "not_identifiable_line", "fmt3", "format_rms", "format_values", "channel_text",
-           "straight_run_line"]
+           "straight_run_line", "size_in_si", "size_with_unit", "round_header", "IDENTIFIABILITY_LEGEND"]
 
 Z95 = 1.959963984540054
 """The two-sided 95 % point of the standard normal."""
@@ -33,6 +33,43 @@ CHANNEL_UNITS = {"u": "m/s", "v": "m/s", "r": "deg/s", "heading": "deg", "positi
 
 
 # --------------------------------------------------------------------------- numbers
+
+GRAVITY = 9.80665
+"""g [m/s^2] of a size in sqrt(g L)."""
+
+IDENTIFIABILITY_LEGEND = ("(identifiability: R, the multiple correlation of the effect with the other fitted "
+                          "parameters, 0 to 1, near 1 when they can stand in for it; sd, its standard error in the "
+                          "effect's unit with them fitted too (alone: with them held); detection size, the smallest "
+                          "size of it the diagnosis sets out to find)")
+"""The one-line legend printed before the first identifiability line of a diagnosis."""
+
+
+def size_in_si(value: float, unit: str, L: float, T: float) -> str:
+    """A size in a ship-relative unit said in SI, to print beside it: ``"0.140 m/s"`` for ``value``
+    sqrt(g L) (speed = value * sqrt(g L), ``L`` [m]), ``"H = 33.6 m"`` for a ratio T/H (depth H = T / value,
+    ``T`` the draft [m]; ``"H infinite"`` at 0); ``""`` for any other unit (already SI-like: m/s, deg)."""
+    if unit == "sqrt(gL)":
+        return f"{fmt3(abs(value) * math.sqrt(GRAVITY * L))} m/s"
+    if unit == "T/H":
+        return "H infinite" if value == 0 else f"H = {fmt3(T / abs(value))} m"
+    return ""
+
+
+def size_with_unit(value: float, unit: str, L: float, T: float) -> str:
+    """``value`` with its ``unit`` and, for a ship-relative one, its SI value beside it
+    (:func:`size_in_si`): ``"0.0259 sqrt(gL) = 0.140 m/s"``, ``"0.0893 T/H, H = 33.6 m"``, ``"0.738 deg"``."""
+    text = f"{fmt3(value)} {unit}".rstrip()
+    si = size_in_si(value, unit, L, T)
+    return text if not si else f"{text} = {si}" if unit == "sqrt(gL)" else f"{text}, {si}"
+
+
+def round_header(number: int, named) -> str:
+    """The console line before a search round's candidates: ``"round 1: candidates against the ship alone"``,
+    ``"round 2: after naming current"``."""
+    if not named:
+        return f"round {number}: candidates against the ship alone"
+    return f"round {number}: after naming {', '.join(named)}"
+
 
 
 def fmt3(x) -> str:

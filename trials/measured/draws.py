@@ -37,6 +37,11 @@ def ship_values(ship: Ship, names) -> np.ndarray:
     return np.asarray(out, dtype=float)
 
 
+NO_COVARIANCE = ("the ship config has no covariance: section to draw samples from: run `mmg identify` on the "
+                 "ship's records (it writes one into DIR/ship.yaml) and give that DIR/ship.yaml, or drop --samples")
+"""What to do about a ship without a covariance when samples are asked for."""
+
+
 def parameter_covariance(ship: Ship, cov=None, leave_out=()) -> tuple[list[str], np.ndarray, np.ndarray, list[str]]:
     """The parameters to sample: (names, mean, covariance, the names left out), the covariance's names in
     ``leave_out`` left out (the others keep their joint distribution: the marginal of a normal).
@@ -58,8 +63,7 @@ def parameter_covariance(ship: Ship, cov=None, leave_out=()) -> tuple[list[str],
     if cov is None:
         cov = ship.covariance
         if cov is None:
-            raise InputError("samples", ship.name, "the ship config has no covariance: section (mmg identify "
-                                                   "writes one into DIR/ship.yaml) and none was given")
+            raise InputError("samples", ship.name, NO_COVARIANCE)
     if isinstance(cov, ParameterCovariance):
         names, values, matrix = list(cov.names), cov.values, cov.matrix
     elif isinstance(cov, Mapping):

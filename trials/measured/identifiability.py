@@ -54,9 +54,10 @@ import numpy as np
 import mmg.effects as E
 
 from .decision import STATISTICAL_REASON
+from .diagnose_report import IDENTIFIABILITY_LEGEND, size_with_unit
 
 __all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "floor_in_fit_unit", "block_confounding",
-           "assess", "verdict", "not_identifiable_lines", "STATISTICAL_REASON"]
+           "assess", "verdict", "not_identifiable_lines", "STATISTICAL_REASON", "identifiability_line"]
 
 DETECTION_SIZE = {n: c.detection_size for n, c in E.REGISTRY.items()}
 """The smallest size of each effect that matters physically, in its fit parameters' unit
@@ -293,6 +294,17 @@ def _sp(unit: str) -> str:
     return f" {unit}" if unit else ""
 
 
+def identifiability_line(row: dict, R: float, sd_unit: str, det_unit: str, particulars) -> str:
+    """The console line of one candidate's identifiability ``row`` (keys ``effect``, ``std``,
+    ``std_conditional``, ``detection_size``, ``confused_with``): R, its sd in ``sd_unit`` (the fit
+    parameter's) and its detection size in ``det_unit``, a size in a ship-relative unit with its SI value
+    beside it (:func:`trials.measured.diagnose_report.size_with_unit`, ``particulars``' L and T [m])."""
+    sp = _sp(sd_unit)
+    det = size_with_unit(row["detection_size"], det_unit, particulars.L, particulars.T)
+    return (f"identifiability of {row['effect']}: R {R:.3f}, sd {row['std']:.3g}{sp} (alone "
+            f"{row['std_conditional']:.3g}{sp}), detection size {det}, with {', '.join(row['confused_with']) or '-'}")
+
+
 def _fmt(x: float) -> str:
     return f"{x:.2g}" if abs(x) < 1 else f"{x:.3g}"
 
@@ -358,8 +370,9 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
                "std": float(f"{b['sd']:.3g}"), "std_conditional": float(f"{b['sd_conditional']:.3g}"),
                "detection_size": float(f"{det:.3g}"), "unit": _unit(cls), "confused_with": confused}
         table.append(row)
-        say(f"identifiability of {cls.name}: R {b['R']:.3f}, sd {b['sd']:.3g} (alone {b['sd_conditional']:.3g}), "
-            f"detection size {det:.3g}, with {', '.join(confused) or '-'}")
+        if not table[:-1]:
+            say(IDENTIFIABILITY_LEGEND)
+        say(identifiability_line(row, b["R"], _unit(cls) or _size_unit(cls), _size_unit(cls), fitter.ship.particulars))
         fl = floor_in_fit_unit(cls.name, least_floor(cls.name, getattr(fitter, "kind", "")), L)
         row["confounded"], reason, kind = verdict(b, det, fl, (weak or {}).get(cls.name), _unit(cls), _size_unit(cls))
         row["floor"], row["reason_kind"] = fl, kind

@@ -85,7 +85,7 @@ __all__ = ["identify", "IdentifyOptions",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description", "identification_covariance", "run_covariance", "fold_spread_json",
            "COVARIANCE_METHOD", "identification_summary", "start_noise", "DEFAULT_INITIAL_STATE", "run_spread",
-           "START_UNITS",
+           "START_UNITS", "free_parameter_text",
            "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale", "Y_P_astern")
@@ -1045,6 +1045,20 @@ def _cov_std(cov: dict | None) -> dict:
     return dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"], float))))) if cov else {}
 
 
+def free_parameter_text(fit) -> str:
+    """The fit's free parameters counted in words, the same on the console and in report.md: ``"22 model
+    parameters and 12 start-state offsets (34 in all)"``, or ``"22 model parameters"`` without offsets.
+
+    ``fit`` has ``free``, each with its ``kind``: ``"start"`` for a record's start-state offset (a nuisance
+    that moves one replay's start, not the model), anything else a model parameter."""
+    starts = sum(1 for f in fit.free if f.kind == "start")
+    model = len(fit.free) - starts
+    text = f"{model} model parameter{'s' * (model != 1)}"
+    if starts:
+        text += f" and {starts} start-state offset{'s' * (starts != 1)} ({model + starts} in all)"
+    return text
+
+
 def _report_fit(ident: Identification, cov: dict | None, warn: list) -> list:
     """The report's title, stages, values with standard errors (of ``cov``, the written covariance section),
     warnings (``warn``: :func:`identification_summary`'s) and strong correlations."""
@@ -1054,7 +1068,7 @@ def _report_fit(ident: Identification, cov: dict | None, warn: list) -> list:
         lines += [f"Fitted in the form of {ident.prior.name} (the prior, 'config' below); 'initial' scores are "
                   f"{ident.initial.name}'s.", ""]
     lines += [
-             f"Records: {len(ident.runs)}; free parameters: {len(fit.free)}; residuals {fit.n_residuals}; "
+             f"Records: {len(ident.runs)}; fitted: {free_parameter_text(fit)}; residuals {fit.n_residuals}; "
              f"records weighted {ident.record_weighting!r}; velocity residuals weighted {ident.velocity_weight:g} "
              f"beside the heading's.", "", *_stage_lines(ident), "",
              "## Values and standard errors", "",
