@@ -64,7 +64,9 @@ class HeldoutTable:
         (heading RMS [deg] of the scaled and the identified model; NaN where the replay diverged).
     kinds : dict
         Per kind present: ``n`` records, ``n_diverged`` (either model NaN; left out of the means),
-        ``scaled_deg`` and ``identified_deg`` (means [deg]) and ``ratio`` (scaled over identified).
+        ``scaled_deg`` and ``identified_deg`` (means [deg]), ``ratio`` (scaled over identified),
+        ``n_better`` (records the identified model predicts with the lower heading RMS) and the medians
+        ``scaled_median_deg``, ``identified_median_deg`` [deg] (one spinning replay can carry a mean).
     overall : dict
         The same over all held-out records, plus ``kind_mean_ratio``: the mean over kinds of the
         scaled means over the mean over kinds of the identified means (every kind alike).
@@ -95,11 +97,12 @@ class HeldoutTable:
                "|---|---|---|---|---|"]
         out += [f"| {r['fold']} | {r['record']} | {r['kind']} | {f(r['scaled_deg'])} | {f(r['identified_deg'])} |"
                 for r in self.rows]
-        out += ["", "| kind | records | diverged | scaled mean [deg] | identified mean [deg] | ratio |",
-                "|---|---|---|---|---|---|"]
+        out += ["", "| kind | records | diverged | scaled mean [deg] | identified mean [deg] | ratio of means "
+                "| identified better | scaled median [deg] | identified median [deg] |", "|---|---|---|---|---|---|---|---|---|"]
         for k, d in list(self.kinds.items()) + [("all", self.overall)]:
             out.append(f"| {k} | {d['n']} | {d['n_diverged']} | {f(d['scaled_deg'])} | {f(d['identified_deg'])} "
-                       f"| {g(d['ratio'])} |")
+                       f"| {g(d['ratio'])} | {d['n_better']} | {f(d['scaled_median_deg'])} "
+                       f"| {f(d['identified_median_deg'])} |")
         out.append(f"\nmean over kinds: ratio {g(self.overall['kind_mean_ratio'])}")
         return "\n".join(out)
 
@@ -109,7 +112,16 @@ def _means(rows) -> dict:
     s = sum(r["scaled_deg"] for r in ok) / len(ok) if ok else math.nan
     i = sum(r["identified_deg"] for r in ok) / len(ok) if ok else math.nan
     return {"n": len(rows), "n_diverged": len(rows) - len(ok), "scaled_deg": s, "identified_deg": i,
-            "ratio": s / i if ok and i > 0 else math.nan}
+            "ratio": s / i if ok and i > 0 else math.nan,
+            "n_better": sum(r["identified_deg"] < r["scaled_deg"] for r in ok),
+            "scaled_median_deg": _median([r["scaled_deg"] for r in ok]),
+            "identified_median_deg": _median([r["identified_deg"] for r in ok])}
+
+
+def _median(xs) -> float:
+    xs = sorted(xs)
+    n = len(xs)
+    return math.nan if n == 0 else (xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2]))
 
 
 def heldout_table(rows) -> HeldoutTable:

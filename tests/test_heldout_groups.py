@@ -42,6 +42,10 @@ def test_kind_means_and_ratios_are_the_hand_sums():
     # every kind alike: (90 + 15) / (75 + 5)
     assert t.overall["kind_mean_ratio"] == pytest.approx(105.0 / 80.0)
     assert t.overall["n"] == 4 and t.overall["n_diverged"] == 0
+    # identified lower on r1, b1, b2; medians of (10, 20, 60, 120) and (4, 6, 60, 90)
+    assert t.overall["n_better"] == 3 and t.kinds["random"]["n_better"] == 1
+    assert (t.overall["scaled_median_deg"], t.overall["identified_median_deg"]) == pytest.approx((40.0, 33.0))
+    assert t.kinds["berthing"]["identified_median_deg"] == pytest.approx(5.0)
 
 
 def test_a_diverged_replay_is_counted_and_left_out_of_both_means():
@@ -51,7 +55,7 @@ def test_a_diverged_replay_is_counted_and_left_out_of_both_means():
     assert d["n"] == 2 and d["n_diverged"] == 1
     assert (d["scaled_deg"], d["identified_deg"], d["ratio"]) == pytest.approx((40.0, 20.0, 2.0))
     assert t.to_json()["rows"][0]["identified_deg"] is None
-    assert "| random | 2 | 1 | 40.0 | 20.0 | 2.00x |" in t.to_markdown()
+    assert "| random | 2 | 1 | 40.0 | 20.0 | 2.00x | 1 | 40.0 | 20.0 |" in t.to_markdown()
 
 
 def test_rows_from_predict_match_by_file_not_by_order():
