@@ -55,16 +55,16 @@ def test_each_records_start_state_is_fitted_well_below_the_noise_of_its_first_sa
     assert [f.name for f in old.fit.free] == ["kappa"]   # the raw first sample: nothing fitted for the start
 
 
-def _linear_fit(A, y, prior, sig):
+def _linear_fit(A, y, prior, sig, rows=None):
     """A linear least squares with a prior solved by hand, returned as ekf.identify's result of it: the data
-    rows A theta - y, then the prior's (theta - prior) / sig."""
+    rows A theta - y, then the prior's (theta - prior) / sig; ``rows``: each record's data rows."""
     n = A.shape[1]
     J = np.vstack([A, np.diag(1.0 / sig)])
     theta = np.linalg.solve(J.T @ J, A.T @ y + prior / sig ** 2)
     fun = np.concatenate([A @ theta - y, (theta - prior) / sig])
     free = [FreeParameter(f"p{i}", "hull", i, float(prior[i]), float(sig[i])) for i in range(n)]
     sol = SimpleNamespace(jac=J, fun=fun, x=theta, cost=0.5 * float(fun @ fun), nfev=1, message="", status=1)
-    return _result(free, sol, 0.5 * float(fun @ fun)), theta
+    return _result(free, sol, 0.5 * float(fun @ fun), rows), theta
 
 
 def test_the_written_covariance_keeps_the_prior_at_its_stated_std():

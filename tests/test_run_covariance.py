@@ -4,28 +4,19 @@ independent repetitions when the runs share an error the model does not carry, a
 simulator's records (the per-record parts add up to the whole)."""
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
 
 import mmg
-from ekf.identify import FreeParameter, _result, run_jackknife_covariance
+from ekf.identify import run_jackknife_covariance
 from trials.measured.identify import identification_covariance, identify
 
-from .test_identify_covariance import _records
+from .test_identify_covariance import _linear_fit, _records
 
 
 def _fit(A, y, rows, prior, sig):
-    """The MAP linear least squares (data rows A theta - y, prior rows (theta - prior) / sig), solved by hand,
-    as ekf.identify's result with each record's rows."""
-    n = A.shape[1]
-    J = np.vstack([A, np.diag(1.0 / sig)])
-    theta = np.linalg.solve(J.T @ J, A.T @ y + prior / sig ** 2)
-    fun = np.concatenate([A @ theta - y, (theta - prior) / sig])
-    free = [FreeParameter(f"p{i}", "hull", i, float(prior[i]), float(sig[i])) for i in range(n)]
-    sol = SimpleNamespace(jac=J, fun=fun, x=theta, cost=0.5 * float(fun @ fun), nfev=1, message="", status=1)
-    return _result(free, sol, 0.5 * float(fun @ fun), rows), theta
+    """The MAP linear least squares solved by hand, as ekf.identify's result with each record's rows."""
+    return _linear_fit(A, y, prior, sig, rows)
 
 
 def _problem(rng, n_rec=12, per=30, offset_sd=0.0, noise_sd=0.05):
