@@ -241,7 +241,9 @@ def summary_lines(res) -> list[str]:
            f"identified better on {s['better']} of {s['n']}"]
     if "band_coverage90" in s:
         out.append(f"90 % heading bands of the kept-out records ({s['band_records']} records): "
-                   f"{100 * s['band_coverage90']:.1f} % of their samples inside; median width "
+                   f"{100 * s['band_coverage90']:.1f} % of their samples inside; unbounded (over 5 % of the draws "
+                   f"diverged) on {100 * s['band_unbounded_share']:.1f} % of them, inside on "
+                   f"{100 * s['band_coverage90_where_bounded']:.1f} % of the others; median width "
                    f"{s['band_median_width_deg']:.3g} deg (median over the records)")
     for key, words in (("heading_rms_deg", "heading RMS [deg]"), ("yaw_rate_rms_degps", "yaw-rate RMS [deg/s]"),
                        ("speed_rms_mps", "speed RMS [m/s]"), ("final_position_error_L", "final position error [L]")):

@@ -115,11 +115,14 @@ def test_kept_out_bands_pool_samples_inside_over_all_samples():
     long record counts by its length), the width the median over the records of their medians."""
     from trials.measured.nested import band_summary
 
-    recs = [{"band": {"samples": 100, "inside": 90, "median_width_deg": 4.0}},
-            {"band": {"samples": 300, "inside": 150, "median_width_deg": 10.0}},
-            {"band": {"samples": 50, "inside": 50, "median_width_deg": 2.0}}, {"name": "no band"}]
+    recs = [{"band": {"samples": 100, "inside": 90, "bounded": 100, "inside_bounded": 90, "median_width_deg": 4.0}},
+            {"band": {"samples": 300, "inside": 150, "bounded": 200, "inside_bounded": 50, "median_width_deg": 10.0}},
+            {"band": {"samples": 50, "inside": 50, "bounded": 0, "inside_bounded": 0, "median_width_deg": 2.0}},
+            {"name": "no band"}]
     s = band_summary(recs)
     assert s["band_coverage90"] == pytest.approx(290 / 450) and s["band_median_width_deg"] == 4.0
+    assert s["band_unbounded_share"] == pytest.approx(150 / 450)
+    assert s["band_coverage90_where_bounded"] == pytest.approx(140 / 300)
     assert s["band_records"] == 3 and band_summary([{"name": "x"}]) == {}
 
 
@@ -135,3 +138,4 @@ def test_a_folds_band_of_a_kept_out_record_draws_from_its_fit():
     assert b["samples"] == len(runs[3].meas) and b["draws"] == 16
     assert b["median_width_deg"] > 0.0 and 0.0 <= b["coverage90"] <= 1.0
     assert b["inside"] == round(b["coverage90"] * b["samples"])
+    assert b["bounded"] == round((1 - b["unbounded_share"]) * b["samples"]) and b["inside_bounded"] <= b["bounded"]

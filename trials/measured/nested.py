@@ -150,20 +150,29 @@ def band_scores(ident, run, samples: int, seed: int = 0) -> dict:
     b = prediction_bands(ident.ship, run, samples, seed, covariance=cov if cov is not None else {"names": [], "matrix": []},
                          run_spread=run_spread(ident), jobs=1)
     n = len(b.t)
+    bounded = int(round((1.0 - b.unbounded_share) * n))
+    inside_b = int(round(b.coverage90_where_bounded * bounded)) if bounded else 0
     return {"samples": n, "inside": int(round(b.coverage90 * n)), "coverage90": b.coverage90,
-            "median_width_deg": b.median_width_deg, "unbounded_share": b.unbounded_share,
-            "draws": b.draws, "diverged_draws": b.diverged}
+            "bounded": bounded, "inside_bounded": inside_b, "median_width_deg": b.median_width_deg,
+            "unbounded_share": b.unbounded_share, "draws": b.draws, "diverged_draws": b.diverged}
 
 
 def band_summary(records: list[dict]) -> dict:
     """The kept-out records' 90 % heading bands pooled (where the records carry them, :func:`band_scores`):
-    ``band_coverage90`` (samples inside over all samples), ``band_median_width_deg`` (the median over the
-    records of each record's median width), ``band_records``; {} where none carries a band."""
+    ``band_coverage90`` (samples inside over all samples; a sample where the band is unbounded counts as
+    inside), ``band_unbounded_share`` (samples where it is, over all), ``band_coverage90_where_bounded``
+    (inside over the bounded samples), ``band_median_width_deg`` (the median over the records of each
+    record's median width), ``band_records``; {} where none carries a band."""
     b = [r["band"] for r in records if r.get("band")]
     if not b:
         return {}
-    return {"band_coverage90": sum(x["inside"] for x in b) / sum(x["samples"] for x in b),
-            "band_median_width_deg": float(np.median([x["median_width_deg"] for x in b])), "band_records": len(b)}
+    n = sum(x["samples"] for x in b)
+    nb = sum(x.get("bounded", x["samples"]) for x in b)
+    return {"band_coverage90": sum(x["inside"] for x in b) / n,
+            "band_median_width_deg": float(np.median([x["median_width_deg"] for x in b])), "band_records": len(b),
+            "band_unbounded_share": 1.0 - nb / n,
+            "band_coverage90_where_bounded": (sum(x.get("inside_bounded", x["inside"]) for x in b) / nb) if nb else
+            float("nan")}
 
 
 def _outer_task(task) -> list[dict]:
