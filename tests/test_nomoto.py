@@ -333,3 +333,22 @@ def test_failed_four_point_fit_is_labelled_unusable_in_console_json_and_figure(t
     assert not any(lb.startswith("2nd order four-point") for lb in drawn)
     monkeypatch.undo()
     plt.close(figs[0])
+
+
+def test_percent_errors_print_without_spurious_digits_and_unusable_ones_are_named():
+    """A per-cent column prints one decimal (0.0086674 % is 0.0, -4910.234 % is -4910.2), other numbers keep
+    their significant digits; errors beyond +-100 % are named in a note under the table, row by row."""
+    import pandas as pd
+
+    from trials.papers.artyszuk import markdown_parts, to_markdown, unusable_note
+
+    df = pd.DataFrame([{"variation": "psi at point 2 by 1.1", "K % least squares": -4910.234, "K % four-point": 0.0086674,
+                        "T1": -0.0080541},
+                       {"variation": "none", "K % least squares": 5355.0, "K % four-point": -99.0, "T1": 2.5}])
+    md = to_markdown(df)
+    assert "| -4910.2 | 0.0 | -0.0080541 |" in md and "| 5355.0 | -99.0 | 2.5 |" in md
+    note = unusable_note(df)
+    assert "K % least squares on psi at point 2 by 1.1, none" in note and "four-point" not in note
+    assert unusable_note(df.assign(**{"K % least squares": [1.0, 2.0]})) == ""
+    parts = markdown_parts({"table8_robust": df})
+    assert any(p.startswith("Errors beyond +-100 %") for p in parts)

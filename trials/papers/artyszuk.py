@@ -542,20 +542,46 @@ def printable(df: pd.DataFrame) -> tuple[pd.DataFrame, list]:
     return out, empty
 
 
+PCT_DECIMALS = 1
+"""Decimals of a per-cent column (a name with " % "): an error of a few hundredths of a per cent is 0.0."""
+UNUSABLE_PCT = 100.0
+"""A per-cent error beyond which a method has not identified the parameter at all (:func:`unusable_note`)."""
+
+
 def to_markdown(df: pd.DataFrame, floatfmt: str = "{:.5g}") -> str:
     """A DataFrame as a GitHub Markdown table (no extra dependency), as :func:`printable` leaves it:
-    all-NaN columns left out (say why beside the table), numerical zeros printed as 0, NaN as n/a."""
-    def fmt(v):
+    all-NaN columns left out (say why beside the table), numerical zeros printed as 0, NaN as n/a; a
+    per-cent column (" % " in its name) with :data:`PCT_DECIMALS` decimals, no more precision than it has."""
+    def fmt(v, col):
         if isinstance(v, (float, np.floating)):
-            return "n/a" if not np.isfinite(v) else ("0" if v == 0 else floatfmt.format(v))
+            if not np.isfinite(v):
+                return "n/a"
+            if " % " in col:
+                return f"{v:.{PCT_DECIMALS}f}"
+            return "0" if v == 0 else floatfmt.format(v)
         return str(v)
 
     df, _ = printable(df)
     cols = list(df.columns)
     lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
     for _, r in df.iterrows():
-        lines.append("| " + " | ".join(fmt(r[c]) for c in cols) + " |")
+        lines.append("| " + " | ".join(fmt(r[c], c) for c in cols) + " |")
     return "\n".join(lines)
+
+
+def unusable_note(df: pd.DataFrame) -> str:
+    """One sentence naming the per-cent errors beyond +-:data:`UNUSABLE_PCT` (the column and the rows' first
+    cell): there the method has not identified the parameter, whatever the digits say; "" where none is."""
+    cols = [c for c in df.columns if " % " in c]
+    bad = []
+    for c in cols:
+        rows = [str(r.iloc[0]) for _, r in df.iterrows() if np.isfinite(r[c]) and abs(r[c]) > UNUSABLE_PCT]
+        if rows:
+            bad.append(f"{c} on {', '.join(rows)}")
+    if not bad:
+        return ""
+    return (f"Errors beyond +-{UNUSABLE_PCT:g} % (the method did not identify the parameter there; such a fit is "
+            f"unusable, not merely inaccurate): {'; '.join(bad)}.")
 
 
 def markdown_parts(tables: dict, level: int = 2) -> list:
@@ -568,6 +594,8 @@ def markdown_parts(tables: dict, level: int = 2) -> list:
         if key not in tables:
             continue
         md += [f"{'#' * level} {title}\n", to_markdown(tables[key]), ""]
+        if unusable_note(tables[key]):
+            md += [unusable_note(tables[key]) + "\n"]
         _, empty = printable(tables[key])
         if empty:
             why = notes.get(f"{key}_empty", "no value in any row")
