@@ -352,3 +352,22 @@ def test_percent_errors_print_without_spurious_digits_and_unusable_ones_are_name
     assert unusable_note(df.assign(**{"K % least squares": [1.0, 2.0]})) == ""
     parts = markdown_parts({"table8_robust": df})
     assert any(p.startswith("Errors beyond +-100 %") for p in parts)
+
+
+def test_nomoto_paper_console_prints_the_cells_and_notes_of_its_markdown(tmp_path, capsys):
+    """`mmg nomoto-paper` prints each table row with the cells of artyszuk_tables.md (per-cent errors with one
+    decimal, not 0.0086674) and names the errors beyond +-100 % as the Markdown does."""
+    import re
+
+    from trials.cli import main
+
+    assert main(["nomoto-paper", "--out", str(tmp_path / "np"), "--fast"]) == 0
+    out = capsys.readouterr().out
+    md = (tmp_path / "np" / "artyszuk_tables.md").read_text()
+    rows = [ln.strip("|").split(" | ") for ln in md.splitlines() if ln.startswith("| ") and not ln.startswith("| ---")]
+    lines = out.splitlines()
+    for cells in rows:
+        pattern = r"\s+".join(re.escape(c.strip()) for c in cells[1:])
+        assert any(re.search(pattern + r"$", ln) for ln in lines), f"no console line ends with {cells[1:]}"
+    assert "0.0086674" not in out
+    assert out.count("Errors beyond +-100 %") == md.count("Errors beyond +-100 %") > 0
