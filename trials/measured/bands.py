@@ -130,6 +130,13 @@ class Bands:
         return float(np.mean((h >= self.lo[ok]) & (h <= self.hi[ok]))) if ok.any() else float("nan")
 
     @property
+    def empty(self) -> bool:
+        """Whether every draw replayed the same track (nothing was drawn: no covariance and no run spread,
+        :attr:`notes`): a band of no width (to 1e-9 deg and m), whose coverages say nothing of the prediction's uncertainty."""
+        with np.errstate(invalid="ignore"):
+            return bool(np.all(np.abs(self.hi - self.lo) <= 1e-9) and np.all(self.radius <= 1e-9))
+
+    @property
     def median_width_deg(self) -> float:
         """The median over the samples of the heading band's width hi - lo [deg] (inf where unbounded)."""
         return float(np.median(self.hi - self.lo))
@@ -144,17 +151,18 @@ class Bands:
         ``position_band_m`` ``{"t_s", "x_median", "y_median", "radius"}`` at every sample, the coverages,
         median width [deg] and radius [m], the share of samples where the heading band is unbounded and the
         coverage over the others, the
-        draws and how many diverged (unbounded values: null)."""
+        draws and how many diverged (unbounded values: null; the coverages null for an :attr:`empty` band)."""
         lst = lambda a: [float(x) for x in a]          # noqa: E731
+        cov = lambda x: None if self.empty else x      # noqa: E731
         t = lst(self.t)
         return {"draws": int(self.draws), "diverged_draws": int(self.diverged),
                 "heading_band_deg": {"t_s": t, "lo": lst(self.lo), "hi": lst(self.hi)},
-                "coverage90": self.coverage90, "heading_band_median_width_deg": self.median_width_deg,
+                "coverage90": cov(self.coverage90), "heading_band_median_width_deg": self.median_width_deg,
                 "heading_band_unbounded_share": self.unbounded_share,
-                "coverage90_where_bounded": self.coverage90_where_bounded,
+                "coverage90_where_bounded": cov(self.coverage90_where_bounded),
                 "position_band_m": {"t_s": t, "x_median": lst(self.x_median), "y_median": lst(self.y_median),
                                     "radius": lst(self.radius)},
-                "position_coverage90": self.position_coverage90,
+                "position_coverage90": cov(self.position_coverage90),
                 "position_band_median_radius_m": self.median_radius_m}
 
     def to_pandas(self):
