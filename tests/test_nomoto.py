@@ -371,3 +371,19 @@ def test_nomoto_paper_console_prints_the_cells_and_notes_of_its_markdown(tmp_pat
         assert any(re.search(pattern + r"$", ln) for ln in lines), f"no console line ends with {cells[1:]}"
     assert "0.0086674" not in out
     assert out.count("Errors beyond +-100 %") == md.count("Errors beyond +-100 %") > 0
+
+
+def test_unusable_fit_prints_no_intervals(tmp_path, capsys):
+    """The simulated ZZ20 of the Esso Osaka: the least-squares fit's T1, T2 are not real (UNUSABLE); its 95 %
+    intervals are not printed as if they bounded anything, the line says why instead."""
+    from trials.cli import main
+
+    assert main(["simulate", "zz20", "--out", str(tmp_path / "s")]) == 0
+    capsys.readouterr()
+    js = tmp_path / "n.json"
+    assert main(["nomoto", str(tmp_path / "s" / "log.csv"), "--length", "325 m", "--json", str(js),
+                 "--no-output-error"]) == 0
+    out = capsys.readouterr().out
+    assert json.loads(js.read_text())["second_order_least_squares"]["usable"] is False
+    line = next(ln for ln in out.splitlines() if ln.startswith("95 % intervals, least squares"))
+    assert "UNUSABLE" in line and "K' [" not in line
