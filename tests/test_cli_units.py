@@ -113,3 +113,18 @@ def test_imo_speed_takes_a_bare_number_in_metres_per_second_like_every_other_opt
     for bad in ("0", "-3", "fast", "inf"):
         with pytest.raises(argparse.ArgumentTypeError):
             _speed_text(bad)
+
+
+def test_estimate_preprocessing_rms_line_carries_units():
+    """Each channel of the preprocessing RMS is printed with its unit, r and delta in degrees (converted from
+    the JSON's radians by hand here)."""
+    import math
+    import re
+
+    from trials.cli.estimate import preprocessing_rms_text
+
+    line = preprocessing_rms_text("ZZ20", {"u": 0.00982, "v": 0.00529, "r": math.radians(0.5), "delta": math.radians(2.0),
+                                           "n": 0.00187})
+    assert "u 0.00982 m/s" in line and "v 0.00529 m/s" in line and "n 0.00187 rps" in line
+    assert "r 0.5 deg/s" in line and "delta 2 deg" in line
+    assert not re.search(r"\d(,|$)", line)                  # no number without a unit after it
