@@ -57,3 +57,14 @@ def test_diagnose_figure_readable():
     rec = NS(name="rec", seg=NS(inputs=NS(t=rep.run.t), meas=meas))
     check_figure(diagnose_figure(NS(records=[rec], pred_before=[pred], pred_after=[0.5 * (meas + pred)],
                                     named=["wind"]), 0), min_data_share=0.2)
+
+
+def test_stopping_figure_keeps_a_long_ship_name_on_the_canvas(imo_res):
+    """An identified model's name and a speed in m/s (as `mmg imo DIR/ship.yaml --speed '0.49 m/s'` titles it):
+    no title cut by the canvas's edge."""
+    import dataclasses
+
+    from trials.imo.plots import stopping_figure
+
+    res = dataclasses.replace(imo_res, ship="Esso Osaka 3 m model (identified)", speed="0.49 m/s")
+    check_figure(stopping_figure(res, pyplot=False), min_data_share=0.3)

@@ -82,6 +82,7 @@ def diagnose_figure(diag, i: int):
     view.unit = "m"
     track_h = 3.2
     fig = Figure(figsize=(11, 8 + (track_h if wide else 0)), layout="constrained")
+    fig.get_layout_engine().set(w_pad=0.08)          # the y labels of the residual panels clear the canvas's edge
     if wide:
         gs = fig.add_gridspec(6, 1, height_ratios=[1.0] * 5 + [track_h / 1.3])
         cell, track_cell = (lambda k: gs[k, 0]), gs[5, 0]                  # noqa: E731
