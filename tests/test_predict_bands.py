@@ -340,3 +340,18 @@ def test_cli_predict_says_no_band_when_nothing_is_drawn(tmp_path, capsys):
     assert rc == 0, err
     assert "no band" in out and "heading coverage" not in out and "median width" not in out
     assert json.loads(js.read_text())["runs"][0]["coverage90"] is None
+
+
+def test_band_from_an_unfinished_identification_says_so(tmp_path):
+    """A ship whose identification: section says the fit did not converge: its band is drawn from a covariance
+    about no optimum, and the notes say so; a converged one has no such note."""
+    import dataclasses
+
+    from mmg.ship import IdentificationNotes
+
+    ship = mmg.load_ship(str(_ship_with_sections(tmp_path, spread=False)))
+    run = _run(ship, amp_deg=15.0)
+    unfinished = dataclasses.replace(ship, identification=IdentificationNotes(converged=False))
+    assert any("did not converge" in n for n in prediction_bands(unfinished, run, 3, 0).notes)
+    finished = dataclasses.replace(ship, identification=IdentificationNotes(converged=True))
+    assert not any("identification" in n for n in prediction_bands(finished, run, 3, 0).notes)

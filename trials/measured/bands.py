@@ -247,6 +247,20 @@ def _disturbed(run: MeasuredRun, names, row, notes: set) -> MeasuredRun:
     return replace(run, meas=meas, effects=es)
 
 
+def _fit_doubts(ship: Ship, names, covariance) -> list:
+    """A note when the ship is drawn from the covariance its own ``identification:`` section doubts: a fit
+    that stopped before converging (the covariance is not about an optimum) or that replays its training
+    records worse than the initial model."""
+    ident = ship.identification
+    if covariance is not None or not len(names) or ident is None:
+        return []
+    why = ([] if ident.converged else ["did not converge (a fit stage stopped at its evaluation limit)"]) + (
+        [f"replays {len(ident.training_replays_worse)} training record(s) worse than the initial model"]
+        if ident.training_replays_worse else [])
+    return [f"ship drawn from the covariance of an identification that {' and '.join(why)}: the band is not "
+            "the uncertainty of a finished fit"] if why else []
+
+
 def _ship_draws(ship: Ship, covariance, samples: int, seed: int, notes: list):
     """(names, rows (samples, k), mean) of the ship's parameter draws; no names where there is no covariance."""
     cov = ship.covariance if covariance is None else covariance
@@ -332,6 +346,7 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     src = ship.source or ship.name
     notes: list = []
     names, rows, mean = _ship_draws(ship, covariance, samples, seed, notes)
+    notes += _fit_doubts(ship, names, covariance)
     spread = ship.run_spread if run_spread is None else run_spread
     if spread is None:
         notes.append("start state not drawn: the ship config has no run_spread: section")
