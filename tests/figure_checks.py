@@ -1,5 +1,5 @@
 """Checks any matplotlib figure can be put through: legends inside the canvas, no two texts on top of each
-other, the data filling a fair share of the canvas (:func:`check_figure`)."""
+other, no text cut by the canvas's edge, the data filling a fair share of the canvas (:func:`check_figure`)."""
 from __future__ import annotations
 
 import itertools
@@ -49,7 +49,8 @@ def _texts(fig, renderer) -> list:
 def check_figure(fig, min_data_share: float = 0.3, tol_px: float = 1.0) -> None:
     """Assert that ``fig``, rendered, is readable.
 
-    * every legend's window extent lies inside the figure's canvas (``tol_px`` pixels of slack);
+    * every legend's window extent lies inside the figure's canvas (``tol_px`` pixels of slack), and so does
+      every text (:func:`_texts`: no title or label cut by the canvas's edge);
     * no two texts (:func:`_texts`) overlap by more than ``tol_px`` in both directions;
     * the data (each axes' data limits of what it draws, cut to its box, in display coordinates) cover at
       least ``min_data_share`` of the canvas (a constant series counts its axes' box in that direction).
@@ -61,6 +62,9 @@ def check_figure(fig, min_data_share: float = 0.3, tol_px: float = 1.0) -> None:
         assert (b.x0 >= fb.x0 - tol_px and b.y0 >= fb.y0 - tol_px and b.x1 <= fb.x1 + tol_px
                 and b.y1 <= fb.y1 + tol_px), f"a legend {b.bounds} leaves the canvas {fb.bounds}"
     texts = _texts(fig, r)
+    for o, b, s in texts:
+        assert (b.x0 >= fb.x0 - tol_px and b.y0 >= fb.y0 - tol_px and b.x1 <= fb.x1 + tol_px
+                and b.y1 <= fb.y1 + tol_px), f"a text is cut by the canvas's edge: {s!r} ({o}) at {b.bounds}"
     for (o1, b1, s1), (o2, b2, s2) in itertools.combinations(texts, 2):
         dx = min(b1.x1, b2.x1) - max(b1.x0, b2.x0)
         dy = min(b1.y1, b2.y1) - max(b1.y0, b2.y0)

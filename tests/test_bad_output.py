@@ -584,3 +584,16 @@ def test_not_written_looks_only_into_the_folders_written(tmp_path):
     (tmp_path / ".staging-xyz").mkdir()                     # another run in progress
     assert output.not_written(tmp_path, ["a/mine.png"]) == ["a/old.png", "b/", "top.txt"]
     assert output.not_written(tmp_path, ["a/mine.png", "a/old.png", "top.txt"]) == ["b/"]
+
+
+def test_own_json_being_written_is_not_another_runs_file(tmp_path):
+    """A JSON file written beside the figures (``--json DIR/x.json --plots DIR``) is this run's: its temporary
+    file, alive while the figures' folder is committed, is not listed as what another run left there; a
+    real leftover temporary file of another run still is."""
+    (tmp_path / ".old.json.abc.tmp").write_text("{}")
+    with StagedFile(tmp_path / "x.json") as tmp:
+        tmp.write_text("{}")
+        with StagedOutput(tmp_path) as stage:
+            stage.path("a.png").write_bytes(b"png")
+    assert stage.written == ["a.png"]
+    assert stage.others == [".old.json.abc.tmp"]

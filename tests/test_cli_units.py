@@ -113,3 +113,35 @@ def test_imo_speed_takes_a_bare_number_in_metres_per_second_like_every_other_opt
     for bad in ("0", "-3", "fast", "inf"):
         with pytest.raises(argparse.ArgumentTypeError):
             _speed_text(bad)
+
+
+def test_estimate_preprocessing_rms_line_carries_units():
+    """Each channel of the preprocessing RMS is printed with its unit, r and delta in degrees (converted from
+    the JSON's radians by hand here)."""
+    import math
+    import re
+
+    from trials.cli.estimate import preprocessing_rms_text
+
+    line = preprocessing_rms_text("ZZ20", {"u": 0.00982, "v": 0.00529, "r": math.radians(0.5), "delta": math.radians(2.0),
+                                           "n": 0.00187})
+    assert "u 0.00982 m/s" in line and "v 0.00529 m/s" in line and "n 0.00187 rps" in line
+    assert "r 0.5 deg/s" in line and "delta 2 deg" in line
+    assert not re.search(r"\d(,|$)", line)                  # no number without a unit after it
+
+
+def test_every_printed_metric_carries_a_unit():
+    """`mmg simulate` / `mmg metrics` lines: a number's unit is its key's suffix or follows it; the speed loss
+    (1 - U_steady / U_0 = 0.82) prints as 82.0 % of the approach speed."""
+    import io
+
+    from trials.cli.common import METRIC_KEYS, print_metrics
+
+    units = ("_s", "_mps", "_deg", "_kn", "_rpm", "_L")
+    buf = io.StringIO()
+    print_metrics({k: 0.82 for k in METRIC_KEYS if k not in ("trial", "kind")}, out=buf)
+    lines = buf.getvalue().splitlines()
+    assert any(ln.split()[0] == "speed_loss" and "82.0 % of the approach speed" in ln for ln in lines)
+    for ln in lines:
+        key, rest = ln.split(None, 1)
+        assert key.endswith(units) or not rest.replace(".", "").isdigit(), ln

@@ -57,3 +57,31 @@ def test_diagnose_figure_readable():
     rec = NS(name="rec", seg=NS(inputs=NS(t=rep.run.t), meas=meas))
     check_figure(diagnose_figure(NS(records=[rec], pred_before=[pred], pred_after=[0.5 * (meas + pred)],
                                     named=["wind"]), 0), min_data_share=0.2)
+
+
+def test_stopping_figure_keeps_a_long_ship_name_on_the_canvas(imo_res):
+    """An identified model's name and a speed in m/s (as `mmg imo DIR/ship.yaml --speed '0.49 m/s'` titles it):
+    no title cut by the canvas's edge."""
+    import dataclasses
+
+    from trials.imo.plots import stopping_figure
+
+    res = dataclasses.replace(imo_res, ship="Esso Osaka 3 m model (identified)", speed="0.49 m/s")
+    check_figure(stopping_figure(res, pyplot=False), min_data_share=0.3)
+
+
+def test_diagnose_figure_draws_no_residual_for_a_channel_not_logged():
+    """A record without sway velocity (v left out of the fit): its panel says so and draws no line (not a flat
+    zero residual that reads as a perfect fit); the other panels keep their two lines."""
+    from types import SimpleNamespace as NS
+
+    from trials.measured.diagnose_plots import diagnose_figure
+
+    rep, meas, pred = _replayed(turn)
+    rec = NS(name="rec", seg=NS(inputs=NS(t=rep.run.t), meas=meas), absent={"v": {"column": "", "compared_instead": ""}})
+    fig = diagnose_figure(NS(records=[rec], pred_before=[pred], pred_after=[0.5 * (meas + pred)], named=["wind"]), 0)
+    v_ax = next(ax for ax in fig.axes if ax.get_ylabel() == "v [m/s]")
+    assert v_ax.get_lines() == [] and any("v not logged" in t.get_text() for t in v_ax.texts)
+    u_ax = next(ax for ax in fig.axes if ax.get_ylabel() == "u [m/s]")
+    assert len(u_ax.get_lines()) == 2
+    check_figure(fig, min_data_share=0.2)

@@ -343,3 +343,13 @@ def test_samples_on_a_dask_cluster_match_a_serial_run(tmp_path):
         par = mmg.imo(ship, samples=4, cov=cov, seed=2, executor=local_executor(backend="dask", client=client))
     assert par.as_dict() == ser.as_dict()
     assert par.samples == ser.samples
+
+
+def test_interval_text_has_its_unit_and_says_unbounded():
+    """A 90 % interval on the console carries the criterion's unit; an end among failed samples (None) is
+    'unbounded', not a bare '-' that reads as a missing figure."""
+    from trials.imo.report import interval_text
+
+    assert interval_text([2.1849, 3.5], "L") == "[2.18, 3.5] L"
+    assert interval_text([2.1849, None], "L") == "[2.18, unbounded] L"
+    assert interval_text(None, "deg") == "-"

@@ -110,3 +110,29 @@ def test_monte_carlo_cli_refuses_bad_trials_before_writing(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "nope.yaml" in err[0] and "manoeuvre.kind" in err[1]
     assert not out.exists()
+
+
+def test_cli_log_filter_says_what_it_wrote_and_how_many_diverged(tmp_path, capsys, monkeypatch):
+    """`mmg log-filter` writes runs.csv alone: its console says so, with the runs and the diverged ones counted
+    (a diverged run is not silent), and its help names no summary it does not write."""
+    import pandas as pd
+
+    import trials.estimates.montecarlo as mc
+    from trials.cli import main
+
+    def fake(out, **kw):
+        runs = pd.DataFrame({"trial": ["ZZ20", "ZZ20", "ST35"], "seed": [1000, 1001, 1000],
+                             "diverged": [None, "covariance not positive definite", None]})
+        runs.to_csv(Path(out) / "runs.csv", index=False)
+        return runs
+
+    monkeypatch.setattr(mc, "log_filter_monte_carlo", fake)
+    assert main(["log-filter", str(tmp_path / "lf"), "--seeds", "1", "--backend", "serial"]) == 0
+    out = capsys.readouterr().out
+    assert "3 run(s) of 2 trial(s), 1 diverged" in out and "runs.csv" in out
+    try:
+        main(["log-filter", "--help"])
+    except SystemExit:
+        pass
+    helptext = capsys.readouterr().out
+    assert "runs.csv" in helptext and "summary" not in helptext

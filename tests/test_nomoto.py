@@ -352,3 +352,38 @@ def test_percent_errors_print_without_spurious_digits_and_unusable_ones_are_name
     assert unusable_note(df.assign(**{"K % least squares": [1.0, 2.0]})) == ""
     parts = markdown_parts({"table8_robust": df})
     assert any(p.startswith("Errors beyond +-100 %") for p in parts)
+
+
+def test_nomoto_paper_console_prints_the_cells_and_notes_of_its_markdown(tmp_path, capsys):
+    """`mmg nomoto-paper` prints each table row with the cells of artyszuk_tables.md (per-cent errors with one
+    decimal, not 0.0086674) and names the errors beyond +-100 % as the Markdown does."""
+    import re
+
+    from trials.cli import main
+
+    assert main(["nomoto-paper", "--out", str(tmp_path / "np"), "--fast"]) == 0
+    out = capsys.readouterr().out
+    md = (tmp_path / "np" / "artyszuk_tables.md").read_text()
+    rows = [ln.strip("|").split(" | ") for ln in md.splitlines() if ln.startswith("| ") and not ln.startswith("| ---")]
+    lines = out.splitlines()
+    for cells in rows:
+        pattern = r"\s+".join(re.escape(c.strip()) for c in cells[1:])
+        assert any(re.search(pattern + r"$", ln) for ln in lines), f"no console line ends with {cells[1:]}"
+    assert "0.0086674" not in out
+    assert out.count("Errors beyond +-100 %") == md.count("Errors beyond +-100 %") > 0
+
+
+def test_unusable_fit_prints_no_intervals(tmp_path, capsys):
+    """The simulated ZZ20 of the Esso Osaka: the least-squares fit's T1, T2 are not real (UNUSABLE); its 95 %
+    intervals are not printed as if they bounded anything, the line says why instead."""
+    from trials.cli import main
+
+    assert main(["simulate", "zz20", "--out", str(tmp_path / "s")]) == 0
+    capsys.readouterr()
+    js = tmp_path / "n.json"
+    assert main(["nomoto", str(tmp_path / "s" / "log.csv"), "--length", "325 m", "--json", str(js),
+                 "--no-output-error"]) == 0
+    out = capsys.readouterr().out
+    assert json.loads(js.read_text())["second_order_least_squares"]["usable"] is False
+    line = next(ln for ln in out.splitlines() if ln.startswith("95 % intervals, least squares"))
+    assert "UNUSABLE" in line and "K' [" not in line

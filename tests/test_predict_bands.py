@@ -316,3 +316,42 @@ def test_run_spread_without_per_record_nuisances_is_the_measured_start_noise(shi
     assert sp["std"] == pytest.approx(np.sqrt(np.mean(noise[:, [0, 1, 2, 5]] ** 2, axis=0)), rel=1e-5)
     assert 0.003 < sp["std"][0] < 0.006                         # the noise added: 0.003 and 0.006
     assert "no per-record nuisance fitted" in sp["source"]
+
+
+def test_a_band_with_nothing_drawn_is_empty_and_has_no_coverage(ship):
+    """A ship with neither covariance: nor run_spread: replays one track N times: the band is empty and its
+    JSON coverages are null (not 0 %: the record is not outside a band, there is none); one parameter drawn
+    makes a band."""
+    run = _run(ship, amp_deg=15.0)
+    assert ship.covariance is None and ship.run_spread is None
+    b = prediction_bands(ship, run, 4, 0)
+    assert b.empty and b.median_width_deg == 0.0
+    js = b.to_json()
+    assert js["coverage90"] is None and js["position_coverage90"] is None and js["coverage90_where_bounded"] is None
+    drawn = prediction_bands(ship, run, 4, 0, covariance=COV)
+    assert not drawn.empty and drawn.to_json()["coverage90"] == drawn.coverage90
+
+
+@needs_frt
+def test_cli_predict_says_no_band_when_nothing_is_drawn(tmp_path, capsys):
+    rec = _slice(FRT / ZIGZAG, tmp_path / "zz_slice.csv", rows=300)
+    js, plots = tmp_path / "p.json", tmp_path / "plots"
+    rc, out, err = _run_cli(["predict", "--ship", SHIP, rec, "--json", js, "--plots", plots, "--samples", "5"], capsys)
+    assert rc == 0, err
+    assert "no band" in out and "heading coverage" not in out and "median width" not in out
+    assert json.loads(js.read_text())["runs"][0]["coverage90"] is None
+
+
+def test_band_from_an_unfinished_identification_says_so(tmp_path):
+    """A ship whose identification: section says the fit did not converge: its band is drawn from a covariance
+    about no optimum, and the notes say so; a converged one has no such note."""
+    import dataclasses
+
+    from mmg.ship import IdentificationNotes
+
+    ship = mmg.load_ship(str(_ship_with_sections(tmp_path, spread=False)))
+    run = _run(ship, amp_deg=15.0)
+    unfinished = dataclasses.replace(ship, identification=IdentificationNotes(converged=False))
+    assert any("did not converge" in n for n in prediction_bands(unfinished, run, 3, 0).notes)
+    finished = dataclasses.replace(ship, identification=IdentificationNotes(converged=True))
+    assert not any("identification" in n for n in prediction_bands(finished, run, 3, 0).notes)

@@ -27,10 +27,12 @@ def report(ident) -> str:
                      f"{v['delta']:9.5f} {v['psi_deg']:9.3f}")
     lines.append("")
     lines += _fit_table(ident)
-    for fit in (ident.least_squares, ident.output_error):
+    for key, fit in (("least_squares", ident.least_squares), ("output_error", ident.output_error)):
         if fit is None:
             continue
         ci = "  ".join(f"{k}' [{_f(lo)}, {_f(hi)}] [-]" for k, (lo, hi) in fit.ci95.items() if k != "delta_bias")
+        if not ident.usable(key):          # an interval about a fit that identified nothing means nothing
+            ci = f"none: the fit is UNUSABLE ({ident.problems[key]})"
         lines.append(f"95 % intervals, {fit.method.replace('_', ' ')}: {ci}")
     note = ident.four_point.note()
     if note:

@@ -98,13 +98,17 @@ def _rudder_timing(text: str) -> float | None:
 
 
 def print_metrics(m: dict, out=None) -> None:
-    """The main metrics of a trial or record, one per line."""
+    """The main metrics of a trial or record, one per line (a key's suffix is its unit: _s, _deg, _L, ...;
+    the speed loss, a fraction, as per cent of the approach speed)."""
     from ..files.output import fmt
 
     out = out or sys.stdout
     for k in METRIC_KEYS:
         if k in m:
-            print(f"  {k:26s} {fmt(m[k])}", file=out)
+            v = m[k]
+            text = (f"{100 * v:.1f} % of the approach speed" if k == "speed_loss" and isinstance(v, (int, float))
+                    else fmt(v))
+            print(f"  {k:26s} {text}", file=out)
 
 
 def _listing(names) -> str:

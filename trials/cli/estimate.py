@@ -1,6 +1,7 @@
 """``mmg estimate``: hull coefficients from logs or trials (:func:`trials.estimates.estimation.estimate_and_report`)."""
 from __future__ import annotations
 
+import math
 import sys
 
 from .common import _listing, _output_path, _seed
@@ -13,6 +14,20 @@ def _aot_deferred(when: bool):
     from mmg import _aot
 
     return _aot.build_deferred() if when else nullcontext()
+
+
+PREPROCESSING_UNITS = {"u": (1.0, "m/s"), "v": (1.0, "m/s"), "r": (180 / math.pi, "deg/s"),
+                       "delta": (180 / math.pi, "deg"), "n": (1.0, "rps")}
+"""Factor from SI and unit of each channel of ``preprocessing_rms.json`` on the console."""
+
+
+def preprocessing_rms_text(name: str, rms: dict) -> str:
+    """The console line of a trial's preprocessing RMS ({channel: RMS in SI}), each with its unit."""
+    parts = []
+    for k, v in rms.items():
+        f, unit = PREPROCESSING_UNITS.get(k, (1.0, "(SI)"))
+        parts.append(f"{k} {f * v:.3g} {unit}")
+    return f"  preprocessing RMS {name} (recovered - true): " + ", ".join(parts)
 
 
 def cmd_estimate(args) -> int:
@@ -46,7 +61,7 @@ def cmd_estimate(args) -> int:
         print(tab.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
         return 0
     for n, r in rep["rms"].items():
-        print(f"  preprocessing RMS {n}: " + ", ".join(f"{k} {v:.3g}" for k, v in r.items()))
+        print(preprocessing_rms_text(n, r))
     cols = [c for c in tab.columns if c in ("coeff", "real") or c.endswith("final") or c.endswith("err(%)")]
     print(tab[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     return 0

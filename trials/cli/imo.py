@@ -12,7 +12,7 @@ def cmd_imo(args) -> int:
     from mmg.ship import load_ship
 
     from ..files.output import StagedOutput, check_output_dir
-    from ..imo.report import write_report
+    from ..imo.report import interval_text, write_report
     from ..imo.result import imo
     from ..imo.sampling import covariance_of, local_executor
     from ..imo.standard import approach_speed, plan, speed_label
@@ -59,8 +59,7 @@ def cmd_imo(args) -> int:
         val = "-" if r["value"] is None else f"{r['value']:.3g} {r['unit']}"
         extra = ""
         if r["interval"]:
-            lo, hi = ("-" if x is None else f"{x:.3g}" for x in r["interval"])
-            extra = f"  90 % [{lo}, {hi}]  P = {r['probability']:.3f}"
+            extra = f"  90 % {interval_text(r['interval'], r['unit'])}  P = {r['probability']:.3f}"
         print(f"  {r['name']:40s} {val:>10s}  limit {r['limit']:.3g} {r['unit']}{extra}  {r['verdict']}")
     widths = res.interval_widths()
     if widths:

@@ -37,10 +37,22 @@ def cmd_log_filter(args) -> int:
     check_output_dir(args.out, "OUT")
     sigma = args.sigma_tau if args.sigma_tau is not None else (1e-4 if args.true_rudder else 0.15)
     with backend_client(args), StagedOutput(args.out) as stage:
-        log_filter_monte_carlo(stage.dir, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs, sigma_tau=sigma,
-                               first_seed=args.first_seed, rudder="true" if args.true_rudder else "rebuilt",
-                               config=args.config, backend=args.backend)
+        runs = log_filter_monte_carlo(stage.dir, n_seeds=args.seeds, trials=args.trials, n_jobs=args.jobs,
+                                      sigma_tau=sigma, first_seed=args.first_seed,
+                                      rudder="true" if args.true_rudder else "rebuilt", config=args.config,
+                                      backend=args.backend)
+    print(runs_line(runs, Path(args.out) / "runs.csv"))
     return 0
+
+
+def runs_line(runs, path) -> str:
+    """The console's line of a Monte Carlo that writes runs alone: how many runs of how many trials, and how
+    many diverged (a run with a ``diverged`` message), so a run that failed is not silent."""
+    n = len(runs)
+    bad = int(runs["diverged"].fillna("").astype(str).str.strip().ne("").sum()) if "diverged" in runs else 0
+    trials = runs["trial"].nunique() if "trial" in runs else 0
+    return (f"wrote {path}: {n} run(s) of {trials} trial(s), {bad} diverged (each row: the final estimates and "
+            f"their % errors; no summary table)")
 
 
 def cmd_output_error(args) -> int:
@@ -71,8 +83,8 @@ def cmd_output_error(args) -> int:
 
 def add_parser(sub) -> None:
     """The montecarlo, log-filter and output-error subcommands of ``mmg`` (its options, help and function)."""
-    def mc_common(p, what):
-        p.add_argument("out", type=_output_path, help="output folder (runs.csv, summary.csv/.md)")
+    def mc_common(p, what, files="runs.csv, summary.csv/.md"):
+        p.add_argument("out", type=_output_path, help=f"output folder ({files})")
         p.add_argument("--seeds", type=_positive_int, default=20, help="noise seeds per trial (default 20)")
         p.add_argument("--first-seed", type=_seed, default=1000, help="noise seed of the first run of each trial")
         p.add_argument("--jobs", type=_positive_int, default=2, help="workers (default 2)")
@@ -89,7 +101,7 @@ def add_parser(sub) -> None:
     p.set_defaults(func=cmd_montecarlo)
 
     p = sub.add_parser("log-filter", help="Monte Carlo of the EKF on the raw 5 s log (near the Cramer-Rao bound)")
-    mc_common(p, "raw-log EKF")
+    mc_common(p, "raw-log EKF", "runs.csv")
     p.add_argument("--trials", nargs="*", default=None,
                    help="trial names (default ST35 ZZ10 ZZ20 'S-type 120') or turning/zigzag/S-type trial YAMLs")
     p.add_argument("--sigma-tau", type=quantity("time", "s", 0.0, lo_open=True), default=None,

@@ -33,8 +33,6 @@ def cmd_nomoto(args) -> int:
 
 
 def cmd_nomoto_paper(args) -> int:
-    import pandas as pd
-
     from ..papers import artyszuk as a
     from ..files.output import StagedOutput, check_output_dir
 
@@ -42,13 +40,7 @@ def cmd_nomoto_paper(args) -> int:
     with StagedOutput(args.out) as stage:
         tables = a.reproduce(fast=args.fast)
         paths = a.write_tables(tables, stage.dir)
-    with pd.option_context("display.width", 200, "display.max_columns", 40, "display.float_format", "{:.5g}".format):
-        for key, title in a.TITLES.items():
-            print(f"\n{title}")
-            print(a.printable(tables[key])[0].to_string(index=False))     # as artyszuk_tables.md: no empty column
-            note = tables.get("notes", {}).get(key)
-            if note:
-                print(f"note: {note}")
+    print("\n".join(a.text_parts(tables)))
     print(f"\nwrote {len(paths)} files to {args.out}")
     return 0
 

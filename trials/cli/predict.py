@@ -39,7 +39,7 @@ def cmd_predict(args) -> int:
     with StagedFile(args.json) as tmp:     # the files first (renamed last, after the plots), then the console
         with StagedOutput(args.plots) if args.plots is not None else nullcontext() as stage:
             for k, (r, name) in enumerate(zip(pred.runs, names if args.plots is not None else ())):
-                (bands[k] if bands else r).plot(pyplot=False).savefig(stage.path(name))
+                (bands[k] if bands and not bands[k].empty else r).plot(pyplot=False).savefig(stage.path(name))
         tmp.write_text(text)
     for r in pred.runs:
         s = r.scores()
@@ -99,6 +99,10 @@ def _print_bands(bands) -> None:
 
     num = lambda x, unit: f"{x:.3g} {unit}" if np.isfinite(x) else "unbounded (diverged draws)"   # noqa: E731
     for b in bands or ():
+        if b.empty:
+            print(f"{b.nominal.run.name}: no band: the {b.draws} draws all replay the nominal ship and start "
+                  f"(nothing to draw them from: see the notes), so no width and no coverage")
+            continue
         print(f"{b.nominal.run.name}: 90 % band from {b.draws} draws ({b.diverged} diverged): heading coverage "
               f"{100 * b.coverage90:.0f} % of samples, median width {num(b.median_width_deg, 'deg')}; position "
               f"coverage {100 * b.position_coverage90:.0f} %, median radius {num(b.median_radius_m, 'm')}"

@@ -459,7 +459,7 @@ def not_written(out, written, limit: int = 10000) -> list[str]:
             if len(found) >= limit:
                 return
             r = f"{rel}/{e.name}" if rel else e.name
-            if e.name.startswith((".staging-", ".mmg-write-check-")) or r in mine:
+            if e.name.startswith((".staging-", ".mmg-write-check-")) or r in mine or _live_staged_file(out / r):
                 continue
             if e.is_dir(follow_symlinks=False):
                 if r in visited:
@@ -543,6 +543,14 @@ def record_labels(sources) -> list[str]:
     return out
 
 
+_live_tmps: set = set()                        # this process's StagedFile temporaries not yet renamed or removed
+
+
+def _live_staged_file(p: Path) -> bool:
+    """Whether ``p`` is the temporary file of a :class:`StagedFile` of this process still being written."""
+    return _abs(p) in _live_tmps
+
+
 class StagedFile:
     """One file written all-or-nothing: ``with StagedFile(target) as tmp: write tmp`` writes a
     temporary file beside ``target`` (its missing folders created) and renames it onto
@@ -567,6 +575,7 @@ class StagedFile:
                 raise write_error(e, self.target) from None
             os.close(fd)
             self.tmp = Path(tmp)
+            _live_tmps.add(_abs(self.tmp))
             try:
                 mode = stat.S_IMODE(os.stat(self.target).st_mode) if self.target.is_file() else _umask_mode()
                 os.chmod(self.tmp, mode)
@@ -575,6 +584,7 @@ class StagedFile:
         return self.tmp
 
     def __exit__(self, exc_type, exc, tb):
+        _live_tmps.discard(_abs(self.tmp))
         with _critical():
             interrupted = exc_type is None and _signal_pending()
             if exc_type is None and not interrupted:

@@ -118,7 +118,7 @@ def stopping_figure(res, pyplot: bool = True):
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("y, east (L)")
     ax.set_ylabel("x, north (L)")
-    ax.set_title(f"{res.ship}: full astern from {res.speed}, rudder midships", fontsize=9)
+    fig.suptitle(f"{res.ship}: full astern from {res.speed}, rudder midships", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1))
     a1 = fig.add_subplot(gs[0, 1])

@@ -7,7 +7,7 @@ from ..analysis.metrics import IMO_STANDARD
 from .sampling import FAIL_PROBABILITY, PASS_PROBABILITY
 from .standard import STOPPING, speed_label
 
-__all__ = ["write_report", "report_lines", "FIGURES"]
+__all__ = ["write_report", "report_lines", "interval_text", "FIGURES"]
 
 FIGURES = ("tracks.png", "zigzags.png", "stopping.png", "distributions.png")
 """The figures ``mmg imo`` writes (``distributions.png`` only with samples)."""
@@ -22,7 +22,18 @@ def _prob(p) -> str:
 
 
 def _interval(iv) -> str:
-    return "-" if not iv else f"[{_num(iv[0])}, {_num(iv[1])}]"
+    return "-" if not iv else f"[{_end(iv[0])}, {_end(iv[1])}]"
+
+
+def _end(v) -> str:
+    """An interval's end: None is a percentile among the samples that gave no figure (at +inf)."""
+    return "unbounded" if v is None else _num(v)
+
+
+def interval_text(iv, unit: str) -> str:
+    """A criterion's 90 % interval on the console, with its unit: ``[2.18, 3.5] L``; an end among the samples
+    that gave no figure is ``unbounded``; "-" without an interval."""
+    return "-" if not iv else f"{_interval(iv)} {unit}"
 
 
 def _table(res) -> list[str]:

@@ -130,6 +130,13 @@ class Bands:
         return float(np.mean((h >= self.lo[ok]) & (h <= self.hi[ok]))) if ok.any() else float("nan")
 
     @property
+    def empty(self) -> bool:
+        """Whether every draw replayed the same track (nothing was drawn: no covariance and no run spread,
+        :attr:`notes`): a band of no width (to 1e-9 deg and m), whose coverages say nothing of the prediction's uncertainty."""
+        with np.errstate(invalid="ignore"):
+            return bool(np.all(np.abs(self.hi - self.lo) <= 1e-9) and np.all(self.radius <= 1e-9))
+
+    @property
     def median_width_deg(self) -> float:
         """The median over the samples of the heading band's width hi - lo [deg] (inf where unbounded)."""
         return float(np.median(self.hi - self.lo))
@@ -144,17 +151,18 @@ class Bands:
         ``position_band_m`` ``{"t_s", "x_median", "y_median", "radius"}`` at every sample, the coverages,
         median width [deg] and radius [m], the share of samples where the heading band is unbounded and the
         coverage over the others, the
-        draws and how many diverged (unbounded values: null)."""
+        draws and how many diverged (unbounded values: null; the coverages null for an :attr:`empty` band)."""
         lst = lambda a: [float(x) for x in a]          # noqa: E731
+        cov = lambda x: None if self.empty else x      # noqa: E731
         t = lst(self.t)
         return {"draws": int(self.draws), "diverged_draws": int(self.diverged),
                 "heading_band_deg": {"t_s": t, "lo": lst(self.lo), "hi": lst(self.hi)},
-                "coverage90": self.coverage90, "heading_band_median_width_deg": self.median_width_deg,
+                "coverage90": cov(self.coverage90), "heading_band_median_width_deg": self.median_width_deg,
                 "heading_band_unbounded_share": self.unbounded_share,
-                "coverage90_where_bounded": self.coverage90_where_bounded,
+                "coverage90_where_bounded": cov(self.coverage90_where_bounded),
                 "position_band_m": {"t_s": t, "x_median": lst(self.x_median), "y_median": lst(self.y_median),
                                     "radius": lst(self.radius)},
-                "position_coverage90": self.position_coverage90,
+                "position_coverage90": cov(self.position_coverage90),
                 "position_band_median_radius_m": self.median_radius_m}
 
     def to_pandas(self):
@@ -237,6 +245,20 @@ def _disturbed(run: MeasuredRun, names, row, notes: set) -> MeasuredRun:
         add = E.EffectSet(((e, e.from_fit(vec)),))
         es = add if es is None else es.merged(add)
     return replace(run, meas=meas, effects=es)
+
+
+def _fit_doubts(ship: Ship, names, covariance) -> list:
+    """A note when the ship is drawn from the covariance its own ``identification:`` section doubts: a fit
+    that stopped before converging (the covariance is not about an optimum) or that replays its training
+    records worse than the initial model."""
+    ident = ship.identification
+    if covariance is not None or not len(names) or ident is None:
+        return []
+    why = ([] if ident.converged else ["did not converge (a fit stage stopped at its evaluation limit)"]) + (
+        [f"replays {len(ident.training_replays_worse)} training record(s) worse than the initial model"]
+        if ident.training_replays_worse else [])
+    return [f"ship drawn from the covariance of an identification that {' and '.join(why)}: the band is not "
+            "the uncertainty of a finished fit"] if why else []
 
 
 def _ship_draws(ship: Ship, covariance, samples: int, seed: int, notes: list):
@@ -324,6 +346,7 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     src = ship.source or ship.name
     notes: list = []
     names, rows, mean = _ship_draws(ship, covariance, samples, seed, notes)
+    notes += _fit_doubts(ship, names, covariance)
     spread = ship.run_spread if run_spread is None else run_spread
     if spread is None:
         notes.append("start state not drawn: the ship config has no run_spread: section")

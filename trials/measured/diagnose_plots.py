@@ -82,6 +82,7 @@ def diagnose_figure(diag, i: int):
     view.unit = "m"
     track_h = 3.2
     fig = Figure(figsize=(11, 8 + (track_h if wide else 0)), layout="constrained")
+    fig.get_layout_engine().set(w_pad=0.08)          # the y labels of the residual panels clear the canvas's edge
     if wide:
         gs = fig.add_gridspec(6, 1, height_ratios=[1.0] * 5 + [track_h / 1.3])
         cell, track_cell = (lambda k: gs[k, 0]), gs[5, 0]                  # noqa: E731
@@ -89,10 +90,17 @@ def diagnose_figure(diag, i: int):
         gs = fig.add_gridspec(5, 2)
         cell, track_cell = (lambda k: gs[k, 0]), gs[:, 1]                  # noqa: E731
     after = "after (" + (", ".join(diag.named) or "nothing named") + ")"
-    for k, (lab, _, f) in enumerate(_RESIDUALS):
+    absent = getattr(rec, "absent", None) or {}
+    for k, (lab, ch, f) in enumerate(_RESIDUALS):
         ax = fig.add_subplot(cell(k))
-        ax.plot(t, f(b, m), lw=0.8, label="before (ship fitted, no effect)")
-        ax.plot(t, f(a, m), lw=0.8, label=after)
+        if ch in absent and not absent[ch].get("compared_instead"):       # nothing logged to compare with
+            ax.text(0.5, 0.5, f"{ch} not logged: no residual", transform=ax.transAxes, ha="center", va="center",
+                    fontsize=9, color="0.3")
+            ax.set_xlim(float(t[0]), float(t[-1]))
+            ax.set_yticks([])
+        else:
+            ax.plot(t, f(b, m), lw=0.8, label="before (ship fitted, no effect)")
+            ax.plot(t, f(a, m), lw=0.8, label=after)
         ax.set_ylabel(lab, fontsize=8)
         ax.tick_params(labelsize=7)
         if k == 0:

@@ -552,21 +552,48 @@ def to_markdown(df: pd.DataFrame, floatfmt: str = "{:.5g}") -> str:
     """A DataFrame as a GitHub Markdown table (no extra dependency), as :func:`printable` leaves it:
     all-NaN columns left out (say why beside the table), numerical zeros printed as 0, NaN as n/a; a
     per-cent column (" % " in its name) with :data:`PCT_DECIMALS` decimals, no more precision than it has."""
-    def fmt(v, col):
-        if isinstance(v, (float, np.floating)):
-            if not np.isfinite(v):
-                return "n/a"
-            if " % " in col:
-                return f"{v:.{PCT_DECIMALS}f}"
-            return "0" if v == 0 else floatfmt.format(v)
-        return str(v)
-
     df, _ = printable(df)
     cols = list(df.columns)
     lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
     for _, r in df.iterrows():
-        lines.append("| " + " | ".join(fmt(r[c], c) for c in cols) + " |")
+        lines.append("| " + " | ".join(_cell(r[c], c, floatfmt) for c in cols) + " |")
     return "\n".join(lines)
+
+
+def _cell(v, col: str, floatfmt: str = "{:.5g}") -> str:
+    """One printed cell of column ``col``: NaN as n/a, a per-cent column (" % " in its name) with
+    :data:`PCT_DECIMALS` decimals, other numbers with ``floatfmt`` (a numerical zero as 0)."""
+    if isinstance(v, (float, np.floating)):
+        if not np.isfinite(v):
+            return "n/a"
+        if " % " in col:
+            return f"{v:.{PCT_DECIMALS}f}"
+        return "0" if v == 0 else floatfmt.format(v)
+    return str(v)
+
+
+def to_text(df: pd.DataFrame, floatfmt: str = "{:.5g}") -> str:
+    """A DataFrame as a console table with the cells of :func:`to_markdown` (columns that cannot run
+    together, :func:`trials.files.tables.text_table`)."""
+    from ..files.tables import text_table
+
+    df, _ = printable(df)
+    cols = [str(c) for c in df.columns]
+    rows = [[_cell(r[c], str(c), floatfmt) for c in df.columns] for _, r in df.iterrows()]
+    return "\n".join(text_table(cols, rows, align=">" * len(cols)))
+
+
+def text_parts(tables: dict) -> list:
+    """The console's lines of ``mmg nomoto-paper``: each table of :func:`reproduce` under its title, the
+    note naming its unusable errors (:func:`unusable_note`) and its own note, as :func:`markdown_parts`."""
+    notes = tables.get("notes", {})
+    out = []
+    for key, title in TITLES.items():
+        if key not in tables:
+            continue
+        out += ["", title, to_text(tables[key])]
+        out += [f"note: {n}" for n in (unusable_note(tables[key]), notes.get(key)) if n]
+    return out
 
 
 def unusable_note(df: pd.DataFrame) -> str:
