@@ -31,7 +31,8 @@ from mmg.ship import Ship
 from .predict import MeasuredRun, replay_record
 
 __all__ = ["Candidate", "NestedCV", "Selection", "nested_cross_validate", "select_candidate", "choose",
-           "replay_scores", "fit_model", "check_choosable", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES"]
+           "replay_scores", "fit_model", "check_choosable", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES",
+           "band_scores", "band_sections", "band_summary"]
 
 HULL_FORMS = {"kijima": "", "crossflow": "_crossflow"}
 """The hull forms ``mmg identify --hull`` knows, by the suffix of their bundled config's name after the
@@ -138,17 +139,25 @@ def _inner_task(task) -> list[dict]:
     return out
 
 
-def band_scores(ident, run, samples: int, seed: int = 0) -> dict:
-    """The 90 % heading band of ``run`` predicted by the identified model ``ident`` (its ship drawn from the
-    covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
-    :func:`trials.measured.bands.prediction_bands`): ``samples`` (the record's), ``inside`` (of them in the
-    band), ``coverage90``, ``median_width_deg``, ``unbounded_share``, ``draws``, ``diverged_draws``."""
-    from .bands import prediction_bands
+def band_sections(ident) -> tuple:
+    """(covariance, run spread) the bands of ``ident``'s predictions draw from: what ``mmg identify`` would
+    write into ship.yaml (an empty covariance where it is not finite)."""
     from .identify import identification_covariance, run_spread
 
     cov = identification_covariance(ident)
-    b = prediction_bands(ident.ship, run, samples, seed, covariance=cov if cov is not None else {"names": [], "matrix": []},
-                         run_spread=run_spread(ident), jobs=1)
+    return (cov if cov is not None else {"names": [], "matrix": []}), run_spread(ident)
+
+
+def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None = None) -> dict:
+    """The 90 % heading band of ``run`` predicted by the identified model ``ident`` (its ship drawn from the
+    covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
+    :func:`trials.measured.bands.prediction_bands`; ``sections``: :func:`band_sections` of ``ident``, made
+    once for several runs): ``samples`` (the record's), ``inside`` (of them in the band), ``coverage90``,
+    ``median_width_deg``, ``unbounded_share``, ``draws``, ``diverged_draws``."""
+    from .bands import prediction_bands
+
+    cov, spread = band_sections(ident) if sections is None else sections
+    b = prediction_bands(ident.ship, run, samples, seed, covariance=cov, run_spread=spread, jobs=1)
     n = len(b.t)
     bounded = int(round((1.0 - b.unbounded_share) * n))
     inside_b = int(round(b.coverage90_where_bounded * bounded)) if bounded else 0
@@ -186,8 +195,9 @@ def _outer_task(task) -> list[dict]:
             "identified": replay_scores(ident.replay(r), horizon_s, ident.ship), "ship": ident.ship, "values": values}
            for r in tests]
     if band_samples:
+        sections = band_sections(ident)                # one covariance and run spread per fold
         for rec, r in zip(out, tests):
-            rec["band"] = band_scores(ident, r, band_samples, seed=outer)
+            rec["band"] = band_scores(ident, r, band_samples, seed=outer, sections=sections)
     return out
 
 
