@@ -32,9 +32,10 @@ from ._inlining import hot_loops_only
 from .nondim import force_scale, inertia_scale, mass_scale, moment_scale, r_prime
 from .fourquadrant import N_HARMONICS, atan2_of, b4_70_coefficients, ct_from_kt, fourier_ct, pitch_angle
 from .terms import AXES, TERMS, sabs, term_value
-from .wind import fujiwara_series
+from .wind import apparent_air_velocity, fujiwara_series
 
 _fujiwara_series = njit(cache=True, error_model="numpy", inline="always")(fujiwara_series)
+_apparent_air_velocity = njit(cache=True, error_model="numpy", inline="always")(apparent_air_velocity)
 
 # state indices
 U_, V_, R_, X_, Y_, PSI_, DELTA_, N_ = range(8)
@@ -468,8 +469,8 @@ def wind_loads(u, v, psi, p):
 
     The true wind of speed ``p[P_WIND_V]`` [m/s] comes FROM ``p[P_WIND_FROM]`` [rad, clockwise from
     north]; the apparent wind is the true one minus the ship's velocity over ground (through the
-    water plus the current; the anemometer is at midship, as :func:`mmg.wind.relative_wind_from_true`
-    takes it) and acts through the Fujiwara series (:func:`mmg.wind.fujiwara_series`, the one
+    water plus the current; the anemometer is at midship: :func:`mmg.wind.apparent_air_velocity`,
+    compiled) and acts through the Fujiwara series (:func:`mmg.wind.fujiwara_series`, the one
     definition the replay's measured-wind loads also use):
     X = q A_T C_X, Y = q A_L C_Y, N = q A_L L_oa C_N, q = 1/2 rho_air V_rel^2 times the effect's scale
     (``p[P_WIND_Q]`` = 1/2 rho_air scale).  Real or complex states (complex-step derivatives)."""
@@ -479,8 +480,9 @@ def wind_loads(u, v, psi, p):
         return z, z, z
     rel = p[P_WIND_FROM] - psi
     cur = p[P_CUR_DIR] - psi
-    ax = -Vt * np.cos(rel) - u - p[P_CUR_SPEED] * np.cos(cur)    # apparent air velocity, ship axes
-    ay = -Vt * np.sin(rel) - v - p[P_CUR_SPEED] * np.sin(cur)
+    ax, ay = _apparent_air_velocity(Vt, rel, u, v)               # relative to the water: minus the current's
+    ax = ax - p[P_CUR_SPEED] * np.cos(cur)
+    ay = ay - p[P_CUR_SPEED] * np.sin(cur)
     V2 = ax * ax + ay * ay
     if V2.real < 1e-18:
         z = 0.0 * u

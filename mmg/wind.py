@@ -61,6 +61,7 @@ __all__ = [
     "angle_from_dataset",
     "true_wind_from_relative",
     "relative_wind_from_true",
+    "apparent_air_velocity",
 ]
 
 RHO_AIR = 1.225
@@ -386,9 +387,31 @@ def relative_wind_from_true(V_true, dir_true, u, v, psi):
         Apparent wind angle gamma [rad] in (-pi, pi]: comes FROM, from the bow,
         positive towards starboard.
     """
-    Vt = np.asarray(V_true, dtype=float)
     rel = np.asarray(dir_true, dtype=float) - np.asarray(psi, dtype=float)
-    # true air velocity in ship axes minus ship velocity
-    ax = -Vt * np.cos(rel) - np.asarray(u, dtype=float)
-    ay = -Vt * np.sin(rel) - np.asarray(v, dtype=float)
+    ax, ay = apparent_air_velocity(np.asarray(V_true, dtype=float), rel, np.asarray(u, dtype=float),
+                                   np.asarray(v, dtype=float))
     return np.hypot(ax, ay), angle_from_dataset(np.arctan2(-ay, -ax))
+
+
+def apparent_air_velocity(V_true, rel, u, v):
+    """The air's velocity relative to the ship, in ship axes [m/s]: the true wind's minus the ship's.
+
+    The one definition of the apparent wind: :func:`relative_wind_from_true` and the simulator's
+    steady-wind loads (:func:`mmg.model.wind_loads`, which compiles this function) use it.
+
+    Parameters
+    ----------
+    V_true : float or array
+        True wind speed [m/s].
+    rel : float or array
+        True wind direction (comes FROM, clockwise from north) minus the heading [rad].
+    u, v : float or array
+        The ship's velocity over ground in ship axes [m/s] (x forward, y to starboard).
+
+    Returns
+    -------
+    ax, ay : float or array
+        Apparent air velocity [m/s], x forward, y to starboard (the wind blows along it: it comes
+        from the direction of -(ax, ay)).
+    """
+    return -V_true * np.cos(rel) - u, -V_true * np.sin(rel) - v

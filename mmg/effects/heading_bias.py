@@ -35,6 +35,11 @@ class HeadingBias(Effect):
         return abs(float(values["bias_deg"]))
 
     @staticmethod
+    def logged_heading(psi, bias):
+        """The heading a compass with the bias ``bias`` [rad] logs for the true heading ``psi`` [rad]."""
+        return psi + bias
+
+    @staticmethod
     def _rot(u, v, a):
         c, s = np.cos(a), np.sin(a)
         return u * c - v * s, u * s + v * c
@@ -52,5 +57,5 @@ class HeadingBias(Effect):
         b = np.radians(values["bias_deg"])
         out = np.array(states, float)
         out[:, 0], out[:, 1] = cls._rot(out[:, 0], out[:, 1], -b)
-        out[:, 5] += b
+        out[:, 5] = cls.logged_heading(out[:, 5], b)
         return out

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from mmg.units import KNOT, M_PER_DEG_LAT, M_PER_DEG_LON
+from mmg.effects.heading_bias import HeadingBias
 
 LOG_COLUMNS = ("time_s", "lat_deg", "lon_deg", "heading_deg", "speed_kn", "rpm")
 TRUTH_COLUMNS = ("time_s", "u_mps", "v_mps", "r_radps", "delta_rad", "delta_order_rad",
@@ -67,7 +68,7 @@ def log_columns(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = No
     lat = np.degrees(spec.start_lat) + x[sel] / M_PER_DEG_LAT + noise(np.degrees(spec.noise_lat))
     lon = np.degrees(spec.start_lon) + y[sel] / M_PER_DEG_LON + noise(np.degrees(spec.noise_lon))
     b = spec.bias
-    hdg = np.mod(np.degrees(psi[sel] + b.heading) + noise(np.degrees(spec.noise_heading)), 360.0)
+    hdg = np.mod(np.degrees(HeadingBias.logged_heading(psi[sel], b.heading)) + noise(np.degrees(spec.noise_heading)), 360.0)
     spd = (sog[sel] + b.speed) / KNOT + noise(spec.noise_speed / KNOT)
     rpm = (n[sel] + b.rpm) * 60.0 + noise(spec.noise_rpm * 60.0)
     out = {"time_s": ts, "lat_deg": lat, "lon_deg": lon, "heading_deg": hdg, "speed_kn": spd, "rpm": rpm}
