@@ -217,7 +217,7 @@ class Scaling:
         """The full-scale values of the transferred parameters (by their ``mmg identify`` names, SI) from
         ``model`` (its config's or identified values), each scale-effect correction times (1 + xi)
         (``xi`` in the order of :data:`EFFECTS`; zeros when None)."""
-        from mmg.nondim import inertia_scale, mass_scale
+        from mmg.parameters import CONSTANTS, MASS_NAMES
 
         xf, xw, xe, xk = (0.0, 0.0, 0.0, 0.0) if xi is None else (float(x) for x in xi)
         out = dict(model.hull.as_dict())
@@ -231,10 +231,9 @@ class Scaling:
         out["epsilon"] = (1.0 - w_rs) / (1.0 - self.wake_to_ship(w_m)) * (1.0 + xe)
         out["kappa"] = r.kappa * (1.0 + xk)
         out.update({k: getattr(r, k) for k in TRANSFERRED if k not in ("epsilon", "kappa")})
-        pa, ms = self.base.particulars, model.mass
-        out["m_x"] = ms.m_x_prime * mass_scale(pa.rho, pa.L, pa.T)
-        out["m_y"] = ms.m_y_prime * mass_scale(pa.rho, pa.L, pa.T)
-        out["J_z"] = ms.J_z_prime * inertia_scale(pa.rho, pa.L, pa.T)
+        for name in MASS_NAMES:                   # primed: the model's value at the ship's scale
+            entry = CONSTANTS[name]
+            out[name] = getattr(model.mass, entry.config_key) * entry.config_scale(self.base)
         return out
 
     def ship(self, model: Ship, xi=None) -> Ship:
