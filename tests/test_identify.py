@@ -72,7 +72,7 @@ def test_identify_improves_the_open_loop_replay_and_writes_a_usable_ship(tmp_pat
 def test_each_record_is_replayed_once_per_model(monkeypatch):
     """The scores, the physical check and the report read the same replays: one per record and model
     (the identified and the initial), and the identified replay is not the initial one."""
-    import trials.measured.identify as I
+    import trials.measured.identify.fit as I
 
     ship = mmg.load_ship(SHIP)
     runs = _synthetic_runs(ship.with_hull({"N_r": ship.hull.value("N_r") * 1.3}), seeds=(0,), duration=40.0)

@@ -68,25 +68,20 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass, replace
 from functools import cached_property
-from pathlib import Path
 
 import numpy as np
 
 from mmg.errors import InputError
 from mmg.model import pack
-from mmg.parameters import unit_of
 from mmg.ship import Ship
 
-from .predict import MeasuredRun, measured_run, replay_record
+from ..predict import MeasuredRun, measured_run, replay_record
 
-__all__ = ["identify", "IdentifyOptions",
-           "cross_validate", "cv_folds", "write_identification", "load_runs", "ship_yaml", "Identification",
-           "fit_covariance", "ship_with_values",
-           "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
-           "stage_description", "identification_covariance", "run_covariance", "fold_spread_json",
-           "COVARIANCE_METHOD", "identification_summary", "start_noise", "DEFAULT_INITIAL_STATE", "run_spread",
-           "START_UNITS", "free_parameter_text",
-           "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
+__all__ = ["identify", "IdentifyOptions", "cross_validate", "cv_folds", "load_runs", "Identification",
+           "ship_with_values", "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV", "stage_description",
+           "start_noise", "DEFAULT_INITIAL_STATE", "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern",
+           "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
+
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale", "Y_P_astern")
 DEFAULT_MAX_NFEV = 30
@@ -116,8 +111,8 @@ def load_runs(ship: Ship, paths, wind: bool | None = None, say=_log, names=None)
     the names to give instead (labels made over the training and test records together)."""
     from dataclasses import replace
 
-    from ..files.output import record_labels
-    from ..files.shipcheck import ShipMismatch, read_for_ship
+    from ...files.output import record_labels
+    from ...files.shipcheck import ShipMismatch, read_for_ship
 
     paths = list(paths)
     runs = []
@@ -209,7 +204,7 @@ class Identification:
 
     @cached_property
     def _physical(self):
-        from .physical import physical_check
+        from ..physical import physical_check
 
         return physical_check(self.ship, self.prior or self.initial, self.runs, [self.replay(r) for r in self.runs])
 
@@ -231,38 +226,6 @@ class Identification:
     @cached_property
     def _replays(self) -> dict:
         return {}
-
-
-METRIC_COLUMNS = (("advance_L", "advance [L]"), ("tactical_diameter_L", "tactical diameter [L]"),
-                  ("overshoots_deg", "overshoots [deg]"))
-
-
-def manoeuvre_metrics(rep) -> tuple[dict | None, dict | None]:
-    """Turning / zigzag metrics (:func:`trials.analysis.metrics.record_metrics`) of the measured record and of
-    its replay (a :class:`trials.measured.predict.Replayed`); ``None`` where the record is neither manoeuvre."""
-    from ..analysis.metrics import record_metrics
-    from ..files.records import TrialRecord
-
-    run = rep.run
-    out = []
-    for s in (run.meas, rep.pred):
-        rec = TrialRecord(t=run.t, name=run.name, source=run.source, x=s[:, 3], y=s[:, 4], psi=s[:, 5],
-                          u=s[:, 0], v=s[:, 1], r=s[:, 2], U=np.hypot(s[:, 0], s[:, 1]), delta=run.inputs.delta,
-                          n=run.inputs.n, meta={"length_m": rep.L})
-        try:
-            out.append(record_metrics(rec) if np.all(np.isfinite(s)) else None)
-        except (InputError, ValueError):
-            out.append(None)
-    return out[0], out[1]
-
-
-def _fmt_metric(m: dict | None, key: str) -> str:
-    if m is None or m.get(key) is None:
-        return "-"
-    v = m[key]
-    if isinstance(v, (list, tuple)):
-        return ", ".join(f"{x:.1f}" for x in v[:3]) if len(v) else "-"
-    return f"{v:.2f}" if np.isfinite(v) else "-"
 
 
 def with_ship_effects(run: MeasuredRun, ship: Ship) -> MeasuredRun:
@@ -508,7 +471,7 @@ def _whole_record_residuals(problem: tuple, theta, velocity_weight: float, strid
 def _residual_tau(problem: tuple, fit, o: IdentifyOptions, stride: int = 2) -> float:
     """The integrated autocorrelation time [samples at ``stride``] of the last stage's residuals: each
     channel's (u, v, r, heading) median over the records, the mean over the channels (as ``mmg diagnose``)."""
-    from .diagnose import _tau
+    from ..diagnose import _tau
 
     res, _ = _whole_record_residuals(problem, fit.theta, o.velocity_weight, stride)
     taus = [np.median([_tau(d[:, j]) for d in res]) for j in range(4)]
@@ -557,7 +520,7 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, options: IdentifyOpti
     if o.initial_state not in INITIAL_STATES:
         raise ValueError(f"initial_state {o.initial_state!r}: one of {INITIAL_STATES}")
     if o.initial is not None:                                 # the same ship's, before any record is read
-        from ..files.shipcheck import check_same_ship
+        from ...files.shipcheck import check_same_ship
 
         check_same_ship(ship, o.initial)
     runs = _training_runs(ship, paths_or_runs, o)
@@ -714,7 +677,7 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
     same numbers either way."""
     ref = ship if initial is None else initial
     if initial is not None:
-        from ..files.shipcheck import check_same_ship
+        from ...files.shipcheck import check_same_ship
 
         check_same_ship(ship, initial)
     idx = np.arange(len(runs))
@@ -729,564 +692,8 @@ def cross_validate(ship: Ship, runs: list[MeasuredRun], folds: int = 4, progress
             if progress:
                 progress(k + 1, folds)
         return out
-    from ..files.sweep import run_sweep
+    from ...files.sweep import run_sweep
 
     parts = run_sweep(_fold, tasks, backend=backend, client=client, n_jobs=n_jobs,
                       labels=[f"cross-validation fold {k + 1}/{folds}" for k in range(folds)])
     return [r for part in parts for r in part]
-
-
-
-def _covariance_section(fit, cov: np.ndarray, note: str, method: str = "") -> dict | None:
-    """The ``covariance:`` section of the shared parameters (a record's own nuisance left out: the block
-    of the joint covariance is their marginal); None when it is not finite."""
-    keep = [i for i, f in enumerate(fit.free) if f.record is None]
-    cov = np.asarray(cov, float)[np.ix_(keep, keep)]
-    if not np.all(np.isfinite(cov)):
-        return None
-    cov = 0.5 * (cov + cov.T)
-    names = [fit.free[i].name for i in keep]
-    return {"names": names, "units": [unit_of(n) for n in names],
-            "values": [float(f"{fit.theta[i]:.10g}") for i in keep],
-            "matrix": [[float(f"{x:.10g}") for x in row] for row in cov], "source": note,
-            **({"method": method} if method else {})}
-
-
-def fit_covariance(fit, note: str = "") -> dict | None:
-    """The ``covariance:`` section of a ship YAML from a fit (:class:`ekf.identify.IdentifyResult`) with
-    its own Gauss-Newton covariance (``corr * std std^T``: the whole inverse J^T J, prior rows included,
-    times the residual variance): its shared parameters' names, units (:func:`mmg.parameters.unit_of`), fitted
-    values and covariance; None when it is not finite (a singular fit).  What ``mmg identify`` writes is
-    :func:`identification_covariance`'s."""
-    std = np.asarray(fit.std, dtype=float)
-    cov = np.asarray(fit.corr, dtype=float) * np.outer(std, std)
-    return _covariance_section(fit, cov, note or "Gauss-Newton covariance of the fit scaled by the residual variance")
-
-
-def posterior_covariance(fit, tau: float = 1.0) -> np.ndarray:
-    """(J_d^T J_d / (s_d^2 max(tau, 1)) + diag(1 / sigma_prior^2))^-1 over every free parameter of ``fit``:
-    the data rows' information (:attr:`ekf.identify.IdentifyResult.info_data`) scaled by their own
-    residual variance s_d^2 = ss_d / (N_d - n) and divided by their correlation time, the prior's at its
-    stated std; NaN where the fit has no data information or it is singular."""
-    n = len(fit.free)
-    if fit.info_data is None or fit.ss_data is None:
-        return np.full((n, n), np.nan)
-    n_data = int(fit.n_residuals) - n
-    sd2 = float(fit.ss_data) / max(n_data - n, 1)
-    sig = np.array([f.sigma for f in fit.free], float)
-    info = np.asarray(fit.info_data, float) / (sd2 * max(float(tau), 1.0)) + np.diag(1.0 / sig ** 2)
-    try:
-        return np.linalg.inv(info)
-    except np.linalg.LinAlgError:
-        return np.full((n, n), np.nan)
-
-
-COVARIANCE_METHOD = "posterior+run-jackknife"
-"""The ``method`` of the covariance ``mmg identify`` writes (:func:`identification_covariance`)."""
-
-
-def run_covariance(ident: Identification) -> np.ndarray | None:
-    """The run-to-run part of the written covariance: :func:`ekf.identify.run_jackknife_covariance` over
-    the training records' independent runs (:func:`same_run_groups`: a record and its cuts are one run),
-    over every free parameter; None with fewer than two runs or a fit without per-record scores."""
-    from ekf.identify import run_jackknife_covariance
-
-    try:
-        return run_jackknife_covariance(ident.fit, same_run_groups(ident.runs))
-    except ValueError:
-        return None
-
-
-def identification_covariance(ident: Identification, parts: bool = False):
-    """The ``covariance:`` section ``mmg identify`` writes into ship.yaml (module docstring).
-
-    The sum of two parts over the shared parameters' block: the linearised posterior
-    (:func:`posterior_covariance` with the fit's residual correlation time :attr:`Identification.tau`:
-    the residuals' noise and the prior at its stated std, which alone speaks for a parameter the records
-    do not inform) and the run-to-run jackknife (:func:`run_covariance`: how far the fit moves when one
-    independent run is left out, which counts what the records disagree on: a model form that is not
-    the ship's, a disturbance that differs from run to run).  Where the model is right and the runs
-    agree, the two count the same noise and the sum overstates the variance by up to 2 (standard errors
-    by up to 1.41); on real records the run-to-run part dominates.
-
-    Parameters
-    ----------
-    ident : Identification
-    parts : bool
-        Also return the two parts' full matrices (every free parameter): ``(section, posterior, runs)``.
-
-    Returns
-    -------
-    dict or None
-        The section (``names``, ``units``, ``values``, ``matrix``, ``source``, ``method``); None when it
-        is not finite.  With ``parts``, a tuple as above (``runs`` None where it could not be made).
-    """
-    tau = max(float(ident.tau), 1.0)
-    start = ("each record's start state fitted as a nuisance" if ident.initial_state == "fit"
-             else "each record replayed from its first sample")
-    post = posterior_covariance(ident.fit, tau)
-    runs = run_covariance(ident)
-    n_runs = len(set(same_run_groups(ident.runs)))
-    note = (f"linearised posterior of mmg identify's fit ({start}): (J_d^T J_d / (s_d^2 tau) + "
-            f"diag(1 / sigma_prior^2))^-1, the prior at its stated std, the data's information divided by the "
-            f"residuals' integrated autocorrelation time tau = {tau:.3g} samples"
-            + (" (inflated)" if tau > 1.0 else " (not inflated: white residuals)"))
-    if runs is not None:
-        note += (f"; plus the delete-one-run jackknife over the {n_runs} independent runs (one Gauss-Newton step "
-                 f"from the fit without each run): the spread from run to run")
-        section = _covariance_section(ident.fit, post + runs, note, COVARIANCE_METHOD)
-    else:
-        note += f"; no run-to-run part ({n_runs} independent run: the jackknife needs two or more)"
-        section = _covariance_section(ident.fit, post, note, "posterior")
-    return (section, post, runs) if parts else section
-
-
-START_UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "psi": "rad"}
-"""The SI unit of each fitted start-state offset (kind ``"start"``), by state name."""
-
-
-def _nuisance_groups(ident: Identification) -> dict:
-    """{quantity name: (SI unit, factor to SI, [fitted value of each record that has it])} of the fit's
-    per-record nuisances: start offsets as ``start.<state>``, effect parameters as ``<effect>.<parameter>``
-    (a parameter in degrees as ``..._rad``, in radians)."""
-    from mmg.replay import STATE
-
-    effects = _nuisance_effects(ident.record_nuisance)
-    out = {}
-    for f, v in zip(ident.fit.free, ident.fit.theta):
-        if f.record is None:
-            continue
-        if f.kind == "start":
-            name, unit, k = f"start.{STATE[f.sub]}", START_UNITS[STATE[f.sub]], 1.0
-        else:
-            q = effects[f.index].fit_parameters()[f.sub]
-            deg = q.unit == "deg"
-            name = f"{effects[f.index].name}.{q.name[:-4] + '_rad' if deg and q.name.endswith('_deg') else q.name}"
-            unit, k = ("rad", np.pi / 180.0) if deg else (q.unit, 1.0)
-        out.setdefault(name, (unit, k, []))[2].append(float(v))
-    order = {f"start.{x}": i for i, x in enumerate(STATE)}          # the start offsets in state order, first
-    return dict(sorted(out.items(), key=lambda kv: order.get(kv[0], len(order))))
-
-
-def run_spread(ident: Identification) -> dict | None:
-    """The ``run_spread:`` section of ship.yaml: how much each record's own disturbance varies between runs.
-
-    Where the fit has per-record nuisances (each record's start-state offsets, ``initial_state="fit"``;
-    the ``record_nuisance`` effects), each quantity's sample standard deviation (ddof 1) of its fitted
-    values across the training records that have it (two at least); otherwise (``initial_state="sample"``,
-    or a single record) the measured start-state noise (:func:`start_noise`: the std of a first sample's
-    error), the root mean square over the records, for u, v, r and the heading.
-
-    Returns
-    -------
-    dict or None
-        ``names`` (``start.u``, ``start.v``, ``start.r``, ``start.psi``, ``<effect>.<parameter>``), ``units``
-        (SI), ``std`` (in ``units``), ``records`` (the training records) and ``source`` (how it was
-        computed); None when there is nothing finite to write.
-    """
-    groups = {k: g for k, g in _nuisance_groups(ident).items() if len(g[2]) >= 2}
-    n = len(ident.runs)
-    if groups:
-        names = list(groups)
-        units = [groups[k][0] for k in names]
-        std = [groups[k][1] * float(np.std(groups[k][2], ddof=1)) for k in names]
-        counts = sorted({len(groups[k][2]) for k in names})
-        over = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
-        source = (f"sample standard deviation (ddof 1) of mmg identify's fitted per-record nuisances across "
-                  f"{over} of the {n} training records (a start offset is fitted only where the channel shows noise)")
-    else:
-        from mmg.replay import STATE
-
-        noise = np.array([start_noise(r) for r in ident.runs])
-        names, units, std = [], [], []
-        for j in (0, 1, 2, 5):
-            col = noise[:, j][np.isfinite(noise[:, j])]
-            if len(col):
-                names.append(f"start.{STATE[j]}")
-                units.append(START_UNITS[STATE[j]])
-                std.append(float(np.sqrt(np.mean(col ** 2))))
-        source = (f"no per-record nuisance fitted on two or more records: the measured start-state noise "
-                  f"(start_noise, the RMS over the {n} training records of each channel's noise std), the std of "
-                  f"a first sample's error")
-    keep = [i for i, s in enumerate(std) if np.isfinite(s)]
-    if not keep:
-        return None
-    return {"names": [names[i] for i in keep], "units": [units[i] for i in keep],
-            "std": [float(f"{std[i]:.6g}") for i in keep], "records": n, "source": source}
-
-
-def _change_text(pct: float) -> str:
-    """A fitted value's change from its config value, in per cent; "-" where the config value is 0
-    (a term the config does not have, e.g. ``Y_P_astern``: no relative change to give)."""
-    return "-" if not np.isfinite(pct) else f"{pct:+.0f} %"
-
-
-def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None,
-              identification: dict | None = None, spread: dict | None = None) -> str:
-    """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
-    ``w_P0`` constant term, ``Y_P_astern``, the rudder's ``epsilon``, ``kappa``, ``gamma_R_pos``,
-    ``gamma_R_neg``, ``l_R_prime``, the added masses, a rudder offset and the wind factors) and ``note`` in its header and ``source``; with
-    ``covariance`` (:func:`fit_covariance`) its ``covariance:`` section (else none: the initial
-    ship's own section, if any, is about other values and is dropped); with ``identification``
-    (:func:`identification_summary`) its ``identification:`` section and its warnings as header comments,
-    with ``spread`` (:func:`run_spread`) its ``run_spread:`` section (else none of either, as the covariance)."""
-    import yaml
-
-    from mmg.parameters import write_yaml_value
-
-    data = yaml.safe_load(Path(ship_path).read_text())
-    for k, v in values.items():
-        write_yaml_value(data, k, v, ship_path)
-    data.pop("covariance", None)
-    data.pop("identification", None)
-    if covariance is not None:
-        data["covariance"] = covariance
-    if identification is not None:
-        data["identification"] = identification
-    data.pop("run_spread", None)
-    if spread is not None:
-        data["run_spread"] = spread
-    data["name"] = f"{data['name']} (identified)"
-    data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
-    head = "".join(f"# {ln}\n" for ln in note.splitlines() + _warning_lines(identification))
-    return head + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
-
-
-def _warning_lines(identification: dict | None) -> list[str]:
-    """The header comment lines of an ``identification:`` section: whether the fit converged, then its warnings."""
-    if identification is None:
-        return []
-    from mmg.ship import one_line
-
-    w = identification["warnings"]
-    out = [("every fit stage converged" if identification["converged"] else
-            "NOT CONVERGED: a fit stage stopped at its evaluation limit")
-           + (f"; {len(w)} warning(s) (also in the identification: section):" if w else "; no warnings")]
-    return out + [f"- {one_line(x)}" for x in w]
-
-
-_COMPUTE = object()
-
-
-def identification_summary(ident: Identification, covariance=_COMPUTE) -> dict:
-    """What ``mmg identify`` says of its own fit: the ``identification:`` section of the ship.yaml it writes.
-
-    Parameters
-    ----------
-    ident : Identification
-    covariance : dict or None, optional
-        The ``covariance:`` section written beside it (:func:`identification_covariance` of ``ident`` when
-        omitted; None: none written).
-
-    Returns
-    -------
-    dict
-        ``converged`` (bool: every fit stage converged, scipy status > 0), ``warnings`` (list of str, one
-        sentence each: the fit's own (a value on its bound, a changed sign), each stage stopped at its
-        evaluation limit, each training record the identified model replays worse than the initial one,
-        each failed physical check), ``covariance_method`` (the covariance section's ``method`` when it
-        has one, else how :func:`identification_covariance` made it) and ``training_replays_worse``
-        (those records' names).
-    """
-    if covariance is _COMPUTE:
-        covariance = identification_covariance(ident)
-    fit = ident.fit
-    st = ident.stages or ({"description": stage_description(ident.segment_s), "max_nfev": None,
-                           "evaluations": fit.iterations, "status": fit.status},)
-    warn = [w for w in fit.warnings() if not (fit.status == 0 and w.startswith("the fit stopped at its evaluation"))]
-    for k, x in enumerate(st):                        # every stage's stop (the fit's own says the last one's only)
-        if not x["status"] > 0:
-            lim = "" if x.get("max_nfev") is None else f" ({x['max_nfev']})"
-            warn.append(f"stage {k + 1}/{len(st)} ({x['description'].split(':')[0]}) stopped at its evaluation "
-                        f"limit{lim} after {x['evaluations']} evaluations without converging: mmg identify --max-nfev "
-                        f"raises it")
-    worse = []
-    for a, b in zip(ident.scores(model="initial"), ident.scores()):
-        ha, hb = a["heading_rms_deg"], b["heading_rms_deg"]
-        if np.isfinite(ha) and not hb <= ha:
-            worse.append(a["name"])
-            warn.append(f"training record {a['name']}: the identified model replays it worse than the initial model "
-                        f"(heading RMS {hb:.2f} deg against {ha:.2f} deg)")
-    warn += [f"physical check: {w}" for w in ident.physical_check().warnings()]
-    return {"converged": bool(all(x["status"] > 0 for x in st)), "warnings": warn,
-            "covariance_method": _covariance_method(ident, covariance), "training_replays_worse": worse}
-
-
-def _covariance_method(ident: Identification, covariance: dict | None) -> str:
-    """The ``method`` of a covariance section, else how :func:`identification_covariance` makes it."""
-    if covariance is None:
-        return "none written (the fit's covariance is not finite)"
-    if covariance.get("method"):
-        return str(covariance["method"])
-    return (f"linearised posterior (J_d^T J_d / (s_d^2 tau) + diag(1 / sigma_prior^2))^-1: the prior at its stated "
-            f"std, the data's information divided by the residuals' correlation time tau = "
-            f"{max(float(ident.tau), 1.0):.3g} samples")
-
-
-def _stage_lines(ident: Identification) -> list[str]:
-    """The report's account of the fit stages: what each fitted, how many evaluations of its limit it
-    used and why it stopped (a stage at its limit says how to raise it)."""
-    st = ident.stages or ({"description": stage_description(ident.segment_s), "evaluations": ident.fit.iterations,
-                           "max_nfev": None, "status": ident.fit.status, "message": ident.fit.message},)
-    out = [f"Fitted in {len(st)} stage{'s' if len(st) > 1 else ''}, each starting from the previous one's values:"]
-    for k, s in enumerate(st):
-        lim = "" if s.get("max_nfev") is None else f" of at most {s['max_nfev']}"
-        stop = (" (stopped at its evaluation limit, not converged: mmg identify --max-nfev raises it)"
-                if s["status"] == 0 else f" ({s['message']})")
-        out.append(f"{k + 1}. {s['description']}; {s['evaluations']} evaluations{lim}{stop}.")
-    if len(st) > 1:
-        out += ["", "Each stage has its own cost (segments restarted from the record, or the whole record open loop): "
-                    "a stage's cost is not comparable with the one before it (the whole record usually costs more)."]
-    return out
-
-
-def _cov_std(cov: dict | None) -> dict:
-    """{name: standard error} of a ``covariance:`` section (:func:`identification_covariance`); {} for None."""
-    return dict(zip(cov["names"], np.sqrt(np.diag(np.asarray(cov["matrix"], float))))) if cov else {}
-
-
-def free_parameter_text(fit) -> str:
-    """The fit's free parameters counted in words, the same on the console and in report.md: ``"22 model
-    parameters and 12 start-state offsets (34 in all)"``, or ``"22 model parameters"`` without offsets.
-
-    ``fit`` has ``free``, each with its ``kind``: ``"start"`` for a record's start-state offset (a nuisance
-    that moves one replay's start, not the model), anything else a model parameter."""
-    starts = sum(1 for f in fit.free if f.kind == "start")
-    model = len(fit.free) - starts
-    text = f"{model} model parameter{'s' * (model != 1)}"
-    if starts:
-        text += f" and {starts} start-state offset{'s' * (starts != 1)} ({model + starts} in all)"
-    return text
-
-
-def _report_fit(ident: Identification, cov: dict | None, warn: list) -> list:
-    """The report's title, stages, values with standard errors (of ``cov``, the written covariance section),
-    warnings (``warn``: :func:`identification_summary`'s) and strong correlations."""
-    fit = ident.fit
-    lines = [f"# Identification of {ident.initial.name}", ""]
-    if ident.prior is not None:
-        lines += [f"Fitted in the form of {ident.prior.name} (the prior, 'config' below); 'initial' scores are "
-                  f"{ident.initial.name}'s.", ""]
-    lines += [
-             f"Records: {len(ident.runs)}; fitted: {free_parameter_text(fit)}; residuals {fit.n_residuals}; "
-             f"records weighted {ident.record_weighting!r}; velocity residuals weighted {ident.velocity_weight:g} "
-             f"beside the heading's.", "", *_stage_lines(ident), "",
-             "## Values and standard errors", "",
-             "Standard errors from the covariance written into ship.yaml "
-             f"(method `{(cov or {}).get('method', 'none')}`: the linearised posterior, the prior at "
-             f"its stated std, the data's information divided by the residuals' correlation time tau = "
-             f"{max(ident.tau, 1.0):.3g} samples, plus the delete-one-run jackknife over the independent runs where "
-             "there are two or more; :func:`identification_covariance`); where it is singular, the "
-             "fit's own Gauss-Newton ones.", "",
-             "| parameter | config | identified | std | change |", "|---|---|---|---|---|"]
-    std = _cov_std(cov)
-    starts = [f for f in fit.free if f.kind == "start"]
-    for name, row in fit.to_pandas().iterrows():
-        if name.startswith("start."):
-            continue
-        lines.append(f"| {name} | {row.prior:.5g} | {row.estimate:.5g} | {std.get(name, row['std']):.2g} | "
-                     f"{_change_text(row.change_pct)} |")
-    if starts:
-        lines += ["", f"Each record's start state (u, v, r, heading of its first sample) was fitted as a nuisance "
-                      f"({len(starts)} offsets, not listed; prior 0 with twice the record's noise level as std)."]
-    if warn:
-        lines += ["", "## Warnings", "",
-                  "Where the identified values should not be read as the ship's physics, or the fit not as "
-                  "finished (also in ship.yaml's identification: section, which mmg imo reads):", ""] + \
-                 [f"- {w}" for w in warn]
-    names = [f.name for f in fit.free]
-    lines += ["", "## Correlations (|rho| >= 0.8)", ""]
-    strong = [(names[i], names[j], fit.corr[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
-              if np.isfinite(fit.corr[i, j]) and abs(fit.corr[i, j]) >= 0.8]
-    lines += [f"- {x} / {y}: {c:+.2f}" for x, y, c in strong] or ["- none"]
-    return lines
-
-
-def _report_physical(chk) -> list:
-    """The report's physical checks (:mod:`trials.measured.physical`)."""
-    lines = ["", "## Physical checks", "",
-             "Energy: with the propeller stopped and the rudder amidships the ship must lose energy at every "
-             "state (dT/dt <= 0, mmg.dissipation), checked at the states the training records log and over "
-             "the box of their ranges; replays: every training record replayed open loop.", ""]
-    for what, c in (("identified, logged states", chk.logged), ("identified, range box", chk.box),
-                    ("prior, logged states", chk.prior_logged), ("prior, range box", chk.prior_box)):
-        lines.append(f"- {what}: {c.describe()}")
-    lines.append(f"- replays: {len(chk.divergences)} diverged" + "".join(f"\n  - {d.describe()}" for d in chk.divergences))
-    return lines
-
-
-def _report_training(ident: Identification) -> list:
-    """The report's training fits (heading and speed RMS) and manoeuvre metrics, measured and replayed."""
-    a = ident.scores(model="initial")
-    b = ident.scores()
-    lines = []
-    lines += ["", "## Training fits (open-loop replay from each record's first state)", "",
-              "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] |",
-              "|---|---|---|---|---|"]
-    for x, y in zip(a, b):
-        lines.append(f"| {x['name']} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | "
-                     f"{x['speed_rms_mps']:.3f} | {y['speed_rms_mps']:.3f} |")
-    ha, hb = np.nanmean([x["heading_rms_deg"] for x in a]), np.nanmean([y["heading_rms_deg"] for y in b])
-    lines.append(f"| **mean** | {ha:.2f} | {hb:.2f} | | |")
-    lines += ["", "## Manoeuvre metrics: measured, initial model, identified model", "",
-              "From each record and from its open-loop replays (same inputs); '-' where the record or the "
-              "replay is not a complete turn / zigzag.", "",
-              "| record | " + " | ".join(f"{h} meas / init / ident" for _, h in METRIC_COLUMNS) + " |",
-              "|---|" + "---|" * len(METRIC_COLUMNS)]
-    for r in ident.runs:
-        m0, mi = manoeuvre_metrics(replay_record(ident.initial, r))
-        _, mf = manoeuvre_metrics(ident.replay(r))
-        lines.append(f"| {r.name} | " + " | ".join(f"{_fmt_metric(m0, k)} / {_fmt_metric(mi, k)} / {_fmt_metric(mf, k)}"
-                                                    for k, _ in METRIC_COLUMNS) + " |")
-    return lines
-
-
-def _report_test(ident: Identification, test_runs) -> list:
-    """The report's predictions of the records never trained on."""
-    lines = []
-    lines += ["", "## Predictions of records never trained on", "",
-              "| record | heading RMS initial [deg] | identified [deg] | speed RMS initial [m/s] | identified [m/s] | "
-              "final position error initial [L] | identified [L] |", "|---|---|---|---|---|---|---|"]
-    gone = []
-    for r in test_runs:
-        ri, rf = ident.replay(r, "initial"), ident.replay(r)
-        x, y = ri.scores(), rf.scores()
-        gone += [f"{r.name} ({who}, at t = {g.diverged_at:.1f} s)" for who, g in (("initial", ri), ("identified", rf))
-                 if g.diverged_at is not None]
-        lines.append(f"| {r.name} | {x['heading_rms_deg']:.2f} | {y['heading_rms_deg']:.2f} | {x['speed_rms_mps']:.3f} | "
-                     f"{y['speed_rms_mps']:.3f} | {x['final_position_error_L']:.2f} | {y['final_position_error_L']:.2f} |")
-    if gone:
-        lines += ["", f"'nan': the replay diverged (its state stopped being finite): {', '.join(gone)}."]
-    return lines
-
-
-def _comparable_spread(cv: list, ident: Identification, cov: dict | None):
-    """(:class:`~trials.measured.foldspread.FoldSpread` of ``cv`` against ``cov``'s standard errors, the shared
-    parameters not in every fold) where the folds fitted the model written; else (None, the reason)."""
-    from .foldspread import fold_spread
-
-    if cov is None:
-        return None, "No covariance was written (singular fit): the folds' spread is not compared."
-    sp = fold_spread(cv, _cov_std(cov))
-    shared = {n for n in ident.fit.values() if "[" not in n}
-    left = sorted(shared - set(sp.names))
-    droppable = {"Y_P_astern", *_wind_keys()}          # left out of a fold whose records cannot fit them (_free_of)
-    if not sp.same_choice or not set(sp.names) <= shared or not set(left) <= droppable:
-        return None, ("The folds fitted another model than the one written (another hull form or free set): "
-                      "no fold spread (it compares fits of one model).")
-    return sp, left
-
-
-def fold_spread_json(cv: list, ident: Identification, cov: dict | None, posterior=None) -> dict | None:
-    """What ``mmg identify --cv`` writes to ``DIR/fold_spread.json``: the written standard errors against the
-    folds' jackknife (:mod:`trials.measured.foldspread`).
-
-    Returns
-    -------
-    dict or None
-        ``{"median_ratio", "folds", "method", "parameters": [{"name", "stated_se", "jackknife_se", "ratio",
-        "posterior_se"}, ...]}`` (ratio: jackknife over stated; ``posterior_se`` the linearised posterior's
-        alone, from ``posterior``, the full matrix over the fit's free parameters, where given) with
-        ``median_ratio_posterior`` beside it; ``{"median_ratio": None, "note": ...}`` where the folds
-        cannot be compared; None where the folds carry no values.
-    """
-    if not all("values" in c for c in cv):
-        return None
-    sp, left = _comparable_spread(cv, ident, cov)
-    if sp is None:
-        return {"median_ratio": None, "note": left, "parameters": []}
-    post = {}
-    if posterior is not None:
-        d = np.sqrt(np.abs(np.diag(np.asarray(posterior, float))))
-        post = {f.name: float(x) for f, x in zip(ident.fit.free, d)}
-
-    def num(x):
-        return float(x) if np.isfinite(x) else None
-
-    params = [{"name": n, "stated_se": num(sp.stated[j]), "jackknife_se": num(sp.jackknife[j]),
-               "ratio": num(sp.ratio[j]), "posterior_se": post.get(n)} for j, n in enumerate(sp.names)]
-    rp = [p["jackknife_se"] / p["posterior_se"] for p in params
-          if p["jackknife_se"] is not None and p["posterior_se"]]
-    return {"median_ratio": num(sp.median_ratio()), "folds": len(sp.values), "method": cov.get("method", ""),
-            "median_ratio_posterior": float(np.median(rp)) if rp else None, "not_in_every_fold": left,
-            "parameters": params}
-
-
-def _report_spread(cv: list, ident: Identification, cov: dict | None) -> list:
-    """The report's check of the written standard errors (``cov``, ship.yaml's covariance section) against
-    the folds' spread (:mod:`trials.measured.foldspread`); nothing where the folds carry no values."""
-    if not all("values" in c for c in cv):
-        return []
-    sp, left = _comparable_spread(cv, ident, cov)
-    if sp is None:
-        return ["", left]
-    lines = ["", "## The written standard errors against the folds' spread", "",
-             "Each fold fitted the model without its kept-out records.  The jackknife standard error over the "
-             f"{len(sp.values)} folds counts how the fit moves when a group of records is left out; the written one "
-             "(ship.yaml's covariance) is meant to count the same: its run-to-run part is a jackknife over single "
-             "runs of the fit on all the records.  A ratio well above 1 says the written covariance (and "
-             "`mmg imo --samples`, which draws from it) is too sure by about that factor; well below 1, too cautious "
-             "(or that the folds' fits stopped short of their optimum: the report's stages).  "
-             "`DIR/fold_spread.json` has the same figures.", "",
-             "| parameter | identified | written std | jackknife std | ratio | folds' signs differ |",
-             "|---|---|---|---|---|---|"]
-    fitted = ident.fit.values()
-    for j, n in enumerate(sp.names):
-        lines.append(f"| {n} | {fitted.get(n, np.nan):.5g} | {sp.stated[j]:.2g} | {sp.jackknife[j]:.2g} | "
-                     f"{sp.ratio[j]:.1f} | {'yes' if sp.sign_differs[j] else ''} |")
-    lines += ["", f"Median ratio {sp.median_ratio():.2f} over {int(np.isfinite(sp.ratio).sum())} parameters "
-                  f"({len(sp.values)} folds: a rough figure)."]
-    if left:
-        lines += [f"Not in every fold's fit (no record to fit it on there): {', '.join(left)}."]
-    return lines
-
-
-def _report_cv(cv: list) -> list:
-    """The report's cross-validation table and summary."""
-    lines = []
-    lines += ["", f"## Cross-validation ({max(c['fold'] for c in cv) + 1} folds, each record kept out once)", "",
-              "| record | fold | heading RMS initial [deg] | identified without it [deg] | ratio |", "|---|---|---|---|---|"]
-    for c in cv:
-        x, y = c["initial"]["heading_rms_deg"], c["identified"]["heading_rms_deg"]
-        lines.append(f"| {c['name']} | {c['fold']} | {x:.2f} | {y:.2f} | {x / y:.2f} |")
-    ok = [c for c in cv if np.isfinite(c["identified"]["heading_rms_deg"])]   # (a diverged replay: below)
-    xa = np.mean([c["initial"]["heading_rms_deg"] for c in ok])
-    xb = np.mean([c["identified"]["heading_rms_deg"] for c in ok])
-    better = sum(c["identified"]["heading_rms_deg"] < c["initial"]["heading_rms_deg"] for c in cv)
-    lines.append(f"| **mean** | | {xa:.2f} | {xb:.2f} | {xa / xb:.2f} |")
-    lines += ["", f"Identified better on {better} of {len(cv)} kept-out records; mean ratio {xa / xb:.2f}."]
-    diverged = [c["name"] for c in cv if not np.isfinite(c["identified"]["heading_rms_deg"])]
-    if diverged:
-        lines += ["", f"The identified model's replay diverged on {len(diverged)} kept-out record(s) "
-                      f"({', '.join(diverged)}): counted as not better, left out of both means."]
-    return lines
-
-
-def write_identification(ident: Identification, ship_path, out_dir, cv: list | None = None, test_runs=None) -> dict:
-    """Write ``out_dir/ship.yaml`` (with :func:`identification_summary` as its ``identification:`` section
-    and header comments) and ``out_dir/report.md``; return the paths written.
-
-    ``ship_path`` is the initial ship's YAML (its comments are not kept; the fitted values
-    replace the config's).  ``cv`` is :func:`cross_validate`'s output, reported when given;
-    ``test_runs`` (records never trained on) are predicted with both models and reported."""
-    out_dir = Path(out_dir)
-    fit = ident.fit
-    note = (f"segment-wise output error over {len(ident.runs)} records "
-            f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
-    cov, post, _ = identification_covariance(ident, parts=True)
-    summary = identification_summary(ident, cov)
-    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, summary, spread=run_spread(ident)))
-    lines = _report_fit(ident, cov, summary["warnings"]) + _report_physical(ident.physical_check()) + _report_training(ident)
-    if test_runs:
-        lines += _report_test(ident, test_runs)
-    written = {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
-    if cv:
-        lines += _report_cv(cv) + _report_spread(cv, ident, cov)
-        spread = fold_spread_json(cv, ident, cov, post)
-        if spread is not None:
-            import json
-
-            (out_dir / "fold_spread.json").write_text(json.dumps(spread, indent=1) + "\n")
-            written["fold_spread"] = out_dir / "fold_spread.json"
-    (out_dir / "report.md").write_text("\n".join(lines) + "\n")
-    return written
