@@ -29,8 +29,8 @@ differ) and dates (``2026-12-04``, ``14-Sep-2020``, ``13:51:45``).  Equal means 
 Every command runs with ``PYTHONHASHSEED=0`` and one BLAS / OpenMP thread, in both trees alike, so
 that a difference is the code's and not the run's.
 
-    python bench/before_after.py --before main [--after REV] [--quick] [--jobs 2] [--rtol 0]
-        [--json bench/out/before_after.json] [--keep]
+    python bench/before_after.py --before main [--after REV] [--quick] [--only COMMAND ...] [--jobs 2]
+        [--rtol 0] [--json bench/out/before_after.json] [--keep]
 
 Prints a table (command | outputs compared | numbers compared | differing, with the first
 differences) and writes the same as JSON.  Exit 0 when every number is equal, 1 when some differ
@@ -218,6 +218,19 @@ def plan(dev: Path, frt: Path, trials: list, quick: bool, jobs: int) -> list:
     return [first, second]
 
 
+GROUPS = ("diagnose", "identify", "predict", "imo", "simulate", "metrics")
+NEEDS = {"predict": "identify", "imo": "identify", "metrics": "simulate"}
+"""The table's rows, and the row whose outputs another reads."""
+
+
+def only(stages: list, groups) -> list:
+    """``stages`` with the commands of ``groups`` (and of the groups they read) alone; all when None."""
+    if not groups:
+        return stages
+    keep = set(groups) | {NEEDS[g] for g in groups if g in NEEDS}
+    return [[c for c in s if c.group in keep] for s in stages]
+
+
 def child_env(tree: Path, frt: Path) -> dict:
     """The environment of every command: the tree first on ``PYTHONPATH``, the data folder named,
     one BLAS / OpenMP thread, a fixed hash seed, no display."""
@@ -352,6 +365,9 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--after", default=None, help="git revision after (default: this working tree as it is)")
     ap.add_argument("--quick", action="store_true", help="4 development logs, 3 trials, 8 IMO samples")
     ap.add_argument("--jobs", type=int, default=2, help="commands run at once, and --jobs of those that take it")
+    ap.add_argument("--only", nargs="+", choices=GROUPS, metavar="COMMAND",
+                    help=f"run these commands alone ({', '.join(GROUPS)}; predict and imo bring identify, "
+                         "metrics simulate)")
     ap.add_argument("--rtol", type=float, default=0.0, help="relative tolerance (default 0: exactly equal)")
     ap.add_argument("--dev", type=Path, default=DATA / "diagnose-dev" / "data", help="development-set folder")
     ap.add_argument("--frt", type=Path, default=Path(os.environ.get("MMG_FRT_DATA") or DATA / "frt-ds-esso"),
@@ -380,7 +396,8 @@ def main(argv=None) -> int:
         if after:
             trees.append(tree_a)
         trials = list(QUICK_TRIALS) if args.quick else sorted(p.stem for p in (tree_b / "configs" / "trials").glob("*.yaml"))
-        stages = {s: plan(args.dev.resolve(), args.frt.resolve(), trials, args.quick, args.jobs) for s in ("before", "after")}
+        stages = {s: only(plan(args.dev.resolve(), args.frt.resolve(), trials, args.quick, args.jobs), args.only)
+                  for s in ("before", "after")}
         wall = {}
         for side, tree in (("before", tree_b), ("after", tree_a)):
             print(f"{side}: {args.before if side == 'before' else args.after or 'working tree'} in {tree}", flush=True)
@@ -391,7 +408,7 @@ def main(argv=None) -> int:
         summary = {"before": {"rev": args.before, "commit": before},
                    "after": {"rev": args.after or "working tree", "commit": after or rev_hash("HEAD"),
                              "uncommitted_edits_included": after is None},
-                   "mode": "quick" if args.quick else "full", "rtol": args.rtol, "jobs": args.jobs,
+                   "mode": "quick" if args.quick else "full", "only": args.only, "rtol": args.rtol, "jobs": args.jobs,
                    "wall_seconds": wall, "rows": rows,
                    "equal": all(r["differing"] == 0 for r in rows.values()),
                    "left_out": {"masks": [[k, p.pattern] for k, p in MASKS], "json_keys": TIMING_KEYS.pattern}}
