@@ -33,8 +33,8 @@ that a difference is the code's and not the run's.
         [--rtol 0] [--json bench/out/before_after.json] [--keep]
 
 Prints a table (command | outputs compared | numbers compared | differing, with the first
-differences) and writes the same as JSON.  Exit 0 when every number is equal, 1 when some differ
-or a command's exit status differs, 2 on bad arguments or missing data.
+differences) and writes the same as JSON.  Exit 0 when every number is equal and every command
+succeeded in both trees, 1 otherwise, 2 on bad arguments or missing data.
 """
 from __future__ import annotations
 
@@ -245,7 +245,7 @@ def check_import(tree: Path, env: dict) -> None:
     out = subprocess.run([sys.executable, "-c", code], cwd=tree, env=env, capture_output=True, text=True)
     files = out.stdout.split()
     if out.returncode != 0 or len(files) != 3 or not all(Path(f).resolve().is_relative_to(tree.resolve()) for f in files):
-        sys.exit(f"error: the package does not import from {tree}: {out.stdout.strip()} {out.stderr.strip()[-300:]}")
+        stop(f"the package does not import from {tree}: {out.stdout.strip()} {out.stderr.strip()[-300:]}")
 
 
 def run_one(cmd: Command, tree: Path, side: Path, env: dict) -> None:
@@ -323,16 +323,22 @@ def summarise(stages_b: list, stages_a: list, rtol: float, show: int = 3) -> dic
 
 def print_table(rows: dict) -> None:
     """The table: command | outputs compared | numbers compared | differing, then the first differences."""
-    print(f"{'command':<10} {'runs':>5} {'outputs compared':>17} {'numbers compared':>17} {'differing':>10}")
+    print(f"{'command':<13} {'runs':>5} {'outputs compared':>17} {'numbers compared':>17} {'differing':>10}")
     for g, r in rows.items():
-        print(f"{'mmg ' + g:<10} {r['commands']:>5} {r['outputs']:>17} {r['numbers']:>17} {r['differing']:>10}")
-    print(f"{'all':<10} {sum(r['commands'] for r in rows.values()):>5} {sum(r['outputs'] for r in rows.values()):>17} "
+        print(f"{'mmg ' + g:<13} {r['commands']:>5} {r['outputs']:>17} {r['numbers']:>17} {r['differing']:>10}")
+    print(f"{'all':<13} {sum(r['commands'] for r in rows.values()):>5} {sum(r['outputs'] for r in rows.values()):>17} "
           f"{sum(r['numbers'] for r in rows.values()):>17} {sum(r['differing'] for r in rows.values()):>10}")
     for g, r in rows.items():
         for w, x, y in r["first_differences"]:
             print(f"  {g}: {w}: before {x}, after {y}")
         for f in r["failed"]:
             print(f"  {g}: a command failed: {f} (before, after); its stderr.txt says why")
+
+
+def stop(message: str) -> None:
+    """One line on stderr, exit 2."""
+    print(f"error: {message}", file=sys.stderr)
+    sys.exit(2)
 
 
 # --- git -------------------------------------------------------------------------------------------
@@ -342,7 +348,7 @@ def rev_hash(rev: str) -> str:
     p = subprocess.run(["git", "rev-parse", "--verify", "--quiet", f"{rev}^{{commit}}"], cwd=REPO,
                        capture_output=True, text=True)
     if p.returncode != 0:
-        sys.exit(f"error: --before/--after: no commit named {rev!r} in {REPO}")
+        stop(f"--before/--after: no commit named {rev!r} in {REPO}")
     return p.stdout.strip()
 
 
@@ -414,8 +420,10 @@ def main(argv=None) -> int:
                    "left_out": {"masks": [[k, p.pattern] for k, p in MASKS], "json_keys": TIMING_KEYS.pattern}}
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(summary, indent=1) + "\n")
-        print(f"{'all numbers equal' if summary['equal'] else 'numbers differ'}; wrote {args.json}")
-        return 0 if summary["equal"] else 1
+        failed = [f for r in rows.values() for f in r["failed"]]
+        print(f"{'all numbers equal' if summary['equal'] else 'numbers differ'}"
+              f"{f'; {len(failed)} command(s) failed' if failed else ''}; wrote {args.json}")
+        return 0 if summary["equal"] and not failed else 1
     finally:
         if args.keep:
             print(f"kept {tmp}")
