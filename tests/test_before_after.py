@@ -92,3 +92,15 @@ def test_compare_command_finds_the_one_changed_number(ba, tmp_path):
     assert where[0].endswith("diagnosis.json /parameters/heading_bias/bias_deg")
     assert where[1].endswith("stdout.txt line 1")
     assert ba.compare_command(runs["before"], runs["after"], rtol=1e-15)["differences"][0][1:] == (0.591, 0.592)
+
+
+def test_a_tree_the_package_does_not_import_from_is_refused(ba, tmp_path, capsys):
+    """The commands must run the tree's own code: a folder without it (the package found elsewhere,
+    through PYTHONPATH) stops the script with exit 2."""
+    repo = BENCH.parent
+    env = ba.child_env(repo, tmp_path)
+    ba.check_import(repo, env)                  # the checkout itself: its own code
+    with pytest.raises(SystemExit) as stopped:
+        ba.check_import(tmp_path, env)
+    assert stopped.value.code == 2
+    assert f"does not import from {tmp_path}" in capsys.readouterr().err
