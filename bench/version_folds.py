@@ -41,7 +41,7 @@ sys.path.insert(1, str(Path(__file__).resolve().parent))
 from frt_gap import KINDS, kind_of  # noqa: E402  (the record kinds, defined once)
 from identify_cv import INITIAL, SUBSETS, kind_summary  # noqa: E402  (the nested bench's records and summary)
 
-__all__ = ["outer_folds", "fit_fold", "score_fold", "fold_check", "kind_rows", "main"]
+__all__ = ["outer_folds", "fit_fold", "version_predict", "score_fold", "fold_check", "kind_rows", "main"]
 
 CLI = "import sys; from trials.cli import main; sys.exit(main())"
 """The command-line entry of a version's code, run with ``python -c`` (works for every version)."""
@@ -87,6 +87,18 @@ def fit_fold(root: Path, train, out: Path, ship: str = "esso_osaka_3m", timeout_
     yaml = out / "ident" / "ship.yaml"
     return {"status": status, "wall_s": time.perf_counter() - t0, "trials_file": which,
             "ship_yaml": str(yaml) if status == "done" and yaml.is_file() else None}
+
+
+def version_predict(root: Path, ship_yaml, tests, out: Path) -> dict:
+    """``mmg predict --ship ship_yaml tests --wind on`` of the code under ``root`` (its own physics replaying
+    its own fit): {record name: whole-record heading RMS [deg], None where it is not finite}."""
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    js = out / "pred_version.json"
+    subprocess.run(["nice", "-n", "5", sys.executable, "-c", CLI, "predict", "--ship", str(ship_yaml), "--wind", "on",
+                    *map(str, tests), "--json", str(js)], cwd=out, env=env, capture_output=True, check=True)
+    runs = json.loads(js.read_text())["runs"]
+    val = (lambda v: None if v is None or not math.isfinite(v) else float(v))  # noqa: E731
+    return {Path(r["file"]).stem: val(r.get("heading_rms_deg")) for r in runs}
 
 
 def _clean(score: dict) -> dict:
@@ -158,6 +170,8 @@ def _args(argv=None):
     ap.add_argument("--timeout", type=float, default=25.0, help="minutes a fold's fit may take (default 25)")
     ap.add_argument("--today", nargs="+", default=[], metavar="NAME=FILE",
                     help="bench/identify_cv.py --json runs to tabulate beside (same folds, checked)")
+    ap.add_argument("--version-predict", action="store_true",
+                    help="also replay each fold's fit with the version's own mmg predict (its physics)")
     return ap.parse_args(argv)
 
 
@@ -195,12 +209,19 @@ def main(argv=None) -> int:
     path = a.json or a.out / "folds.json"
     state = json.loads(path.read_text()) if path.is_file() else {"version": str(a.version), "label": label, "folds": {}}
     for j, (train, tests) in enumerate(folds):
-        if str(j) in state["folds"] or (a.only is not None and j not in a.only):
+        done = state["folds"].get(str(j))
+        if done and a.version_predict and done["ship_yaml"] and "version_predict" not in done:
+            done["version_predict"] = version_predict(a.version, done["ship_yaml"], tests, a.out / f"fold{j}")
+            path.write_text(json.dumps(state, indent=1) + "\n")
+        if done or (a.only is not None and j not in a.only):
             continue
         print(f"fold {j}: fitting on {len(train)} records with {label} ...", flush=True)
         fit = fit_fold(a.version, train, a.out / f"fold{j}", a.ship, a.timeout)
         rec = score_fold(fit["ship_yaml"], tests) if fit["ship_yaml"] else []
         state["folds"][str(j)] = {**fit, "train": [Path(p).stem for p in train], "records": rec}
+        if a.version_predict and fit["ship_yaml"]:
+            state["folds"][str(j)]["version_predict"] = version_predict(a.version, fit["ship_yaml"], tests,
+                                                                        a.out / f"fold{j}")
         a.out.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(state, indent=1) + "\n")
         print(f"fold {j}: {fit['status']} in {fit['wall_s']:.0f} s ({fit['trials_file']}); saved {path}", flush=True)
@@ -210,15 +231,24 @@ def main(argv=None) -> int:
 
 def print_tables(state: dict, today: dict, folds) -> None:
     """Per kept-out record and per kind (Markdown), from the saved ``state``."""
-    records = [dict(r, fold=int(j)) for j, f in sorted(state["folds"].items()) for r in f["records"]]
+    records = [dict(r, fold=int(j), own=f.get("version_predict", {}).get(r["name"], "-"))
+               for j, f in sorted(state["folds"].items()) for r in f["records"]]
     for j, f in sorted(state["folds"].items()):
         print(f"fold {j}: {f['status']}, {f['wall_s']:.0f} s, {len(f['train'])} training, "
               f"{len(folds[int(j)][1])} kept out, {len(f['records'])} scored")
-    fmt = (lambda v: "div." if v is None else f"{v:.1f}")  # noqa: E731
-    print(f"\n| record | fold | scaled [deg] | {state['label']} procedure [deg] |\n|---|---|---|---|")
+    fmt = (lambda v: v if isinstance(v, str) else "div." if v is None else f"{v:.1f}")  # noqa: E731
+    print(f"\n| record | fold | scaled [deg] | {state['label']} procedure [deg] | the same fit, "
+          f"{state['label']}'s own predict [deg] |\n|---|---|---|---|---|")
     for r in records:
         print(f"| {r['name']} | {r['fold']} | {fmt(r['scaled']['heading_rms_deg'])} "
-              f"| {fmt(r['identified']['heading_rms_deg'])} |")
+              f"| {fmt(r['identified']['heading_rms_deg'])} | {fmt(r['own'])} |")
+    own = {}
+    for r in records:
+        if isinstance(r["own"], float):
+            own.setdefault(kind_of(r["name"]), []).append(r["own"])
+    if own:
+        print(f"\n{state['label']}'s own predict of the same fits, mean whole-record heading RMS over the finite "
+              "replays [deg]: " + ", ".join(f"{k} {sum(v) / len(v):.1f} ({len(v)})" for k, v in own.items()))
     head = ["kind", "records", "scaled", f"{state['label']} procedure"] + list(today)
     print("\nMean heading RMS of the kept-out records [deg], whole record / 60 s windows every 30 s:\n")
     print("| " + " | ".join(head) + " |\n|" + "---|" * len(head))

@@ -74,3 +74,16 @@ def test_a_run_in_other_folds_is_named():
     moved = {"records": [{"name": "a", "fold": 1}, {"name": "b", "fold": 1}, {"name": "c", "fold": 0}]}
     assert vf.fold_check(folds, same) == []
     assert vf.fold_check(folds, moved) == ["a", "c"]
+
+
+def test_the_versions_own_predict_is_read_per_record(tmp_path):
+    vf = _load()
+    body = ("    import json\n    out = args[args.index('--json') + 1]\n"
+            "    assert args[0] == 'predict' and args[args.index('--wind') + 1] == 'on'\n"
+            "    json.dump({'runs': [{'file': 'x/random_a.csv', 'heading_rms_deg': 12.5},\n"
+            "                        {'file': 'x/turn_b.csv', 'heading_rms_deg': float('nan')}]}, open(out, 'w'))\n"
+            "    return 0\n")
+    root = _fake_version(tmp_path / "v", body)
+    (tmp_path / "run").mkdir()
+    got = vf.version_predict(root, tmp_path / "ship.yaml", ["x/random_a.csv", "x/turn_b.csv"], tmp_path / "run")
+    assert got == {"random_a": 12.5, "turn_b": None}
