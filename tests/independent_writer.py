@@ -74,24 +74,43 @@ def speed(ship):
     return 0.09 * math.sqrt(G * ship.particulars.L)
 
 
-def simulate(ship, order_t, order_delta, T):
-    """The clean ship in still water under a rudder schedule (actual blade orders)."""
-    from mmg.integrate import CommandLaw
-    from mmg.simulation import simulate as sim
+def simulate(ship, order_t, order_delta, T, wind=None):
+    """The clean ship in still water under a rudder schedule (actual blade orders); ``wind``: a steady
+    true wind (speed [m/s], from [deg clockwise from north]) with the ship's published (Fujiwara) loads,
+    written straight into the compiled model's wind slots (:func:`mmg.model.wind_loads`)."""
+    from mmg.integrate import CommandLaw, integrate
+    from mmg.simulation import SimulationResult, prepare
 
     law = CommandLaw.schedule(order_t, order_delta)
-    return sim(ship, law, T, DT_SIM, speed(ship), trim=False)
+    pk, eq = prepare(ship, speed(ship), trim=False)
+    if wind is not None:
+        pk = _with_wind(pk, ship, *wind)
+    t, states, orders, done = integrate(pk, eq.state(), law, T, DT_SIM)
+    return SimulationResult(t, states, orders, eq, done, ship.name)
 
 
-def turn(ship, rudder_deg, T):
+def _with_wind(pk, ship, V, from_deg):
+    """The packed ship with a steady true wind in :func:`mmg.model.wind_loads`'s slots."""
+    import mmg.model as M
+    from mmg.wind import RHO_AIR, amplitude_vector
+
+    g = ship.wind.particulars()
+    p = pk.p.copy()
+    p[M.P_WIND_V], p[M.P_WIND_FROM], p[M.P_WIND_Q] = V, math.radians(from_deg), 0.5 * RHO_AIR
+    p[M.P_WIND_AT], p[M.P_WIND_AL], p[M.P_WIND_ALL] = g.A_T, g.A_L, g.A_L * g.L
+    p[M.P_WIND_AMP:M.P_WIND_AMP + M.N_WIND_AMP] = amplitude_vector(g)
+    return replace(pk, p=p)
+
+
+def turn(ship, rudder_deg, T, wind=None):
     """A turn: blade 0 in the approach, ``rudder_deg`` (+ starboard) from 5 sqrt(L/g) on (actual angles)."""
     s = math.sqrt(ship.particulars.L / G)
     a = math.radians(rudder_deg)
     t1 = 5.0 * s
-    return simulate(ship, [0.0, t1, t1 + 1e-6, T], [0.0, 0.0, a, a], T)
+    return simulate(ship, [0.0, t1, t1 + 1e-6, T], [0.0, 0.0, a, a], T, wind)
 
 
-def zigzag(ship, rudder_deg, heading_deg, offset_deg, T, first=1.0):
+def zigzag(ship, rudder_deg, heading_deg, offset_deg, T, first=1.0, wind=None):
     """A zigzag steered on the indicator: the helm orders +-a there, the blade goes to +-a + o; the
     order reverses when the (true) heading passes +-heading_deg.  ``first``: +1 starboard first, -1
     port first.  Built by re-simulating with the reversal times found so far (the schedule is the
@@ -115,7 +134,7 @@ def zigzag(ship, rudder_deg, heading_deg, offset_deg, T, first=1.0):
 
     while True:
         ts, ds, side = table()
-        sim = simulate(ship, ts, ds, T)
+        sim = simulate(ship, ts, ds, T, wind)
         psi = sim.states[:, 5]
         after = sim.t > (switches[-1] if switches else t0) + 1e-9
         hit = np.nonzero(after & ((psi >= lim) if side > 0 else (psi <= -lim)))[0]
@@ -124,8 +143,11 @@ def zigzag(ship, rudder_deg, heading_deg, offset_deg, T, first=1.0):
         switches.append(float(sim.t[hit[0]]))
 
 
-def log(ship, sim, *, current=None, bias_deg=0.0, offset_deg=0.0, seed=0, noise=True):
-    """Sample the simulation every DT and log it with the effects and noise (plain formulas)."""
+def log(ship, sim, *, current=None, bias_deg=0.0, offset_deg=0.0, wind=None, seed=0, noise=True):
+    """Sample the simulation every DT and log it with the effects and noise (plain formulas); ``wind``:
+    the steady true wind the simulation had (speed [m/s], from [deg]), logged as it is and as the
+    apparent wind at midship (the true wind's velocity minus the ship's over ground, in the ship's
+    axes; its direction the one it comes from, from the bow, clockwise)."""
     L = ship.particulars.L
     lam = 325.0 / L                                       # Froude scale of the dev set's noise
     t = np.arange(0.0, sim.t[-1] + 1e-9, DT)
@@ -142,6 +164,7 @@ def log(ship, sim, *, current=None, bias_deg=0.0, offset_deg=0.0, seed=0, noise=
     u_log = xd * np.cos(psi_log) + yd * np.sin(psi_log)
     v_log = -xd * np.sin(psi_log) + yd * np.cos(psi_log)
     delta_log = delta - math.radians(offset_deg)
+    wv, wd, wr, wg = _wind_channels(wind, xd, yd, psi)
     rng = np.random.default_rng(seed)
     uni = (lambda h: rng.uniform(-h, h, len(t))) if noise else (lambda h: 0.0 * t)   # noqa: E731
     vel = 0.02 / math.sqrt(lam)
@@ -155,11 +178,23 @@ def log(ship, sim, *, current=None, bias_deg=0.0, offset_deg=0.0, seed=0, noise=
         "r_angvelo [rad/s]": r + uni(0.0002 * math.sqrt(lam)),
         "n_prop [rps]": n,
         "delta_rudder [rad]": delta_log,
-        "wind_velo_relative_mid [m/s]": 0.0 * t,
-        "wind_dir_relative_mid [rad]": 0.0 * t,
-        "wind_velo_true [m/s]": 0.0 * t,
-        "wind_dir_true [rad]": 0.0 * t,
+        "wind_velo_relative_mid [m/s]": wr,
+        "wind_dir_relative_mid [rad]": wg,
+        "wind_velo_true [m/s]": wv,
+        "wind_dir_true [rad]": wd,
     })
+
+
+def _wind_channels(wind, xd, yd, psi):
+    """(true speed, true from-direction, apparent speed, apparent from-direction off the bow), arrays."""
+    z = 0.0 * psi
+    if wind is None:
+        return z, z, z, z
+    V, frm = wind[0], math.radians(wind[1])
+    an, ae = -V * math.cos(frm) - xd, -V * math.sin(frm) - yd          # apparent air velocity, north/east
+    ax = an * np.cos(psi) + ae * np.sin(psi)
+    ay = -an * np.sin(psi) + ae * np.cos(psi)
+    return z + V, z + frm % (2 * math.pi), np.hypot(ax, ay), np.mod(np.arctan2(-ay, -ax), 2 * math.pi)
 
 
 def records(tmp_path, ship, kinds=("turn", "zigzag"), zigzag_s=ZIGZAG_S, turn_s=TURN_S, **effects):
@@ -170,9 +205,9 @@ def records(tmp_path, ship, kinds=("turn", "zigzag"), zigzag_s=ZIGZAG_S, turn_s=
     paths = []
     for k, kind in enumerate(kinds):
         if kind == "turn":
-            sim = turn(ship, 35.0, turn_s * s)
+            sim = turn(ship, 35.0, turn_s * s, wind=effects.get("wind"))
         else:
-            sim = zigzag(ship, 20.0, 20.0, off, zigzag_s * s)
+            sim = zigzag(ship, 20.0, 20.0, off, zigzag_s * s, wind=effects.get("wind"))
         p = tmp_path / f"{kind}.csv"
         log(ship, sim, seed=k + 1, **effects).to_csv(p, index=False)
         paths.append(p)
@@ -181,9 +216,9 @@ def records(tmp_path, ship, kinds=("turn", "zigzag"), zigzag_s=ZIGZAG_S, turn_s=
 
 # --------------------------------------------------------------------------- the mirror image
 
-MIRROR_NEGATED = ("vm_velo [m/s]", "r_angvelo [rad/s]", "delta_rudder [rad]", "wind_dir_relative_mid [rad]")
-"""Columns of a record that change sign in its port <-> starboard mirror image: sway, yaw rate, rudder
-angle (+ starboard) and the relative wind's direction (from the bow, + starboard)."""
+MIRROR_NEGATED = ("vm_velo [m/s]", "r_angvelo [rad/s]", "delta_rudder [rad]")
+"""Columns of a record that change sign in its port <-> starboard mirror image: sway, yaw rate and
+rudder angle (+ starboard); the relative wind's direction (from the bow, clockwise) too, in [0, 2 pi)."""
 
 
 def _wrap(a):
@@ -194,15 +229,15 @@ def mirror(frame, about_deg=0.0):
     """The port <-> starboard mirror image of a written record about the heading ``about_deg``
     (clockwise from north; the approach heading): headings and the true wind's direction psi ->
     2 about - psi; positions reflected in the line through the origin along ``about_deg``; sway,
-    yaw rate, rudder angle and the relative wind's direction negated (:data:`MIRROR_NEGATED`);
+    yaw rate, rudder angle (:data:`MIRROR_NEGATED`) and the relative wind's direction negated;
     surge, revolutions, times and wind speeds as they are."""
     a = math.radians(about_deg)
     out = frame.copy()
     for c in MIRROR_NEGATED:
         out[c] = -frame[c]
     out["psi_hat [rad]"] = _wrap(2 * a - frame["psi_hat [rad]"])
-    out["wind_dir_true [rad]"] = np.where(frame["wind_velo_true [m/s]"] != 0.0,
-                                          _wrap(2 * a - frame["wind_dir_true [rad]"]), frame["wind_dir_true [rad]"])
+    out["wind_dir_relative_mid [rad]"] = np.mod(-frame["wind_dir_relative_mid [rad]"], 2 * math.pi)
+    out["wind_dir_true [rad]"] = np.mod(2 * a - frame["wind_dir_true [rad]"], 2 * math.pi)
     x, y = frame["x_position_mid [m]"].to_numpy(), frame["y_position_mid [m]"].to_numpy()
     along = x * math.cos(a) + y * math.sin(a)
     across = -x * math.sin(a) + y * math.cos(a)
