@@ -80,12 +80,13 @@ def simulate(ship, order_t, order_delta, T, wind=None):
     written straight into the compiled model's wind slots (:func:`mmg.model.wind_loads`)."""
     from mmg.integrate import CommandLaw, integrate
     from mmg.simulation import SimulationResult, prepare
+    from mmg.simulation import simulate as still_air
 
     law = CommandLaw.schedule(order_t, order_delta)
-    pk, eq = prepare(ship, speed(ship), trim=False)
-    if wind is not None:
-        pk = _with_wind(pk, ship, *wind)
-    t, states, orders, done = integrate(pk, eq.state(), law, T, DT_SIM)
+    if wind is None:
+        return still_air(ship, law, T, DT_SIM, speed(ship), trim=False)
+    pk, eq = prepare(ship, speed(ship), trim=False)          # what simulate does, with the wind's slots set
+    t, states, orders, done = integrate(_with_wind(pk, ship, *wind), eq.state(), law, T, DT_SIM)
     return SimulationResult(t, states, orders, eq, done, ship.name)
 
 

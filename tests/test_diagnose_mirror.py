@@ -131,6 +131,26 @@ def test_without_hand(config):
     assert W.load_config().hull.value("Y_0") != 0.0             # the config itself has a hand
 
 
+def test_writer_wind_channels(truth):
+    """The writer's wind, checked on its output: a wind from the east on a ship heading north at U is
+    logged at the start from atan(V / U) off the starboard bow at sqrt(U^2 + V^2), its true wind as
+    given throughout, and :func:`mmg.wind.true_wind_from_relative` gets the true wind back from the
+    logged channels at every sample; the wind pushes the ship to port (west)."""
+    from mmg.wind import true_wind_from_relative
+
+    s = math.sqrt(truth.particulars.L / W.G)
+    V = 1.4
+    f = W.log(truth, W.turn(truth, 0.0, 20.0 * s, wind=(V, 90.0)), noise=False, wind=(V, 90.0))
+    U = W.speed(truth)
+    assert abs(f["wind_dir_relative_mid [rad]"].iloc[0] - math.atan2(V, U)) < 1e-9
+    assert abs(f["wind_velo_relative_mid [m/s]"].iloc[0] - math.hypot(U, V)) < 1e-9
+    assert np.allclose(f["wind_velo_true [m/s]"], V) and np.allclose(f["wind_dir_true [rad]"], math.pi / 2)
+    Vt, dt = true_wind_from_relative(f["wind_velo_relative_mid [m/s]"], f["wind_dir_relative_mid [rad]"],
+                                     f["u_velo [m/s]"], f["vm_velo [m/s]"], f["psi_hat [rad]"])
+    assert np.allclose(Vt, V, atol=1e-9) and np.allclose(dt, math.pi / 2, atol=1e-9)
+    assert f["y_position_mid [m]"].iloc[-1] < 0.0
+
+
 @pytest.mark.parametrize("kind", ["turn", "zigzag"])
 def test_mirror_is_the_other_hands_record(truth, kind):
     """The mirror image of a starboard (first) record with current, bias, offset and wind is what the
