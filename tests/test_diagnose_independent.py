@@ -2,17 +2,8 @@
 
 The records here are NOT made by :mod:`mmg.effects` (the code the diagnosis inverts): the clean
 ship is simulated by :func:`mmg.simulation.simulate`, and each effect is applied afterwards by the
-plain formulas below, in the conventions of ``../shared/data/diagnose-dev/README.md``:
-
-* current ``c`` setting towards ``chi`` (clockwise from north; x north, y east): the simulation in
-  still water is the motion relative to the water; over ground x += c cos(chi) t, y += c sin(chi) t,
-  and the logged u, v are the over-ground velocity resolved in the heading axes;
-* heading bias ``b``: logged heading = true + b, logged u, v = the over-ground velocity resolved in
-  the logged heading's axes, positions right;
-* rudder offset ``o``: the blade sits o to starboard of the indicator: the ship is simulated with
-  the actual blade angle, the indicator logs actual - o (a zigzag: the helm orders +-a on the
-  indicator, so the blade is at +-a + o);
-* noise: uniform, independent per sample, seeded (the dev set's half-widths, Froude-scaled).
+plain formulas of the independent writer, ``tests/independent_writer.py`` (its docstring gives the
+conventions, those of ``../shared/data/diagnose-dev/README.md``).
 
 The record is written as an FRT-DS-ESSO CSV and the FILE is diagnosed.  The truth ship differs
 from the config by 5 % in a few hull coefficients, so "the same model" is not what passes.  A sign
@@ -25,152 +16,30 @@ import math
 from dataclasses import replace
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from .conftest import REPO
+from .independent_writer import G, load_config
+from .independent_writer import angdiff as _angdiff
+from .independent_writer import log as _log
+from .independent_writer import records as _records
+from .independent_writer import truth_ship as _truth_ship
+from .independent_writer import turn as _turn
 
 DEV = REPO.parent / "shared" / "data" / "diagnose-dev"
 
-G = 9.80665
-DT = 0.2                     # logged sampling step [s] of the 3 m model records
-DT_SIM = 0.02                # integration step [s]
-TURN_S, ZIGZAG_S = 120.0, 160.0   # record lengths [sqrt(L/g)]
 
-
-def _angdiff(a_deg, b_deg):
-    return (a_deg - b_deg + 180.0) % 360.0 - 180.0
-
-
-# --------------------------------------------------------------------------- the independent writer
+# --------------------------------------------------------------------------- the independent writer (tests/independent_writer.py)
 
 
 @pytest.fixture(scope="module")
 def config():
-    from mmg.resources import ship_path
-    from mmg.ship import load_ship
-
-    return load_ship(ship_path("esso_osaka_3m"))
+    return load_config()
 
 
 @pytest.fixture(scope="module")
 def truth(config):
     return _truth_ship(config)
-
-
-def _truth_ship(config):
-    """The ship that makes the records: a few hull coefficients 5 % off the config's."""
-    h = config.hull
-    moved = {"Y_beta": 1.05, "N_r": 1.05, "Y_r": 0.95, "N_beta": 0.95, "Y_bb": 1.05, "N_rr": 0.95}
-    vals = tuple(v * moved.get(n, 1.0) for n, v in zip(h.names, h.values))
-    return replace(config, hull=replace(h, values=vals))
-
-
-def _speed(ship):
-    return 0.09 * math.sqrt(G * ship.particulars.L)
-
-
-def _simulate(ship, order_t, order_delta, T):
-    """The clean ship in still water under a rudder schedule (actual blade orders)."""
-    from mmg.integrate import CommandLaw
-    from mmg.simulation import simulate
-
-    law = CommandLaw.schedule(order_t, order_delta)
-    return simulate(ship, law, T, DT_SIM, _speed(ship), trim=False)
-
-
-def _turn(ship, rudder_deg, T):
-    """A turn: blade 0 in the approach, ``rudder_deg`` from 5 sqrt(L/g) on (actual angles)."""
-    s = math.sqrt(ship.particulars.L / G)
-    a = math.radians(rudder_deg)
-    t1 = 5.0 * s
-    return _simulate(ship, [0.0, t1, t1 + 1e-6, T], [0.0, 0.0, a, a], T)
-
-
-def _zigzag(ship, rudder_deg, heading_deg, offset_deg, T):
-    """A zigzag steered on the indicator: the helm orders +-a there, the blade goes to +-a + o; the
-    order reverses when the (true) heading passes +-heading_deg.  Built by re-simulating with the
-    reversal times found so far (the schedule is the helm's, the simulator only integrates)."""
-    s = math.sqrt(ship.particulars.L / G)
-    a, o, lim = math.radians(rudder_deg), math.radians(offset_deg), math.radians(heading_deg)
-    t0 = 5.0 * s
-    switches = []                                   # reversal times
-
-    def table():
-        # before the execute the helm holds the indicator at -o (blade at 0: a straight approach)
-        ts, ds, side = [0.0, t0, t0 + 1e-6], [0.0, 0.0, a + o], 1.0
-        for tk in switches:
-            ts += [tk, tk + 1e-6]
-            ds += [side * a + o, -side * a + o]
-            side = -side
-        ts.append(T)
-        ds.append(side * a + o)
-        return ts, ds, side
-
-    while True:
-        ts, ds, side = table()
-        sim = _simulate(ship, ts, ds, T)
-        psi = sim.states[:, 5]
-        after = sim.t > (switches[-1] if switches else t0) + 1e-9
-        hit = np.nonzero(after & ((psi >= lim) if side > 0 else (psi <= -lim)))[0]
-        if not len(hit):
-            return sim
-        switches.append(float(sim.t[hit[0]]))
-
-
-def _log(ship, sim, *, current=None, bias_deg=0.0, offset_deg=0.0, seed=0):
-    """Sample the simulation every DT and log it with the effects and noise (plain formulas)."""
-    L = ship.particulars.L
-    lam = 325.0 / L                                       # Froude scale of the dev set's noise
-    t = np.arange(0.0, sim.t[-1] + 1e-9, DT)
-    i = np.minimum(np.searchsorted(sim.t, t - 1e-9), len(sim.t) - 1)
-    u, v, r, x, y, psi, delta, n = (sim.states[i, j] for j in range(8))
-    # earth-frame velocity through the water (x north, y east)
-    xd = u * np.cos(psi) - v * np.sin(psi)
-    yd = u * np.sin(psi) + v * np.cos(psi)
-    if current is not None:
-        c, chi = current[0], math.radians(current[1])
-        xd, yd = xd + c * math.cos(chi), yd + c * math.sin(chi)
-        x, y = x + c * math.cos(chi) * t, y + c * math.sin(chi) * t
-    psi_log = psi + math.radians(bias_deg)
-    u_log = xd * np.cos(psi_log) + yd * np.sin(psi_log)
-    v_log = -xd * np.sin(psi_log) + yd * np.cos(psi_log)
-    delta_log = delta - math.radians(offset_deg)
-    rng = np.random.default_rng(seed)
-    uni = lambda h: rng.uniform(-h, h, len(t))        # noqa: E731
-    vel = 0.02 / math.sqrt(lam)
-    return pd.DataFrame({
-        "t [s]": t,
-        "x_position_mid [m]": x + uni(0.5 / lam),
-        "u_velo [m/s]": u_log + uni(vel),
-        "y_position_mid [m]": y + uni(0.5 / lam),
-        "vm_velo [m/s]": v_log + uni(vel),
-        "psi_hat [rad]": np.mod(psi_log + uni(math.radians(0.05)) + math.pi, 2 * math.pi) - math.pi,
-        "r_angvelo [rad/s]": r + uni(0.0002 * math.sqrt(lam)),
-        "n_prop [rps]": n,
-        "delta_rudder [rad]": delta_log,
-        "wind_velo_relative_mid [m/s]": 0.0 * t,
-        "wind_dir_relative_mid [rad]": 0.0 * t,
-        "wind_velo_true [m/s]": 0.0 * t,
-        "wind_dir_true [rad]": 0.0 * t,
-    })
-
-
-def _records(tmp_path, ship, kinds=("turn", "zigzag"), zigzag_s=ZIGZAG_S, **effects):
-    """Write the records (35 deg starboard turn of TURN_S, 20/20 zigzag of ``zigzag_s`` sqrt(L/g)) with
-    ``effects`` as FRT-DS-ESSO CSVs; returns their paths."""
-    s = math.sqrt(ship.particulars.L / G)
-    off = effects.get("offset_deg", 0.0)
-    paths = []
-    for k, kind in enumerate(kinds):
-        if kind == "turn":
-            sim = _turn(ship, 35.0, TURN_S * s)
-        else:
-            sim = _zigzag(ship, 20.0, 20.0, off, zigzag_s * s)
-        p = tmp_path / f"{kind}.csv"
-        _log(ship, sim, seed=k + 1, **effects).to_csv(p, index=False)
-        paths.append(p)
-    return paths
 
 
 def _diagnose(config, paths, **kw):
