@@ -83,10 +83,11 @@ from mmg.model import pack
 from mmg.parameters import MASS_NAMES, config_values
 from mmg.ship import Ship
 
-from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, WEAK_BIC, Z_THRESHOLD, calibration, clears_floor, evidence_short, floor,
+from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, WEAK_BIC, Z_THRESHOLD, clears_floor, evidence_short, floor,
                        floor_parts, magnitude, mean_heading, over_floor, record_kind, residual_floor)
-from .diagnose_records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
-from .diagnose_report import fmt3, format_rms, format_values, round_header, size_with_unit
+from .decision import calibration as _read_calibration  # the package's submodule .calibration takes the name
+from .records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
+from .report import fmt3, format_rms, format_values, round_header, size_with_unit
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "straight_contradicts",
            "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
@@ -409,7 +410,7 @@ def _describe(recs, diffs, noise, rms_after, L: float | None = None, kind: str |
            and (L is None or rms[c] > residual_floor(c, U, L, kind))]
     if not big:
         return False, "", ratio
-    from .diagnose_report import channel_text
+    from .report import channel_text
 
     parts = []
     psi = M[:, 5]
@@ -495,7 +496,7 @@ class Diagnosis:
 
     def summary_lines(self) -> list:
         """The console text (:func:`trials.measured.diagnose_report.summary_lines`)."""
-        from .diagnose_report import summary_lines
+        from .report import summary_lines
 
         return summary_lines(self)
 
@@ -1011,7 +1012,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     t0 = time.perf_counter()
     o = DiagnoseOptions(**kwargs) if options is None else replace(options, **kwargs)
     say = o.say or (lambda m: None)
-    calibration()                               # a bad calibration file: refused before any work
+    _read_calibration()                         # a bad calibration file: refused before any work
     recs = prepare(ship, items, wind=o.wind, segment_s=o.segment_s)
     if not recs:
         raise InputError("diagnose", "", "no record")
@@ -1076,7 +1077,7 @@ def diagnose_each(ship: Ship, items, options: DiagnoseOptions | None = None, pro
     -------
     list of Diagnosis
     """
-    from ..files.sweep import run_sweep
+    from ...files.sweep import run_sweep
 
     o = options or DiagnoseOptions()
     recs = prepare(ship, items, wind=o.wind, segment_s=o.segment_s)
@@ -1233,7 +1234,7 @@ def _diagnosis(ship, recs, baseline, search, cands, noise, ns: int, stride: int)
     current, named, rounds = search
     cand, cand_log = cands
     _, inflate = _taus(current, stride)
-    from .diagnose_report import effect_estimate, effect_evidence, effect_intervals
+    from .report import effect_estimate, effect_evidence, effect_intervals
 
     params, ses, ivs = {}, {}, {}
     for cls in current.effects:
