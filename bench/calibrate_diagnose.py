@@ -71,7 +71,7 @@ def main(argv=None):
     if a.write:
         OUT.parent.mkdir(parents=True, exist_ok=True)
         OUT.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "
-                       "(trials/measured/decision.py).\n" + yaml.safe_dump(doc, sort_keys=False))
+                       "(trials/measured/diagnose/decision.py).\n" + yaml.safe_dump(doc, sort_keys=False))
         print(f"wrote {OUT}")
 
 

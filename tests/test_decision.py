@@ -1,4 +1,4 @@
-"""The naming decision of mmg diagnose (trials/measured/decision.py): the size measure against plain
+"""The naming decision of mmg diagnose (trials/measured/diagnose/decision.py): the size measure against plain
 formulas, the kind of record, the calibrated false-alarm probability, and the floor acting on a
 diagnosis (a floor above the fitted size must stop the naming; no floor must let it through)."""
 from __future__ import annotations
@@ -170,6 +170,7 @@ def test_an_effect_that_loses_its_evidence_is_dropped(monkeypatch):
     import mmg.effects as E
     import trials.measured.decision as D
     import trials.measured.diagnose as G
+    import trials.measured.diagnose.search as S
 
     ship = mmg.load_ship("esso_osaka_3m")
     rec = G.synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, seed=5)
@@ -178,9 +179,9 @@ def test_an_effect_that_loses_its_evidence_is_dropped(monkeypatch):
     def forced(fitter, base, cand, ns, o, say):
         effs = [E.get("current"), E.get("heading_bias")]
         m = fitter.fit(effs, start_ship=base.theta[:ns])
-        return m, ["current", "heading_bias"], [{"round": 1, "model": [], "candidates": []}]
+        return m, ["current", "heading_bias"], [{"round": 1, "model": [], "candidates": []}], fitter
 
-    monkeypatch.setattr(G, "_search", forced)
+    monkeypatch.setattr(S, "_search", forced)
     d = G.diagnose(ship, [rec], candidates=["current", "heading_bias"])
     assert d.named == ["heading_bias"]
     assert [x["effect"] for x in d.rounds[-1]["dropped"]] == ["current"]

@@ -68,7 +68,7 @@ def cmd_diagnose(args) -> int:
         with StagedFile(args.out_ship) if args.out_ship is not None else nullcontext() as tship:
             with StagedOutput(args.plots) if args.plots is not None else nullcontext() as stage:
                 if args.plots is not None:
-                    from ..measured.diagnose_plots import diagnose_figure, diagnose_summary_figure
+                    from ..measured.diagnose.plots import diagnose_figure, diagnose_summary_figure
 
                     for i, r in enumerate(d.records):       # named after their files (unique: prepare)
                         diagnose_figure(d, i).savefig(stage.path(f"{r.name}.png"))

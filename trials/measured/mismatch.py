@@ -260,7 +260,7 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     -------
     trials.files.records.TrialRecord
     """
-    from .diagnose_records import synthetic_record
+    from .diagnose.records import synthetic_record
 
     tr = TRIALS[kind]
     eff = {k: dict(v) for k, v in (effects or {}).items()}

@@ -68,7 +68,7 @@ def absent_channels(rec) -> dict:
         ``{channel: {"column": the layout's exact header ('' when the layout has none),
         "compared_instead": what its residual compares ('' when nothing: the channel is left out)}}``.
     """
-    from ..files.logio import channel_column
+    from ...files.logio import channel_column
 
     out = {}
     if rec.r is None:
@@ -95,11 +95,11 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from ekf.identify import Segmented, segment_resets
     from mmg.effects import Context
 
-    from ..files.logio import require_finite
-    from .predict import measured_run
-    from ..files.records import TrialRecord
-    from ..files.output import record_labels
-    from ..files.shipcheck import read_for_ship
+    from ...files.logio import require_finite
+    from ..predict import measured_run
+    from ...files.records import TrialRecord
+    from ...files.output import record_labels
+    from ...files.shipcheck import read_for_ship
 
     L = ship.particulars.L
     seg_s = segment_s or 52.0 * math.sqrt(L / 9.80665)
@@ -234,7 +234,7 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     from mmg.simulation import simulate
     from mmg.wind import relative_wind_from_true
 
-    from ..files.records import logged_record
+    from ...files.records import logged_record
 
     es = effects if isinstance(effects, E.EffectSet) else E.effect_set(effects or {})
     truth = truth_ship or ship

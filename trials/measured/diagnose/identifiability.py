@@ -54,7 +54,7 @@ import numpy as np
 import mmg.effects as E
 
 from .decision import STATISTICAL_REASON
-from .diagnose_report import IDENTIFIABILITY_LEGEND, size_with_unit
+from .report import IDENTIFIABILITY_LEGEND, size_with_unit
 
 __all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "floor_in_fit_unit", "block_confounding",
            "assess", "verdict", "not_identifiable_lines", "STATISTICAL_REASON", "identifiability_line"]
@@ -238,7 +238,7 @@ def _trial_segments(fitter, specs, segment_s):
     """The candidate trials simulated with the config ship at the records' approach speed, prepared."""
     from dataclasses import replace
 
-    from .diagnose_records import prepare, synthetic_record
+    from .records import prepare, synthetic_record
 
     recs = fitter.recs
     U = float(np.median([math.hypot(p.seg.meas[0, 0], p.seg.meas[0, 1]) for p in recs]))
@@ -450,6 +450,6 @@ def _name(f) -> str:
 def not_identifiable_lines(entries) -> list[str]:
     """One console line per ``not_identifiable`` entry
     (:func:`trials.measured.diagnose_report.not_identifiable_line`, the one the console prints)."""
-    from .diagnose_report import not_identifiable_line
+    from .report import not_identifiable_line
 
     return [not_identifiable_line(e) for e in entries]

@@ -352,7 +352,7 @@ def summary_lines(diag) -> list[str]:
                      f"({fmt3(v['z'])} prior std away): not written to --out-ship")
     for st in getattr(diag, "straight_runs", None) or []:
         lines.append(straight_run_line(st))
-    from ..files.tables import text_table
+    from ...files.tables import text_table
 
     rows = [[f"  {c} [{CHANNEL_UNITS.get(c, '')}]", fmt3(diag.rms_config.get(c)), fmt3(diag.rms_before.get(c)),
              fmt3(diag.rms_after.get(c))] for c in diag.rms_after]

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from .predict_plots import replay_layout
+from ..predict_plots import replay_layout
 
 _RESIDUALS = (("u [m/s]", "u", lambda p, m: p[:, 0] - m[:, 0]), ("v [m/s]", "v", lambda p, m: p[:, 1] - m[:, 1]),
               ("r [deg/s]", "r", lambda p, m: np.degrees(p[:, 2] - m[:, 2])),
@@ -160,8 +160,8 @@ def _text_panel(ax, lines, title):
 def _evidence_lines(diag) -> list:
     """The evidence panel: dBIC, z and the false-alarm p of each named effect (a table whose columns fit any
     value), the effects that cannot be told apart, the legend."""
-    from ..files.tables import text_table
-    from .diagnose_report import fmt3
+    from ...files.tables import text_table
+    from .report import fmt3
 
     ev = diag.evidence or {}
     rows = []
@@ -182,8 +182,8 @@ def _interval_panels(fig, gs, col: int, diag):
     the evidence below them; a text panel (the candidates' evidence) when nothing is named."""
     import mmg.effects as E
 
-    from ..files.tables import text_table
-    from .diagnose_report import fmt3, parameter_label
+    from ...files.tables import text_table
+    from .report import fmt3, parameter_label
 
     n_rows = gs.get_geometry()[0]
     rows = [(e, k, v) for e in diag.named for k, v in diag.parameters.get(e, {}).items()]
@@ -241,7 +241,7 @@ def diagnose_summary_figure(diag):
     nothing is named)."""
     from matplotlib.figure import Figure
 
-    from .diagnose_report import fmt3
+    from .report import fmt3
 
     fig = Figure(figsize=(15, 12), layout="constrained")
     gs = fig.add_gridspec(7, 2, width_ratios=[2.6, 1.0])
