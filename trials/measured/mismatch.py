@@ -251,7 +251,7 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     """A full-scale trial of ``truth`` logged as the development set's are.
 
     10 s straight run at heading 0, then the execute; a turn runs 1500 s after it, a zigzag to its
-    ninth reversal plus 60 s; constant propeller revolutions (the approach's, at ``speed_kn``);
+    ninth reversal plus 60 s (simulated for 4000 s, longer below 10 kn in proportion); constant propeller revolutions (the approach's, at ``speed_kn``);
     1 s samples; uniform noise of half-widths ``noise`` (u, v, r, x, y, psi).
 
     Parameters
@@ -293,7 +293,7 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     te = 10.0
     zig = tr["kind"] == "zigzag"
     rec = synthetic_record(ship, tr["kind"], eff, truth_ship=rpm, speed=speed_kn * KNOT,
-                           duration=4000.0 if zig else te + 1500.0, dt=1.0, rudder_deg=tr["rudder_deg"],
+                           duration=4000.0 * max(1.0, 10.0 / speed_kn) if zig else te + 1500.0, dt=1.0, rudder_deg=tr["rudder_deg"],
                            heading_deg=tr.get("heading_deg"), t_execute=te, true_wind=true_wind, noise=noise,
                            noise_dist="uniform", seed=seed, name=name or kind)
     if zig:
