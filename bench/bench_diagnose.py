@@ -16,7 +16,11 @@ records, detection per effect and size split zigzag / turn (``bench/diagnose_mis
 
     python bench/bench_diagnose.py --mismatch [--clean 40] [--seeds 5] [--seed0 0] [--jobs 2] [--effects ...]
         [--only ID ...] [--candidate-start config|current] [--max-nfev N] [--trials ...]
-        [--quick] [--tag _cal]
+        [--quick] [--tag _cal] [--wide]
+
+``--wide`` draws each record's hand, manoeuvre (turns 15-35 deg, zigzags 10/10-20/20, either hand
+first) and approach speed (6-15 kn), with winds beside each other effect, and prints the figures per
+class (hand, manoeuvre, speed band); ``--summarise`` prints that table for any run.
 
 writes bench/out/diagnose_mismatch<tag>.json (every record's factors, truth, named effects and
 candidate rounds) and bench/out/diagnose_detection_mismatch<tag>.png; the summary gives, per effect
@@ -93,6 +97,8 @@ def _refuse_bad_options(ap, a) -> None:
         ap.error("--summarise: summarises --mismatch runs; give --mismatch with it")
     if a.summarise and (a.only or a.max_nfev is not None or a.trials is not None):
         ap.error("--summarise: reads runs already made; --only, --max-nfev and --trials are not used with it")
+    if a.wide and (not a.mismatch or a.trials is not None or a.summarise):
+        ap.error("--wide: draws its own trials for a --mismatch run; not with --trials or --summarise")
     if a.max_nfev is not None and a.max_nfev <= SCREEN_NFEV:
         ap.error(f"--max-nfev: {a.max_nfev} is not more than the screening budget of {SCREEN_NFEV} evaluations")
 
@@ -125,6 +131,10 @@ def main(argv=None):
     ap.add_argument("--trials", nargs="*", default=None,
                     help="--mismatch: the trials to draw from (default all: turn35 turn35p zz10 zz15 zz20; "
                          "turn_pair: both 35 deg turns of one member diagnosed together)")
+    ap.add_argument("--wide", action="store_true",
+                    help="--mismatch: the wider draw: either hand first, turns 15-35 deg, zigzags 10/10-20/20, "
+                         "approach 6-15 kn per record, winds 8-25 m/s alone and 15-25 m/s beside each other effect "
+                         "(diagnose_mismatch.wide_jobs); prints the per-class table")
     ap.add_argument("--summarise", nargs="+", default=None, metavar="JSON",
                     help="--mismatch: print the summary of runs already made (bench/out/diagnose_mismatch<tag>.json), "
                          "pooled, their not_identifiable lists completed by the evidence rule of the code as it is "

@@ -44,6 +44,29 @@ SIZES = {
 FAMILY_SIZE = 40
 """Members drawn per family seed; clean record i sails member i mod this, effect records a random one."""
 
+WIDE_SIZES = {
+    "current": ("speed_mps", "m/s", [0.15, 0.25]),
+    "wind": ("speed_mps", "m/s", [8.0, 10.0, 15.0, 20.0, 25.0]),
+    "heading_bias": ("bias_deg", "deg", [1.0, 1.5]),
+    "rudder_offset": ("offset_deg", "deg", [1.0, 1.5]),
+}
+"""``--wide``: the sizes per effect alone (at or above the sizes the acceptance figures are for, and
+winds from 8 to 25 m/s)."""
+
+WIDE_BESIDE_WIND = (15.0, 20.0, 25.0)
+"""``--wide``: true wind speeds [m/s] of the records with a wind beside another effect
+(``wind+current``, ``wind+heading_bias``, ``wind+rudder_offset``; the other effect at one of its
+:data:`WIDE_SIZES`, drawn)."""
+
+WIDE_SPEEDS_KN = (6.0, 15.0)
+"""``--wide``: approach speeds [kn], uniform per record."""
+
+SPEED_BANDS_KN = ((6.0, 9.0), (9.0, 12.0), (12.0, 15.0))
+"""The approach-speed classes of the per-class table [kn] (a band holds its lower end; the last, both)."""
+
+ACCEPT = {"current": 0.15, "wind": 10.0, "heading_bias": 1.0, "rudder_offset": 1.0}
+"""The smallest size whose detection the per-class table counts (the issue's acceptance sizes)."""
+
 
 @functools.lru_cache(maxsize=4)
 def _family(seed0: int):
@@ -81,6 +104,75 @@ def jobs(nclean: int, seeds: int, effects, seed0: int, trials=None) -> list[dict
     return out
 
 
+def _wide_trial(rng, manoeuvre: str, hand: str) -> str:
+    """A :data:`~trials.measured.mismatch.TRIALS` key of that manoeuvre and hand, its size drawn."""
+    size = int(rng.choice([10, 15, 20] if manoeuvre == "zigzag" else [15, 20, 25, 30, 35]))
+    return f"{'zz' if manoeuvre == 'zigzag' else 'turn'}{size}{'p' if hand == 'port' else ''}"
+
+
+def _effect_spec(eff: str, size: float, rng) -> tuple[dict, tuple]:
+    """One effect's spec (mmg.effects) and true wind of that size, its direction or sign drawn."""
+    sign = float(rng.choice([-1.0, 1.0]))
+    direction = float(rng.uniform(0.0, 360.0))
+    if eff == "current":
+        return {"current": {"speed_mps": size, "direction_deg": direction}}, (0.0, 0.0)
+    if eff == "wind":
+        return {"wind": {}}, (size, math.radians(direction))
+    if eff == "heading_bias":
+        return {"heading_bias": {"bias_deg": sign * size}}, (0.0, 0.0)
+    return {"rudder_offset": {"offset_deg": sign * size}}, (0.0, 0.0)
+
+
+def wide_jobs(nclean: int, seeds: int, effects, seed0: int) -> list[dict]:
+    """The wider draw (``--wide``): every record's hand, manoeuvre (turn 15-35 deg or zigzag 10/10 to
+    20/20) and approach speed (uniform in :data:`WIDE_SPEEDS_KN`) drawn.  Clean records cycle the four
+    (hand, manoeuvre) classes; effect records draw both (a rudder offset: zigzags only, since on one
+    turn an offset is reported ``not_identifiable`` by design); each effect alone at its
+    :data:`WIDE_SIZES`, and a wind of :data:`WIDE_BESIDE_WIND` beside each other effect in ``effects``."""
+    hands, mans = ("starboard", "port"), ("turn", "zigzag")
+
+    def job(key, jid, effect, size, i, eff_list, wind=None):
+        rng = np.random.default_rng([seed0, 7919] + key)
+        if effect is None:
+            hand, man = hands[i % 2], mans[(i // 2) % 2]
+        else:
+            hand = hands[int(rng.integers(2))]
+            man = "zigzag" if "rudder_offset" in eff_list else mans[int(rng.integers(2))]
+        spec, tw = {}, (0.0, 0.0)
+        for e in eff_list:
+            sz = wind if (e == "wind" and wind is not None) else (
+                size if len(eff_list) == 1 else float(rng.choice(WIDE_SIZES[e][2])))
+            sp, w = _effect_spec(e, sz, rng)
+            spec.update(sp)
+            tw = w if e == "wind" else tw
+        return {"id": jid, "effect": effect, "size": size, "member": int(rng.integers(FAMILY_SIZE)) if effect else i % FAMILY_SIZE,
+                "trial": _wide_trial(rng, man, hand), "speed_kn": round(float(rng.uniform(*WIDE_SPEEDS_KN)), 2),
+                "spec": spec, "true_wind": tw, "seed": seed0 + 100000 * key[0] + 1000 * key[1] + key[2] + 7}
+
+    out = [job([0, 0, i], f"clean_{i}", None, 0.0, i, []) for i in range(nclean)]
+    for ie, eff in enumerate(effects):
+        for isz, size in enumerate(WIDE_SIZES[eff][2]):
+            out += [job([ie + 1, isz, s], f"{eff}_{size:g}_{s}", eff, size, s, [eff]) for s in range(seeds)]
+        if eff == "wind" or "wind" not in effects:
+            continue
+        for iw, w in enumerate(WIDE_BESIDE_WIND):
+            out += [job([ie + 11, iw, s], f"wind+{eff}_{w:g}_{s}", f"wind+{eff}", w, s, ["wind", eff], wind=w)
+                    for s in range(seeds)]
+    clean, eff_jobs = out[:nclean], out[nclean:]            # interleaved: a run cut short still holds both
+    step = max(1, math.ceil(nclean / max(len(eff_jobs), 1)))
+    mixed = []
+    for k in range(max(len(clean), len(eff_jobs) * step)):
+        mixed += clean[k:k + 1]
+        if k % step == step - 1 and k // step < len(eff_jobs):
+            mixed.append(eff_jobs[k // step])
+    return mixed + eff_jobs[len(mixed) - len(clean):]
+
+
+def true_effects(r: dict) -> set:
+    """The effects a record was made with (``"wind+current"``: both)."""
+    return set(r["effect"].split("+")) if r["effect"] else set()
+
+
 def run_one(job: dict, seed0: int) -> dict:
     """Make the job's record, diagnose it with the bundled config as a user would, return the row."""
     import mmg
@@ -90,7 +182,7 @@ def run_one(job: dict, seed0: int) -> dict:
     config = mmg.load_ship(mmg.ship_path("esso_osaka"))
     member, factors = _family(seed0)[job["member"]]
     recs = [trial_records(config, member, t, job["spec"], seed=job["seed"] + 1000003 * k, true_wind=job["true_wind"],
-                          name=f"{job['id']}_{t}" if k else job["id"])
+                          speed_kn=job.get("speed_kn", 10.0), name=f"{job['id']}_{t}" if k else job["id"])
             for k, t in enumerate(PAIRS.get(job["trial"], (job["trial"],)))]
     rec = recs[0]
     t0 = time.perf_counter()
@@ -102,6 +194,7 @@ def run_one(job: dict, seed0: int) -> dict:
         truth["wind"] = {"speed_mps": job["true_wind"][0], "from_deg": math.degrees(job["true_wind"][1]),
                          **member.wind.values()}
     return {**{k: job[k] for k in ("id", "seed", "member", "trial", "effect", "size")},
+            "speed_kn": job.get("speed_kn", 10.0),
             "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
             "parameters": d.parameters, "not_identifiable": [n["effect"] for n in d.not_identifiable],
             "not_identifiable_reasons": {n["effect"]: n.get("reason") for n in d.not_identifiable},
@@ -158,7 +251,8 @@ def summarise(rows: list) -> dict:
         if not er:
             continue
         table["detection"][eff] = []
-        for size in sizes:
+        present = sorted({r["size"] for r in er})
+        for size in (sizes if set(present) <= set(sizes) else present):
             sr = [r for r in er if r["size"] == size]
             zz = [r for r in sr if r["trial"].startswith("zz")]
             tu = [r for r in sr if r["trial"].startswith("turn")]
@@ -171,10 +265,67 @@ def summarise(rows: list) -> dict:
                   f"{_pct(*silent):>10s}")
             table["detection"][eff].append({"size": size, "zigzag": list(dz), "turn": list(dt), "exact": list(ex),
                                             "turn_not_identifiable": list(ni), "silent": list(silent)})
-    allr = _rate(rows, lambda r: set(r["named"]) == ({r["effect"]} if r["effect"] else set()))
+    allr = _rate(rows, lambda r: set(r["named"]) == true_effects(r))
     print(f"\nexact (named set == true set) over all records: {_pct(*allr)}")
     table["exact"] = list(allr)
     table["reasons"] = _reason_counts(rows)
+    table["classes"] = class_table(rows)
+    return table
+
+
+def record_class(r: dict) -> tuple[str, str, str]:
+    """(hand of the first rudder, manoeuvre, approach-speed band) of a record row."""
+    from trials.measured.mismatch import trial_hand
+
+    trial = PAIRS.get(r["trial"], (r["trial"],))[0]
+    hand = "pair" if r["trial"] in PAIRS else trial_hand(trial)
+    v = float(r.get("speed_kn", 10.0))
+    band = next((f"{lo:g}-{hi:g} kn" for lo, hi in SPEED_BANDS_KN if lo <= v < hi or (hi == SPEED_BANDS_KN[-1][1] and v == hi)),
+                f"{v:g} kn")
+    return hand, "zigzag" if trial.startswith("zz") else "turn", band
+
+
+def true_sizes(r: dict) -> dict:
+    """{effect: size} of a record's truth (current and wind [m/s], bias and offset [deg], magnitudes)."""
+    key = {"current": "speed_mps", "wind": "speed_mps", "heading_bias": "bias_deg", "rudder_offset": "offset_deg"}
+    return {e: abs(float(v[key[e]])) for e, v in r["truth"].items() if e in key}
+
+
+def class_figures(rows: list) -> dict:
+    """The acceptance figures of a set of records: false alarms on the clean ones, detection of each
+    effect at or above its :data:`ACCEPT` size (a rudder offset: zigzags only; an effect beside a wind
+    counts), and the wind records with nothing named but their true effects: each ``[k, n]``."""
+    out = {"false_alarms": list(_rate([r for r in rows if r["effect"] is None], lambda r: r["named"]))}
+    for eff, floor in ACCEPT.items():
+        sel = [r for r in rows if true_sizes(r).get(eff, 0.0) >= floor - 1e-12
+               and (eff != "rudder_offset" or record_class(r)[1] == "zigzag")]
+        out[eff] = list(_rate(sel, lambda r, e=eff: e in r["named"]))
+    out["wind_no_spurious"] = list(_rate([r for r in rows if "wind" in true_effects(r)],
+                                         lambda r: set(r["named"]) <= true_effects(r)))
+    return out
+
+
+def class_table(rows: list) -> dict:
+    """Print and return :func:`class_figures` per class (hand, manoeuvre, speed band), per hand, per
+    manoeuvre, per hand and manoeuvre, per speed band, and over all records."""
+    cls = {id(r): record_class(r) for r in rows}
+    groups = {}
+    for r in rows:
+        h, m, b = cls[id(r)]
+        for key in ((h, m, b), (h, m, "all"), (h, "all", "all"), ("all", m, "all"), ("all", "all", b)):
+            groups.setdefault(key, []).append(r)
+    groups[("all", "all", "all")] = list(rows)
+    cols = ["false_alarms"] + list(ACCEPT) + ["wind_no_spurious"]
+    head = ["clean: false alarms", "current>=0.15 m/s", "wind>=10 m/s", "bias>=1 deg", "offset>=1 deg (zz)",
+            "wind: no spurious"]
+    print("\nper class (hand of the first rudder, manoeuvre, approach speed): k/n records")
+    print(f"{'hand':10s} {'manoeuvre':9s} {'speed':9s} " + " ".join(f"{h:>20s}" for h in head))
+    order = lambda k: tuple((x == "all", x) for x in k)  # noqa: E731
+    table = {}
+    for key in sorted(groups, key=order):
+        fig = class_figures(groups[key])
+        table[" / ".join(key)] = fig
+        print(f"{key[0]:10s} {key[1]:9s} {key[2]:9s} " + " ".join(f"{_pct(*fig[c]):>20s}" for c in cols))
     return table
 
 
@@ -272,13 +423,15 @@ def main_mismatch(a) -> None:
     bad = set(a.trials or ()) - set(KINDS) - set(PAIRS)
     if bad:
         raise SystemExit(f"--mismatch: unknown trials {sorted(bad)}; have {list(KINDS) + list(PAIRS)}")
-    todo = jobs(nclean, seeds, effects, a.seed0, a.trials)
+    todo = (wide_jobs(nclean, seeds, effects, a.seed0) if getattr(a, "wide", False)
+            else jobs(nclean, seeds, effects, a.seed0, a.trials))
     if a.only:                                   # the same records as a full run of these options, by id
         todo = [j for j in todo if j["id"] in set(a.only)]
     todo = [{**j, "candidate_start": a.candidate_start, "max_nfev": a.max_nfev} for j in todo]
     path = out / f"diagnose_mismatch{a.tag}.json"
+    wide = getattr(a, "wide", False)
     head = {"family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds, "effects": effects,
-            "sizes": {e: SIZES[e] for e in effects}}
+            "sizes": {e: (WIDE_SIZES if wide else SIZES)[e] for e in effects}, "wide": wide}
     save = lambda rows: path.write_text(json.dumps({**head, "records": rows}, indent=1, default=float))  # noqa: E731
     t0 = time.perf_counter()
     nc = sum(j["effect"] is None for j in todo)

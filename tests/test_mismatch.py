@@ -130,3 +130,80 @@ def test_zigzag_ends_sixty_seconds_after_its_ninth_reversal(config, family):
     assert len(flips) == 9
     assert rec.t[-1] == pytest.approx(rec.t[flips[-1]] + 60.0, abs=1.0)
     assert np.max(np.abs(d)) == pytest.approx(math.radians(20.0), abs=1e-6)
+
+
+def test_port_first_zigzag_puts_port_rudder_first_and_swings_to_port_first(config, family):
+    rec = trial_records(config, family[3][0], "zz15p", {}, seed=4, speed_kn=7.0, noise=(0.0,) * 6)
+    d = np.asarray(rec.delta)
+    big = d[np.abs(d) > math.radians(5.0)]
+    assert big[0] < 0.0                                                      # port rudder first
+    assert np.max(np.abs(d)) == pytest.approx(math.radians(15.0), abs=1e-6)
+    psi = np.degrees(np.unwrap(rec.psi))
+    first = psi[np.argmax(np.abs(psi) > 15.0)]                             # first +-15 deg heading crossing
+    assert first < -15.0
+    assert np.mean(rec.u[:10]) == pytest.approx(7 * 1852 / 3600, abs=0.03)   # 7 kn approach
+    flips = np.flatnonzero(np.sign(d[1:]) != np.sign(d[:-1])) + 1
+    assert len(flips[rec.t[flips] > 11.0]) == 9
+
+
+def test_trial_names_say_their_hand_and_size():
+    from trials.measured.mismatch import DEV_TRIALS, TRIALS, WIDE_TRIALS, trial_hand
+
+    assert set(DEV_TRIALS) < set(WIDE_TRIALS) == set(TRIALS)
+    for name, tr in TRIALS.items():
+        size = float(name.removeprefix("turn").removeprefix("zz").removesuffix("p"))
+        assert abs(tr["rudder_deg"]) == size
+        assert trial_hand(name) == ("port" if name.endswith("p") else "starboard")
+        assert (tr["kind"] == "zigzag") == name.startswith("zz")
+    assert {abs(t["rudder_deg"]) for t in TRIALS.values() if t["kind"] == "turning"} == {15, 20, 25, 30, 35}
+
+
+def test_wide_draw_spans_hands_manoeuvres_speeds_and_winds_beside_each_effect():
+    import sys
+
+    sys.path.insert(0, str(REPO / "bench"))
+    import diagnose_mismatch as dm
+    from trials.measured.mismatch import TRIALS, trial_hand
+
+    effects = ["current", "wind", "heading_bias", "rudder_offset"]
+    jobs = dm.wide_jobs(40, 3, effects, 1)
+    assert len({j["id"] for j in jobs}) == len(jobs) and len({j["seed"] for j in jobs}) == len(jobs)
+    clean = [j for j in jobs if j["effect"] is None]
+    assert len(clean) == 40
+    classes = {(trial_hand(j["trial"]), TRIALS[j["trial"]]["kind"]) for j in clean}
+    assert classes == {(h, k) for h in ("starboard", "port") for k in ("turning", "zigzag")}
+    assert all(6.0 <= j["speed_kn"] <= 15.0 for j in jobs)
+    assert max(j["speed_kn"] for j in jobs) - min(j["speed_kn"] for j in jobs) > 6.0
+    for e in ("current", "heading_bias", "rudder_offset"):
+        both = [j for j in jobs if j["effect"] == f"wind+{e}"]
+        assert len(both) == 3 * len(dm.WIDE_BESIDE_WIND)
+        assert all(set(j["spec"]) == {"wind", e} and j["true_wind"][0] >= 15.0 for j in both)
+    assert all(TRIALS[j["trial"]]["kind"] == "zigzag" for j in jobs if "rudder_offset" in (j["effect"] or ""))
+    wind = [j["true_wind"][0] for j in jobs if j["effect"] == "wind"]
+    assert min(wind) == 8.0 and max(wind) == 25.0
+    assert dm.jobs(5, 1, ["current"], 0) == dm.jobs(5, 1, ["current"], 0)          # the old draw is untouched
+    assert {j["trial"] for j in dm.jobs(5, 0, [], 0)} == set(dm.KINDS)
+
+
+def test_class_figures_count_by_the_records_truth():
+    import sys
+
+    sys.path.insert(0, str(REPO / "bench"))
+    import diagnose_mismatch as dm
+
+    def row(trial, effect, truth, named, v=10.0):
+        return {"trial": trial, "effect": effect, "truth": truth, "named": named, "speed_kn": v}
+
+    rows = [row("zz20p", None, {}, ["current"], 6.5), row("zz20p", None, {}, []),
+            row("zz10p", "wind+rudder_offset", {"wind": {"speed_mps": 20.0}, "rudder_offset": {"offset_deg": -1.0}},
+                ["wind", "heading_bias"]),
+            row("turn20", "rudder_offset", {"rudder_offset": {"offset_deg": 1.5}}, []),
+            row("turn25p", "current", {"current": {"speed_mps": 0.1, "direction_deg": 3.0}}, [])]
+    f = dm.class_figures(rows)
+    assert f["false_alarms"] == [1, 2]
+    assert f["rudder_offset"] == [0, 1]              # the turn's offset is not counted; the zigzag's missed
+    assert f["current"] == [0, 0]                    # 0.1 m/s is under the 0.15 m/s counted
+    assert f["wind"] == [1, 1] and f["wind_no_spurious"] == [0, 1]
+    assert dm.record_class(rows[0]) == ("port", "zigzag", "6-9 kn")
+    assert dm.record_class(rows[3]) == ("starboard", "turn", "9-12 kn")
+    assert dm.record_class(row("zz10", None, {}, [], 15.0))[2] == "12-15 kn"

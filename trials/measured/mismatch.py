@@ -7,7 +7,8 @@ even follow the model's form.  This module draws such ships from a config (:func
 (:func:`trial_records`) the way the independent development set ``../shared/data/diagnose-dev/`` was
 made: 10 kn approach at constant propeller revolutions, 35 deg turns to starboard and port, 10/10,
 15/15 and 20/20 zigzags of nine reversals and a 60 s tail, 1 s samples, uniform log noise of the
-set's half-widths.
+set's half-widths; and the wider trials users run (:data:`WIDE_TRIALS`: zigzags port first, turns
+of 15 to 35 deg to either hand, at any approach speed).
 
 Every factor is ``1 + u`` with ``u`` uniform in ``[-h, h]`` (a random sign and size), ``h`` the
 relative half-width of :class:`MismatchSpec`.  A fraction of the family has its hull's nonlinear
@@ -25,8 +26,9 @@ import numpy as np
 from mmg.ship import Ship
 from mmg.units import KNOT
 
-__all__ = ["DEV_NOISE_HALF_WIDTHS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS", "TRIALS", "MismatchSpec", "crossflow_fit",
-           "mismatch_family", "mismatch_member", "mismatch_ship", "trial_records"]
+__all__ = ["DEV_NOISE_HALF_WIDTHS", "DEV_TRIALS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS", "TRIALS", "MismatchSpec", "crossflow_fit",
+           "WIDE_TRIALS",
+           "mismatch_family", "mismatch_member", "mismatch_ship", "trial_hand", "trial_records"]
 
 HULL_LINEAR_TERMS = ("beta", "r", "cos(beta)^2")
 """Hull terms counted as linear (with the resistance): the rest, but the constant ``"1"``, are nonlinear."""
@@ -45,7 +47,20 @@ TRIALS = {
     "zz15": {"kind": "zigzag", "rudder_deg": 15.0, "heading_deg": 15.0},
     "zz20": {"kind": "zigzag", "rudder_deg": 20.0, "heading_deg": 20.0},
 }
-"""The development set's trials: 35 deg turns (starboard, port) and zigzags (starboard first)."""
+"""The development set's trials: 35 deg turns (starboard, port) and zigzags (starboard first).
+
+The wider family's trials are added below: zigzags port first (``zz10p``, ``zz15p``, ``zz20p``) and
+turns of 15 to 30 deg to either hand (``turn15`` ... ``turn30p``; a trailing ``p``: to port)."""
+
+TRIALS.update({f"zz{a}p": {"kind": "zigzag", "rudder_deg": -float(a), "heading_deg": float(a)} for a in (10, 15, 20)})
+TRIALS.update({f"turn{a}{h}": {"kind": "turning", "rudder_deg": s * float(a)}
+               for a in (15, 20, 25, 30) for h, s in (("", 1.0), ("p", -1.0))})
+
+DEV_TRIALS = ("turn35", "turn35p", "zz10", "zz15", "zz20")
+"""The development set's trials (the default of the mismatch bench)."""
+
+WIDE_TRIALS = tuple(TRIALS)
+"""Every trial of :data:`TRIALS`: either hand first, zigzags 10/10 to 20/20, turns 15 to 35 deg."""
 
 
 @dataclass(frozen=True)
@@ -215,6 +230,11 @@ def mismatch_family(ship: Ship, n: int, seed: int, spec: MismatchSpec = Mismatch
     return [mismatch_member(ship, rng, spec, crossflow=i in cross) for i in range(n)]
 
 
+def trial_hand(kind: str) -> str:
+    """``"starboard"`` or ``"port"``: the hand of a :data:`TRIALS` trial's first rudder."""
+    return "port" if TRIALS[kind]["rudder_deg"] < 0 else "starboard"
+
+
 def _zigzag_end(rec, t_execute: float, reversals: int, tail: float) -> float:
     """The time of the ``reversals``-th rudder reversal after the execute, plus ``tail`` [s]."""
     d = np.asarray(rec.delta)
@@ -231,7 +251,7 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     """A full-scale trial of ``truth`` logged as the development set's are.
 
     10 s straight run at heading 0, then the execute; a turn runs 1500 s after it, a zigzag to its
-    ninth reversal plus 60 s; constant propeller revolutions (the approach's, at ``speed_kn``);
+    ninth reversal plus 60 s (simulated for 4000 s, longer below 10 kn in proportion); constant propeller revolutions (the approach's, at ``speed_kn``);
     1 s samples; uniform noise of half-widths ``noise`` (u, v, r, x, y, psi).
 
     Parameters
@@ -273,7 +293,7 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     te = 10.0
     zig = tr["kind"] == "zigzag"
     rec = synthetic_record(ship, tr["kind"], eff, truth_ship=rpm, speed=speed_kn * KNOT,
-                           duration=4000.0 if zig else te + 1500.0, dt=1.0, rudder_deg=tr["rudder_deg"],
+                           duration=4000.0 * max(1.0, 10.0 / speed_kn) if zig else te + 1500.0, dt=1.0, rudder_deg=tr["rudder_deg"],
                            heading_deg=tr.get("heading_deg"), t_execute=te, true_wind=true_wind, noise=noise,
                            noise_dist="uniform", seed=seed, name=name or kind)
     if zig:
