@@ -181,8 +181,24 @@ def summarise(rows: list) -> dict:
     allr = _rate(rows, lambda r: set(r["named"]) == ({r["effect"]} if r["effect"] else set()))
     print(f"\nexact (named set == true set) over all records: {_pct(*allr)}")
     table["exact"] = list(allr)
+    table["per_trial"] = _per_trial(rows)
     table["reasons"] = _reason_counts(rows)
     return table
+
+
+def _per_trial(rows) -> dict:
+    """Print and return per trial: false alarms on its clean records, its effect records whose effect
+    was named, and those named exactly."""
+    out = {}
+    print(f"\n{'trial':9s} {'false alarms':>14s} {'effect named':>14s} {'exact':>14s}")
+    for trial in sorted({r["trial"] for r in rows}):
+        tr = [r for r in rows if r["trial"] == trial]
+        fa = _rate([r for r in tr if r["effect"] is None], lambda r: r["named"])
+        hit = _rate([r for r in tr if r["effect"]], lambda r: r["effect"] in r["named"])
+        ex = _rate(tr, lambda r: set(r["named"]) == ({r["effect"]} if r["effect"] else set()))
+        print(f"{trial:9s} {_pct(*fa):>14s} {_pct(*hit):>14s} {_pct(*ex):>14s}")
+        out[trial] = {"false_alarms": list(fa), "effect_named": list(hit), "exact": list(ex)}
+    return out
 
 
 _OLD_RUN_PHRASES = (("statistics", "its standard error"), ("floor", "mismatch lends"), ("evidence", "(a name needs"),
