@@ -6,7 +6,10 @@ each with one known effect (or none), writes it as an FRT-DS-ESSO CSV
 (:func:`trials.measured.diagnose_records.write_frt_csv`), runs the command line on it alone and
 prints the truth beside what the command named.  Effect sizes are full scale.
 
-    python bench/diagnose_cli_family.py [--ship kvlcc2_l7] [--seed0 63000] [--out bench/out/cli_family]
+    python bench/diagnose_cli_family.py [--ship kvlcc2_l7] [--seed0 63000] [--out bench/out/cli_family] [--reuse]
+
+``--reuse`` reads the JSON an earlier run of the same options wrote beside a log instead of running
+the command again.
 """
 from __future__ import annotations
 
@@ -37,6 +40,7 @@ def main(argv=None) -> None:
     ap.add_argument("--ship", default="kvlcc2_l7")
     ap.add_argument("--seed0", type=int, default=63000, help="family and noise seed")
     ap.add_argument("--out", type=Path, default=REPO / "bench" / "out" / "cli_family")
+    ap.add_argument("--reuse", action="store_true", help="read the JSONs of an earlier run instead of diagnosing again")
     a = ap.parse_args(argv)
     import mmg
     from trials.measured.diagnose_records import write_frt_csv
@@ -54,9 +58,12 @@ def main(argv=None) -> None:
         t0 = time.perf_counter()
         cmd = [sys.executable, "-m", "trials.cli", "diagnose", "--ship", a.ship, "--json", str(js), "--backend", "serial",
                str(log)]
-        p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
+        if a.reuse and js.is_file():
+            p = subprocess.CompletedProcess(cmd, 0, "", "")
+        else:
+            p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
         d = json.loads(js.read_text()) if p.returncode == 0 else {}
-        named = list(d.get("named", []))
+        named = list(d.get("named_effects", []))
         ok = set(named) == ({truth} if truth != "clean" else set())
         right += ok
         full = eff or "none"
