@@ -103,3 +103,21 @@ def test_trial_is_the_full_scale_one_froude_scaled(kvlcc2, family):
     cur = trial_records(kvlcc2, member, "zz10", {"current": {"speed_mps": 0.15, "direction_deg": 30.0}}, seed=1,
                         noise=(0.0,) * 6)
     assert cur.meta["effects"]["current"]["speed_mps"] == pytest.approx(0.15 / k)
+
+
+def test_the_baseline_frees_the_kvlcc2_resistance_and_pure_yaw_terms(kvlcc2):
+    """The diagnosis's baseline frees the straight-ahead resistance whatever its term (the KVLCC2's
+    X_0 on ``1``, at the resistance's 10 % prior width of the YAML value) and the pure-yaw
+    nonlinearity of the cubic form (``r^3``, as ``r|r|`` of Kijima's), beside Y_v, Y_r, N_v, N_r;
+    never the sway and yaw constants of a ship that has them (the Esso Osaka's Y_0, N_0)."""
+    from mmg.model import pack
+    from trials.measured.diagnose import _ship_free
+
+    for kind in ("zigzag", "turn"):
+        free = {f.name: f for f in _ship_free(kvlcc2, pack(kvlcc2), kind=kind)}
+        assert {"X_0", "Y_v", "Y_r", "N_v", "N_r", "Y_rrr", "N_rrr"} <= set(free), kind
+        assert free["X_0"].sigma == pytest.approx(0.10 * abs(COEF["X_0"]["value"]))
+        assert free["X_0"].upper <= 0.0                 # the resistance keeps its sign
+    esso = mmg.load_ship("esso_osaka")
+    names = {f.name for f in _ship_free(esso, pack(esso), kind="zigzag")}
+    assert "X_uu" in names and not {"Y_0", "N_0"} & names
