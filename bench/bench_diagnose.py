@@ -14,7 +14,7 @@ bench/out/diagnose_bench.json keeps the figures as they come.
 each record diagnosed alone with the bundled config; false alarms over ``--clean`` (default 40) clean
 records, detection per effect and size split zigzag / turn (``bench/diagnose_mismatch.py``):
 
-    python bench/bench_diagnose.py --mismatch [--clean 40] [--seeds 5] [--seed0 0] [--jobs 2] [--effects ...]
+    python bench/bench_diagnose.py --mismatch [--ship esso_osaka] [--clean 40] [--seeds 5] [--seed0 0] [--jobs 2] [--effects ...]
         [--only ID ...] [--candidate-start config|current] [--max-nfev N] [--trials ...]
         [--quick] [--tag _cal] [--wide]
 
@@ -93,6 +93,8 @@ def _refuse_bad_options(ap, a) -> None:
     """Options that would be ignored or do the wrong thing silently are refused (exit 2, one line)."""
     from trials.measured.diagnose import SCREEN_NFEV
 
+    if a.ship is not None and not a.mismatch:
+        ap.error("--ship: the config of --mismatch runs; give --mismatch with it")
     if a.summarise and not a.mismatch:
         ap.error("--summarise: summarises --mismatch runs; give --mismatch with it")
     if a.summarise and (a.only or a.max_nfev is not None or a.trials is not None):
@@ -118,6 +120,9 @@ def main(argv=None):
     ap.add_argument("--tag", default="", help="suffix of the output names (bench/out/diagnose_bench<tag>.json, ...)")
     ap.add_argument("--mismatch", action="store_true",
                     help="full-scale trials of the mismatch family, one record per diagnose (bench/diagnose_mismatch.py)")
+    ap.add_argument("--ship", default=None, metavar="SHIP",
+                    help="--mismatch: the config diagnosed and drawn around (default esso_osaka; a model-scale one, "
+                         "e.g. kvlcc2_l7, sails the full-scale trials Froude-scaled to it)")
     ap.add_argument("--seed0", type=int, default=0, help="--mismatch: the family's and the noise seeds' offset")
     ap.add_argument("--jobs", type=int, default=2, help="--mismatch: parallel processes")
     ap.add_argument("--only", nargs="+", default=None, metavar="ID",
@@ -149,7 +154,9 @@ def main(argv=None):
         return
     if a.mismatch:
         sys.path.insert(0, str(REPO / "bench"))
-        from diagnose_mismatch import main_mismatch
+        from diagnose_mismatch import SHIP, main_mismatch
+
+        a.ship = a.ship or SHIP
 
         main_mismatch(a)
         return

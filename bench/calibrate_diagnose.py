@@ -8,7 +8,11 @@ with no floor: ``MMG_DIAGNOSE_CALIBRATION=none``), and runs with effects.  The f
 afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the records that set them.
 
     python bench/calibrate_diagnose.py bench/out/diagnose_mismatch_cal.json[:KIND] ... [--alpha 0.05] [--write]
-        [--kinds turn turn_pair]
+        [--kinds turn turn_pair] [--ship esso_osaka] [--out FILE]
+
+``--ship`` is the config the runs diagnosed (``bench_diagnose.py --mismatch --ship``; its length
+makes the floors' sqrt(gL) units); ``--out`` writes another file than the packaged one (a
+calibration of another ship, used through ``MMG_DIAGNOSE_CALIBRATION=FILE``).
 
 ``PATH:KIND`` takes only the records of one kind of a run (``turn``, ``zigzag``): a run made while
 the diagnosis of the other kind was another (the rudder's inflow freed on zigzags too, variant 6
@@ -41,6 +45,8 @@ def main(argv=None):
     ap.add_argument("--write", action="store_true", help=f"write {OUT.relative_to(REPO)}")
     ap.add_argument("--kinds", nargs="+", default=None, metavar="KIND",
                     help="write only these kinds' floors (turn, zigzag, turn_pair); the others kept from the packaged file")
+    ap.add_argument("--ship", default="esso_osaka", help="the config the runs diagnosed (default esso_osaka)")
+    ap.add_argument("--out", type=Path, default=OUT, help="the file --write writes (default the packaged one)")
     a = ap.parse_args(argv)
     import yaml
 
@@ -52,7 +58,11 @@ def main(argv=None):
         data = json.loads(Path(p).read_text())
         recs = data["records"] if isinstance(data, dict) else data
         records += [r for r in recs if not kind or only_kind(r, kind) is not None]
-    cal = calibrate(records, mmg.load_ship("esso_osaka").particulars.L, a.alpha)
+    L = mmg.load_ship(mmg.ship_path(a.ship)).particulars.L
+    ships = {r.get("ship", "esso_osaka") for r in records}
+    if ships != {a.ship}:
+        ap.error(f"--ship {a.ship}: the runs diagnosed {sorted(ships)}")
+    cal = calibrate(records, L, a.alpha)
     print("not named at the size to detect (floor above it):", {k: sorted(v) for k, v in cal.hidden.items()})
     for row in cal.to_pandas().itertuples():
         v = np.asarray(cal.clean[row.effect][row.kind])
@@ -62,17 +72,17 @@ def main(argv=None):
                      f"({cal.n_clean} clean records and {cal.n_effects} with effects of the mismatch family, seeds of "
                      f"those bench runs; {datetime.date.today().isoformat()})", **cal.to_json()}
     print("residual floors (u, v / U, r L / U, heading deg):", cal.residual_floors)
-    k, n = short_of_name(records, mmg.load_ship("esso_osaka").particulars.L)
+    k, n = short_of_name(records, L)
     print(f"clean records with a candidate short of a name (reported not_identifiable; packaged floors): {k} of {n}")
     if a.kinds:
-        old = yaml.safe_load(OUT.read_text()) if OUT.exists() else {}
+        old = yaml.safe_load(a.out.read_text()) if a.out.exists() else {}
         source = f"{old.get('source', '')}; then for {', '.join(a.kinds)} only: {doc['source']}".lstrip("; ")
         doc = {"source": source, **{k: v for k, v in merge_kinds(old, doc, a.kinds).items() if k != "source"}}
     if a.write:
-        OUT.parent.mkdir(parents=True, exist_ok=True)
-        OUT.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "
+        a.out.parent.mkdir(parents=True, exist_ok=True)
+        a.out.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "
                        "(trials/measured/diagnose/decision.py).\n" + yaml.safe_dump(doc, sort_keys=False))
-        print(f"wrote {OUT}")
+        print(f"wrote {a.out}")
 
 
 if __name__ == "__main__":

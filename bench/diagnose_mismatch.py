@@ -5,7 +5,9 @@ starboard and port, 10/10, 15/15, 20/20 zigzags; 10 kn, constant revolutions, 1 
 of the set's half-widths) of members of the mismatch family (:mod:`trials.measured.mismatch`:
 hull +-10 % linear, +-25 % nonlinear, a quarter with the cross-flow hull form, rudder and propeller
 +-15 %, added masses +-10 %, wind loads +-30 %), each diagnosed alone as a user would
-(``diagnose(load_ship(ship_path("esso_osaka")), [record])``).  Clean records give the false-alarm
+(``diagnose(load_ship(ship_path(SHIP)), [record])``, SHIP ``--ship``, default ``esso_osaka``; a
+model-scale config such as ``kvlcc2_l7`` sails the same full-scale trials Froude-scaled to it,
+:func:`trials.measured.mismatch.froude_scaled`; sizes stay full-scale in the tables).  Clean records give the false-alarm
 rate; records with one effect (current, wind, heading bias, rudder offset, at several sizes, random
 direction or sign, random member and trial) the detection rate.  The JSON keeps every record's
 candidate statistics per round (``rounds``), to calibrate the naming decision on the clean ones.
@@ -68,12 +70,16 @@ ACCEPT = {"current": 0.15, "wind": 10.0, "heading_bias": 1.0, "rudder_offset": 1
 """The smallest size whose detection the per-class table counts (the issue's acceptance sizes)."""
 
 
+SHIP = "esso_osaka"
+"""The config diagnosed (and the family drawn around) unless ``--ship`` names another."""
+
+
 @functools.lru_cache(maxsize=4)
-def _family(seed0: int):
+def _family(seed0: int, ship: str = SHIP):
     import mmg
     from trials.measured.mismatch import mismatch_family
 
-    return mismatch_family(mmg.load_ship("esso_osaka"), FAMILY_SIZE, seed0)
+    return mismatch_family(mmg.load_ship(mmg.ship_path(ship)), FAMILY_SIZE, seed0)
 
 
 def jobs(nclean: int, seeds: int, effects, seed0: int, trials=None) -> list[dict]:
@@ -179,8 +185,9 @@ def run_one(job: dict, seed0: int) -> dict:
     from trials.measured.diagnose import diagnose
     from trials.measured.mismatch import trial_records
 
-    config = mmg.load_ship(mmg.ship_path("esso_osaka"))
-    member, factors = _family(seed0)[job["member"]]
+    ship = job.get("ship", SHIP)
+    config = mmg.load_ship(mmg.ship_path(ship))
+    member, factors = _family(seed0, ship)[job["member"]]
     recs = [trial_records(config, member, t, job["spec"], seed=job["seed"] + 1000003 * k, true_wind=job["true_wind"],
                           speed_kn=job.get("speed_kn", 10.0), name=f"{job['id']}_{t}" if k else job["id"])
             for k, t in enumerate(PAIRS.get(job["trial"], (job["trial"],)))]
@@ -189,12 +196,12 @@ def run_one(job: dict, seed0: int) -> dict:
     extra = {"max_nfev": job["max_nfev"]} if job.get("max_nfev") is not None else {}
     d = diagnose(config, recs, candidate_start=job.get("candidate_start", "config"), **extra)
     js = d.to_json()
-    truth = {k: dict(v) for k, v in job["spec"].items()}
+    truth = {k: dict(v) for k, v in rec.meta["effects"].items()}          # as the record holds them (fit units)
     if "wind" in truth:
-        truth["wind"] = {"speed_mps": job["true_wind"][0], "from_deg": math.degrees(job["true_wind"][1]),
-                         **member.wind.values()}
+        w = rec.meta["effects"]["wind"]
+        truth["wind"] = {"speed_mps": w["true_speed_mps"], "from_deg": w["true_from_deg"], **member.wind.values()}
     return {**{k: job[k] for k in ("id", "seed", "member", "trial", "effect", "size")},
-            "speed_kn": job.get("speed_kn", 10.0),
+            "speed_kn": job.get("speed_kn", 10.0), "ship": ship, "froude_scale": config.froude_scale,
             "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
             "parameters": d.parameters, "not_identifiable": [n["effect"] for n in d.not_identifiable],
             "not_identifiable_reasons": {n["effect"]: n.get("reason") for n in d.not_identifiable},
@@ -268,6 +275,7 @@ def summarise(rows: list) -> dict:
     allr = _rate(rows, lambda r: set(r["named"]) == true_effects(r))
     print(f"\nexact (named set == true set) over all records: {_pct(*allr)}")
     table["exact"] = list(allr)
+    table["per_trial"] = _per_trial(rows)
     table["reasons"] = _reason_counts(rows)
     table["classes"] = class_table(rows)
     return table
@@ -327,6 +335,21 @@ def class_table(rows: list) -> dict:
         table[" / ".join(key)] = fig
         print(f"{key[0]:10s} {key[1]:9s} {key[2]:9s} " + " ".join(f"{_pct(*fig[c]):>20s}" for c in cols))
     return table
+
+
+def _per_trial(rows) -> dict:
+    """Print and return per trial: false alarms on its clean records, its effect records whose effect
+    was named, and those named exactly."""
+    out = {}
+    print(f"\n{'trial':9s} {'false alarms':>14s} {'effect named':>14s} {'exact':>14s}")
+    for trial in sorted({r["trial"] for r in rows}):
+        tr = [r for r in rows if r["trial"] == trial]
+        fa = _rate([r for r in tr if r["effect"] is None], lambda r: r["named"])
+        hit = _rate([r for r in tr if r["effect"]], lambda r: r["effect"] in r["named"])
+        ex = _rate(tr, lambda r: set(r["named"]) == ({r["effect"]} if r["effect"] else set()))
+        print(f"{trial:9s} {_pct(*fa):>14s} {_pct(*hit):>14s} {_pct(*ex):>14s}")
+        out[trial] = {"false_alarms": list(fa), "effect_named": list(hit), "exact": list(ex)}
+    return out
 
 
 _OLD_RUN_PHRASES = (("statistics", "its standard error"), ("floor", "mismatch lends"), ("evidence", "(a name needs"),
@@ -411,6 +434,14 @@ def plot(table: dict, path: Path, title: str) -> None:
 
 def main_mismatch(a) -> None:
     """The ``--mismatch`` mode of bench/bench_diagnose.py (options parsed there)."""
+    import mmg
+    from mmg.errors import InputError
+
+    try:
+        mmg.load_ship(mmg.ship_path(a.ship))
+    except InputError as e:
+        print(f"--ship: {e}", file=sys.stderr)
+        raise SystemExit(2) from None
     nclean = 4 if a.quick and a.clean is None else (a.clean if a.clean is not None else 40)
     seeds = 1 if a.quick else a.seeds
     effects = a.effects if a.effects is not None else (["current", "wind"] if a.quick else list(SIZES))
@@ -427,20 +458,20 @@ def main_mismatch(a) -> None:
             else jobs(nclean, seeds, effects, a.seed0, a.trials))
     if a.only:                                   # the same records as a full run of these options, by id
         todo = [j for j in todo if j["id"] in set(a.only)]
-    todo = [{**j, "candidate_start": a.candidate_start, "max_nfev": a.max_nfev} for j in todo]
+    todo = [{**j, "candidate_start": a.candidate_start, "max_nfev": a.max_nfev, "ship": a.ship} for j in todo]
     path = out / f"diagnose_mismatch{a.tag}.json"
     wide = getattr(a, "wide", False)
-    head = {"family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds, "effects": effects,
-            "sizes": {e: (WIDE_SIZES if wide else SIZES)[e] for e in effects}, "wide": wide}
+    head = {"ship": a.ship, "family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds,
+            "effects": effects, "sizes": {e: (WIDE_SIZES if wide else SIZES)[e] for e in effects}, "wide": wide}
     save = lambda rows: path.write_text(json.dumps({**head, "records": rows}, indent=1, default=float))  # noqa: E731
     t0 = time.perf_counter()
     nc = sum(j["effect"] is None for j in todo)
-    print(f"mismatch bench: {len(todo)} records ({nc} clean, {len(todo) - nc} with an effect), family seed "
+    print(f"mismatch bench on {a.ship}: {len(todo)} records ({nc} clean, {len(todo) - nc} with an effect), family seed "
           f"{a.seed0}, {a.jobs} job(s)", flush=True)
     rows = _execute(todo, a.seed0, a.jobs, save)
     table = summarise(rows)
     save(rows)
     path.write_text(json.dumps({**head, "summary": table, "records": rows}, indent=1, default=float))
     png = out / f"diagnose_detection_mismatch{a.tag}.png"
-    plot(table, png, f"mmg diagnose on the mismatch family (seed {a.seed0}, {seeds} seed(s)/size)")
+    plot(table, png, f"mmg diagnose on the {a.ship} mismatch family (seed {a.seed0}, {seeds} seed(s)/size)")
     print(f"wrote {path} and {png}; {time.perf_counter() - t0:.0f} s wall")

@@ -132,3 +132,40 @@ def test_merge_kinds_replaces_only_the_kinds_named(cal):
     assert m["residual_floors"] == {"zigzag": {"u": 0.004}, "turn": {"u": 0.02}}
     assert m["clean"]["current"] == {"zigzag": [0.2], "turn": [0.0, 0.3]}
     assert old["floors"]["current"]["turn"] == 1.0                          # the input is not changed
+
+
+def test_calibrating_one_ship_on_runs_of_another_is_refused(tmp_path, capsys):
+    """The floors' sqrt(gL) unit is the diagnosed config's: runs of the KVLCC2 do not calibrate the
+    Esso Osaka (exit 2, one line naming both), and nothing is written."""
+    import importlib.util
+    import json
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "bench" / "calibrate_diagnose.py"
+    spec = importlib.util.spec_from_file_location("calibrate_diagnose_cli", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    run = tmp_path / "run.json"
+    run.write_text(json.dumps({"records": [{**_turn_with_offset(), "ship": "kvlcc2_l7", "effect": None}]}))
+    out = tmp_path / "cal.yaml"
+    with pytest.raises(SystemExit) as e:
+        mod.main([str(run), "--ship", "esso_osaka", "--write", "--out", str(out)])
+    assert e.value.code == 2
+    assert "kvlcc2_l7" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_bench_ship_needs_mismatch_and_a_known_ship(capsys):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "bench" / "bench_diagnose.py"
+    spec = importlib.util.spec_from_file_location("bench_diagnose_cli", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    for argv, why in ((["--ship", "kvlcc2_l7"], "give --mismatch"),
+                      (["--mismatch", "--ship", "no_such_ship", "--effects", "none", "--clean", "1"], "no_such_ship: no bundled")):
+        with pytest.raises(SystemExit) as e:
+            mod.main(argv)
+        assert e.value.code == 2, argv
+        assert why in capsys.readouterr().err, argv

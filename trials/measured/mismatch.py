@@ -7,14 +7,16 @@ even follow the model's form.  This module draws such ships from a config (:func
 (:func:`trial_records`) the way the independent development set ``../shared/data/diagnose-dev/`` was
 made: 10 kn approach at constant propeller revolutions, 35 deg turns to starboard and port, 10/10,
 15/15 and 20/20 zigzags of nine reversals and a 60 s tail, 1 s samples, uniform log noise of the
-set's half-widths; and the wider trials users run (:data:`WIDE_TRIALS`: zigzags port first, turns
-of 15 to 35 deg to either hand, at any approach speed).
+set's half-widths; the wider trials users run (:data:`WIDE_TRIALS`: zigzags port first, turns
+of 15 to 35 deg to either hand, at any approach speed); for a model-scale config (``froude_scale`` > 1,
+e.g. ``kvlcc2_l7``) the same full-scale trial Froude-scaled to the model.
 
 Every factor is ``1 + u`` with ``u`` uniform in ``[-h, h]`` (a random sign and size), ``h`` the
 relative half-width of :class:`MismatchSpec`.  A fraction of the family has its hull's nonlinear
 part in another form: the low-speed cross-flow form (:func:`mmg.terms.crossflow_Y`,
-:func:`mmg.terms.crossflow_N`), its coefficients fitted by least squares to the config's Kijima
-nonlinear forces over the operating range and then perturbed like the others.
+:func:`mmg.terms.crossflow_N`), its coefficients fitted by least squares to the config's nonlinear
+sway forces and yaw moments (Kijima's terms in beta, or the MMG standard method's cubic terms in
+v') over the operating range and then perturbed like the others.
 """
 from __future__ import annotations
 
@@ -26,12 +28,13 @@ import numpy as np
 from mmg.ship import Ship
 from mmg.units import KNOT
 
-__all__ = ["DEV_NOISE_HALF_WIDTHS", "DEV_TRIALS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS", "TRIALS", "MismatchSpec", "crossflow_fit",
-           "WIDE_TRIALS",
-           "mismatch_family", "mismatch_member", "mismatch_ship", "trial_hand", "trial_records"]
+__all__ = ["DEV_NOISE_HALF_WIDTHS", "DEV_TRIALS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS", "TRIALS", "MismatchSpec",
+           "WIDE_TRIALS", "crossflow_fit", "froude_scaled", "mismatch_family", "mismatch_member", "mismatch_ship",
+           "trial_hand", "trial_records"]
 
-HULL_LINEAR_TERMS = ("beta", "r", "cos(beta)^2")
-"""Hull terms counted as linear (with the resistance): the rest, but the constant ``"1"``, are nonlinear."""
+HULL_LINEAR_TERMS = ("beta", "r", "v")
+"""Hull terms counted as linear; with them the straight-ahead resistance (:func:`mmg.terms.is_resistance`:
+``X_uu``'s ``cos(beta)^2``, ``X_0``'s ``1``).  The rest, but the other constants ``"1"``, are nonlinear."""
 
 RUDDER_CONSTANTS = ("f_alpha", "epsilon", "kappa", "t_R", "a_H", "x_H_prime", "gamma_R_pos", "gamma_R_neg")
 """The rudder constants the family moves (the geometry, A_R, H_R, eta, x_R', l_R', is kept)."""
@@ -70,10 +73,11 @@ class MismatchSpec:
     Attributes
     ----------
     hull_linear : float
-        Hull terms of :data:`HULL_LINEAR_TERMS` (``beta``, ``r``, the resistance ``cos(beta)^2``).
+        Hull terms of :data:`HULL_LINEAR_TERMS` (``beta``, ``r``, ``v``) and the resistance
+        (``X_uu``'s ``cos(beta)^2``, ``X_0``'s ``1``).
     hull_nonlinear : float
-        Every other hull term but the constants ``"1"`` (``beta|beta|``, ``r|r|``, ``beta^2*r``,
-        ``beta*r^2``, ``r*sin(beta)``, the cross-flow drags).
+        Every other hull term but the sway and yaw constants ``"1"`` (``beta|beta|``, ``r|r|``,
+        ``beta^2*r``, ``v^3``, ``r*sin(beta)``, ``v^2``, the cross-flow drags, ...).
     rudder : float
         The rudder constants of :data:`RUDDER_CONSTANTS`.
     propeller : float
@@ -104,8 +108,21 @@ def _factor(rng: np.random.Generator, h: float) -> float:
     return float(1.0 + rng.uniform(-h, h))
 
 
+def _is_linear(name: str, axis: str, term: str) -> bool:
+    """Whether a hull term takes the linear half-width: a :data:`HULL_LINEAR_TERMS` term or the resistance."""
+    from mmg.terms import is_resistance
+
+    return term in HULL_LINEAR_TERMS or is_resistance(name, term, axis)
+
+
+def _nonlinear_sway_yaw(hull) -> list:
+    """(name, axis, term, value) of the hull's nonlinear sway and yaw terms (neither linear nor constant)."""
+    return [(n, a, t, v) for n, a, t, v in zip(hull.names, hull.axes, hull.terms, hull.values)
+            if a in ("Y", "N") and t != "1" and not _is_linear(n, a, t)]
+
+
 def crossflow_fit(ship: Ship, beta_max_deg: float = 25.0, r_max: float = 0.8) -> dict:
-    """The cross-flow form of a Kijima hull's nonlinear sway force and yaw moment.
+    """The cross-flow form of a hull's nonlinear sway force and yaw moment.
 
     Least squares over a grid of |beta| <= ``beta_max_deg``, |r'| <= ``r_max`` (v' = -sin beta):
     Y_nl ~ Y_CD F(v', r') + Y_rr r'|r'|, N_nl ~ N_CD G(v', r') + N_CDY F(v', r') with F, G the
@@ -117,8 +134,9 @@ def crossflow_fit(ship: Ship, beta_max_deg: float = 25.0, r_max: float = 0.8) ->
     Parameters
     ----------
     ship : Ship
-        A ship whose hull has the Kijima nonlinear terms (``beta|beta|``, ``r|r|``, ``beta^2*r``,
-        ``beta*r^2`` on Y and N; absent ones count as 0).
+        A ship whose hull has nonlinear sway and yaw terms: Kijima's (``beta|beta|``, ``r|r|``,
+        ``beta^2*r``, ``beta*r^2``), the MMG standard method's (``v^3``, ``v^2*r``, ``v*r^2``,
+        ``r^3``) or any other of :data:`mmg.terms.TERMS`.
     beta_max_deg, r_max : float
         The operating range.
 
@@ -126,22 +144,23 @@ def crossflow_fit(ship: Ship, beta_max_deg: float = 25.0, r_max: float = 0.8) ->
     -------
     dict
         ``{"Y": [(name, term, value), ...], "N": [...], "rms_fraction": {"Y": .., "N": ..}}``: the
-        fitted terms and the residual's rms as a fraction of the Kijima nonlinear part's.
+        fitted terms and the residual's rms as a fraction of the config's nonlinear part's.
     """
-    from mmg.terms import crossflow_N, crossflow_Y
+    from mmg.terms import crossflow_N, crossflow_Y, term_id, term_value
 
     b, r = (g.ravel() for g in np.meshgrid(np.radians(np.linspace(-beta_max_deg, beta_max_deg, 41)),
                                            np.linspace(-r_max, r_max, 33)))
-    kij = {"beta|beta|": b * np.abs(b), "r|r|": r * np.abs(r), "beta^2*r": b * b * r, "beta*r^2": b * r * r}
     v = -np.sin(b)
+    nonlinear = _nonlinear_sway_yaw(ship.hull)
+    cols = {t: np.array([term_value(term_id(t), x, y, z) for x, y, z in zip(b, v, r)], float)
+            for t in {t for _, _, t, _ in nonlinear}}
     F = np.array([crossflow_Y(x, y) for x, y in zip(v, r)])
     G = np.array([crossflow_N(x, y) for x, y in zip(v, r)])
     basis = {"Y": [("Y_CD", "int(|v+x*r|*(v+x*r))", F), ("Y_rr", "r|r|", r * np.abs(r))],
              "N": [("N_CD", "int(x*|v+x*r|*(v+x*r))", G), ("N_CDY", "int(|v+x*r|*(v+x*r))", F)]}
-    h = ship.hull
     out, frac = {}, {}
     for ax in ("Y", "N"):
-        target = sum(val * kij[term] for a, term, val in zip(h.axes, h.terms, h.values) if a == ax and term in kij)
+        target = sum((val * cols[term] for _, a, term, val in nonlinear if a == ax), np.zeros_like(b))
         A = np.column_stack([col for _, _, col in basis[ax]])
         c, *_ = np.linalg.lstsq(A, target, rcond=None)
         frac[ax] = float(np.sqrt(np.mean((target - A @ c) ** 2)) / max(np.sqrt(np.mean(target ** 2)), 1e-12))
@@ -158,13 +177,14 @@ def _hull(ship: Ship, rng, spec: MismatchSpec, crossflow: bool):
     rows = list(zip(h.names, h.axes, h.terms, h.values))
     if crossflow:
         fit = crossflow_fit(ship, spec.beta_max_deg, spec.r_max)
-        kij = ("beta|beta|", "r|r|", "beta^2*r", "beta*r^2")
-        rows = [row for row in rows if not (row[1] in ("Y", "N") and row[2] in kij)]
+        gone = {row[0] for row in _nonlinear_sway_yaw(h)}
+        rows = [row for row in rows if row[0] not in gone]
         rows += [(name, ax, term, val) for ax in ("Y", "N") for name, term, val in fit[ax]]
     factors = {}
-    for name, _, term, _ in rows:
-        if term != "1":
-            factors[name] = _factor(rng, spec.hull_linear if term in HULL_LINEAR_TERMS else spec.hull_nonlinear)
+    for name, axis, term, _ in rows:
+        linear = _is_linear(name, axis, term)
+        if term != "1" or linear:
+            factors[name] = _factor(rng, spec.hull_linear if linear else spec.hull_nonlinear)
     hull = HullModel(names=tuple(r[0] for r in rows), axes=tuple(r[1] for r in rows), terms=tuple(r[2] for r in rows),
                      values=tuple(r[3] * factors.get(r[0], 1.0) for r in rows))
     return hull, factors
@@ -187,10 +207,11 @@ def mismatch_member(ship: Ship, rng: np.random.Generator, spec: MismatchSpec = M
     Returns
     -------
     (Ship, dict)
-        The member and ``{"hull_form": "kijima" | "crossflow", "hull": {name: factor}, "rudder":
+        The member and ``{"hull_form": "kijima" | "config" | "crossflow", "hull": {name: factor}, "rudder":
         {...}, "propeller": {"w_P0": .., "t_P": .., "K_T": ..}, "mass": {"m_x_prime": .., ...},
-        "wind": {"surge": .., "sway": .., "yaw": ..}}`` (a cross-flow member's hull factors are on
-        its fitted cross-flow values, :func:`crossflow_fit`).
+        "wind": {"surge": .., "sway": .., "yaw": ..}}`` (``hull_form``: the config's own form,
+        ``kijima`` where it is Kijima's in beta, else ``config``; a cross-flow member's hull factors
+        are on its fitted cross-flow values, :func:`crossflow_fit`).
     """
     cf = rng.uniform() < spec.crossflow_fraction           # drawn always: the same stream either way
     crossflow = bool(cf if crossflow is None else crossflow)
@@ -205,7 +226,8 @@ def mismatch_member(ship: Ship, rng: np.random.Generator, spec: MismatchSpec = M
                   propeller=replace(pr, w_P0=first(pr.w_P0, fp["w_P0"]), t_P=first(pr.t_P, fp["t_P"]),
                                     K_T=tuple(c * fp["K_T"] for c in pr.K_T)),
                   mass=replace(ship.mass, **{k: getattr(ship.mass, k) * f for k, f in fm.items()}))
-    factors = {"hull_form": "crossflow" if crossflow else "kijima", "hull": fh, "rudder": fr, "propeller": fp,
+    own = "kijima" if any("beta" in t for t in ship.hull.terms) else "config"
+    factors = {"hull_form": "crossflow" if crossflow else own, "hull": fh, "rudder": fr, "propeller": fp,
                "mass": fm}
     if ship.wind is not None:
         fw = {k: _factor(rng, spec.wind) for k in ("surge", "sway", "yaw")}
@@ -246,13 +268,36 @@ def _zigzag_end(rec, t_execute: float, reversals: int, tail: float) -> float:
     return float(rec.t[flips[reversals - 1]]) + tail
 
 
+def froude_scaled(effects: dict, true_wind, noise, lam: float):
+    """Full-scale effects, true wind and noise half-widths at the scale of a 1/``lam`` model.
+
+    Froude similarity: speeds (a current's ``speed_mps``, the true wind's) and u, v go as
+    1/sqrt(lam), r as sqrt(lam), x, y as 1/lam; angles (offsets, biases, directions, psi) and
+    ratios (T/H, wind-load factors) are the same at both scales.
+
+    Returns
+    -------
+    (dict, (float, float), tuple)
+    """
+    k = 1.0 / math.sqrt(lam)
+    eff = {e: dict(v) for e, v in (effects or {}).items()}
+    if "current" in eff and "speed_mps" in eff["current"]:
+        eff["current"]["speed_mps"] = eff["current"]["speed_mps"] * k
+    du, dv, dr, dx, dy, dpsi = noise
+    return eff, (true_wind[0] * k, true_wind[1]), (du * k, dv * k, dr / k, dx / lam, dy / lam, dpsi)
+
+
 def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 0, true_wind=(0.0, 0.0),
                   speed_kn: float = 10.0, noise=DEV_NOISE_HALF_WIDTHS, name: str | None = None):
     """A full-scale trial of ``truth`` logged as the development set's are.
 
     10 s straight run at heading 0, then the execute; a turn runs 1500 s after it, a zigzag to its
-    ninth reversal plus 60 s (simulated for 4000 s, longer below 10 kn in proportion); constant propeller revolutions (the approach's, at ``speed_kn``);
-    1 s samples; uniform noise of half-widths ``noise`` (u, v, r, x, y, psi).
+    ninth reversal plus 60 s (simulated for 4000 s, longer below 10 kn in proportion); constant propeller
+    revolutions (the approach's, at ``speed_kn``); 1 s samples; uniform noise of half-widths ``noise`` (u, v,
+    r, x, y, psi).  For a model-scale ``ship`` (``ship.froude_scale`` = lambda > 1) the trial is the
+    full-scale one Froude-scaled: ``speed_kn``, ``effects``, ``true_wind`` and ``noise`` are given at full
+    scale and taken to the model by :func:`froude_scaled`, the times (execute, length, tail, sampling) by
+    1/sqrt(lambda); the record's ``meta["effects"]`` holds the model-scale effects.
 
     Parameters
     ----------
@@ -269,9 +314,9 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     seed : int
         Noise seed.
     true_wind : (float, float)
-        True wind speed [m/s] and the direction it comes from [rad, clockwise from north].
+        True wind speed [m/s, full scale] and the direction it comes from [rad, clockwise from north].
     speed_kn : float
-        Approach speed [kn].
+        Approach speed [kn, full scale].
     noise : sequence of 6 floats
         Uniform half-widths.
     name : str, optional
@@ -283,19 +328,22 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     from .diagnose.records import synthetic_record
 
     tr = TRIALS[kind]
-    eff = {k: dict(v) for k, v in (effects or {}).items()}
+    lam = ship.froude_scale
+    eff, true_wind, noise = froude_scaled(effects, true_wind, noise, lam)
+    ts = 1.0 / math.sqrt(lam)                              # model time / full-scale time
     if "wind" in eff:
         if truth.wind is None:
             raise ValueError("a wind effect needs the truth ship's wind section")
         eff["wind"] = {**truth.wind.values(), **eff["wind"], "true_speed_mps": float(true_wind[0]),
                        "true_from_deg": math.degrees(true_wind[1])}
     rpm = replace(truth, engine=replace(truth.engine, mode="constant_rpm"))
-    te = 10.0
+    te = 10.0 * ts
     zig = tr["kind"] == "zigzag"
-    rec = synthetic_record(ship, tr["kind"], eff, truth_ship=rpm, speed=speed_kn * KNOT,
-                           duration=4000.0 * max(1.0, 10.0 / speed_kn) if zig else te + 1500.0, dt=1.0, rudder_deg=tr["rudder_deg"],
+    rec = synthetic_record(ship, tr["kind"], eff, truth_ship=rpm, speed=speed_kn * KNOT * ts,
+                           duration=(4000.0 * max(1.0, 10.0 / speed_kn) if zig else 10.0 + 1500.0) * ts, dt=ts,
+                           rudder_deg=tr["rudder_deg"],
                            heading_deg=tr.get("heading_deg"), t_execute=te, true_wind=true_wind, noise=noise,
                            noise_dist="uniform", seed=seed, name=name or kind)
     if zig:
-        rec = rec.slice_time(-math.inf, _zigzag_end(rec, te, 9, 60.0) + 1e-9)
+        rec = rec.slice_time(-math.inf, _zigzag_end(rec, te, 9, 60.0 * ts) + 1e-9 * ts)
     return replace(rec, meta={**rec.meta, "trial": kind, "effects": eff})

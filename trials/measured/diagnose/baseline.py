@@ -9,6 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from mmg.terms import is_resistance
 from mmg.parameters import MASS_NAMES
 from mmg.ship import Ship
 
@@ -21,8 +22,10 @@ __all__ = ["SHIP_FREE_TERMS", "TURN_HULL_TERMS", "DRIFT_KIND", "CONSTANTS_FREE",
            "fit_baseline"]
 
 
-SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2")
-"""Hull terms whose coefficients the diagnosis fits with every model (plus :data:`CONSTANTS_FREE`,
+SHIP_FREE_TERMS = ("beta", "r", "v", "cos(beta)^2", "r|r|", "u^2", "r^3")
+"""Hull terms whose coefficients the diagnosis fits with every model (with the straight-ahead resistance
+whatever its term, :func:`mmg.terms.is_resistance`, e.g. the MMG standard method's X_0 on ``1``; ``r^3`` is
+that form's pure-yaw nonlinearity, Kijima's ``r|r|``; plus :data:`CONSTANTS_FREE`,
 :data:`TURN_CONSTANTS_FREE` on turns, :data:`ZIGZAG_CONSTANTS_FREE` on zigzags, :data:`TURN_HULL_TERMS` on
 turns to one side that need them,
 :data:`MASS_FREE`)."""
@@ -105,7 +108,8 @@ def _baseline_prior(f, term):
     from ekf.identify import DIAGNOSIS_PRIOR_REL_STD as P
 
     if f.kind == "hull":
-        fam = "hull" if term in LINEAR_TERMS else "resistance" if term in RESISTANCE_TERMS else "hull_nonlinear"
+        resistance = term in RESISTANCE_TERMS or is_resistance(f.name, term)
+        fam = "hull" if term in LINEAR_TERMS else "resistance" if resistance else "hull_nonlinear"
         lo, hi = (0.0, np.inf) if f.prior > 0 else (-np.inf, 0.0) if f.prior < 0 else (f.lower, f.upper)
         return replace(f, sigma=max(P[fam] * abs(f.prior), P["hull_floor"]), lower=max(lo, f.lower),
                        upper=min(hi, f.upper))
@@ -122,7 +126,8 @@ def _ship_free(ship: Ship, packed, names=None, kind: str = "zigzag", drift: bool
     from ekf.identify import DIAGNOSIS_PRIOR_REL_STD, free_parameters
 
     if names is None:
-        names = [n for n, t in zip(ship.hull.names, ship.hull.terms) if t in SHIP_FREE_TERMS] + list(CONSTANTS_FREE)
+        names = [n for n, a, t in zip(ship.hull.names, ship.hull.axes, ship.hull.terms)
+                 if t in SHIP_FREE_TERMS or is_resistance(n, t, a)] + list(CONSTANTS_FREE)
         if kind == "zigzag":
             names += list(ZIGZAG_CONSTANTS_FREE)
         else:
