@@ -87,6 +87,7 @@ from .decision import (BIC_THRESHOLD, MAGNITUDE_UNITS, WEAK_BIC, Z_THRESHOLD, ca
                        floor_parts, magnitude, mean_heading, over_floor, record_kind, residual_floor)
 from .diagnose_records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .diagnose_report import fmt3, format_rms, format_values, round_header, size_with_unit
+from .model_form import reclassify
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "straight_contradicts",
            "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
@@ -492,6 +493,16 @@ class Diagnosis:
     """The records' leading straight runs the fit used (:func:`straight_run_table`)."""
     absent_channels: list = field(default_factory=list)
     """Residual channels a record does not log and what was compared instead (:func:`absent_table`)."""
+    model_form_effects: list = field(default_factory=list)
+    """Effects the search named whose fit stands for a gap of the model's form, reported ``model_form_mismatch``
+    instead (:func:`trials.measured.model_form.reclassify`): kept in the fitted model, not named."""
+
+    @property
+    def effect_status(self) -> dict:
+        """{effect: "named", "model_form_mismatch" or "not_identifiable"} of the effects reported."""
+        out = {x["effect"]: "not_identifiable" for x in self.not_identifiable or []}
+        out.update({x["effect"]: x["status"] for x in self.model_form_effects})
+        return {**out, **{e: "named" for e in self.named}}
 
     def summary_lines(self) -> list:
         """The console text (:func:`trials.measured.diagnose_report.summary_lines`)."""
@@ -514,7 +525,8 @@ class Diagnosis:
                "files": [r.source for r in self.records], "names": [r.name for r in self.records],
                "seconds": round(self.seconds, 2),
                "identifiability": self.identifiability, "straight_runs": self.straight_runs,
-               "absent_channels": self.absent_channels}
+               "absent_channels": self.absent_channels, "model_form_effects": self.model_form_effects,
+               "effect_status": self.effect_status}
         if self.runs:
             out["runs"] = [dict(r.to_json(), name=r.records[0].name, file=r.records[0].source) for r in self.runs]
         return out
@@ -1046,6 +1058,8 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
                      len(sfree), o.stride)
     res.not_identifiable, res.identifiability = ni + covered, table
     res.baseline = "fitted" if kept else "config (the fit replayed worse)"
+    for ent in reclassify(res):                 # a named effect whose fit stands for the model's form
+        say(f"{ent['effect']}: {ent['status']}, not named: {ent['reason']}")
     res.seconds = time.perf_counter() - t0
     if o.per_run and len(recs) > 1:
         res.runs = diagnose_each(ship, recs, o, progress=o.say is not None)
