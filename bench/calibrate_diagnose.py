@@ -69,6 +69,9 @@ def main(argv=None):
         source = f"{old.get('source', '')}; then for {', '.join(a.kinds)} only: {doc['source']}".lstrip("; ")
         doc = {"source": source, **{k: v for k, v in merge_kinds(old, doc, a.kinds).items() if k != "source"}}
     if a.write:
+        kept = (yaml.safe_load(OUT.read_text()) or {}) if OUT.exists() else {}
+        if "model_form" in kept:             # chosen on principle, not calibrated here: carried over as it is
+            doc["model_form"] = kept["model_form"]
         OUT.parent.mkdir(parents=True, exist_ok=True)
         OUT.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "
                        "(trials/measured/decision.py).\n" + yaml.safe_dump(doc, sort_keys=False))

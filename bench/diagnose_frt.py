@@ -430,7 +430,9 @@ def main(argv=None) -> int:
             results[i] = r
             what = r["error"] if "error" in r else \
                 ("named " + ("+".join(r["diagnosis"]["named_effects"]) or "nothing") + "; not_identifiable "
-                 + (",".join(x.get("effect", "?") for x in r["diagnosis"].get("not_identifiable") or []) or "-"))
+                 + (",".join(x.get("effect", "?") for x in r["diagnosis"].get("not_identifiable") or []) or "-")
+                 + "; model_form_mismatch " + (",".join(x["effect"] for x in r["diagnosis"].get("model_form_effects") or [])
+                                               or "-"))
             print(f"[{k + 1:2d}/{len(todo)}] {r['file']:45s} {what}  {r['seconds']:.1f} s  "
                   f"(wall {time.perf_counter() - t0:.0f} s)", flush=True)
     wall = time.perf_counter() - t0
