@@ -14,12 +14,12 @@ WIND = {p.name: p for p in E.REGISTRY["wind"].fit_parameters()}
 RMS = {"u": 0.01, "v": 0.02, "r": 0.03, "heading": 0.4, "position": 5.0}
 
 
-def _diag(wind: dict) -> Diagnosis:
-    """A diagnosis that named a current and a wind with the values ``wind``."""
+def _diag(wind: dict, se: float = 0.1) -> Diagnosis:
+    """A diagnosis that named a current and a wind with the values ``wind``, each with standard error ``se``."""
     cur = {"speed_mps": 0.2, "direction_deg": 45.0}
     return Diagnosis(named=["current", "wind"], parameters={"current": dict(cur), "wind": dict(wind)},
                      standard_errors={"current": {"speed_mps": 0.01, "direction_deg": 3.0},
-                                      "wind": {k: 0.1 for k in wind}},
+                                      "wind": {k: se for k in wind}},
                      rms_config=RMS, rms_before=RMS, rms_after=RMS, unexplained=False, unexplained_description="",
                      candidates=[], rounds=[], ship_values={}, records=[], pred_before=[], pred_after=[], seconds=0.0,
                      intervals_95={"current": {}, "wind": {k: [v - 0.2, v + 0.2] for k, v in wind.items()}},
@@ -40,7 +40,8 @@ def test_shape_on_its_bound_is_model_form_mismatch_not_named():
     out = reclassify(d)
     assert d.named == ["current"] and "wind" not in d.parameters and "wind" not in d.evidence
     assert [e["effect"] for e in out] == ["wind"] and out[0]["status"] == STATUS == "model_form_mismatch"
-    assert out[0]["shapes"] == {"yaw_factor": {"fitted": yaw.lower, "lower": yaw.lower, "upper": yaw.upper}}
+    z = (yaw.default - yaw.lower) / 0.1                   # 8 standard errors from the published curve's 1
+    assert out[0]["shapes"] == {"yaw_factor": {"fitted": yaw.lower, "lower": yaw.lower, "upper": yaw.upper, "z": z}}
     assert out[0]["coefficients"] == {}
     assert out[0]["parameters"]["yaw_factor"] == yaw.lower and out[0]["evidence"]["delta_bic"] == 45.0
     assert out[0]["ship_coefficients"] == ["gamma_R_pos"] and "yaw_factor" in out[0]["reason"]
@@ -54,6 +55,18 @@ def test_interior_shape_and_plausible_scale_stay_named():
     d = _diag({"scale": 1.1, "sway_factor": 0.6, "yaw_factor": 1.8})
     assert reclassify(d) == [] and d.named == ["current", "wind"] and d.model_form_effects == []
     assert d.to_json()["effect_status"]["wind"] == "named"
+
+
+def test_shape_on_its_bound_the_records_do_not_pin_stays_named():
+    """A real wind whose yaw factor wandered to its upper bound 3 with a standard error of 0.69 (a 12 m/s
+    wind on a 10/10 zigzag of the independent development set): (3 - 1) / 0.69 = 2.9 standard errors from
+    the published curve, short of the 3 a finding needs, so the bound says nothing of the form."""
+    yaw = WIND["yaw_factor"]
+    assert (yaw.upper - yaw.default) / 0.69 < 3.0
+    d = _diag({"scale": 0.72, "sway_factor": 1.0, "yaw_factor": yaw.upper}, se=0.69)
+    assert reclassify(d) == [] and d.named == ["current", "wind"]
+    d = _diag({"scale": 0.72, "sway_factor": 1.0, "yaw_factor": yaw.upper}, se=float("nan"))
+    assert reclassify(d) == []                          # no standard error: not judged on its bound
 
 
 @pytest.mark.parametrize("frac, flagged", [(0.5, True), (2.0, False)])

@@ -5,11 +5,15 @@ better, precisely and by more than the ship's own mismatch lends it.  A fit can 
 bending the effect into what the ship model lacks; it then says so in its own values.  A named effect
 is reported ``model_form_mismatch`` instead of named (:func:`effect_form`) when
 
-1. **a shape parameter sits on its bound**: a fitted parameter that shapes the effect without saying
-   whether it is there (the fit parameters not among
+1. **a shape parameter sits on its bound, where the records pin it**: a fitted parameter that shapes
+   the effect without saying whether it is there (the fit parameters not among
    :meth:`mmg.effects.Effect.presence_parameters`, e.g. the wind's ``sway_factor`` and ``yaw_factor``)
-   lies within ``bound_tolerance`` of its range from a bound of that range: the bound set its value,
-   not the records, which ask for a load of a form the effect cannot follow; or
+   lies within ``bound_tolerance`` of its range from a bound of that range, and more than
+   :data:`~trials.measured.decision.Z_THRESHOLD` of its standard errors from its neutral value (the
+   published curve's 1): the records ask for a load of a form the effect cannot follow, and the bound
+   stopped it.  A shape the records do not pin (z at most that) merely wandered to its bound along a
+   direction they do not resolve (a zigzag sees the wind from a narrow band of angles), which says
+   nothing of the form; or
 2. **a value lies outside what the measured channels allow**: a parameter outside its physically
    plausible range (``plausible``, per effect and parameter): e.g. a wind's ``scale``, a factor on the
    loads the record's *measured* relative wind makes, far beyond the scatter of real ships' wind
@@ -26,7 +30,7 @@ from __future__ import annotations
 
 import math
 
-from .decision import calibration
+from .decision import Z_THRESHOLD, calibration
 
 __all__ = ["STATUS", "rules", "shape_parameters", "effect_form", "reclassify", "form_line"]
 
@@ -53,7 +57,8 @@ def shape_parameters(cls) -> list:
             and math.isfinite(p.upper) and p.upper > p.lower]
 
 
-def effect_form(effect: str, values: dict, rule: dict, ship_mismatch: dict | None = None) -> dict | None:
+def effect_form(effect: str, values: dict, rule: dict, ship_mismatch: dict | None = None,
+                standard_errors: dict | None = None) -> dict | None:
     """The ``model_form_mismatch`` entry of a named effect, or None when its fit keeps within its form.
 
     Parameters
@@ -67,11 +72,13 @@ def effect_form(effect: str, values: dict, rule: dict, ship_mismatch: dict | Non
     ship_mismatch : dict, optional
         The ship coefficients the same fit took beyond their priors
         (:func:`trials.measured.diagnose.model_form_mismatch`).
+    standard_errors : dict, optional
+        Its reported standard errors; a shape without a finite one is not judged on its bound.
 
     Returns
     -------
     dict or None
-        ``{"effect", "status", "shapes": {parameter: {"fitted", "lower", "upper"}}, "coefficients":
+        ``{"effect", "status", "shapes": {parameter: {"fitted", "lower", "upper", "z"}}, "coefficients":
         {parameter: {"fitted", "plausible"}}, "ship_coefficients": [names], "reason"}``.
     """
     import mmg.effects as E
@@ -81,17 +88,22 @@ def effect_form(effect: str, values: dict, rule: dict, ship_mismatch: dict | Non
         return None
     shapes, coefs = {}, {}
     tol = rule.get("bound_tolerance")
+    se = standard_errors or {}
     for p in shape_parameters(cls) if tol is not None else ():
-        v = values.get(p.name)
-        if v is not None and min(v - p.lower, p.upper - v) <= tol * (p.upper - p.lower):
-            shapes[p.name] = {"fitted": float(v), "lower": p.lower, "upper": p.upper}
+        v, s = values.get(p.name), se.get(p.name)
+        if v is None or s is None or not math.isfinite(s) or min(v - p.lower, p.upper - v) > tol * (p.upper - p.lower):
+            continue
+        z = abs(v - p.default) / s if s > 0 else math.inf
+        if z > Z_THRESHOLD:
+            shapes[p.name] = {"fitted": float(v), "lower": p.lower, "upper": p.upper, "z": round(z, 2)}
     for name, (lo, hi) in (rule.get("plausible") or {}).get(effect, {}).items():
         v = values.get(name)
         if v is not None and not lo <= abs(v) <= hi:
             coefs[name] = {"fitted": float(v), "plausible": [lo, hi]}
     if not shapes and not coefs:
         return None
-    why = [f"{k} {v['fitted']:.3g} on its bound (range {v['lower']:g}-{v['upper']:g})" for k, v in shapes.items()]
+    why = [f"{k} {v['fitted']:.3g} on its bound (range {v['lower']:g}-{v['upper']:g}), {v['z']:.3g} standard errors "
+           "from the published curve's" for k, v in shapes.items()]
     why += [f"{k} {v['fitted']:.3g} outside the plausible {v['plausible'][0]:.3g}-{v['plausible'][1]:.3g}"
             for k, v in coefs.items()]
     return {"effect": effect, "status": STATUS, "shapes": shapes, "coefficients": coefs,
@@ -108,7 +120,8 @@ def reclassify(diag, rule: dict | None = None) -> list:
     rule = rules() if rule is None else rule
     out = []
     for e in list(diag.named):
-        ent = effect_form(e, diag.parameters.get(e, {}), rule, diag.model_form_mismatch)
+        ent = effect_form(e, diag.parameters.get(e, {}), rule, diag.model_form_mismatch,
+                          (diag.standard_errors or {}).get(e))
         if ent is None:
             continue
         for key in ("parameters", "standard_errors", "intervals_95", "evidence"):
