@@ -79,9 +79,12 @@ def main(argv=None):
         source = f"{old.get('source', '')}; then for {', '.join(a.kinds)} only: {doc['source']}".lstrip("; ")
         doc = {"source": source, **{k: v for k, v in merge_kinds(old, doc, a.kinds).items() if k != "source"}}
     if a.write:
+        kept = (yaml.safe_load(a.out.read_text()) or {}) if a.out.exists() else {}
+        if "model_form" in kept:             # chosen on principle, not calibrated here: carried over as it is
+            doc["model_form"] = kept["model_form"]
         a.out.parent.mkdir(parents=True, exist_ok=True)
         a.out.write_text("# Written by bench/calibrate_diagnose.py: the naming floors of mmg diagnose "
-                       "(trials/measured/diagnose/decision.py).\n" + yaml.safe_dump(doc, sort_keys=False))
+                         "(trials/measured/diagnose/decision.py).\n" + yaml.safe_dump(doc, sort_keys=False))
         print(f"wrote {a.out}")
 
 

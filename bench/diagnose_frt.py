@@ -14,6 +14,8 @@ A record the diagnosis refuses or fails on gets a one-line row saying why; nothi
     python bench/diagnose_frt.py [--jobs 2] [--folders turning zigzag] [--only turn_cut zigzag_31-Jul-2020_13_04_24]
                                  [--json bench/out/diagnose_frt.json] [--md docs/diagnose.md]
 
+Where ``--md`` has the ``diagnose_frt`` markers (docs/diagnose.md) the summary goes between them and
+the per-record table beside the JSON (``bench/out/diagnose_frt.md``); else the table with the summary.
 ``--only`` keeps the records whose file stem contains any of the strings given.  The data are read
 from the shared folder and never copied; the script stops with a message where it is absent.
 """
@@ -37,6 +39,8 @@ FRT = REPO.parent / "shared" / "data" / "frt-ds-esso"
 FOLDERS = ("turning", "zigzag", "random", "berthing")
 SLOW_S = 120.0
 """A record whose diagnosis takes longer than this [s] is noted."""
+LIST_MAX = 10
+"""The summary names the records with nothing named when there are at most this many (else counts them)."""
 KIND = {"turning": "turn", "zigzag": "zigzag", "random": "random", "berthing": "berthing"}
 
 
@@ -132,7 +136,8 @@ def _one(path: str, folder: str, ship: str) -> dict:
         out["diagnosis"] = {k: j.get(k) for k in ("named_effects", "parameters", "standard_errors", "intervals_95",
                                                     "evidence", "not_identifiable", "model_form_mismatch", "rms_config",
                                                     "rms_before", "rms_after", "unexplained", "unexplained_description",
-                                                    "candidates", "rounds", "ship_coefficients", "threshold")}
+                                                    "candidates", "rounds", "ship_coefficients", "threshold",
+                                                    "model_form_effects", "effect_status")}
     except Exception as e:  # noqa: BLE001 - the row says why
         out["error"] = "diagnose: " + _one_line(e)
     out["seconds"] = time.perf_counter() - t0
@@ -190,6 +195,9 @@ def fitted_text(d: dict, eff: str) -> str:
         if eff == "current":
             return f"**{_f(vals['speed_mps'])} m/s to {_f(vals['direction_deg'])} deg**"
         return "**" + ", ".join(f"{SHORT.get(k, k)} {_f(v)}" for k, v in vals.items()) + "**"
+    form = next((x for x in d.get("model_form_effects") or [] if x["effect"] == eff), None)
+    if form is not None:
+        return "model_form_mismatch (" + ", ".join(f"{SHORT.get(k, k)} {_f(v)}" for k, v in form["parameters"].items()) + ")"
     skipped = next((c.get("skipped") for c in d.get("candidates") or [] if c.get("effect") == eff and "skipped" in c), None)
     if skipped:
         return f"skipped ({skipped})"
@@ -245,7 +253,7 @@ def summary(results: list) -> list[str]:
             counts.setdefault(e, []).append(r)
     none = [r for r in ok if not r["diagnosis"]["named_effects"]]
     lines.append(f"Nothing named on {len(none)} of {len(ok)}" +
-                 (" (" + ", ".join(Path(r['file']).stem for r in none) + ")." if none else "."))
+                 (" (" + ", ".join(Path(r['file']).stem for r in none) + ")." if 0 < len(none) <= LIST_MAX else "."))
     for e, rs in sorted(counts.items(), key=lambda kv: -len(kv[1])):
         per = ", ".join(f"{f} {sum(r['folder'] == f for r in rs)} of {sum(r['folder'] == f for r in ok)}"
                         for f in FOLDERS if any(r["folder"] == f for r in ok))
@@ -272,6 +280,7 @@ def summary(results: list) -> list[str]:
                                    f"(sd {_f(x['sd_deg'])}), {_f(abs(x['z_before']))} -> {_f(abs(x['z_after']))} sd"
                                    for nm, x in st) + "." if st else
                   " (none opens steady, straight and with a relative wind under half the ship's speed)."))
+    lines.append(form_summary(ok))
     un = [r for r in ok if r["diagnosis"].get("unexplained")]
     lines.append(f"`unexplained` on {len(un)} of {len(ok)}.")
     for r in bad:
@@ -282,6 +291,27 @@ def summary(results: list) -> list[str]:
     lines.append(f"Diagnosis time: median {np.median([r['seconds'] for r in results]):.0f} s, "
                  f"total {sum(r['seconds'] for r in results):.0f} s (CPU-seconds of the workers).")
     return lines
+
+
+def form_summary(ok: list) -> str:
+    """How many named effects became ``model_form_mismatch`` (:mod:`trials.measured.diagnose.model_form`), record by
+    record (those with none left out), and what put them there: a shape on its bound, a value outside
+    its plausible range."""
+    per, why = {}, {"shape on its bound": 0, "value outside its plausible range": 0}
+    for r in ok:
+        mf = r["diagnosis"].get("model_form_effects") or []
+        if mf:
+            stem = Path(r["file"]).stem.split("_", 1)[-1]               # the folder says the kind
+            per.setdefault(r["folder"], []).append(f"{stem} {len(mf)} ({', '.join(x['effect'] for x in mf)})")
+        for x in mf:
+            why["shape on its bound"] += bool(x.get("shapes"))
+            why["value outside its plausible range"] += bool(x.get("coefficients"))
+    n = sum(len(r["diagnosis"].get("model_form_effects") or []) for r in ok)
+    total = n + sum(len(r["diagnosis"]["named_effects"]) for r in ok)
+    return (f"Named effects reported `model_form_mismatch` instead: {n} of the {total} the search named, on "
+            f"{sum(map(len, per.values()))} of {len(ok)} records" +
+            (" (" + ", ".join(f"{k} {v}" for k, v in why.items()) + "); per record: "
+             + "; ".join(f"{f}: " + ", ".join(v) for f, v in per.items()) + "." if per else "."))
 
 
 def markdown(results: list, cmd: str, ship: str, wall: float) -> str:
@@ -307,8 +337,7 @@ def markdown(results: list, cmd: str, ship: str, wall: float) -> str:
            "time [s] | notes |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     out += [row(i + 1, r) for i, r in enumerate(results)]
-    s = summary(results)
-    out += ["", s[0], ""] + [f"- {ln}" for ln in s[1:]] + [""]
+    out += ["", summary_md(results), ""]
     return "\n".join(out)
 
 
@@ -327,16 +356,35 @@ def records(folders, only) -> list[tuple[str, str]]:
 BEGIN, END = "<!-- diagnose_frt: begin -->", "<!-- diagnose_frt: end -->"
 
 
+def summary_md(results: list) -> str:
+    """The summary as markdown: its first line, then one bullet per line."""
+    s = summary(results)
+    return "\n".join([s[0], ""] + [f"- {ln}" for ln in s[1:]])
+
+
+def write_outputs(md: Path, table: Path, results: list, cmd: str, ship: str, wall: float) -> Path:
+    """Write the per-record table (:func:`markdown`) to ``md``, or, where ``md`` has the markers
+    :data:`BEGIN` and :data:`END` (docs/diagnose.md keeps its prose around them), the summary alone
+    between them and the table to ``table``; returns where the table went."""
+    old = md.read_text() if md.is_file() else ""
+    full = markdown(results, cmd, ship, wall)
+    if BEGIN in old and END in old:
+        write_md(md, summary_md(results))
+        write_md(table, full)
+        return table
+    write_md(md, full)
+    return md
+
+
 def write_md(path: Path, text: str) -> None:
-    """Write the table to ``path``: between the markers :data:`BEGIN` and :data:`END` where the file
-    has them (docs/diagnose.md keeps its prose around the generated table), else the whole file."""
+    """Write ``text`` to ``path``: between the markers :data:`BEGIN` and :data:`END` where the file
+    has them, else the whole file."""
     path.parent.mkdir(parents=True, exist_ok=True)
     old = path.read_text() if path.is_file() else ""
     if BEGIN in old and END in old:
         head, rest = old.split(BEGIN, 1)
         _, tail = rest.split(END, 1)
-        text = "\n".join("### " + ln[2:] if ln.startswith("# ") else ln for ln in text.rstrip().splitlines())
-        text = f"{head}{BEGIN}\n{text}\n{END}{tail}"
+        text = f"{head}{BEGIN}\n{text.rstrip()}\n{END}{tail}"
     path.write_text(text)
 
 
@@ -348,13 +396,15 @@ def main(argv=None) -> int:
     ap.add_argument("--only", nargs="*", help="keep records whose file stem contains one of these strings")
     ap.add_argument("--json", default=str(REPO / "bench" / "out" / "diagnose_frt.json"))
     ap.add_argument("--md", default=str(REPO / "docs" / "diagnose.md"),
-                    help="where the table goes (between the diagnose_frt markers where the file has them)")
+                    help="where the table goes (where the file has the diagnose_frt markers: the summary between them, "
+                         "the table beside --json)")
     ap.add_argument("--from-json", action="store_true", help="only rewrite the table from --json (no diagnosis)")
     a = ap.parse_args(argv)
     if a.from_json:
         data = json.loads(Path(a.json).read_text())
-        write_md(Path(a.md), markdown(data["records"], data["command"].strip(), data["ship"], data["wall_s"]))
-        print("\n".join(summary(data["records"])) + f"\nwrote {a.md}")
+        where = write_outputs(Path(a.md), Path(a.json).with_suffix(".md"), data["records"], data["command"].strip(),
+                              data["ship"], data["wall_s"])
+        print("\n".join(summary(data["records"])) + f"\nwrote {a.md}" + (f" and {where}" if where != Path(a.md) else ""))
         return 0
     if not FRT.is_dir():
         print(f"FRT-DS-ESSO folder absent: {FRT}", file=sys.stderr)
@@ -380,7 +430,9 @@ def main(argv=None) -> int:
             results[i] = r
             what = r["error"] if "error" in r else \
                 ("named " + ("+".join(r["diagnosis"]["named_effects"]) or "nothing") + "; not_identifiable "
-                 + (",".join(x.get("effect", "?") for x in r["diagnosis"].get("not_identifiable") or []) or "-"))
+                 + (",".join(x.get("effect", "?") for x in r["diagnosis"].get("not_identifiable") or []) or "-")
+                 + "; model_form_mismatch " + (",".join(x["effect"] for x in r["diagnosis"].get("model_form_effects") or [])
+                                               or "-"))
             print(f"[{k + 1:2d}/{len(todo)}] {r['file']:45s} {what}  {r['seconds']:.1f} s  "
                   f"(wall {time.perf_counter() - t0:.0f} s)", flush=True)
     wall = time.perf_counter() - t0
@@ -392,10 +444,11 @@ def main(argv=None) -> int:
     out.write_text(json.dumps({"ship": a.ship, "command": cmd, "wall_s": wall, "records": results}, indent=1,
                               default=float))
     md = Path(a.md)
-    write_md(md, markdown(results, cmd.strip(), a.ship, wall))
+    where = write_outputs(md, out.with_suffix(".md"), results, cmd.strip(), a.ship, wall)
     for ln in summary(results):
         print(ln)
-    print(f"wrote {out} and {md} ({wall:.0f} s wall)")
+    print(f"wrote {out} and {md}" + (f" (summary; the per-record table: {where})" if where != md else "")
+          + f" ({wall:.0f} s wall)")
     return 0
 
 

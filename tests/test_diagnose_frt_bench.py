@@ -46,3 +46,20 @@ def test_logged_true_wind_preferred_and_zero_wind_reported_absent():
     assert math.isclose(w["true_from_deg"], 300.0, abs_tol=1e-9)
     assert frt.measured_wind(_rec(wind_speed_rel=np.zeros(n), wind_dir_rel=np.zeros(n), u=np.ones(n), v=np.zeros(n),
                                   psi=np.zeros(n)))["source"] == "none"
+
+
+def test_summary_counts_model_form_effects_record_by_record():
+    """Two records: one whose wind the rule reported model_form_mismatch beside a named current, one with
+    nothing named; the summary counts 1 of the 2 effects the search named, on 1 of 2 records, by name."""
+    form = {"effect": "wind", "status": "model_form_mismatch", "shapes": {"yaw_factor": {}}, "coefficients": {},
+            "parameters": {"scale": 1.0, "sway_factor": 1.0, "yaw_factor": 0.2}}
+    d1 = {"named_effects": ["current"], "parameters": {"current": {"speed_mps": 0.01, "direction_deg": 30.0}},
+          "model_form_effects": [form]}
+    d2 = {"named_effects": [], "parameters": {}, "model_form_effects": []}
+    recs = [{"file": "turning/turn_14-Oct-2020_14_08_51.csv", "folder": "turning", "diagnosis": d1, "seconds": 1.0},
+            {"file": "zigzag/zigzag_31-Jul-2020_13_04_24.csv", "folder": "zigzag", "diagnosis": d2, "seconds": 1.0}]
+    line = frt.form_summary(recs)
+    assert "1 of the 2 the search named, on 1 of 2 records" in line
+    assert "shape on its bound 1, value outside its plausible range 0" in line
+    assert "turning: 14-Oct-2020_14_08_51 1 (wind)" in line and "13_04_24" not in line
+    assert frt.fitted_text(d1, "wind").startswith("model_form_mismatch (scale 1.00")

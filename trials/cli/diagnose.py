@@ -44,6 +44,8 @@ def cmd_diagnose(args) -> int:
 
         note = (f"mmg diagnose over {len(recs)} record(s): named {', '.join(d.named) or 'nothing'}; "
                 + "; ".join(f"{e} " + ", ".join(f"{k} = {v:.4g}" for k, v in p.items()) for e, p in d.parameters.items())
+                + "".join(f"; {x['effect']} reported model_form_mismatch (fitted beside these coefficients, not "
+                          f"written: {x['reason'].split(':')[0]})" for x in d.model_form_effects)
                 + ". The named effects are in the effects: section, so mmg predict with this config replays these "
                   "records with them; a current, a rudder offset or a heading bias belongs to these records, not the "
                   "ship: for other trials move it to their trial config's effects: section")

@@ -60,6 +60,9 @@ checking the scale) and the ship config:
    its noise level (estimated from the record's own second differences) and
    ``unexplained_description`` saying which channel and what it correlates with (heading: an
    earth-fixed cause; rudder; relative wind; body-fixed constant).
+   A named effect whose fit stands for a gap of the model's form (a shape parameter on its bound, a
+   value the measured channels do not allow) is reported ``model_form_mismatch`` instead
+   (:mod:`.model_form`).
 
 Residual frames.  FRT-DS-ESSO u, v are GNSS velocities over ground resolved in the logged
 heading; the replay's hydrodynamics need the velocity through the water.  Every replay (its

@@ -333,7 +333,8 @@ def not_identifiable_line(ni: dict) -> str:
 
 def summary_lines(diag) -> list[str]:
     """The console text of a :class:`trials.measured.diagnose.Diagnosis`: a line per named effect
-    (:func:`effect_line`), the statistics' legend, a line per effect that cannot be told apart, the
+    (:func:`effect_line`), one per effect reported ``model_form_mismatch``
+    (:func:`~.model_form.form_line`), the statistics' legend, a line per effect that cannot be told apart, the
     residual RMS per channel (config, ship fitted, with the named effects), ``unexplained`` when set."""
     from .decision import BIC_THRESHOLD, Z_THRESHOLD
 
@@ -343,6 +344,9 @@ def summary_lines(diag) -> list[str]:
                                  (diag.evidence or {}).get(e, {})))
     if not diag.named:
         lines.append("nothing named")
+    from .model_form import form_line
+
+    lines += [form_line(x) for x in getattr(diag, "model_form_effects", None) or []]
     lines.append(f"  (dBIC: information gain with the effect, named above {BIC_THRESHOLD:g}; z: the fit's distance from "
                  f"no effect in standard errors, named above {Z_THRESHOLD:g}; false-alarm p: chance of naming it at "
                  "this dBIC on records without it, n/a: not calibrated)")

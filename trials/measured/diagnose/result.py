@@ -147,6 +147,16 @@ class Diagnosis:
     """The records' leading straight runs the fit used (:func:`straight_run_table`)."""
     absent_channels: list = field(default_factory=list)
     """Residual channels a record does not log and what was compared instead (:func:`absent_table`)."""
+    model_form_effects: list = field(default_factory=list)
+    """Effects the search named whose fit stands for a gap of the model's form, reported ``model_form_mismatch``
+    instead (:func:`~.model_form.reclassify`): kept in the fitted model, not named."""
+
+    @property
+    def effect_status(self) -> dict:
+        """{effect: "named", "model_form_mismatch" or "not_identifiable"} of the effects reported."""
+        out = {x["effect"]: "not_identifiable" for x in self.not_identifiable or []}
+        out.update({x["effect"]: x["status"] for x in self.model_form_effects})
+        return {**out, **{e: "named" for e in self.named}}
 
     def summary_lines(self) -> list:
         """The console text (:func:`trials.measured.diagnose_report.summary_lines`)."""
@@ -169,7 +179,8 @@ class Diagnosis:
                "files": [r.source for r in self.records], "names": [r.name for r in self.records],
                "seconds": round(self.seconds, 2),
                "identifiability": self.identifiability, "straight_runs": self.straight_runs,
-               "absent_channels": self.absent_channels}
+               "absent_channels": self.absent_channels, "model_form_effects": self.model_form_effects,
+               "effect_status": self.effect_status}
         if self.runs:
             out["runs"] = [dict(r.to_json(), name=r.records[0].name, file=r.records[0].source) for r in self.runs]
         return out
