@@ -82,7 +82,7 @@ class StraightRun:
 STRAIGHT_RUN_DRIFT_SD = math.radians(0.1)
 """Std [rad] of a hull's drift angle in its straight run that the model does not have: ten times
 the bundled Esso Osaka's own trim drift (0.009 deg), for a real hull's asymmetry and the small
-wind a straight run is accepted with (:func:`trials.measured.diagnose_records.leading_straight_run`)."""
+wind a straight run is accepted with (:func:`trials.measured.diagnose.records.leading_straight_run`)."""
 
 
 @dataclass(frozen=True)

@@ -302,7 +302,7 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     Parameters
     ----------
     ship : Ship
-        The config (for :func:`~trials.measured.diagnose_records.synthetic_record`'s record).
+        The config (for :func:`~trials.measured.diagnose.records.synthetic_record`'s record).
     truth : Ship
         The ship that sails (a family member).
     kind : str

@@ -34,7 +34,7 @@ checking the scale) and the ship config:
        dBIC = sum_c N_eff,c ln(RSS_c,before / RSS_c,with) - k ln(sum_c N_eff,c) + (chi2_straight,before - chi2_straight,with)
 
    The last term is the **straight run's**: a record that opens with a steady straight run
-   (:func:`~trials.measured.diagnose_records.leading_straight_run`: rudder at its trim, no yaw, little
+   (:func:`~trials.measured.diagnose.records.leading_straight_run`: rudder at its trim, no yaw, little
    wind) logs there a mean sway over ground that any hull leaves at (almost) zero through the water,
    so it is set by a heading bias (-u sin b) and a current's cross part alone, whatever the hull
    coefficients (:func:`ekf.identify.straight_run_residual`, one residual per record with its own

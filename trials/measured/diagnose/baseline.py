@@ -43,7 +43,7 @@ drift stays small and these terms would only trade with the linear ones."""
 
 
 DRIFT_KIND = "turn_drift"
-"""The kind of record set (:data:`~trials.measured.decision.KINDS`) of turns to one side (calibrated on
+"""The kind of record set (:data:`~trials.measured.diagnose.decision.KINDS`) of turns to one side (calibrated on
 single turns) whose baseline freed the drift nonlinearities (:func:`_drift_terms`): its floors are
 calibrated apart from those
 of the turns that keep them at the config's (``"turn"``), since the ship's own mismatch lends the
@@ -56,7 +56,7 @@ CONSTANTS_FREE = ("w_P0",)
 
 
 TURN_CONSTANTS_FREE = ("epsilon",)
-"""Rudder constants it fits as well on turns (:func:`~trials.measured.decision.record_kind` ``turn`` or
+"""Rudder constants it fits as well on turns (:func:`~trials.measured.diagnose.decision.record_kind` ``turn`` or
 ``turn_pair``): the rudder's inflow ratio epsilon (the rudder force, as epsilon^2).  In a 35 deg turn the
 rudder's drag, (1 - t_R) F_N sin(delta), sets much of the speed lost; a rudder force 10-15 % off its
 config leaves a residual in that speed loss and the drift that the resistance (u^2) and the wake cannot
@@ -69,7 +69,7 @@ not identifiable (correlation 0.997 with m_x, m_y, epsilon)."""
 
 
 ZIGZAG_CONSTANTS_FREE = ("gamma_R_pos", "gamma_R_neg")
-"""Rudder constants it fits as well on zigzags (:func:`~trials.measured.decision.record_kind`
+"""Rudder constants it fits as well on zigzags (:func:`~trials.measured.diagnose.decision.record_kind`
 ``zigzag``): the flow-straightening coefficients gamma_R of the rudder's inflow angle for positive and
 negative beta_R, each with its own prior (std 15 % of the config value, at least 0.05:
 ``rudder`` of :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`).  A real ship's two differ (the MMG

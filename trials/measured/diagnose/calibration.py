@@ -1,10 +1,10 @@
-"""Calibration of the naming floors of ``mmg diagnose`` (:mod:`trials.measured.decision`) from the
+"""Calibration of the naming floors of ``mmg diagnose`` (:mod:`trials.measured.diagnose.decision`) from the
 diagnoses of clean records, and of records with effects, of ships that differ from the config as
 real ships do (:mod:`trials.measured.mismatch`; the records of ``bench/bench_diagnose.py --mismatch``,
 each with its ``truth`` and every search round's candidate statistics).
 
 For every clean record the first search round tries each candidate on top of the fitted ship; its
-*clean magnitude* is the candidate's :func:`~trials.measured.decision.magnitude` where its dBIC and
+*clean magnitude* is the candidate's :func:`~trials.measured.diagnose.decision.magnitude` where its dBIC and
 z clear their thresholds (it would be named but for the floor), else 0.  Where they do not clear,
 the magnitude says nothing: a rudder offset on a turning circle wanders to its 10 deg bound at z 1.
 
@@ -69,7 +69,7 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
     round of a record with effects right after its true effects were named (a wind named, what does
     the ship's mismatch lend a shallow-water candidate on top of it).  Before the true effects are
     in, the other candidates soak up theirs (a current takes a heading bias on a zigzag): that is
-    the confusion :mod:`trials.measured.identifiability` reports, not the ship's mismatch.
+    the confusion :mod:`trials.measured.diagnose.identifiability` reports, not the ship's mismatch.
 
     ``hidden`` ({kind: {effect: floor}}, :func:`hidden_effects`, or {kind: set of effects}): effects
     that cannot be named on that kind of record (a rudder offset on one turning circle).  A record's
@@ -171,10 +171,10 @@ def only_kind(rec: dict, kind: str):
 
 def hidden_effects(fl: dict, L: float) -> dict:
     """{kind: {effect: floor}} of the effects whose floor on that kind of record exceeds the size worth detecting
-    (:data:`trials.measured.identifiability.DETECTION_SIZE`): at the sizes worth detecting they are
+    (:data:`trials.measured.diagnose.identifiability.DETECTION_SIZE`): at the sizes worth detecting they are
     not named there, only reported ``not_identifiable``.  A current judged by its parts along and
     across the heading (on zigzags) is hidden only where the smaller part's floor exceeds it
-    (:func:`~trials.measured.decision.least_floor`)."""
+    (:func:`~trials.measured.diagnose.decision.least_floor`)."""
     from .decision import least_floor
     from .identifiability import detection_size, floor_in_fit_unit
 
@@ -200,7 +200,7 @@ in a 35 deg turn, are fitted far worse than the rest: the maximum would be their
 
 def residual_floors(records) -> dict:
     """{kind: {channel: floor}} of the residual RMS after the fit on the clean records: u, v over the
-    speed, r as r L / U, heading [deg] (:func:`trials.measured.decision.residual_floor`)."""
+    speed, r as r L / U, heading [deg] (:func:`trials.measured.diagnose.decision.residual_floor`)."""
     import math
 
     vals: dict = {}
@@ -292,7 +292,7 @@ def merge_kinds(old: dict, new: dict, kinds) -> dict:
 
 def short_of_name(records, L: float) -> tuple[int, int]:
     """(clean records whose first round has a candidate with evidence short of a name, clean records):
-    :func:`~trials.measured.decision.evidence_short` with its size over the packaged floor, which
+    :func:`~trials.measured.diagnose.decision.evidence_short` with its size over the packaged floor, which
     ``mmg diagnose`` reports ``not_identifiable`` (:func:`trials.measured.diagnose.weak_evidence`).
 
     The first round, where ``weak_evidence`` reads the last: the calibration runs are made without

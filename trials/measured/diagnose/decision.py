@@ -17,7 +17,7 @@ An effect is named when three tests hold:
    are large.  The floors bound the sizes the candidates took on clean records of a family of
    ships that differ from the config as real ships do (:mod:`trials.measured.mismatch`; hull
    linear terms +-10 %, nonlinear +-25 %, rudder and propeller constants +-15 %, other wind-load
-   factors, another hull form): :func:`trials.measured.calibration.calibrate` (its module docstring
+   factors, another hull form): :func:`trials.measured.diagnose.calibration.calibrate` (its module docstring
    gives the rule) sets them and ``bench/calibrate_diagnose.py`` writes them, with their sources
    and the clean samples, to the packaged
    ``configs/calibration/diagnose.yaml``.  On a zigzag a current is judged by its components along
@@ -61,13 +61,13 @@ KIND_FALLBACK = {"turn_drift": "turn"}
 """The kind whose calibration stands in where a calibration file has none for a kind."""
 STATISTICAL_REASON = "its standard error and correlation"
 """The ``reason`` of a ``not_identifiable`` entry reported for its statistics (its standard error could
-not have shown the size to detect: :func:`trials.measured.identifiability.verdict`), as against its
+not have shown the size to detect: :func:`trials.measured.diagnose.identifiability.verdict`), as against its
 calibrated floor, its evidence or too little information."""
 
 REASON_KINDS = ("statistics", "floor", "evidence", "information", "rival", "straight_run", "coefficients")
 """The kinds of ``not_identifiable`` reasons, each entry's ``reason_kind``: its standard error and
 confounding (:data:`STATISTICAL_REASON`), the calibrated floor (the ship's own mismatch lends it as much),
-evidence short of a name, too little information (:func:`trials.measured.identifiability.verdict`,
+evidence short of a name, too little information (:func:`trials.measured.diagnose.identifiability.verdict`,
 :func:`trials.measured.diagnose.within_mismatch`, :func:`trials.measured.diagnose.weak_evidence`), and a
 name withheld because another candidate with as much evidence takes its evidence away
 (:func:`trials.measured.diagnose.withheld`), or whose fit the record's straight run contradicts

@@ -33,7 +33,7 @@ candidate whose dBIC showed some evidence, short of a name, while its precision 
 (:func:`trials.measured.diagnose.weak_evidence`), and one whose evidence and precision passed but
 whose size the calibrated floor stopped (:func:`trials.measured.diagnose.within_mismatch`).  Each
 entry's ``reason`` says why in words and figures, its ``reason_kind`` which rule it was
-(:data:`trials.measured.decision.REASON_KINDS`: statistics, floor, evidence, information, and rival
+(:data:`trials.measured.diagnose.decision.REASON_KINDS`: statistics, floor, evidence, information, and rival
 for a name withheld beside a rival, :func:`trials.measured.diagnose.withheld`).
 
 ``what_would_separate``: the information of candidate additional trials (the mirror of a turn,
@@ -90,8 +90,8 @@ def detection_size(effect: str, L: float) -> float:
 
 
 def floor_in_fit_unit(effect: str, fl: float, L: float) -> float:
-    """A calibrated floor (:func:`trials.measured.decision.floor`, in the unit of
-    :func:`~trials.measured.decision.magnitude`: a current's speed over sqrt(g L)) in the unit of
+    """A calibrated floor (:func:`trials.measured.diagnose.decision.floor`, in the unit of
+    :func:`~trials.measured.diagnose.decision.magnitude`: a current's speed over sqrt(g L)) in the unit of
     :func:`detection_size` (the effect's fit parameters: m/s for a current), for a ship of length ``L`` [m]."""
     _, unit = _size_of(effect)
     return fl * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else fl
@@ -298,7 +298,7 @@ def identifiability_line(row: dict, R: float, sd_unit: str, det_unit: str, parti
     """The console line of one candidate's identifiability ``row`` (keys ``effect``, ``std``,
     ``std_conditional``, ``detection_size``, ``confused_with``): R, its sd in ``sd_unit`` (the fit
     parameter's) and its detection size in ``det_unit``, a size in a ship-relative unit with its SI value
-    beside it (:func:`trials.measured.diagnose_report.size_with_unit`, ``particulars``' L and T [m])."""
+    beside it (:func:`trials.measured.diagnose.report.size_with_unit`, ``particulars``' L and T [m])."""
     sp = _sp(sd_unit)
     det = size_with_unit(row["detection_size"], det_unit, particulars.L, particulars.T)
     return (f"identifiability of {row['effect']}: R {R:.3f}, sd {row['std']:.3g}{sp} (alone "
@@ -422,7 +422,7 @@ def verdict(b: dict, det: float, fl: float, weak_why: str | None, unit: str, det
         the first that holds: :data:`STATISTICAL_REASON` (its std could not have shown ``det`` and
         confounding is why), the floor (the ship's own mismatch lends it more than ``det``), ``weak_why``,
         too little information (its std could not have shown ``det``, confounded or not); None: not
-        reported; and that reason's kind (:data:`~trials.measured.decision.REASON_KINDS`: "statistics",
+        reported; and that reason's kind (:data:`~trials.measured.diagnose.decision.REASON_KINDS`: "statistics",
         "floor", "evidence", "information"; None with it).
     """
     from .decision import Z_THRESHOLD
@@ -449,7 +449,7 @@ def _name(f) -> str:
 
 def not_identifiable_lines(entries) -> list[str]:
     """One console line per ``not_identifiable`` entry
-    (:func:`trials.measured.diagnose_report.not_identifiable_line`, the one the console prints)."""
+    (:func:`trials.measured.diagnose.report.not_identifiable_line`, the one the console prints)."""
     from .report import not_identifiable_line
 
     return [not_identifiable_line(e) for e in entries]

@@ -9,7 +9,7 @@ is reported ``model_form_mismatch`` instead of named (:func:`effect_form`) when
    the effect without saying whether it is there (the fit parameters not among
    :meth:`mmg.effects.Effect.presence_parameters`, e.g. the wind's ``sway_factor`` and ``yaw_factor``)
    lies within ``bound_tolerance`` of its range from a bound of that range, and more than
-   :data:`~trials.measured.decision.Z_THRESHOLD` of its standard errors from its neutral value (the
+   :data:`~trials.measured.diagnose.decision.Z_THRESHOLD` of its standard errors from its neutral value (the
    published curve's 1): the records ask for a load of a form the effect cannot follow, and the bound
    stopped it.  A shape the records do not pin (z at most that) merely wandered to its bound along a
    direction they do not resolve (a zigzag sees the wind from a narrow band of angles), which says
@@ -40,7 +40,7 @@ STATUS = "model_form_mismatch"
 
 def rules(cal: dict | None = None) -> dict:
     """``{"bound_tolerance": float or None, "plausible": {effect: {parameter: (lo, hi)}}}`` from the
-    calibration's ``model_form`` section (``cal``, or :func:`trials.measured.decision.calibration`);
+    calibration's ``model_form`` section (``cal``, or :func:`trials.measured.diagnose.decision.calibration`);
     empty ones where it has none."""
     sec = ((calibration() if cal is None else cal) or {}).get("model_form") or {}
     tol = (sec.get("bound_tolerance") or {}).get("value")

@@ -10,7 +10,7 @@ behind it, and the console lines (units, three significant figures, a legend for
   includes 0).  Other parameters: the fitted value +- 1.96 standard errors in the fitted parameter,
   mapped to the named one (a monotone map, e.g. T/H -> H/T), clipped to the parameter's bounds.
 * :func:`effect_evidence`: dBIC and z of the round in which the effect was named, and
-  the calibrated :func:`~trials.measured.decision.false_alarm_probability` at its magnitude.
+  the calibrated :func:`~trials.measured.diagnose.decision.false_alarm_probability` at its magnitude.
 * :func:`summary_lines`: the console text of a :class:`trials.measured.diagnose.Diagnosis`.
 """
 from __future__ import annotations

@@ -30,7 +30,7 @@ CHANNELS = ("u", "v", "r", "heading", "position")
 
 def absent_table(recs) -> list:
     """``[{"record", "channel", "column", "compared_instead"}]``: the residual channels each record does not log
-    (:func:`trials.measured.diagnose_records.absent_channels`)."""
+    (:func:`trials.measured.diagnose.records.absent_channels`)."""
     return [{"record": r.name, "channel": c, **a} for r in recs for c, a in getattr(r, "absent", {}).items()]
 
 
@@ -58,8 +58,8 @@ def model_form_mismatch(free, theta) -> dict:
 def _describe(recs, diffs, noise, rms_after, L: float | None = None, kind: str | None = None) -> tuple[bool, str, dict]:
     """Unexplained flag, description and per-channel ratio residual / noise: a channel is unexplained
     when its residual is above :data:`UNEXPLAINED_FACTOR` times its noise *and* above what the ship's
-    own mismatch leaves (:func:`trials.measured.decision.residual_floor`, with the ship length ``L``
-    and the kind of record set, :func:`~trials.measured.decision.record_kind` when not given)."""
+    own mismatch leaves (:func:`trials.measured.diagnose.decision.residual_floor`, with the ship length ``L``
+    and the kind of record set, :func:`~trials.measured.diagnose.decision.record_kind` when not given)."""
     D = np.vstack(diffs)
     M = np.vstack([r.seg.meas for r in recs])
     delta = np.concatenate([r.seg.inputs.delta for r in recs])
@@ -130,13 +130,13 @@ class Diagnosis:
     """The ship's values as written to ``--out-ship``, by fit name in the fit's units (:mod:`mmg.parameters`;
     :attr:`ship_values` has them under the config's keys)."""
     intervals_95: dict = field(default_factory=dict)
-    """{effect: {parameter: [lo, hi] or "any"}} (:func:`trials.measured.diagnose_report.effect_intervals`)."""
+    """{effect: {parameter: [lo, hi] or "any"}} (:func:`trials.measured.diagnose.report.effect_intervals`)."""
     evidence: dict = field(default_factory=dict)
-    """{effect: {"delta_bic", "z", "false_alarm_probability"}} (:func:`~trials.measured.diagnose_report.effect_evidence`)."""
+    """{effect: {"delta_bic", "z", "false_alarm_probability"}} (:func:`~trials.measured.diagnose.report.effect_evidence`)."""
     not_identifiable: list = field(default_factory=list)
     """[{"effect", "confused_with", "correlation", "what_would_separate"}]: effects these records cannot separate."""
     identifiability: list = field(default_factory=list)
-    """Every candidate's correlation with the rest, std and detection size (:mod:`trials.measured.identifiability`)."""
+    """Every candidate's correlation with the rest, std and detection size (:mod:`trials.measured.diagnose.identifiability`)."""
     model_form_mismatch: dict = field(default_factory=dict)
     """Ship coefficients the fit took far outside their priors (which, how far): :func:`model_form_mismatch`."""
     ship_fit: list = field(default_factory=list)
@@ -159,7 +159,7 @@ class Diagnosis:
         return {**out, **{e: "named" for e in self.named}}
 
     def summary_lines(self) -> list:
-        """The console text (:func:`trials.measured.diagnose_report.summary_lines`)."""
+        """The console text (:func:`trials.measured.diagnose.report.summary_lines`)."""
         from .report import summary_lines
 
         return summary_lines(self)

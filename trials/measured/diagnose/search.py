@@ -107,7 +107,7 @@ def _retry_from_current(fitter, cls, dbic: float, z: float, vals: dict) -> bool:
 
 def straight_contradicts(before, after) -> bool:
     """Whether a model leaves some record's straight run (:class:`ekf.identify.StraightRun`) more than
-    :data:`~trials.measured.decision.Z_THRESHOLD` of its standard errors off, and further off than the
+    :data:`~trials.measured.diagnose.decision.Z_THRESHOLD` of its standard errors off, and further off than the
     model it was tested against: the straight run reads a heading bias plus a current's cross part
     directly, so an effect whose fit it contradicts is asked for by the rest of the record (the
     ship's own mismatch on a turn), not by itself.  (Fresh family seed 21000: a 0.5 deg rudder offset
@@ -133,7 +133,7 @@ def _nested_start(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions, f
 
 def _parts(fitter, name: str, values: dict) -> dict:
     """``{"parts": {part: [size, floor]}}`` of a candidate judged by its parts (a current on a
-    zigzag: :func:`~trials.measured.decision.floor_parts`), else ``{}``."""
+    zigzag: :func:`~trials.measured.diagnose.decision.floor_parts`), else ``{}``."""
     p = floor_parts(name, values, fitter.ship.particulars.L, fitter.kind, fitter.heading)
     return {"parts": {k: list(v) for k, v in p.items()}} if p else {}
 
@@ -198,7 +198,7 @@ def _polish(fitter, current, o: DiagnoseOptions):
 
 def _rival(results, r):
     """The candidate of the round's ``results`` that did not clear the naming tests though its dBIC
-    cleared the threshold and is within :data:`~trials.measured.decision.WEAK_BIC` of ``r``'s or above
+    cleared the threshold and is within :data:`~trials.measured.diagnose.decision.WEAK_BIC` of ``r``'s or above
     (the most evidence of such), or None: the records hold as much evidence for it as for ``r``."""
     rivals = [x for x in results if not x[1] and x[0] > decision.BIC_THRESHOLD and x[0] > r[0] - WEAK_BIC]
     return max(rivals, key=lambda x: x[0]) if rivals else None
@@ -272,7 +272,7 @@ def _prune(fitter, current, named, rounds, ns: int, o: DiagnoseOptions, say):
 
 def _confounding(model: _Model, effect) -> float:
     """R: the multiple correlation of the effect's presence parameters with every other fitted one
-    (:func:`trials.measured.identifiability.block_confounding` of the fit's covariance); NaN where
+    (:func:`trials.measured.diagnose.identifiability.block_confounding` of the fit's covariance); NaN where
     the covariance is not finite."""
     from .identifiability import block_confounding
 

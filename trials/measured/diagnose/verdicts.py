@@ -15,7 +15,7 @@ __all__ = ["verdicts", "to_demote", "withheld", "rivals_withheld", "weak_evidenc
 
 
 def to_demote(table) -> list:
-    """The named effects of an identifiability ``table`` (:func:`trials.measured.identifiability.assess`)
+    """The named effects of an identifiability ``table`` (:func:`trials.measured.diagnose.identifiability.assess`)
     that :func:`_demote` takes out: the statistics reason holds for them and their calibrated floor is
     above their detection size."""
     return [t["effect"] for t in table if t["named"] and t.get("reason_kind") == "statistics"
@@ -25,7 +25,7 @@ def to_demote(table) -> list:
 def _demote(fitter, current, named, demote, rounds, o: DiagnoseOptions, say):
     """The model without the named effects in ``demote`` (refitted from where it was): names the records
     cannot separate from the ship's own coefficients (the statistics reason of
-    :func:`trials.measured.identifiability.verdict`: its marginal sd could not have shown its detection
+    :func:`trials.measured.diagnose.identifiability.verdict`: its marginal sd could not have shown its detection
     size, and confounding is why) on a kind of record whose calibrated floor for it is above that size
     (the ship's own mismatch lends it more than matters), which the issue asks to be reported
     ``not_identifiable`` rather than named as a guess (fresh family seeds 19000 and 23000: a 1.5 deg
@@ -47,7 +47,7 @@ def _demote(fitter, current, named, demote, rounds, o: DiagnoseOptions, say):
 
 def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()):
     """(not_identifiable entries, every candidate's figures): a candidate whose name was withheld beside
-    its rival (:func:`withheld`), :func:`trials.measured.identifiability.assess`, a candidate of the last
+    its rival (:func:`withheld`), :func:`trials.measured.diagnose.identifiability.assess`, a candidate of the last
     round whose dBIC and z cleared but whose size did not clear its calibrated floor
     (:func:`within_mismatch`), one with evidence short of a name (:func:`weak_evidence`), and a rival
     nothing else reports (:func:`rivals_withheld`); one entry per effect, none for a named one."""
@@ -98,7 +98,7 @@ def _rival_entry(effect: str, other: str, reason: str) -> dict:
 
 def weak_evidence(rounds) -> dict:
     """``{effect: reason}`` for the last round's candidates with some evidence that did not reach a
-    name (:func:`~trials.measured.decision.evidence_short`) with a size over the calibrated floor
+    name (:func:`~trials.measured.diagnose.decision.evidence_short`) with a size over the calibrated floor
     (the size and precision tests a name needs pass; only the evidence falls short).  Such an effect
     may be there; dropping it silently would report a clean record.  How often a clean record of the
     calibration runs has one: ``bench/calibrate_diagnose.py`` prints it."""
@@ -116,7 +116,7 @@ def weak_evidence(rounds) -> dict:
 def _over_floor(c: dict) -> bool:
     """Whether a stored candidate's size cleared its floor: a part over its own floor where it was
     judged by its parts (:func:`_parts`), else its size over its floor (the rule of
-    :func:`~trials.measured.decision.clears_floor`, on the figures the round kept)."""
+    :func:`~trials.measured.diagnose.decision.clears_floor`, on the figures the round kept)."""
     return over_floor(c["magnitude"], c.get("floor") or 0.0, c.get("parts"))
 
 
