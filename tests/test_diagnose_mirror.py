@@ -209,7 +209,7 @@ def _signed_parts(real):
 
 
 @pytest.mark.parametrize("case, module, name, mutate", [
-    ("rudder_offset", "trials.measured.diagnose", "clears_floor", _floor_on_starboard_offsets),
+    ("rudder_offset", "trials.measured.diagnose.search", "clears_floor", _floor_on_starboard_offsets),
     ("current", "trials.measured.decision", "over_floor", _signed_parts),
 ])
 def test_mirror_check_catches_a_one_handed_rule(config, truth, tmp_path, monkeypatch, case, module, name, mutate):
