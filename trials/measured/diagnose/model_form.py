@@ -32,7 +32,7 @@ import math
 
 from .decision import Z_THRESHOLD, calibration
 
-__all__ = ["STATUS", "rules", "shape_parameters", "effect_form", "reclassify", "form_line"]
+__all__ = ["STATUS", "rules", "shape_parameters", "effect_form", "reclassify"]
 
 STATUS = "model_form_mismatch"
 """The status of an effect reported for its form (:attr:`trials.measured.diagnose.Diagnosis.effect_status`)."""
@@ -135,14 +135,3 @@ def reclassify(diag, rule: dict | None = None) -> tuple:
             for key in ("parameters", "standard_errors", "intervals_95", "evidence")}
     return replace(diag, named=[e for e in diag.named if e not in moved],
                    model_form_effects=list(diag.model_form_effects) + out, **keep), out
-
-
-def form_line(ent: dict) -> str:
-    """The one console line of a ``model_form_mismatch`` entry: ``wind: model_form_mismatch, not named
-    (scale 5.4 outside the plausible 0.333-3; ...): ...``."""
-    from .report import format_values
-
-    ship = ent.get("ship_coefficients") or []
-    beside = f"; ship coefficients beyond their priors in the same fit: {', '.join(ship)}" if ship else ""
-    return (f"{ent['effect']}: {STATUS}, not named (fitted {format_values(ent['effect'], ent.get('parameters') or {})}; "
-            f"{ent['reason']}{beside})")

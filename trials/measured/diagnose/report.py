@@ -23,7 +23,7 @@ from .decision import false_alarm_probability  # noqa: F401  (re-exported: the r
 
 __all__ = ["Z95", "effect_estimate", "effect_intervals", "polar_interval", "effect_evidence",
            "summary_lines", "not_identifiable_line", "fmt3", "format_rms", "format_values", "channel_text",
-           "straight_run_line", "size_in_si", "size_with_unit", "round_header", "IDENTIFIABILITY_LEGEND"]
+           "straight_run_line", "size_in_si", "size_with_unit", "round_header", "IDENTIFIABILITY_LEGEND", "form_line"]
 
 Z95 = 1.959963984540054
 """The two-sided 95 % point of the standard normal."""
@@ -334,7 +334,7 @@ def not_identifiable_line(ni: dict) -> str:
 def summary_lines(diag) -> list[str]:
     """The console text of a :class:`trials.measured.diagnose.Diagnosis`: a line per named effect
     (:func:`effect_line`), one per effect reported ``model_form_mismatch``
-    (:func:`~.model_form.form_line`), the statistics' legend, a line per effect that cannot be told apart, the
+    (:func:`form_line`), the statistics' legend, a line per effect that cannot be told apart, the
     residual RMS per channel (config, ship fitted, with the named effects), ``unexplained`` when set."""
     from .decision import BIC_THRESHOLD, Z_THRESHOLD
 
@@ -344,8 +344,6 @@ def summary_lines(diag) -> list[str]:
                                  (diag.evidence or {}).get(e, {})))
     if not diag.named:
         lines.append("nothing named")
-    from .model_form import form_line
-
     lines += [form_line(x) for x in getattr(diag, "model_form_effects", None) or []]
     lines.append(f"  (dBIC: information gain with the effect, named above {BIC_THRESHOLD:g}; z: the fit's distance from "
                  f"no effect in standard errors, named above {Z_THRESHOLD:g}; false-alarm p: chance of naming it at "
@@ -403,3 +401,12 @@ def channel_text(channel: str, rms_si: float, noise_si: float, mean_si: float | 
         else "no measurable noise"
     mean = "" if mean_si is None else f", mean {fmt3(f(mean_si))} {unit}"
     return f"{channel} residual {fmt3(f(rms_si))} {unit} RMS ({nz}{mean})"
+
+
+def form_line(ent: dict) -> str:
+    """The one console line of a ``model_form_mismatch`` entry: ``wind: model_form_mismatch, not named
+    (scale 5.4 outside the plausible 0.333-3; ...): ...``."""
+    ship = ent.get("ship_coefficients") or []
+    beside = f"; ship coefficients beyond their priors in the same fit: {', '.join(ship)}" if ship else ""
+    return (f"{ent['effect']}: {ent['status']}, not named (fitted {format_values(ent['effect'], ent.get('parameters') or {})}; "
+            f"{ent['reason']}{beside})")
