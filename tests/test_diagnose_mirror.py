@@ -223,3 +223,28 @@ def test_mirror_check_catches_a_one_handed_rule(config, truth, tmp_path, monkeyp
     bad = mirror_mismatch(d, dm)
     assert bad and bad[0].startswith("named"), bad
     assert (case in d.named) != (case in dm.named), (d.named, dm.named)
+
+
+def test_diagnose_reports_a_wind_outside_the_plausible_range_as_model_form_mismatch(config, truth, tmp_path,
+                                                                                     monkeypatch):
+    """The model-form rule acts inside :func:`~trials.measured.diagnose.diagnose`: the same wind record
+    names the wind with the packaged rule, and with a plausible scale range that excludes the fitted scale
+    (here 5-10, the writer's loads being the config's, scale about 1) the wind leaves the named effects
+    for ``model_form_mismatch``, its values kept in its entry and said in one console line."""
+    from trials.measured.diagnose import diagnose, model_form
+
+    frame = W.log(truth, _sim(truth, "zigzag", EFFECTS["wind"]), seed=7, **EFFECTS["wind"])
+    path = tmp_path / "wind.csv"
+    frame.to_csv(path, index=False)
+    plain = diagnose(config, [path], stride=STRIDE)
+    assert "wind" in plain.named and plain.model_form_effects == []
+    monkeypatch.setattr(model_form, "rules", lambda cal=None: {"bound_tolerance": None,
+                                                               "plausible": {"wind": {"scale": (5.0, 10.0)}}})
+    said = []
+    d = diagnose(config, [path], stride=STRIDE, say=said.append)
+    assert "wind" not in d.named and "wind" not in d.parameters
+    (ent,) = d.model_form_effects
+    assert ent["effect"] == "wind" and ent["parameters"]["scale"] == pytest.approx(plain.parameters["wind"]["scale"])
+    assert d.to_json()["effect_status"]["wind"] == "model_form_mismatch"
+    assert sum("model_form_mismatch, not named" in m for m in said) == 1
+    assert sum("model_form_mismatch, not named" in ln for ln in d.summary_lines()) == 1
