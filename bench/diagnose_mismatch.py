@@ -294,9 +294,12 @@ def record_class(r: dict) -> tuple[str, str, str]:
 
 
 def true_sizes(r: dict) -> dict:
-    """{effect: size} of a record's truth (current and wind [m/s], bias and offset [deg], magnitudes)."""
+    """{effect: size} of a record's truth at full scale (current and wind [m/s], bias and offset [deg],
+    magnitudes): a model-scale record's speeds (``froude_scale`` lambda > 1) times sqrt(lambda)."""
     key = {"current": "speed_mps", "wind": "speed_mps", "heading_bias": "bias_deg", "rudder_offset": "offset_deg"}
-    return {e: abs(float(v[key[e]])) for e, v in r["truth"].items() if e in key}
+    speed = math.sqrt(float(r.get("froude_scale", 1.0)))
+    return {e: abs(float(v[key[e]])) * (speed if key[e] == "speed_mps" else 1.0)
+            for e, v in r["truth"].items() if e in key}
 
 
 def class_figures(rows: list) -> dict:

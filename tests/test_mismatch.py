@@ -207,3 +207,22 @@ def test_class_figures_count_by_the_records_truth():
     assert dm.record_class(rows[0]) == ("port", "zigzag", "6-9 kn")
     assert dm.record_class(rows[3]) == ("starboard", "turn", "9-12 kn")
     assert dm.record_class(row("zz10", None, {}, [], 15.0))[2] == "12-15 kn"
+
+
+def test_class_figures_read_a_model_scale_truth_at_full_scale():
+    """A Froude-scaled record (lambda = 45.7) holds its current at model scale: 0.03 m/s there is
+    0.03 sqrt(45.7) = 0.203 m/s at full scale, above the 0.15 m/s counted; 0.02 (0.135 full) is under it;
+    an angle (a bias) is the same at either scale."""
+    import sys
+
+    sys.path.insert(0, str(REPO / "bench"))
+    import diagnose_mismatch as dm
+
+    lam = 45.7
+    rows = [{"trial": "zz20", "effect": "current", "truth": {"current": {"speed_mps": c}}, "named": ["current"],
+             "speed_kn": 10.0, "froude_scale": lam} for c in (0.03, 0.02)]
+    rows.append({"trial": "zz20", "effect": "heading_bias", "truth": {"heading_bias": {"bias_deg": 1.2}},
+                 "named": [], "speed_kn": 10.0, "froude_scale": lam})
+    assert dm.true_sizes(rows[0])["current"] == pytest.approx(0.03 * lam ** 0.5)
+    f = dm.class_figures(rows)
+    assert f["current"] == [1, 1] and f["heading_bias"] == [0, 1]
