@@ -18,7 +18,7 @@ from .report import fmt3, format_rms
 from .statistics import _chi2, _delta_bic, _rms, _scaled_rss, _stack, _taus
 
 __all__ = ["SHIP_FREE_TERMS", "TURN_HULL_TERMS", "DRIFT_KIND", "CONSTANTS_FREE", "TURN_CONSTANTS_FREE",
-           "ZIGZAG_CONSTANTS_FREE", "MASS_FREE", "LINEAR_TERMS", "RESISTANCE_TERMS", "DRIFT_FALL_MIN",
+           "ZIGZAG_CONSTANTS_FREE", "MASS_FREE", "LINEAR_TERMS", "DRIFT_FALL_MIN",
            "fit_baseline"]
 
 
@@ -94,11 +94,8 @@ the turn, sway and yaw lag) that an effect would otherwise take."""
 
 LINEAR_TERMS = ("beta", "r", "v")
 """Hull terms whose coefficients take the ``hull`` (linear) width of
-:data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`."""
-
-
-RESISTANCE_TERMS = ("cos(beta)^2", "u^2")
-"""Hull terms that take its ``resistance`` width; every other freed hull term its ``hull_nonlinear``."""
+:data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`; the straight-ahead resistance (:func:`mmg.terms.is_resistance`)
+takes its ``resistance`` width, every other freed hull term its ``hull_nonlinear`` one."""
 
 
 def _baseline_prior(f, term):
@@ -108,8 +105,7 @@ def _baseline_prior(f, term):
     from ekf.identify import DIAGNOSIS_PRIOR_REL_STD as P
 
     if f.kind == "hull":
-        resistance = term in RESISTANCE_TERMS or is_resistance(f.name, term)
-        fam = "hull" if term in LINEAR_TERMS else "resistance" if resistance else "hull_nonlinear"
+        fam = "hull" if term in LINEAR_TERMS else "resistance" if is_resistance(f.name, term) else "hull_nonlinear"
         lo, hi = (0.0, np.inf) if f.prior > 0 else (-np.inf, 0.0) if f.prior < 0 else (f.lower, f.upper)
         return replace(f, sigma=max(P[fam] * abs(f.prior), P["hull_floor"]), lower=max(lo, f.lower),
                        upper=min(hi, f.upper))
