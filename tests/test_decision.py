@@ -111,6 +111,30 @@ def test_a_named_calibration_file_that_is_not_there_is_refused(tmp_path, monkeyp
         assert not out.exists()
 
 
+def test_a_calibration_file_with_a_malformed_model_form_section_is_refused_before_any_work(tmp_path, monkeypatch):
+    """A calibration file (MMG_DIAGNOSE_CALIBRATION) whose ``model_form`` ranges are not [lo, hi]: one line
+    naming the file and the section, raised before a record is read (a missing record is not reached)."""
+    from mmg import load_ship, ship_path
+    from mmg.errors import InputError
+    from trials.measured.diagnose import decision, diagnose
+
+    for body in ("floors: {}\nmodel_form:\n  plausible:\n    wind:\n      scale: {range: [3]}\n",
+                 "floors: {}\nmodel_form:\n  plausible:\n    wind:\n      scale: {range: [3, 0.3]}\n",
+                 "floors: {}\nmodel_form:\n  bound_tolerance: {value: one}\n"):
+        bad = tmp_path / "cal.yaml"
+        bad.write_text(body)
+        monkeypatch.setenv("MMG_DIAGNOSE_CALIBRATION", str(bad))
+        decision.calibration.cache_clear()
+        try:
+            with pytest.raises(InputError) as e:
+                diagnose(load_ship(ship_path("esso_osaka")), [tmp_path / "absent.csv"])
+        finally:
+            monkeypatch.delenv("MMG_DIAGNOSE_CALIBRATION")
+            decision.calibration.cache_clear()
+        msg = str(e.value)
+        assert str(bad) in msg and "model_form" in msg and "\n" not in msg, msg
+
+
 def test_current_components_plain_formulas():
     """Along and across a heading: a current setting east seen from a ship heading north is all across
     (to starboard); from a ship heading east all along; speeds over sqrt(gL)."""

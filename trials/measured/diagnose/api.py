@@ -16,7 +16,7 @@ from .decision import calibration, mean_heading, record_kind
 from .fit import _Fitter
 from .options import DiagnoseOptions
 from .records import noise_level, prepare
-from .model_form import reclassify
+from . import model_form
 from .result import Diagnosis, _diagnosis
 from .search import _candidates, search
 from .verdicts import verdicts
@@ -52,6 +52,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     o = DiagnoseOptions(**kwargs) if options is None else replace(options, **kwargs)
     say = o.say or (lambda m: None)
     calibration()                               # a bad calibration file: refused before any work
+    form_rule = model_form.rules()
     recs = prepare(ship, items, wind=o.wind, segment_s=o.segment_s)
     if not recs:
         raise InputError("diagnose", "", "no record")
@@ -66,7 +67,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     current, named, ni, table = verdicts(s.fitter, s.current, s.named, s.fitted, s.covered, s.rounds, o, say)
     res = _diagnosis(s.fitter, (d_config, base, kept), (current, named, s.rounds), (s.fitted, cand_log), (ni, table),
                      noise)
-    res, moved = reclassify(res)                # a named effect whose fit stands for the model's form
+    res, moved = model_form.reclassify(res, form_rule)                # a named effect whose fit stands for the model's form
     for ent in moved:
         say(f"{ent['effect']}: {ent['status']}, not named: {ent['reason']}")
     runs = diagnose_each(ship, recs, o, progress=o.say is not None) if o.per_run and len(recs) > 1 else []

@@ -42,11 +42,28 @@ def rules(cal: dict | None = None) -> dict:
     """``{"bound_tolerance": float or None, "plausible": {effect: {parameter: (lo, hi)}}}`` from the
     calibration's ``model_form`` section (``cal``, or :func:`trials.measured.diagnose.decision.calibration`);
     empty ones where it has none."""
+    import os
+
+    from mmg.errors import InputError
+
     sec = ((calibration() if cal is None else cal) or {}).get("model_form") or {}
-    tol = (sec.get("bound_tolerance") or {}).get("value")
-    plaus = {e: {p: tuple(float(x) for x in d["range"]) for p, d in (ps or {}).items()}
-             for e, ps in (sec.get("plausible") or {}).items()}
-    return {"bound_tolerance": None if tol is None else float(tol), "plausible": plaus}
+    try:
+        tol = (sec.get("bound_tolerance") or {}).get("value")
+        plaus = {e: {p: _range(d["range"]) for p, d in (ps or {}).items()}
+                 for e, ps in (sec.get("plausible") or {}).items()}
+        return {"bound_tolerance": None if tol is None else float(tol), "plausible": plaus}
+    except (AttributeError, KeyError, TypeError, ValueError) as e:
+        src = os.environ.get("MMG_DIAGNOSE_CALIBRATION") or "configs/calibration/diagnose.yaml"
+        raise InputError(src, "model_form", "expected bound_tolerance: {value: fraction} and plausible: "
+                         f"{{effect: {{parameter: {{range: [lo, hi]}}}}}} ({type(e).__name__}: {e})") from None
+
+
+def _range(r) -> tuple:
+    """A plausible range ``[lo, hi]`` as two floats, lo <= hi."""
+    lo, hi = (float(x) for x in r)
+    if not lo <= hi:
+        raise ValueError(f"range {r}: lo above hi")
+    return lo, hi
 
 
 def shape_parameters(cls) -> list:
