@@ -97,6 +97,9 @@ def _refuse_bad_options(ap, a) -> None:
         ap.error("--ship: the config of --mismatch runs; give --mismatch with it")
     if a.summarise and not a.mismatch:
         ap.error("--summarise: summarises --mismatch runs; give --mismatch with it")
+    missing = [f for f in a.summarise or () if not Path(f).is_file()]
+    if missing:
+        ap.error(f"--summarise: no such run file: {missing[0]}")
     if a.summarise and (a.only or a.max_nfev is not None or a.trials is not None):
         ap.error("--summarise: reads runs already made; --only, --max-nfev and --trials are not used with it")
     if a.wide and (not a.mismatch or a.trials is not None or a.summarise):
