@@ -35,7 +35,7 @@ REPO = Path(__file__).resolve().parents[1]
 def setup(name: str):
     """(model call, reference call, number of steps) of a bundled trial."""
     trial = load_trial(REPO / "configs" / "trials" / f"{name}.yaml")
-    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances)
+    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.effects)
     check_ship(trial.ship, pk)
     law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
     nsteps = int(round(trial.duration / trial.dt))

@@ -99,8 +99,7 @@ def _newton(fun, z0, tol: float = 1e-13, max_iter: int = 50) -> np.ndarray:
     raise ValueError("the straight-run equations did not converge (no steady straight run at this speed)")
 
 
-def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = True,
-                 disturbance_slots: dict | None = None, effects=None) -> Equilibrium:
+def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = True, effects=None) -> Equilibrium:
     """Solve the steady straight run at surge speed ``u0`` [m/s].
 
     Parameters
@@ -112,8 +111,6 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
         Propeller revolutions [rps]; solved from the surge balance when None.
     trim : bool
         Solve the trim rudder and sway velocity that cancel Y_0, N_0 (else delta = v = 0).
-    disturbance_slots : dict, optional
-        Packed disturbance values (see :mod:`mmg.disturbances`).
     effects : mmg.effects.EffectSet, optional
         Effects in the packed ship (:meth:`mmg.effects.EffectSet.pack`): a rudder offset, shallow
         water, a steady wind (the approach is then the straight run in that wind at heading 0).
@@ -121,7 +118,7 @@ def straight_run(ship: Ship, u0: float, n: float | None = None, trim: bool = Tru
     power = engine_power(ship, u0) if ship.engine.mode == "constant_power" else 0.0
 
     def pack_all(sh):
-        pk = pack(sh, power, disturbance_slots)
+        pk = pack(sh, power)
         return pk if effects is None else effects.pack(pk, sh)
 
     pk = pack_all(ship)

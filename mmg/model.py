@@ -109,7 +109,7 @@ def _poly_table(rows) -> np.ndarray:
     return out
 
 
-def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: dict | None = None) -> PackedShip:
+def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0) -> PackedShip:
     """Pack a :class:`~mmg.ship.Ship` into arrays.
 
     Parameters
@@ -118,8 +118,6 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: 
     engine_power_W : float
         Delivered power P_0 [W] for a constant-power engine (from the approach
         condition, see :func:`mmg.equilibrium.engine_power`).
-    disturbance_slots : dict, optional
-        Parameter-vector index -> value, as written by :mod:`mmg.disturbances`.
     """
     pa, ms, pr, ru, st, en = ship.particulars, ship.mass, ship.propeller, ship.rudder, ship.steering, ship.engine
     p = np.zeros(N_PARAMS)
@@ -143,8 +141,6 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0, disturbance_slots: 
     p[P_ULOW] = LOW_SPEED_FROUDE * np.sqrt(G * pa.L)
     p[P_FQ_SCALE], p[P_FQ_BLEND], p[P_FQ_A:P_YP_ASTERN] = four_quadrant_slots(pr.K_T, pr.P_D)
     p[P_YP_ASTERN] = pr.Y_P_astern
-    for k, v in (disturbance_slots or {}).items():
-        p[k] = v
     poly = _poly_table([pr.K_T, pr.K_Q, pr.t_P, pr.w_P0])
     h = ship.hull
     return PackedShip(

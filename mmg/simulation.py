@@ -5,7 +5,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .disturbances import as_effects
 from .equilibrium import Equilibrium, straight_run, with_kq_scale
 from .integrate import CommandLaw, integrate
 from .model import STATE_NAMES, pack
@@ -48,26 +47,23 @@ class SimulationResult:
         return df
 
 
-def prepare(ship: Ship, u0: float, n0: float | None = None, trim: bool = True, disturbances=(), effects=None):
+def prepare(ship: Ship, u0: float, n0: float | None = None, trim: bool = True, effects=None):
     """Solve the straight run and pack the (K_Q-calibrated) ship; returns (packed, equilibrium).
 
     ``effects``: an :class:`mmg.effects.EffectSet` added to the ship's own (:attr:`mmg.ship.Ship.effects`;
-    a trial's ``effects:`` section); ``disturbances``: the alias, :mod:`mmg.disturbances` components
-    turned into the same effects (:func:`mmg.disturbances.as_effects`).  Measurement effects (a
-    heading bias) act on logs, not here."""
-    extra, slots = as_effects(disturbances)
-    es = ship.effect_set().merged(extra).merged(effects)
+    a trial's effects).  Measurement effects (a heading bias) act on logs, not here."""
+    es = ship.effect_set().merged(effects)
     es = es if es.items else None
-    eq = straight_run(ship, u0, n=n0, trim=trim, disturbance_slots=slots, effects=es)
+    eq = straight_run(ship, u0, n=n0, trim=trim, effects=es)
     sh = with_kq_scale(ship, eq.K_Q_scale)
-    pk = pack(sh, eq.power_W, slots)
+    pk = pack(sh, eq.power_W)
     if es is not None:
         pk = es.pack(pk, sh)
     return pk, eq
 
 
 def simulate(ship: Ship, law: CommandLaw, duration: float, dt: float, u0: float,
-             n0: float | None = None, trim: bool = True, disturbances=(), effects=None) -> SimulationResult:
+             n0: float | None = None, trim: bool = True, effects=None) -> SimulationResult:
     """Simulate from a steady straight run.
 
     Parameters
@@ -83,12 +79,10 @@ def simulate(ship: Ship, law: CommandLaw, duration: float, dt: float, u0: float,
         Approach rpm [rps]; solved when None.
     trim : bool
         Start from the trimmed straight run (rudder and drift that cancel Y_0, N_0).
-    disturbances : sequence of :class:`mmg.disturbances.Disturbance`
-        Alias of ``effects`` (the same effects, :func:`prepare`), kept for the trial files'
-        ``disturbances:`` section and older scripts.
     effects : mmg.effects.EffectSet, optional
-        Effects besides the ship's own (:func:`prepare`).
+        Effects besides the ship's own (:func:`prepare`), e.g.
+        ``mmg.effects.effect_set({"current": {"speed_mps": 0.5, "direction_deg": 90}})``.
     """
-    pk, eq = prepare(ship, u0, n0, trim, disturbances, effects)
+    pk, eq = prepare(ship, u0, n0, trim, effects)
     t, states, orders, done = integrate(pk, eq.state(), law, duration, dt)
     return SimulationResult(t, states, orders, eq, done, ship.name)

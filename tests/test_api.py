@@ -80,7 +80,7 @@ def test_zigzag_builder_equals_bundled_zz20(zz20):
     ship = mmg.load_ship("esso_osaka")
     trial = mmg.zigzag(ship, rudder="20 deg", heading="20 deg", speed="10 kn", duration="3000 s")
     bundled = zz20.trial
-    for f in ("u0", "n0", "trim", "duration", "dt", "kind", "manoeuvre", "disturbances", "ship"):
+    for f in ("u0", "n0", "trim", "duration", "dt", "kind", "manoeuvre", "effects", "ship"):
         assert getattr(trial, f) == getattr(bundled, f), f
     res = mmg.simulate(trial)
     np.testing.assert_array_equal(res.states, zz20.states)

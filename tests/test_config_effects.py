@@ -67,7 +67,7 @@ def test_steady_wind_in_rhs_is_the_fujiwara_load_of_the_apparent_wind(from_deg, 
 
     ship = mmg.load_ship("esso_osaka_3m")
     cur = (0.05, math.radians(30.0))
-    base = pack(ship, 0.0, {})
+    base = pack(ship, 0.0)
     base = E.effect_set({"current": {"speed_mps": cur[0], "direction_deg": 30.0}}).pack(base)
     es = E.effect_set({"wind": {"true_speed_mps": 2.5, "true_from_deg": from_deg, "scale": 1.3}})
     pk = es.pack(base, ship)
@@ -85,7 +85,7 @@ def test_steady_wind_rhs_is_complex_step_analytic_in_heading():
     from mmg.model import pack, rhs
 
     ship = mmg.load_ship("esso_osaka_3m")
-    pk = E.effect_set({"wind": {"true_speed_mps": 3.0, "true_from_deg": 60.0}}).pack(pack(ship, 0.0, {}), ship)
+    pk = E.effect_set({"wind": {"true_speed_mps": 3.0, "true_from_deg": 60.0}}).pack(pack(ship, 0.0), ship)
     x = np.array([0.35, -0.04, 0.03, 0.0, 0.0, 0.4, 0.1, 10.0])
     h = 1e-20
     xc = x.astype(complex)
@@ -157,6 +157,19 @@ def test_effects_section_equals_the_disturbances_section():
                                      "rudder_offset": {"offset_deg": 1.5}}))
     np.testing.assert_allclose(b.states, a.states, rtol=0, atol=1e-9)
     np.testing.assert_allclose(b.sog, a.sog, rtol=0, atol=1e-9)
+
+
+def test_disturbances_section_is_the_trials_current_and_rudder_offset_effects():
+    """The ``disturbances:`` keys load as the ``current`` and ``rudder_offset`` effects of the trial
+    (knots and degrees converted by hand here); a zero offset is no effect."""
+    t = _trial(disturbances={"current": {"speed": "0.2 kn", "direction": "-30 deg"}, "rudder_offset": "-1.5 deg"})
+    assert t.effects.names() == ["current", "rudder_offset"]
+    assert t.effects.get("current") == pytest.approx({"speed_mps": 0.2 * 1852.0 / 3600.0, "direction_deg": -30.0},
+                                                     rel=1e-12)
+    assert t.effects.get("rudder_offset") == pytest.approx({"offset_deg": -1.5}, rel=1e-12)
+    assert t.current() == pytest.approx((0.2 * 1852.0 / 3600.0, -math.pi / 6), rel=1e-12)
+    none = _trial(disturbances={"rudder_offset": "0 deg"})
+    assert none.effects is None or none.effects.get("rudder_offset") is None
 
 
 def test_heading_bias_effect_equals_log_bias():

@@ -1,7 +1,6 @@
 """One definition of each effect (issue 25): the estimators take an effect parameter's prior from its
 :class:`mmg.effects.Parameter`, the ship coefficients' prior widths come from one table, the replay's
-measured-wind loads are the ``wind`` effect's, ``disturbances=`` builds the same effects as
-``effects=``, and one function turns model states into a logged record (trial runs and the
+measured-wind loads are the ``wind`` effect's, and one function turns model states into a logged record (trial runs and the
 diagnosis's synthetic records alike)."""
 import math
 
@@ -75,22 +74,6 @@ def test_replay_wind_loads_are_the_wind_effects(ship, monkeypatch):
     orig = E.Wind.external.__func__
     monkeypatch.setattr(E.Wind, "external", classmethod(lambda cls, v, ctx: 3.0 * orig(cls, v, ctx)))
     np.testing.assert_allclose(measured_run(ship, rec, wind=True).inputs.ext, 3.0 * base, rtol=1e-12)
-
-
-def test_disturbances_build_the_same_effects(ship):
-    """``simulate(disturbances=...)`` is an alias: the same effects as ``effects=`` (to round-off)."""
-    from mmg.disturbances import RudderOffset, UniformCurrent, as_effects
-    from mmg.integrate import CommandLaw
-    from mmg.simulation import simulate
-
-    dist = [UniformCurrent(0.05, math.radians(40.0)), RudderOffset(math.radians(1.5))]
-    built, slots = as_effects(dist)
-    assert built.names() == ["current", "rudder_offset"] and slots == {}
-    law = CommandLaw.schedule([0.0, 5.0, 5.01, 60.0], [0.0, 0.0, math.radians(20.0), math.radians(20.0)])
-    a = simulate(ship, law, 60.0, 0.05, 0.5, disturbances=dist)
-    es = E.effect_set({"current": {"speed_mps": 0.05, "direction_deg": 40.0}, "rudder_offset": {"offset_deg": 1.5}})
-    b = simulate(ship, law, 60.0, 0.05, 0.5, effects=es)
-    np.testing.assert_allclose(a.states, b.states, rtol=1e-9, atol=1e-9)
 
 
 def test_one_record_generator(ship, monkeypatch):

@@ -53,17 +53,13 @@ def test_state_maps_round_trip_and_conventions():
     assert np.allclose(earth(st[0]), earth(lg[0]))
 
 
-def test_slots_match_disturbance_adapters():
+def test_current_and_rudder_offset_slots_in_si():
+    """The effects write SI into the parameter vector: m/s, and radians from their degrees."""
     from mmg import model as M
-    from mmg.disturbances import RudderOffset, UniformCurrent
 
-    c = UniformCurrent(0.5, math.radians(30.0))
-    cls, vals = c.effect()
-    assert cls is E.Current
-    assert np.allclose([cls.slots(vals)[M.P_CUR_SPEED], cls.slots(vals)[M.P_CUR_DIR]], [0.5, math.radians(30.0)])
-    r = RudderOffset(math.radians(1.5))
-    cls, vals = r.effect()
-    assert math.isclose(cls.slots(vals)[M.P_RUDDER_OFFSET], math.radians(1.5))
+    cur = E.Current.slots({"speed_mps": 0.5, "direction_deg": 30.0})
+    assert np.allclose([cur[M.P_CUR_SPEED], cur[M.P_CUR_DIR]], [0.5, math.pi / 6])
+    assert math.isclose(E.RudderOffset.slots({"offset_deg": 1.5})[M.P_RUDDER_OFFSET], 1.5 * math.pi / 180)
 
 
 def test_current_over_ground_track_in_model(esso):

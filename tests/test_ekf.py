@@ -222,13 +222,13 @@ def test_free_run_with_the_true_derivatives_reproduces_the_log(short_zz):
 def test_free_run_judges_heading_not_a_current_drifted_track(tmp_path):
     """An unmodelled current moves the track, not the heading: the true derivatives still pass."""
     from ekf.estimate import free_run, load_config
-    from mmg.disturbances import UniformCurrent
+    from mmg.effects import effect_set
     from trials.files.logio import write_csv
     from trials.estimates.estimation import data_from_log
     from trials.runs.run import run_trial
 
     tr = replace(load_trial(ZZ20), duration=600.0)
-    tr = replace(tr, disturbances=(UniformCurrent(speed=0.3 * 0.5144, direction=np.radians(90.0)),))
+    tr = replace(tr, effects=effect_set({"current": {"speed_mps": 0.3 * 0.5144, "direction_deg": 90.0}}))
     run = run_trial(tr)
     write_csv(tmp_path / "log.csv", run.log(), run.log_meta())
     write_csv(tmp_path / "truth.csv", run.truth(), run.log_meta())

@@ -94,7 +94,7 @@ def test_sensor_bias_shifts_the_log(tmp_path):
     import yaml
     from dataclasses import replace
 
-    from mmg.disturbances import SensorBias
+    from trials.runs.trial import SensorBias
 
     tr = load_trial(CONFIGS / "trials" / "zz10.yaml")
     tr = replace(tr, duration=100.0)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from mmg.disturbances import RudderOffset, UniformCurrent
+from mmg.effects import effect_set
 from mmg.integrate import CommandLaw
 from mmg.kijima import compare
 from mmg.simulation import prepare, simulate
@@ -75,19 +75,18 @@ def test_kijima_formulas_reproduce_table2(esso):
 def test_uniform_current_drifts_track_only(esso):
     law = CommandLaw.schedule([0.0, 600.0], [0.0, 0.0])
     still = simulate(esso, law, 600.0, 0.1, U0, trim=False)
-    cur = simulate(esso, law, 600.0, 0.1, U0, trim=False, disturbances=[UniformCurrent(1.0, np.pi / 2)])
+    cur = simulate(esso, law, 600.0, 0.1, U0, trim=False, effects=effect_set({"current": {"speed_mps": 1.0, "direction_deg": 90.0}}))
     np.testing.assert_allclose(cur.states[:, [0, 1, 2, 5, 6, 7]], still.states[:, [0, 1, 2, 5, 6, 7]], rtol=0, atol=1e-9)
     np.testing.assert_allclose(cur.y - still.y, cur.t * 1.0, atol=1e-6)
 
 
 def test_rudder_offset_equals_shifted_rudder(esso):
-    from mmg.disturbances import combine
     from mmg.model import pack, rhs
 
     x = np.array([U0, -0.1, 0.002, 0.0, 0.0, 0.0, 10 * DEG, 0.9])
     y = x.copy()
     y[6] = 12 * DEG
     out_a, out_b = np.zeros(8), np.zeros(8)
-    rhs(x, x[6], *pack(esso, 5e6, combine([RudderOffset(2 * DEG)])).args(), out_a)
+    rhs(x, x[6], *effect_set({"rudder_offset": {"offset_deg": 2.0}}).pack(pack(esso, 5e6)).args(), out_a)
     rhs(y, y[6], *pack(esso, 5e6).args(), out_b)
     np.testing.assert_allclose(out_a[:3], out_b[:3], rtol=1e-12)

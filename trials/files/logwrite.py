@@ -49,7 +49,7 @@ def log_columns(t, x, y, psi, sog, n, spec, rng: np.random.Generator | None = No
         Time [s], position north/east [m], heading [rad], speed over ground [m/s], rpm [rps].
     spec : trials.runs.trial.LogSpec
         Interval, start position, noise levels (half-widths of the uniform noise), seed and
-        constant sensor biases (heading, speed, rpm; :class:`mmg.disturbances.SensorBias`).
+        constant sensor biases (heading, speed, rpm; :class:`trials.runs.trial.SensorBias`).
     rng : numpy Generator, optional
         Defaults to ``np.random.default_rng(spec.seed)``.
     wind : (V_rel, gamma) arrays at the integration step, optional

@@ -205,7 +205,7 @@ def tangent(trial, dt: float | None = None, rudder_timing: bool = False) -> Tang
         turning, zigzag, S-type) have such nuisances; a time-scheduled rudder (sine, sawtooth,
         schedule) has none.
     """
-    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances, trial.effects)
+    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.effects)
     law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
     x0 = eq.state()
     step = float(dt or trial.dt)

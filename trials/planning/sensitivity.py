@@ -52,7 +52,7 @@ class TrialDifferences:
 
 def trial_differences(trial, names=DERIVATIVES, factor: float = PERTURBATION) -> TrialDifferences:
     """Steps 1-5 of section 3.2 for one :class:`trials.runs.trial.Trial`: the 12 x 3 table of sums."""
-    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances, trial.effects)
+    pk, eq = prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.effects)
     law = trial.command_law(trim_rudder=eq.delta, psi0=0.0)
     x0 = eq.state()
     _, ref, _, done = integrate(pk, x0, law, trial.duration, trial.dt)

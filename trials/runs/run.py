@@ -331,8 +331,8 @@ class TrialRun:
 
 def prepare_trial(trial: Trial):
     """The packed ship and steady approach (:func:`mmg.simulation.prepare`) of ``trial``: the same for
-    every trial of one ship, approach, disturbances and effects (``run_trial(t, prepared=...)`` reuses it)."""
-    return prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.disturbances, trial.effects)
+    every trial of one ship, approach and effects (``run_trial(t, prepared=...)`` reuses it)."""
+    return prepare(trial.ship, trial.u0, trial.n0, trial.trim, trial.effects)
 
 
 def run_trial(trial, prepared=None) -> TrialRun:
@@ -344,7 +344,7 @@ def run_trial(trial, prepared=None) -> TrialRun:
         A :class:`Trial`, or anything :func:`trials.runs.trial.load_trial` accepts (a bundled
         trial name such as ``"zz20"``, a trial YAML path, a mapping).
     prepared : (PackedShip, Equilibrium), optional
-        :func:`prepare_trial` of a trial with the same ship, approach, disturbances and effects (several
+        :func:`prepare_trial` of a trial with the same ship, approach and effects (several
         manoeuvres of one ship solve their approach once); default solved here.
 
     Returns

@@ -37,17 +37,17 @@ def zero_thrust_advance_ratio(ship: Ship) -> float:
     return min(pos) if pos else float("inf")
 
 
-def _surge(ship: Ship, n: float, effects, slots):
+def _surge(ship: Ship, n: float, effects):
     """du/dt [m/s^2] of the straight run (no drift, rudder amidships) at surge speed u and rpm ``n``, a function of u."""
     from mmg.equilibrium import _accels
     from mmg.model import pack
 
-    pk = pack(ship, 0.0, slots)
+    pk = pack(ship, 0.0)
     pk = effects.pack(pk, ship) if effects is not None else pk
     return lambda u: _accels(pk, u, 0.0, 0.0, n)[0]
 
 
-def _check_approach_rpm(src: str, ap, ship: Ship, label: str, u0: float, n0: float, dist, effects) -> None:
+def _check_approach_rpm(src: str, ap, ship: Ship, label: str, u0: float, n0: float, effects) -> None:
     """InputError naming ``approach.rpm`` unless the given rpm can drive the approach at ``approach.speed``.
 
     * At the approach the propeller must push ahead: its advance ratio J = u (1 - w_P0(u)) / (n D)
@@ -58,17 +58,17 @@ def _check_approach_rpm(src: str, ap, ship: Ship, label: str, u0: float, n0: flo
     * a constant-rpm motor holds the rpm: the ship starts at the approach speed and runs up or
       down to the speed that rpm gives (the MMG 2015 convention of a model-scale self-propulsion
       rpm), which must be within :data:`CONSTANT_RPM_FACTOR_MAX` (either way) of the rpm the straight
-      run needs and drive it to a speed within the ship's data (Froude number, t_P(u), w_P0(u) in [0, 1))."""
-    from mmg.disturbances import as_effects
+      run needs and drive it to a speed within the ship's data (Froude number, t_P(u), w_P0(u) in [0, 1)).
+
+    ``effects``: the trial's (:attr:`Trial.effects`), added to the ship's as the simulator adds them."""
     from mmg.equilibrium import straight_run
 
-    extra, slots = as_effects(dist)                         # as mmg.simulation.prepare builds them
-    es = ship.effect_set().merged(extra).merged(effects)
+    es = ship.effect_set().merged(effects)                  # as mmg.simulation.prepare builds them
     es = es if es.items else None
     pr = ship.propeller
     rpm = f"{ap.rpm} ({n0 * 60:.4g} rpm)" if not ap.rpm.strip().endswith("rpm") else ap.rpm
     try:
-        need = straight_run(ship, u0, None, True, slots, es).n
+        need = straight_run(ship, u0, None, True, es).n
     except ValueError:
         return                                               # no straight run at all: the simulator says so
     needs = f"the straight run at {ap.speed} needs {need * 60:.4g} rpm"
@@ -89,7 +89,7 @@ def _check_approach_rpm(src: str, ap, ship: Ship, label: str, u0: float, n0: flo
                                               f"would run {'up' if n0 > need else 'down'} from its approach speed "
                                               f"during the trial (at most a factor {CONSTANT_RPM_FACTOR_MAX:g} either "
                                               f"way; or write 'solve')")
-    surge = _surge(ship, n0, es, slots)
+    surge = _surge(ship, n0, es)
     top = MAX_FROUDE * np.sqrt(9.81 * ship.particulars.L)
     if surge(top) > 0:
         raise InputError(src, "approach.rpm", f"{rpm} would drive {label} beyond a Froude number of {MAX_FROUDE:g} "

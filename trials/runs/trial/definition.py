@@ -1,20 +1,39 @@
 """The validated trial in SI units: :class:`Trial` (the manoeuvre, the approach, the integration, the
-log and the disturbances, with what the simulator asks of them) and :class:`LogSpec` (how the sea-trial log
-is recorded), and :func:`periodic_order`.
+log and the effects, with what the simulator asks of them), :class:`LogSpec` (how the sea-trial log
+is recorded) with its :class:`SensorBias`, and :func:`periodic_order`.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
 
-from mmg.disturbances import SensorBias
 from mmg.engine_order import AsternOrder
+from mmg.errors import InputError
 from mmg.integrate import CommandLaw
 from mmg.limits import check_steps
 from mmg.ship import Ship
-from mmg.units import DEG
+from mmg.units import DEG, is_finite_number
+
+
+@dataclass(frozen=True)
+class SensorBias:
+    """Constant bias of logged channels: heading [rad], speed [m/s], rpm [rps] (finite numbers).
+
+    It acts on the written log only; the heading part is the ``heading_bias`` effect
+    (:class:`mmg.effects.HeadingBias`) of the logged heading (:meth:`Trial.logged_effects`)."""
+
+    heading: float = 0.0
+    speed: float = 0.0
+    rpm: float = 0.0
+
+    def __post_init__(self):
+        for name in ("heading", "speed", "rpm"):
+            v = getattr(self, name)
+            if not is_finite_number(v):
+                raise InputError("SensorBias", name, f"must be a finite number, got {v!r:.40}")
 
 
 @dataclass(frozen=True)
@@ -66,11 +85,10 @@ class Trial:
         ``table`` as rows of [s, rad(, rps)]).
     log : LogSpec
         How the sea-trial log is recorded.
-    disturbances : tuple
-        Current and rudder offset of the ``disturbances:`` section (:mod:`mmg.disturbances`).
     effects : mmg.effects.EffectSet or None
-        The ``effects:`` section (:mod:`mmg.effects`: ``current``, ``wind``, ``rudder_offset``,
-        ``heading_bias``, ``shallow_water``), added to the ship's own effects
+        The trial's effects (:mod:`mmg.effects`: ``current``, ``wind``, ``rudder_offset``,
+        ``heading_bias``, ``shallow_water``): its ``effects:`` section with the current and rudder
+        offset of its ``disturbances:`` section, added to the ship's own effects
         (:attr:`mmg.ship.Ship.effects`; an effect in both has the values each config states, a
         value stated in both is refused).  A heading
         bias acts on the log (as ``log.bias.heading``), a steady wind also adds the apparent-wind
@@ -90,7 +108,6 @@ class Trial:
     kind: str
     manoeuvre: dict
     log: LogSpec
-    disturbances: tuple
     effects: Optional[object] = None
 
     def __post_init__(self):
@@ -161,21 +178,20 @@ class Trial:
 
     def current(self):
         """(speed [m/s], direction it sets towards [rad]) of the run's current, (0, 0) without one."""
-        c = self.logged_effects().get("current")          # the disturbances: alias builds the same effect
+        c = self.effect_set().get("current")
         if c is not None:
             return c["speed_mps"], float(np.radians(c["direction_deg"]))
         return 0.0, 0.0
 
     def logged_effects(self):
-        """Every effect of the run as the log sees it: :meth:`effect_set` plus the ``disturbances:``
-        section and ``log.bias.heading`` as their effects (:meth:`mmg.disturbances.Disturbance.effect`)."""
-        from mmg.effects import EffectSet
+        """Every effect of the run as the log sees it: :meth:`effect_set` plus ``log.bias.heading`` as
+        the ``heading_bias`` effect."""
+        from mmg.effects import EffectSet, HeadingBias
 
         es = self.effect_set()
-        extra = [d.effect() for d in self.disturbances]
         if self.log.bias.heading and es.get("heading_bias") is None:
-            extra.append(self.log.bias.effect())
-        return es.merged(EffectSet(tuple(extra)))
+            es = es.merged(EffectSet(((HeadingBias, {"bias_deg": math.degrees(self.log.bias.heading)}),)))
+        return es
 
     def summary(self) -> dict:
         """Trial parameters for a log header (degrees and knots, as at the edges)."""

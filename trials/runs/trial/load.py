@@ -30,6 +30,7 @@ stopping  full astern from the approach (IMO MSC.137(76) 5.3.4): the rudder held
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
@@ -38,7 +39,7 @@ from typing import Annotated, Literal, Optional, Union
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from mmg.disturbances import RudderOffset, SensorBias, UniformCurrent
+import mmg.effects as E
 from mmg.engine_order import ASTERN_RPM_RATIO, reversal_time
 from mmg.errors import InputError
 from mmg.limits import MAX_SAMPLES, check_steps
@@ -47,7 +48,7 @@ from mmg.units import (DEG, KNOT, LONGITUDE_RANGE, MAX_CURRENT, MAX_FROUDE, MAX_
                        MAX_RUDDER, MAX_RUDDER_OFFSET, MAX_SHIP_SPEED, to_si)
 
 from .approach import _check_approach_rpm, _polyval
-from .definition import LogSpec, Trial
+from .definition import LogSpec, SensorBias, Trial
 
 
 def _q(dimension):
@@ -490,19 +491,20 @@ def _log_spec(f: _TrialFile, src: str, run: tuple[float, float]) -> LogSpec:
                    noise["speed"], noise["rpm"], SensorBias(bias["heading"], bias["speed"], bias["rpm"]))
 
 
-def _disturbances(f: _TrialFile, src: str) -> list:
-    """disturbances: the uniform current and the rudder offset, SI."""
-    dist = []
+def _disturbances(f: _TrialFile, src: str) -> E.EffectSet:
+    """disturbances: the uniform current and the rudder offset as the ``current`` and ``rudder_offset``
+    effects (:mod:`mmg.effects`); a zero offset is no effect."""
+    items = []
     d = f.disturbances
     if d.current is not None:
-        dist.append(UniformCurrent(
-            _si(src, "disturbances.current.speed", d.current.speed, "speed", 0.0, MAX_CURRENT,
-                why="a current runs at 0-20 kn (its sense is the direction)"),
-            _si(src, "disturbances.current.direction", d.current.direction, "angle", -2 * np.pi, 2 * np.pi)))
+        speed = _si(src, "disturbances.current.speed", d.current.speed, "speed", 0.0, MAX_CURRENT,
+                    why="a current runs at 0-20 kn (its sense is the direction)")
+        towards = _si(src, "disturbances.current.direction", d.current.direction, "angle", -2 * np.pi, 2 * np.pi)
+        items.append((E.Current, {"speed_mps": speed, "direction_deg": math.degrees(towards)}))
     off = _si(src, "disturbances.rudder_offset", d.rudder_offset, "angle", -MAX_RUDDER_OFFSET, MAX_RUDDER_OFFSET)
     if off != 0.0:
-        dist.append(RudderOffset(off))
-    return dist
+        items.append((E.RudderOffset, {"offset_deg": math.degrees(off)}))
+    return E.EffectSet(tuple(items))
 
 
 def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | None = None,
@@ -565,15 +567,17 @@ def trial_from_dict(data: Mapping, source: str = "<dict>", base: str | Path | No
     dist = _disturbances(f, src)
     # effects (mmg.effects), besides the ship's; each value given in one place only
     effects = _trial_effects(f, ship, src, label, legacy=_legacy_statements(f, dist, log.bias.heading, src))
+    if dist.items:                   # the disturbances: section's effects with the effects: section's
+        effects = dist.merged(effects)
     if n0 is not None:
-        _check_approach_rpm(src, f.approach, ship, label, u0, n0, dist, effects)
+        _check_approach_rpm(src, f.approach, ship, label, u0, n0, effects)
     hb = ship.effect_set().merged(effects).get("heading_bias")
     if hb is not None:               # a compass error: on the logged heading, as log.bias.heading
         log = replace(log, bias=replace(log.bias, heading=log.bias.heading + float(np.radians(hb["bias_deg"]))))
     return Trial(
         name=f.name, path=src, ship=ship, ship_path=ship_path, description=f.description,
         u0=u0, n0=n0, trim=f.approach.trim, duration=duration, dt=dt, kind=kind, manoeuvre=conv, log=log,
-        disturbances=tuple(dist), effects=effects,
+        effects=effects,
     )
 
 
@@ -582,19 +586,17 @@ _LEGACY = {"current": "disturbances.current", "rudder_offset": "disturbances.rud
 """The older trial keys of three effects (the same physics as ``effects.<name>``)."""
 
 
-def _legacy_statements(f: _TrialFile, dist: list, heading_bias: float, src: str) -> list:
+def _legacy_statements(f: _TrialFile, dist: E.EffectSet, heading_bias: float, src: str) -> list:
     """The effect values the trial's older keys state: ``(effect, parameter, file, field, value)``.
 
     A key counts when it is written, whatever its value (``rudder_offset: 0 deg`` states a zero offset)."""
     out = []
-    d = f.disturbances
-    for c in dist:
-        if isinstance(c, UniformCurrent):
-            out += [("current", "speed_mps", src, "disturbances.current.speed", c.speed),
-                    ("current", "direction_deg", src, "disturbances.current.direction", float(np.degrees(c.direction)))]
-    if "rudder_offset" in d.model_fields_set:
-        off = next((c.offset for c in dist if isinstance(c, RudderOffset)), 0.0)
-        out.append(("rudder_offset", "offset_deg", src, "disturbances.rudder_offset", float(np.degrees(off))))
+    cur, off = dist.get("current"), dist.get("rudder_offset") or {"offset_deg": 0.0}
+    if cur is not None:
+        out += [("current", "speed_mps", src, "disturbances.current.speed", cur["speed_mps"]),
+                ("current", "direction_deg", src, "disturbances.current.direction", cur["direction_deg"])]
+    if "rudder_offset" in f.disturbances.model_fields_set:
+        out.append(("rudder_offset", "offset_deg", src, "disturbances.rudder_offset", off["offset_deg"]))
     if "bias" in f.log.model_fields_set and "heading" in f.log.bias.model_fields_set:
         out.append(("heading_bias", "bias_deg", src, "log.bias.heading", float(np.degrees(heading_bias))))
     return out
