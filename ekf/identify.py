@@ -43,7 +43,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mmg.model import POLY_WP0, PackedShip
+from mmg.model import PackedShip
 from mmg.parameters import CONSTANTS, DIAGNOSIS_PRIOR_REL_STD, PRIOR_REL_STD, WIND_COLUMNS, parameter
 from mmg.replay import ReplayInputs, replay_states
 
@@ -147,7 +147,8 @@ class Scales:
 
 @dataclass(frozen=True)
 class FreeParameter:
-    """A parameter being fitted: its name, kind (``"hull"`` index or ship constant), prior value and std."""
+    """A parameter being fitted: its name, kind (``"hull"`` index or ship constant), prior value and std, and
+    how it acts (:attr:`apply`, :attr:`loads`: its parameter-table entry's rules)."""
 
     name: str
     kind: str
@@ -163,6 +164,22 @@ class FreeParameter:
     in the fit; None: shared by every record."""
     start: float | None = None
     """Where a fit starts (:func:`identify_segments` without ``start``); the prior when None."""
+    apply: object = None
+    """``apply(packed, index, value)``: writes the value into a packed ship's copied arrays
+    (:attr:`mmg.parameters.ShipParameter.apply`).  None: the rule of its ``kind`` (a parameter made by
+    hand): nothing for kinds ``"effect"`` and ``"start"`` (applied by :func:`effect_set_of` and to the
+    start states), else the parameter table's rule of that kind (:func:`mmg.parameters.rule_of_kind`)."""
+    loads: object = None
+    """``loads(factors, sub, value)``: where the value acts on the records' external loads
+    (:attr:`mmg.parameters.ShipParameter.loads`), or None; as :attr:`apply` when ``apply`` is None."""
+
+    def __post_init__(self):
+        if self.apply is None:
+            from mmg.parameters import not_packed, rule_of_kind
+
+            rules = (not_packed, None) if self.kind in ("effect", "start") else rule_of_kind(self.kind)
+            object.__setattr__(self, "apply", rules[0])
+            object.__setattr__(self, "loads", self.loads if self.loads is not None else rules[1])
 
 
 def effect_prior(effect, name: str, nm: str | None = None, kind: str = "effect", index: int = 0,
@@ -201,30 +218,25 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
     for nm in names:
         spec = parameter(nm, hull_names, terms)
         v = spec.config_value(packed)
+        rules = {"apply": spec.apply, "loads": spec.loads}
         if spec.effect is not None:
-            wind = spec.kind == "wind_scale"          # a factor on the records' loads (sub: their column)
-            f = effect_prior(E.get(spec.effect.effect), spec.effect.parameter, nm, spec.kind, 0 if wind else spec.slot,
-                             spec.effect.factor, None if wind else v)
-            out.append(replace(f, sub=spec.slot) if wind else f)
+            on_loads = spec.loads is not None         # a factor on the records' loads (sub: their column)
+            f = effect_prior(E.get(spec.effect.effect), spec.effect.parameter, nm, spec.kind,
+                             0 if on_loads else spec.slot, spec.effect.factor, None if on_loads else v)
+            out.append(replace(f, sub=spec.slot, **rules) if on_loads else replace(f, **rules))
             continue
         lo, hi = spec.bounds(v)
-        out.append(FreeParameter(nm, spec.kind, spec.slot, v, spec.prior_std(v, rel), lo, hi))
+        out.append(FreeParameter(nm, spec.kind, spec.slot, v, spec.prior_std(v, rel), lo, hi, **rules))
     return out
 
 
 def apply_parameters(packed: PackedShip, free: list[FreeParameter], theta) -> PackedShip:
-    """A copy of ``packed`` with the free parameters set to ``theta``."""
-    coef, p, poly = packed.hull_coef.copy(), packed.p.copy(), packed.poly.copy()
+    """A copy of ``packed`` with the free parameters set to ``theta``, each by its own rule
+    (:attr:`FreeParameter.apply`: the parameter table's, :mod:`mmg.parameters`)."""
+    out = replace(packed, p=packed.p.copy(), poly=packed.poly.copy(), hull_coef=packed.hull_coef.copy())
     for f, v in zip(free, theta):
-        if f.kind == "hull":
-            coef[f.index] = v
-        elif f.kind == "w_P0":
-            poly[POLY_WP0][0] = v
-        elif f.kind in ("effect", "wind_scale", "start"):
-            continue                                  # applied by effect_set_of / to the records' loads / starts
-        else:
-            p[f.index] = v
-    return replace(packed, p=p, poly=poly, hull_coef=coef)
+        f.apply(out, f.index, v)
+    return out
 
 
 def effect_parameters(effects) -> list[FreeParameter]:
@@ -338,14 +350,14 @@ def segment_resets(t: np.ndarray, segment_s: float) -> np.ndarray:
 
 
 def wind_scaled(inputs: ReplayInputs, scale: float, sway_factor: float = 1.0, yaw_factor: float = 1.0) -> ReplayInputs:
-    """``inputs`` with their external (measured-wind) loads (X, Y, N) times a fitted ``wind_scale``,
-    the sway force also times ``sway_factor`` and the yaw moment times ``yaw_factor`` (the wind
-    effect's loads are linear in its scale and in each shape factor, :meth:`mmg.effects.Wind.external`,
-    :func:`mmg.wind.amplitude_vector`): the one place the fitted values are applied, in the fit and in
-    the identified model's replays."""
+    """``inputs`` with their external (measured-wind) loads (X, Y, N) times the wind effect's factors of a
+    fitted ``wind_scale``, ``sway_factor`` and ``yaw_factor`` (:meth:`mmg.effects.Wind.load_factors`): how
+    the fitted values act, in the fit and in the identified model's replays."""
+    from mmg.effects import Wind
+
     if inputs.ext is None:
         return inputs
-    return replace(inputs, ext=inputs.ext * (scale * np.array([1.0, sway_factor, yaw_factor])))
+    return replace(inputs, ext=inputs.ext * Wind.load_factors(scale, sway_factor, yaw_factor))
 
 
 def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
@@ -354,8 +366,8 @@ def _wind_scaled(rec: Segmented, free, theta) -> Segmented:
     f = np.ones(3)                       # wind_scale (sub 0), sway and yaw factors (sub 1, 2)
     hit = False
     for p, v in zip(free, theta):
-        if p.kind == "wind_scale":
-            f[p.sub] = v
+        if p.loads is not None:
+            p.loads(f, p.sub, v)
             hit = True
     return replace(rec, inputs=wind_scaled(rec.inputs, *f)) if hit else rec
 

@@ -3,7 +3,8 @@
 Each entry (:class:`ShipParameter`) says, for one parameter under its fit name (``mmg identify --free``):
 its unit in a fit (SI; ``"1"``: non-dimensional), its prior family (the key of a relative-std table such as
 :data:`PRIOR_REL_STD`) and how its prior std, floor and hard bounds follow from the config value, how a fit
-applies it to the packed ship (``kind`` and ``slot``, :func:`ekf.identify.apply_parameters`), how it is read
+applies it (its rule :attr:`ShipParameter.apply` on the packed ship at its ``slot``, or
+:attr:`ShipParameter.loads` on the records' external loads: :func:`ekf.identify.apply_parameters`), how it is read
 from and written into a :class:`mmg.ship.Ship`, and where a ship YAML holds it.  The hull coefficients are
 the ship's own (:func:`hull_parameter`, one entry per name of its hull model); the rest are the constants
 of :data:`CONSTANTS`.  Estimators, the writers of ship configs and the samplers loop over this table.
@@ -26,7 +27,8 @@ from .terms import is_resistance
 
 __all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD",
            "hull_parameter", "parameter", "ship_value", "with_value", "write_yaml_value", "unit_of", "is_resistance",
-           "EffectPrior", "WIND_COLUMNS", "config_values", "MASS_NAMES"]
+           "EffectPrior", "WIND_COLUMNS", "config_values", "MASS_NAMES", "to_slot", "to_hull", "to_wake",
+           "not_packed", "to_load_factor", "rule_of_kind"]
 
 PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
 """Prior std of a freed ship coefficient relative to its config value, per family (identification's: the
@@ -53,6 +55,33 @@ WIND_COLUMNS = {"wind_scale": ("scale", 0), "wind_sway_factor": ("sway_factor", 
 column of the records' external loads X, Y, N it multiplies; 0: all three)."""
 
 
+def to_slot(packed: PackedShip, index: int, value: float) -> None:
+    """Apply rule: ``value`` into the parameter vector at ``index`` (a rudder or propeller constant, an added mass)."""
+    packed.p[index] = value
+
+
+def to_hull(packed: PackedShip, index: int, value: float) -> None:
+    """Apply rule: ``value`` as hull coefficient ``index`` of the hull model."""
+    packed.hull_coef[index] = value
+
+
+def to_wake(packed: PackedShip, index: int, value: float) -> None:
+    """Apply rule: ``value`` as the constant term of the wake polynomial (w_P0 at u = 0)."""
+    packed.poly[POLY_WP0][0] = value
+
+
+def not_packed(packed: PackedShip, index: int, value: float) -> None:
+    """Apply rule of a value that does not go into the packed ship (a factor on the records' loads, an
+    effect's parameter applied through its :class:`mmg.effects.EffectSet`, a record's start offset)."""
+
+
+def to_load_factor(factors: np.ndarray, index: int, value: float) -> None:
+    """Load rule of a wind value: ``value`` as the wind effect's fit parameter ``index`` (scale, sway and yaw
+    factor, :meth:`mmg.effects.Wind.fit_parameters`) in ``factors``, which :meth:`mmg.effects.Wind.load_factors`
+    turns into the factor on each column of the records' loads."""
+    factors[index] = value
+
+
 @dataclass(frozen=True)
 class EffectPrior:
     """Where an effect parameter's prior comes from: the effect's (registered) name, its parameter, and the
@@ -77,11 +106,11 @@ class ShipParameter:
         The key of its relative prior std in a family table (:data:`PRIOR_REL_STD`), or ``""`` for an absolute
         std (``abs_std``) or an effect's own prior (``effect``).
     kind : str
-        How a fit applies it (:attr:`ekf.identify.FreeParameter.kind`): ``"hull"``, ``"w_P0"``, ``"epsilon"``,
-        ``"kappa"``, ``"rudder"``, ``"propeller"``, ``"mass"``, ``"wind_scale"``.
+        Its kind (:attr:`ekf.identify.FreeParameter.kind`), a label a caller can select by: ``"hull"``,
+        ``"w_P0"``, ``"epsilon"``, ``"kappa"``, ``"rudder"``, ``"propeller"``, ``"mass"``, ``"wind_scale"``.
     slot : int
         Its index in :attr:`mmg.model.PackedShip.p` (a hull coefficient's in ``hull_coef``; the wind's: the
-        loads' column, :data:`WIND_COLUMNS`).
+        loads' column, :data:`WIND_COLUMNS`), the ``index`` its rules are given.
     yaml : str
         Where a ship YAML holds it (documentation; :func:`write_yaml_value` writes it).
     floor : float
@@ -92,6 +121,13 @@ class ShipParameter:
         ``bounds(config_value) -> (lower, upper)``: hard bounds.
     effect : EffectPrior or None
         For an :mod:`mmg.effects` parameter: where its prior comes from.
+    apply : callable
+        ``apply(packed, slot, value)``: writes a fitted value into a packed ship (a copy: the caller's arrays
+        ``p``, ``poly`` and ``hull_coef`` are copies, written in place); :func:`to_slot` by default,
+        :func:`not_packed` for a value that acts elsewhere.
+    loads : callable or None
+        ``loads(factors, slot, value)``: where the value acts on the records' external loads instead
+        (:func:`to_load_factor`); None: it does not.
     """
 
     name: str
@@ -108,6 +144,8 @@ class ShipParameter:
     abs_std: float = 0.0
     bounds: Callable = lambda v: (-np.inf, np.inf)
     effect: EffectPrior | None = None
+    apply: Callable = to_slot
+    loads: Callable | None = None
     config_key: str = ""
     """The key of the value in the config's own unit, where it differs from ``name`` (an added mass's primed
     ``m_x_prime``: :meth:`in_config`)."""
@@ -220,7 +258,8 @@ def _wind_yaml(key: str):
 def _wind(name: str) -> ShipParameter:
     key, col = WIND_COLUMNS[name]
     return ShipParameter(name, "1", "", "wind_scale", col, f"wind.{key}", read=lambda s: 1.0, write=_with_wind(key),
-                         write_yaml=_wind_yaml(key), packed=lambda p: 1.0, effect=EffectPrior("wind", key))
+                         write_yaml=_wind_yaml(key), packed=lambda p: 1.0, effect=EffectPrior("wind", key),
+                         apply=not_packed, loads=to_load_factor)
 
 
 def _constants() -> dict:
@@ -235,7 +274,7 @@ def _constants() -> dict:
     out = [
         ShipParameter("w_P0", "1", "", "w_P0", 0, "propeller.w_P0[0]", read=lambda s: s.propeller.w_P0[0],
                       write=_with_w_P0, write_yaml=set_yaml("propeller", "w_P0", 0),
-                      packed=lambda p: p.poly[POLY_WP0][0], abs_std=0.15, bounds=lambda v: (0.0, 0.8)),
+                      packed=lambda p: p.poly[POLY_WP0][0], abs_std=0.15, bounds=lambda v: (0.0, 0.8), apply=to_wake),
         _rudder("epsilon", P_EPS, "epsilon", 0.3, 3.0),
         _rudder("kappa", P_KAPPA, "kappa", 0.0, 1.0),
         _wind("wind_scale"), _wind("wind_sway_factor"), _wind("wind_yaw_factor"),
@@ -268,6 +307,16 @@ MASS_NAMES = tuple(n for n, p in CONSTANTS.items() if p.kind == "mass")
 """The added masses and the added moment of inertia (the table's ``"mass"`` entries)."""
 
 
+def rule_of_kind(kind: str) -> tuple[Callable, Callable | None]:
+    """(apply rule, load rule) of the table's entries of ``kind`` (:attr:`ShipParameter.apply`,
+    :attr:`ShipParameter.loads`): the rules of a parameter given by its kind alone (a hand-made
+    :class:`ekf.identify.FreeParameter`); a kind not in the table goes into the parameter vector."""
+    for p in (*CONSTANTS.values(), hull_parameter("", 0)):
+        if p.kind == kind:
+            return p.apply, p.loads
+    return to_slot, None
+
+
 def hull_parameter(name: str, index: int, term: str = "") -> ShipParameter:
     """The entry of hull coefficient ``name`` (primed, non-dimensional), at ``index`` of the ship's hull model;
     the straight-ahead resistance (:func:`is_resistance`) bounded to stay negative."""
@@ -278,7 +327,8 @@ def hull_parameter(name: str, index: int, term: str = "") -> ShipParameter:
 
     return ShipParameter(name, "1", "hull", "hull", index, f"hull.coefficients.{name}.value",
                          read=lambda s: s.hull.value(name), write=lambda s, v: s.with_hull({name: float(v)}),
-                         write_yaml=write_yaml, packed=lambda p: p.hull_coef[index], floor=0.01, bounds=bounds)
+                         write_yaml=write_yaml, packed=lambda p: p.hull_coef[index], floor=0.01, bounds=bounds,
+                         apply=to_hull)
 
 
 def parameter(name: str, hull_names=(), hull_terms=()) -> ShipParameter:

@@ -104,6 +104,89 @@ def test_a_parameter_added_to_the_table_alone_is_fitted_written_and_sampled(monk
     assert unit_of("f_alpha") == "1"
 
 
+def _with_t_P0(s, v):
+    t = list(s.propeller.t_P)
+    t[0] = float(v)
+    return replace(s, propeller=replace(s.propeller, t_P=tuple(t)))
+
+
+def test_a_parameter_with_its_own_apply_rule_needs_the_table_alone(monkeypatch, tmp_path):
+    """A made-up entry that goes where no entry goes (the thrust deduction's constant term t_P0, the first
+    coefficient of the t_P polynomial row of the packed ship), its rule on the entry and nothing else: the
+    fit frees it, applies it there (a copy: the caller's packed ship untouched, nothing else moved), a
+    FreeParameter made by hand with its kind takes the same rule, and the ship and its YAML take the value."""
+    from ekf.identify import FreeParameter
+    from mmg.model import POLY_TP
+
+    def to_t_P0(packed, index, value):
+        packed.poly[POLY_TP][0] = value
+
+    spec = ShipParameter("t_P0", "1", "", "thrust_deduction", 0, "propeller.t_P[0]",
+                         read=lambda s: s.propeller.t_P[0], write=_with_t_P0,
+                         write_yaml=lambda d, v, path: d["propeller"]["t_P"].__setitem__(0, float(f"{v:.6g}")),
+                         packed=lambda p: p.poly[POLY_TP][0], abs_std=0.05, bounds=lambda v: (0.0, 0.6),
+                         apply=to_t_P0)
+    ship = mmg.load_ship("esso_osaka_3m")
+    pk = pack(ship)
+    monkeypatch.setitem(CONSTANTS, "t_P0", spec)
+    (f,) = free_parameters(pk, ship.hull.names, ["t_P0"])
+    assert (f.prior, f.sigma, f.lower, f.upper) == (ship.propeller.t_P[0], 0.05, 0.0, 0.6)
+    for free in ([f], [FreeParameter("t_P0", "thrust_deduction", 0, 0.1, 0.05)]):
+        pk2 = apply_parameters(pk, free, [0.2345])
+        want = pk.poly.copy()
+        want[POLY_TP, 0] = 0.2345
+        np.testing.assert_array_equal(pk2.poly, want)
+        np.testing.assert_array_equal(pk2.p, pk.p)
+        np.testing.assert_array_equal(pk2.hull_coef, pk.hull_coef)
+    assert pk.poly[POLY_TP, 0] == ship.propeller.t_P[0]                 # the caller's packed ship as it was
+    assert ship_with_values(ship, {"t_P0": 0.2345}).propeller.t_P[0] == 0.2345
+    text = ship_yaml(mmg.config_path("ships", "esso_osaka_3m.yaml"), {"t_P0": 0.2345}, "made-up rule")
+    (tmp_path / "s.yaml").write_text(text)
+    assert mmg.load_ship(tmp_path / "s.yaml").propeller.t_P[0] == 0.2345
+
+
+def test_the_fitted_wind_factors_act_through_the_wind_effect(monkeypatch):
+    """``--free wind_scale wind_sway_factor wind_yaw_factor`` scale a record's loads by the wind effect's
+    own factors (mmg.effects.Wind.load_factors, no second copy: a changed definition changes the fit's
+    loads), and those factors are what the effect's loads do: the loads at (s, a, b) are the loads at
+    (1, 1, 1) times s, s a, s b (mmg.wind.wind_forces computed at both, compared to round-off)."""
+    import mmg.effects as E
+    from ekf.identify import Segmented, _wind_scaled
+    from mmg.effects.base import Context
+    from mmg.replay import ReplayInputs
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    t = np.arange(0.0, 5.0, 0.1)
+    ctx = Context(t=t, delta=0 * t, n=10 + 0 * t, ship=ship,
+                  channels={"wind_speed_rel": 1.0 + 0.5 * np.sin(t), "wind_dir_rel": np.mod(0.9 * t, 2 * np.pi)})
+    ext = E.Wind.external(E.Wind.values({}), ctx)
+    rec = Segmented("r", np.zeros((len(t), 6)), ReplayInputs(t=t, delta=0 * t, n=10 + 0 * t, ext=ext),
+                    np.ones(len(t), bool))
+    free = free_parameters(pack(ship), ship.hull.names, ["wind_scale", "wind_sway_factor", "wind_yaw_factor"])
+    theta = [0.83, 1.21, 0.64]
+    got = _wind_scaled(rec, free, theta).inputs.ext
+    other = E.Wind.external(E.Wind.values({"scale": 0.83, "sway_factor": 1.21, "yaw_factor": 0.64}), ctx)
+    np.testing.assert_allclose(got, other, rtol=1e-12, atol=1e-12 * np.abs(other).max())
+    monkeypatch.setattr(E.Wind, "load_factors", classmethod(lambda cls, s, a=1.0, b=1.0: np.array([2.0, 3.0, 5.0])))
+    np.testing.assert_array_equal(_wind_scaled(rec, free, theta).inputs.ext, ext * [2.0, 3.0, 5.0])
+
+
+def test_the_identifications_rudder_offset_is_the_effects_slot_to_round_off():
+    """``--free rudder_offset`` (radians, written into the slot) and the rudder_offset effect (degrees,
+    its slots) put the same blade offset into the packed ship, to the last bit or one: the one
+    conversion between them, degrees to radians and back, is exact only to round-off."""
+    import mmg.effects as E
+    from mmg.model import P_RUDDER_OFFSET
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    pk = pack(ship)
+    (f,) = free_parameters(pk, ship.hull.names, ["rudder_offset"])
+    for deg in (-4.0, -0.3, 0.77, 2.5):
+        mine = apply_parameters(pk, [f], [np.radians(deg)]).p[P_RUDDER_OFFSET]
+        effect = E.RudderOffset.pack(pk, {"offset_deg": deg}).p[P_RUDDER_OFFSET]
+        assert mine == pytest.approx(effect, rel=4e-16) and mine == pytest.approx(deg * np.pi / 180.0, rel=1e-15)
+
+
 def test_an_unknown_name_is_refused_by_the_fit_and_the_sampler_and_left_out_by_the_writers():
     ship = mmg.load_ship("esso_osaka_3m")
     with pytest.raises(KeyError, match="unknown parameter"):

@@ -101,6 +101,16 @@ class Wind(Effect):
         return {"scale": float(theta[0]), "sway_factor": float(theta[1]), "yaw_factor": float(theta[2])}
 
     @classmethod
+    def load_factors(cls, scale, sway_factor=1.0, yaw_factor=1.0) -> np.ndarray:
+        """The factors (3,) on the surge force, sway force and yaw moment that take the loads :meth:`external`
+        gives at some values to those at the values times ``scale``, ``sway_factor`` and ``yaw_factor``:
+        scale * (1, sway_factor, yaw_factor), the loads being linear in the scale and in each shape factor
+        (:func:`mmg.wind.wind_forces`, :func:`mmg.wind.amplitude_vector`).  How a fit that computes a
+        record's loads once (``mmg identify --free wind_scale wind_sway_factor wind_yaw_factor``: factors on
+        the loads of the ship's own values) applies its fitted values."""
+        return scale * np.array([1.0, sway_factor, yaw_factor])
+
+    @classmethod
     def presence_parameters(cls):
         """Only the scale: at 0 there is no wind whatever the shape factors say."""
         return ("scale",)
