@@ -14,6 +14,7 @@ from mmg.parameters import MASS_NAMES
 from mmg.ship import Ship
 
 from .fit import _config_model
+from .rules import module_rule, rule
 from .report import fmt3, format_rms
 from .statistics import _chi2, _delta_bic, _rms, _scaled_rss, _stack, _taus
 
@@ -196,7 +197,7 @@ def _drift_terms(fitter, d_config, base, kept, o, say):
     dbic = _delta_bic(ref, m, len(free1) - len(free0), taus, o.stride)
     better = _scaled_rss(m.diffs, fitter.scales) <= _scaled_rss(d_config, fitter.scales)
     fall = _rms(ref.diffs)["heading"] - _rms(m.diffs)["heading"]
-    if better and fall > DRIFT_FALL_MIN:
+    if better and fall > rule("drift_fall_min"):
         say(f"baseline: the drift terms freed (dBIC {fmt3(dbic)}, heading residual {fmt3(fall)} deg less): "
             f"residual RMS {format_rms(_rms(m.diffs, fitter.recs))}")
         return m, True, replace(drift, kind=DRIFT_KIND)
@@ -214,14 +215,10 @@ def fit_baseline(fitter, noise, o, say):
     return d_config, base, kept, fitter
 
 
-DRIFT_FALL_MIN = 0.2192
-"""The fall of the heading residual [deg] that freeing the drift terms must bring
-(:func:`_drift_terms`): the heading residual the ship's own mismatch left on a clean zigzag, where the
-drift stays small, as calibrated when the gate was chosen and ``turn_drift`` calibrated (then
-``residual_floors.zigzag.heading`` of the packaged calibration then, 0.2192 deg).  A fall smaller
-than what a ship that is not its model leaves where these terms play no part is not a drift the
-config misses: on the main job's noiseless ST35 truth file, diagnosed with the ship that made it,
-they took the heading residual from 0.0087 to 0.0067 deg at dBIC 28, and wandered 3.3 prior std
-(``bench/drift_gate.py`` prints the falls).  A number of its own, not read from the zigzag floors in
-use: those moved when the zigzag baseline freed gamma_R (:data:`ZIGZAG_CONSTANTS_FREE`),
-and the turns' gate and the ``turn_drift`` floors calibrated with it must not move with them."""
+_RULES = {"DRIFT_FALL_MIN": "drift_fall_min"}
+"""The module's name of a number of the diagnosis rules (:mod:`.rules`), read-only: ``DRIFT_FALL_MIN``, the
+fall of the heading residual [deg] that freeing the drift terms must bring (:func:`_drift_terms`), the
+heading residual the ship's own mismatch leaves on a clean zigzag, where the drift stays small and these terms
+play no part.  A smaller fall is not a drift the config misses.  It is a number of its own, not the zigzag
+residual floor in use: the ``turn_drift`` floors were calibrated with this gate."""
+__getattr__ = module_rule(__name__, _RULES)

@@ -9,11 +9,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import decision
 from .baseline import DRIFT_KIND
-from .decision import MAGNITUDE_UNITS, WEAK_BIC, clears_floor, floor, floor_parts, magnitude
+from .decision import MAGNITUDE_UNITS, clears_floor, floor, floor_parts, magnitude
 from .fit import _Model
 from .options import DiagnoseOptions
+from .rules import rule
 from .report import fmt3, format_values, round_header, size_with_unit
 from .statistics import _COLS, _chi2, _delta_bic, _effect_index, _effect_report, _taus
 
@@ -77,7 +77,7 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
     k = len(cls.fit_parameters())
     dbic = _delta_bic(current, m, k, taus, o.stride)
     vals, se, z = _effect_report(m, cls, inflate)
-    if m.fit.iterations >= o.screen_nfev and o.max_nfev > o.screen_nfev and (dbic > 0 or z > decision.Z_THRESHOLD):
+    if m.fit.iterations >= o.screen_nfev and o.max_nfev > o.screen_nfev and (dbic > 0 or z > rule("z_threshold")):
         m = fitter.fit(effs, start=m.theta, max_nfev=o.max_nfev - o.screen_nfev)
         dbic = _delta_bic(current, m, k, taus, o.stride)
         vals, se, z = _effect_report(m, cls, inflate)
@@ -85,7 +85,7 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
     if ship0 is None and ns > 0 and _retry_from_current(fitter, cls, dbic, z, vals):
         m, dbic, vals, se, z = _nested_start(fitter, current, cls, taus, inflate, ns, o, (m, dbic, vals, se, z))
     mag = magnitude(cls.name, vals, L)
-    ok = (dbic > decision.BIC_THRESHOLD and z > decision.Z_THRESHOLD
+    ok = (dbic > rule("bic_threshold") and z > rule("z_threshold")
           and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
           and not straight_contradicts(current.straight, m.straight))
     return dbic, ok, cls, m, vals, se, z, mag, _confounding(m, cls)
@@ -100,9 +100,9 @@ def _retry_from_current(fitter, cls, dbic: float, z: float, vals: dict) -> bool:
     bring them and the effect's own parameters together (a 10 m/s wind on a cross-flow member's port
     turn: z 0.07 from the config, dBIC 76 and z 6.6 from the baseline fit)."""
     if fitter.kind == DRIFT_KIND:
-        return dbic <= decision.BIC_THRESHOLD
+        return dbic <= rule("bic_threshold")
     L = fitter.ship.particulars.L
-    return dbic < 0 and z > decision.Z_THRESHOLD and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
+    return dbic < 0 and z > rule("z_threshold") and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
 
 
 def straight_contradicts(before, after) -> bool:
@@ -113,7 +113,7 @@ def straight_contradicts(before, after) -> bool:
     ship's own mismatch on a turn), not by itself.  (Fresh family seed 21000: a 0.5 deg rudder offset
     on a port turn was named as a -0.56 deg heading bias, the straight run reading 0.06 +- 0.11 deg.)"""
     b, a = np.abs(np.asarray(before, float)), np.abs(np.asarray(after, float))
-    return bool(len(a) and np.any((a > decision.Z_THRESHOLD) & (a > b)))
+    return bool(len(a) and np.any((a > rule("z_threshold")) & (a > b)))
 
 
 def _nested_start(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions, first):
@@ -200,7 +200,7 @@ def _rival(results, r):
     """The candidate of the round's ``results`` that did not clear the naming tests though its dBIC
     cleared the threshold and is within :data:`~trials.measured.diagnose.decision.WEAK_BIC` of ``r``'s or above
     (the most evidence of such), or None: the records hold as much evidence for it as for ``r``."""
-    rivals = [x for x in results if not x[1] and x[0] > decision.BIC_THRESHOLD and x[0] > r[0] - WEAK_BIC]
+    rivals = [x for x in results if not x[1] and x[0] > rule("bic_threshold") and x[0] > r[0] - rule("weak_bic")]
     return max(rivals, key=lambda x: x[0]) if rivals else None
 
 
@@ -226,7 +226,7 @@ def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptio
                        max_nfev=o.max_nfev)
         dbic = _delta_bic(with_rival, m, len(cls.fit_parameters()), taus, o.stride)
         stands, z, vals = _holds(fitter, m, cls, inflate)
-        stands = stands and dbic > decision.BIC_THRESHOLD and not straight_contradicts(with_rival.straight, m.straight)
+        stands = stands and dbic > rule("bic_threshold") and not straight_contradicts(with_rival.straight, m.straight)
         rnd.setdefault("withheld" if not stands else "beside_rival", []).append(
             {"effect": cls.name, "rival": rival[2].name, "delta_bic": round(dbic, 2), "z": round(z, 2),
              "parameters": vals})
@@ -240,7 +240,7 @@ def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptio
 def _holds(fitter, model: _Model, cls, inflate: float) -> tuple[bool, float, dict]:
     """(whether a named effect still clears z and its floor in ``model``, its z, its values)."""
     vals, _, z = _effect_report(model, cls, inflate)
-    ok = z > decision.Z_THRESHOLD and clears_floor(cls.name, vals, fitter.ship.particulars.L, fitter.kind, fitter.heading)
+    ok = z > rule("z_threshold") and clears_floor(cls.name, vals, fitter.ship.particulars.L, fitter.kind, fitter.heading)
     return ok, z, vals
 
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import decision
 from .decision import MAGNITUDE_UNITS, evidence_short, over_floor
 from .options import DiagnoseOptions
+from .rules import rule
 from .statistics import _effect_index, _taus
 
 __all__ = ["verdicts", "to_demote", "withheld", "rivals_withheld", "weak_evidence", "within_mismatch"]
@@ -107,7 +107,7 @@ def weak_evidence(rounds) -> dict:
     for c in last["candidates"]:
         if c.get("clears_threshold") or not evidence_short(c["delta_bic"], c["z"]) or not _over_floor(c):
             continue
-        out[c["effect"]] = (f"at dBIC {c['delta_bic']:.3g} (a name needs {decision.BIC_THRESHOLD:.3g}), z {c['z']:.3g}, "
+        out[c["effect"]] = (f"at dBIC {c['delta_bic']:.3g} (a name needs {rule('bic_threshold'):.3g}), z {c['z']:.3g}, "
                             f"{_size_text(c, MAGNITUDE_UNITS.get(c['effect'], ''))}: the record holds too little "
                             "evidence to tell it from the ship's own mismatch")
     return out
@@ -136,7 +136,7 @@ def within_mismatch(rounds, L: float) -> list:
     out = []
     last = rounds[-1] if rounds else {"candidates": []}
     for c in last["candidates"]:
-        if c["delta_bic"] > decision.BIC_THRESHOLD and c["z"] > decision.Z_THRESHOLD and not c["clears_threshold"]:
+        if c["delta_bic"] > rule("bic_threshold") and c["z"] > rule("z_threshold") and not c["clears_threshold"]:
             unit = MAGNITUDE_UNITS.get(c["effect"], "")
             if c.get("straight_contradicts") and _over_floor(c):
                 z = max(abs(x) for x in c["straight_z"])
