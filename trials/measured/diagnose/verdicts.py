@@ -27,12 +27,9 @@ def _demote(fitter, current, named, demote, rounds, o: DiagnoseOptions, say):
     cannot separate from the ship's own coefficients (the statistics reason of
     :func:`trials.measured.diagnose.identifiability.verdict`: its marginal sd could not have shown its detection
     size, and confounding is why) on a kind of record whose calibrated floor for it is above that size
-    (the ship's own mismatch lends it more than matters), which the issue asks to be reported
-    ``not_identifiable`` rather than named as a guess (fresh family seeds 19000 and 23000: a 1.5 deg
-    rudder offset on a single port turn named at 6.0-7.0 deg, sd 1.0 deg, R 0.999 with the hull
-    terms, floor 5.8 deg).  Without the floor condition a 18 m/s wind on a 20/20 zigzag of the
-    development set (dev_29) was demoted: the wind is judged present on its loads, its scale alone
-    trades with the shape factors.  Logged in the last round's ``demoted``."""
+    (the ship's own mismatch lends it more than matters): reported ``not_identifiable`` rather than named
+    as a guess.  The floor condition keeps an effect judged present on its loads (a wind whose scale
+    alone trades with its shape factors) named.  Logged in the last round's ``demoted``."""
     drop = [cls for cls in current.effects if cls.name in demote]
     keep = [e for e in current.effects if e not in drop]
     idx = {i for cls in drop for i in _effect_index(current, cls)}
