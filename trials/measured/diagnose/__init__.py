@@ -73,6 +73,7 @@ water, which is exactly the discrepancy a current leaves.
 
 The package's modules, in the order a diagnosis passes through them:
 
+* :mod:`.rules`: the tuned numbers (thresholds, gates, budgets, windows), read from their file;
 * :mod:`.records`: the records read, checked and segmented (:func:`prepare`), and synthetic ones;
 * :mod:`.options`: how the search runs (:class:`DiagnoseOptions`);
 * :mod:`.statistics`: residuals, their RMS and correlation time, dBIC, an effect's fitted values;
