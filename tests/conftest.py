@@ -99,3 +99,27 @@ def pytest_unconfigure(config):
     if _warmup is not None and _warmup.poll() is None:     # a short or interrupted run: not needed any more
         _warmup.terminate()
         _warmup.wait()
+
+
+@pytest.fixture
+def diagnose_rules(tmp_path, monkeypatch):
+    """A function ``set(**values)`` that puts a copy of the packaged diagnosis rules
+    (``configs/calibration/diagnose_rules.yaml``) with those entries' values changed in use through
+    ``MMG_DIAGNOSE_RULES`` and returns its path; the packaged rules are in use again after the test."""
+    import yaml
+
+    from trials.measured.diagnose import rules as R
+
+    def put(**values):
+        doc = yaml.safe_load((R.config_dir() / "calibration" / "diagnose_rules.yaml").read_text())
+        for k, v in values.items():
+            doc[k]["value"] = v
+        p = tmp_path / "diagnose_rules.yaml"
+        p.write_text(yaml.safe_dump(doc))
+        monkeypatch.setenv(R.ENV, str(p))
+        R.rules.cache_clear()
+        return p
+
+    yield put
+    monkeypatch.delenv(R.ENV, raising=False)
+    R.rules.cache_clear()

@@ -307,20 +307,17 @@ def test_short_of_name_counts_clean_first_rounds(monkeypatch):
     assert short_of_name(recs, 325.0) == (1, 3)
 
 
-def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(monkeypatch):
+def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(diagnose_rules):
     """End to end: a 1.5 deg heading bias on a zigzag, with the naming threshold raised out of reach, is
     not named and not dropped: ``not_identifiable`` carries it with the figures that decided, and the
     console line says so.  (With the threshold as shipped the same record names it: the control.)"""
-    import trials.measured.decision as D
-    import trials.measured.diagnose as G
     from mmg.ship import load_ship
     from trials.measured.diagnose import diagnose, synthetic_record
     ship = load_ship("esso_osaka_3m")
     rec = synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, rudder_deg=20.0, seed=4, name="z")
     opts = {"candidates": ["heading_bias", "current"]}
     assert diagnose(ship, [rec], **opts).named == ["heading_bias"]
-    monkeypatch.setattr(D, "BIC_THRESHOLD", 1e7)
-    monkeypatch.setattr(G, "BIC_THRESHOLD", 1e7)
+    diagnose_rules(bic_threshold=1e7)            # the rules file's threshold, through MMG_DIAGNOSE_RULES
     d = diagnose(ship, [rec], **opts)
     assert d.named == []
     ent = {e["effect"]: e for e in d.not_identifiable}

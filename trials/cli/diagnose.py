@@ -17,8 +17,10 @@ def cmd_diagnose(args) -> int:
     from mmg.ship import load_ship
 
     from ..measured.diagnose import diagnose, prepare
+    from ..measured.diagnose.rules import rules
     from ..files.output import StagedFile, StagedOutput, check_output_dir, check_output_file, dumps_json
 
+    rules()                                              # a bad rules file (MMG_DIAGNOSE_RULES): refused first
     check_backend_options(args)
     check_output_file(args.json)
     if args.plots is not None:

@@ -5,7 +5,8 @@ For the records given (every layout :func:`trials.files.logio.read_record` reads
 checking the scale) and the ship config:
 
 1. **Replay** each record against its measured rudder and revolutions (:mod:`mmg.replay`) in
-   segments of ``segment_s`` (default 52 sqrt(L/g): 29 s for the 3 m model, 300 s at 325 m),
+   segments of ``segment_s`` (default ``segment_length`` of the diagnosis rules, :mod:`.rules`, times
+   sqrt(L/g)),
    each restarting from the measured state, and form the residuals of u, v, r, heading and the
    track (x, y) in the record's own (logged) quantities.  ``rms_config`` is this with the
    config as it is.
@@ -40,18 +41,15 @@ checking the scale) and the ship config:
    coefficients (:func:`ekf.identify.straight_run_residual`, one residual per record with its own
    standard error).  In the fit its weight is sqrt(tau_v), the v channel's correlation time: the fit
    counts each v row as if independent and dBIC counts it 1/tau_v times, so the straight run (a mean
-   of v) keeps in the fit the weight against the v rows that dBIC gives it.  (The first form,
-   sqrt(mean tau), over-weighted it on records whose u, v, r residuals are nearly white: on fresh
-   family seed 18000 a 1 deg bias on a port turn fitted -0.93 deg at z 12.4 but at dBIC -1.3, the
-   fit having traded the channels for the straight run.)  On a turning circle it is the one stretch where a
-   heading bias does not trade with the hull terms (on turns of hulls that were not the model's a
-   1-1.5 deg bias had sd 1.7-2.3 deg without it).  Its samples are also among the v rows; the
+   of v) keeps in the fit the weight against the v rows that dBIC gives it.  On a turning circle it is the
+   one stretch where a heading bias does not trade with the hull terms.  Its samples are also among the v rows; the
    straight run's own term is bounded by its hull-drift allowance, so the double count is small.
 
-   An effect is **named** when dBIC > :data:`BIC_THRESHOLD` (20: twice Kass & Raftery's "very
-   strong", calibrated on clean records by the bench) and its parameters differ from their neutral values by more than
+   An effect is **named** when dBIC > :data:`BIC_THRESHOLD` and its parameters differ from their neutral values by more than
    :data:`Z_THRESHOLD` standard errors (Gauss-Newton, inflated by sqrt(tau)) and its size clears
-   the floor calibrated on ships that are not the model (:mod:`.decision`).  The best named
+   the floor calibrated on ships that are not the model (:mod:`.decision`); these numbers, and the
+   package's other tuned ones, are read from ``configs/calibration/diagnose_rules.yaml`` (:mod:`.rules`),
+   each with its meaning and source.  The best named
    candidate is added and the search repeats over the rest until none clears the threshold.
    **Final check** (:func:`_prune`): every named effect must still clear z and its floor in the
    final joint fit; one that lost its evidence to an effect named after it is dropped.
@@ -75,6 +73,7 @@ water, which is exactly the discrepancy a current leaves.
 
 The package's modules, in the order a diagnosis passes through them:
 
+* :mod:`.rules`: the tuned numbers (thresholds, gates, budgets, windows), read from their file;
 * :mod:`.records`: the records read, checked and segmented (:func:`prepare`), and synthetic ones;
 * :mod:`.options`: how the search runs (:class:`DiagnoseOptions`);
 * :mod:`.statistics`: residuals, their RMS and correlation time, dBIC, an effect's fitted values;
@@ -90,11 +89,10 @@ The package's modules, in the order a diagnosis passes through them:
 from __future__ import annotations
 
 from .api import diagnose, diagnose_each
-from .baseline import (CONSTANTS_FREE, DRIFT_FALL_MIN, DRIFT_KIND, MASS_FREE, SHIP_FREE_TERMS,  # noqa: F401
+from .baseline import (CONSTANTS_FREE, DRIFT_KIND, MASS_FREE, SHIP_FREE_TERMS,  # noqa: F401
                        TURN_CONSTANTS_FREE, TURN_HULL_TERMS, ZIGZAG_CONSTANTS_FREE, _ship_free)
-from .decision import BIC_THRESHOLD, Z_THRESHOLD
 from .fit import _Model  # noqa: F401
-from .options import SCREEN_NFEV, DiagnoseOptions  # noqa: F401
+from .options import DiagnoseOptions  # noqa: F401
 from .records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
 from .result import (CHANNELS, Diagnosis, absent_table, model_form_mismatch, ship_fit_table,  # noqa: F401
                      straight_run_table, _describe)
@@ -106,3 +104,16 @@ __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "st
            "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
            "CONSTANTS_FREE", "TURN_CONSTANTS_FREE", "ZIGZAG_CONSTANTS_FREE", "TURN_HULL_TERMS", "DRIFT_FALL_MIN",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
+
+_RULES = {"BIC_THRESHOLD": "bic_threshold", "Z_THRESHOLD": "z_threshold", "DRIFT_FALL_MIN": "drift_fall_min",
+          "SCREEN_NFEV": "screen_nfev"}
+"""The package's names of numbers of the diagnosis rules (:mod:`.rules`), read-only (their meanings: the
+modules that use them, :mod:`.decision`, :mod:`.baseline`, :mod:`.options`)."""
+
+
+def __getattr__(name):
+    from .rules import rule
+
+    if name in _RULES:
+        return rule(_RULES[name])
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

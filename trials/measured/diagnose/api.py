@@ -18,6 +18,7 @@ from .options import DiagnoseOptions
 from .records import noise_level, prepare
 from . import model_form
 from .result import Diagnosis, _diagnosis
+from .rules import rule, rules
 from .search import _candidates, search
 from .verdicts import verdicts
 
@@ -25,9 +26,9 @@ __all__ = ["diagnose", "diagnose_each"]
 
 
 def _default_stride(recs, L: float) -> int:
-    """Samples 0.36 sqrt(L/g) apart, at least every one."""
+    """Samples ``stride_spacing`` (the diagnosis rules) times sqrt(L/g) apart, at least every one."""
     dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
-    return max(1, int(round(0.36 * math.sqrt(L / 9.80665) / dt)))
+    return max(1, int(round(rule("stride_spacing") * math.sqrt(L / 9.80665) / dt)))
 
 
 def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs) -> Diagnosis:
@@ -49,6 +50,7 @@ def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs
     import mmg.effects as E
 
     t0 = time.perf_counter()
+    rules()                                     # a bad rules file: refused before any work
     o = DiagnoseOptions(**kwargs) if options is None else replace(options, **kwargs)
     say = o.say or (lambda m: None)
     calibration()                               # a bad calibration file: refused before any work

@@ -14,6 +14,7 @@ from mmg.parameters import MASS_NAMES
 from mmg.ship import Ship
 
 from .fit import _config_model
+from .rules import module_rule, rule
 from .report import fmt3, format_rms
 from .statistics import _chi2, _delta_bic, _rms, _scaled_rss, _stack, _taus
 
@@ -33,22 +34,17 @@ turns to one side that need them,
 
 TURN_HULL_TERMS = ("beta|beta|", "beta^2*r", "beta*r^2")
 """Hull terms it fits as well on turns to one side whose records need them (:func:`_drift_terms`): the
-drift nonlinearities.  A 35 deg turn holds a drift of
-10-15 deg for most of the record, where a real hull's side force and moment leave a polynomial
-fitted for small drift (Kijima's) by more than its linear and r|r| terms can take up: on the
-cross-flow members of the mismatch family the baseline left a 1.6-3 deg heading residual and a
-10 m/s wind on a port turn was not identifiable (dBIC -12 to 11; 0 of 6 named over the calibration's
-draws), with these terms freed 0.35-0.45 deg and the wind named (dBIC 46-76).  On a zigzag the
+drift nonlinearities.  A 35 deg turn holds a drift of 10-15 deg for most of the record, where a real hull's
+side force and moment leave a polynomial fitted for small drift (Kijima's) by more than its linear and r|r|
+terms can take up; the residual they leave would otherwise be taken by a candidate effect.  On a zigzag the
 drift stays small and these terms would only trade with the linear ones."""
 
 
 DRIFT_KIND = "turn_drift"
 """The kind of record set (:data:`~trials.measured.diagnose.decision.KINDS`) of turns to one side (calibrated on
 single turns) whose baseline freed the drift nonlinearities (:func:`_drift_terms`): its floors are
-calibrated apart from those
-of the turns that keep them at the config's (``"turn"``), since the ship's own mismatch lends the
-candidates other sizes on the two baselines (fresh seed 27000: one set of floors over both
-named shallow water on 2 of 20 clean Kijima turns)."""
+calibrated apart from those of the turns that keep them at the config's (``"turn"``), since the ship's own
+mismatch lends the candidates other sizes on the two baselines."""
 
 
 CONSTANTS_FREE = ("w_P0",)
@@ -60,12 +56,9 @@ TURN_CONSTANTS_FREE = ("epsilon",)
 ``turn_pair``): the rudder's inflow ratio epsilon (the rudder force, as epsilon^2).  In a 35 deg turn the
 rudder's drag, (1 - t_R) F_N sin(delta), sets much of the speed lost; a rudder force 10-15 % off its
 config leaves a residual in that speed loss and the drift that the resistance (u^2) and the wake cannot
-take, and a candidate effect took it instead: on family member 31 of seed 5000 (rudder constants 9-14 %
-off) a 10 m/s wind on a port turn was fitted at dBIC 19.5 and z 1.9 without epsilon, at dBIC 140 (z 10.5 on its loads)
-(scale 1.08 for 1.10) with it.  On a zigzag the rudder force is what drives the response, and its size
-trades with the freed linear hull terms (a Nomoto gain is their ratio): freeing it there too (variant 6
-in ``docs/diagnose.md``) made a following 18 m/s wind on a 20/20 zigzag of the development set
-not identifiable (correlation 0.997 with m_x, m_y, epsilon)."""
+take, and a candidate effect would take it instead.  On a zigzag the rudder force is what drives the
+response, and its size trades with the freed linear hull terms (a Nomoto gain is their ratio): it is not
+freed there."""
 
 
 ZIGZAG_CONSTANTS_FREE = ("gamma_R_pos", "gamma_R_neg")
@@ -75,14 +68,9 @@ negative beta_R, each with its own prior (std 15 % of the config value, at least
 ``rudder`` of :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`).  A real ship's two differ (the MMG
 standard's KVLCC2: 0.395 and 0.640), and a difference the config does not have makes the rudder's
 force asymmetric in a zigzag, where beta_R swings both ways: it is what the ship's own mismatch lends
-a rudder offset there.  On the zigzags of fresh draws (family seeds 28000-31000, 140
-clean or offset records) the round-1 offset's error was correlated -0.92 with the log of the member's
-gamma_R_pos / gamma_R_neg, and three 1 deg offsets were fitted at 0.61-0.62 deg, under the zigzag floor that
-asymmetry set (0.65 deg).  Freed, the two take the asymmetry: on family seed 32000 the 1 deg offsets
-were fitted at 0.93-1.10 deg (0.87-1.39 without) and the clean zigzags' offsets fell from 0.08-0.53 to
-0.02-0.26 deg.  The offset stays identifiable because it acts at every drift and the asymmetry only
-with drift or yaw, but the two correlate (0.97-0.99 in that fit), so its standard error grows.  On a
-turn to one side beta_R keeps one sign and only one of the two would be seen; it is not freed there."""
+a rudder offset there.  The offset stays identifiable because it acts at every drift and the asymmetry
+only with drift or yaw, but the two correlate, so its standard error grows.  On a turn to one side beta_R
+keeps one sign and only one of the two would be seen; it is not freed there."""
 
 
 MASS_FREE = MASS_NAMES
@@ -168,15 +156,11 @@ def _drift_terms(fitter, d_config, base, kept, o, say):
     baseline fitted on by as many evaluations (the better of the two) by more than
     :data:`DRIFT_FALL_MIN`, and replay the records no worse than the config.
 
-    A size test, not an evidence one.  On 48 clean family turns (``python bench/drift_gate.py --n
-    48``, seed 1000) the fall parts the hull forms: 0.83-5.55 deg on every cross-flow member, at most
-    0.054 deg on the Kijima ones but one (0.240).  A dBIC gate adds nothing there, and fails where an
-    effect fills the residual: a 15 m/s wind on a cross-flow turn (fresh seed 28000) left a 8.5 deg
-    heading residual that the drift terms lowered by 1.9 deg at dBIC -9, the terms stayed at the
-    config's, and the wind was not named.  On a clean record of the ship that made it the six terms,
-    nearly collinear, would wander on whatever the replay leaves (the main job's clean ST35 truth
-    file: a fall of 0.0020 deg at dBIC 28; freed, N_bb 3.1 and Y_bbr 3.3 prior std off the config):
-    the size test keeps them.  Called on turns to one side (record_kind ``"turn"``) whose records
+    A size test, not an evidence one: the fall parts hull forms whose drift forces the config's
+    polynomial misses from those it holds (``python bench/drift_gate.py`` prints the falls; the gate's
+    source is in ``configs/calibration/diagnose_rules.yaml``), where a dBIC gate fails whenever an effect
+    fills the residual, and on a clean record of the ship that made it the six nearly collinear terms
+    would wander on whatever the replay leaves.  Called on turns to one side (record_kind ``"turn"``) whose records
     log their sway.  Where the terms are freed, the fitter returned frees them too and is of kind
     :data:`DRIFT_KIND` (floors of their own); where not, the fitter and the baseline are returned as
     they came."""
@@ -196,7 +180,7 @@ def _drift_terms(fitter, d_config, base, kept, o, say):
     dbic = _delta_bic(ref, m, len(free1) - len(free0), taus, o.stride)
     better = _scaled_rss(m.diffs, fitter.scales) <= _scaled_rss(d_config, fitter.scales)
     fall = _rms(ref.diffs)["heading"] - _rms(m.diffs)["heading"]
-    if better and fall > DRIFT_FALL_MIN:
+    if better and fall > rule("drift_fall_min"):
         say(f"baseline: the drift terms freed (dBIC {fmt3(dbic)}, heading residual {fmt3(fall)} deg less): "
             f"residual RMS {format_rms(_rms(m.diffs, fitter.recs))}")
         return m, True, replace(drift, kind=DRIFT_KIND)
@@ -214,14 +198,10 @@ def fit_baseline(fitter, noise, o, say):
     return d_config, base, kept, fitter
 
 
-DRIFT_FALL_MIN = 0.2192
-"""The fall of the heading residual [deg] that freeing the drift terms must bring
-(:func:`_drift_terms`): the heading residual the ship's own mismatch left on a clean zigzag, where the
-drift stays small, as calibrated when the gate was chosen and ``turn_drift`` calibrated (then
-``residual_floors.zigzag.heading`` of the packaged calibration then, 0.2192 deg).  A fall smaller
-than what a ship that is not its model leaves where these terms play no part is not a drift the
-config misses: on the main job's noiseless ST35 truth file, diagnosed with the ship that made it,
-they took the heading residual from 0.0087 to 0.0067 deg at dBIC 28, and wandered 3.3 prior std
-(``bench/drift_gate.py`` prints the falls).  A number of its own, not read from the zigzag floors in
-use: those moved when the zigzag baseline freed gamma_R (:data:`ZIGZAG_CONSTANTS_FREE`),
-and the turns' gate and the ``turn_drift`` floors calibrated with it must not move with them."""
+_RULES = {"DRIFT_FALL_MIN": "drift_fall_min"}
+"""The module's name of a number of the diagnosis rules (:mod:`.rules`), read-only: ``DRIFT_FALL_MIN``, the
+fall of the heading residual [deg] that freeing the drift terms must bring (:func:`_drift_terms`), the
+heading residual the ship's own mismatch leaves on a clean zigzag, where the drift stays small and these terms
+play no part.  A smaller fall is not a drift the config misses.  It is a number of its own, not the zigzag
+residual floor in use: the ``turn_drift`` floors were calibrated with this gate."""
+__getattr__ = module_rule(__name__, _RULES)

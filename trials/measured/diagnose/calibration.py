@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .decision import MAGNITUDE_UNITS
+from .rules import module_rule, rule
 
 __all__ = [
     "MIN_PASSING",
@@ -79,14 +80,9 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
     kind as the ship's own mismatch, and a name given for it is a wrong name."""
     import math
 
-    from .decision import (
-        BIC_THRESHOLD,
-        COMPONENT_FLOORS,
-        Z_THRESHOLD,
-        current_components,
-        magnitude,
-    )
+    from .decision import COMPONENT_FLOORS, current_components, magnitude
 
+    bic, z_min = rule("bic_threshold"), rule("z_threshold")
     out: dict = {}
     passes: dict = {}
     raw: dict = {}
@@ -99,7 +95,7 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
             for c in rd["candidates"]:
                 if c["effect"] in truth:
                     continue
-                ok = bool(c["delta_bic"] > BIC_THRESHOLD and c["z"] > Z_THRESHOLD)
+                ok = bool(c["delta_bic"] > bic and c["z"] > z_min)
                 sizes = [(c["effect"], magnitude(c["effect"], c["parameters"], L))]
                 if c["effect"] == "current" and kind in COMPONENT_FLOORS:
                     # bench runs of the family sail at heading 0 (trials.measured.mismatch.trial_records)
@@ -127,8 +123,8 @@ def _hidden_here(rec: dict, hidden, L: float) -> set:
 def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
     """{effect: {kind: floor}} (module docstring): the passing share p taken at its upper 95 %
     (Clopper-Pearson) bound, not its estimate (0 of 23 is not a bound of 0); the scale the RMS of
-    the passing sizes, or, with fewer than :data:`MIN_PASSING` of them, of every size the candidate
-    took (``raw``), passing or not (a conservative stand-in)."""
+    the passing sizes, or, with fewer than ``min_passing`` (the diagnosis rules, :mod:`.rules`) of them, of
+    every size the candidate took (``raw``), passing or not (a conservative stand-in)."""
     from scipy.stats import beta, halfnorm
 
     from .decision import COMPONENT_FLOORS
@@ -146,7 +142,7 @@ def floors(clean: dict, alpha: float, raw: dict | None = None) -> dict:
             p_up = float(beta.ppf(0.95, kk + 1, max(n - kk, 1))) if n else 1.0
             f = 0.0
             if p_up > alpha / m:
-                pool = on if kk >= MIN_PASSING else np.asarray((raw or {}).get(e, {}).get(k, v), float)
+                pool = on if kk >= rule("min_passing") else np.asarray((raw or {}).get(e, {}).get(k, v), float)
                 scale = float(np.sqrt(np.mean(pool * pool))) if len(pool) else 0.0
                 f = max(scale * float(halfnorm.ppf(1.0 - alpha / (m * p_up))), float(on.max()) if kk else 0.0)
             out[e][k] = float(f"{f:.4g}")
@@ -187,19 +183,16 @@ def hidden_effects(fl: dict, L: float) -> dict:
     return out
 
 
-MIN_PASSING = 3
-"""Fewer passing sizes than this: the floor's scale is taken from every size the candidate took."""
-
-
-RESIDUAL_QUANTILE = 95.0
-"""The residual floors are this percentile of the clean records' residuals after the fit: a record
-is unexplained when its residual is worse than 95 % of the records of ships that differ from the
-config as real ships do (a few members of the family, cross-flow hulls that lose 85 % of their speed
-in a 35 deg turn, are fitted far worse than the rest: the maximum would be theirs)."""
+_RULES = {"MIN_PASSING": "min_passing", "RESIDUAL_QUANTILE": "residual_quantile"}
+"""The module's names of numbers of the diagnosis rules (:mod:`.rules`), read-only: ``MIN_PASSING``, the
+fewest passing sizes a floor's scale is taken from (else from every size the candidate took);
+``RESIDUAL_QUANTILE``, the percentile of the clean records' residuals the residual floors are."""
+__getattr__ = module_rule(__name__, _RULES)
 
 
 def residual_floors(records) -> dict:
-    """{kind: {channel: floor}} of the residual RMS after the fit on the clean records: u, v over the
+    """{kind: {channel: floor}}: the ``residual_quantile`` percentile (the diagnosis rules) of the residual RMS
+    after the fit on the clean records: u, v over the
     speed, r as r L / U, heading [deg] (:func:`trials.measured.diagnose.decision.residual_floor`)."""
     import math
 
@@ -214,7 +207,8 @@ def residual_floors(records) -> dict:
         v["v"].append(ra["v"] / U)
         v["r"].append(math.radians(ra["r"]) * L / U)
         v["heading"].append(ra["heading"])
-    return {k: {c: float(f"{np.percentile(x, RESIDUAL_QUANTILE):.4g}") for c, x in v.items() if x}
+    q = rule("residual_quantile")
+    return {k: {c: float(f"{np.percentile(x, q):.4g}") for c, x in v.items() if x}
             for k, v in vals.items()}
 
 

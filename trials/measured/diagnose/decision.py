@@ -37,22 +37,19 @@ import numpy as np
 
 import mmg.effects as E
 
+from .rules import module_rule, rule
+
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
            "REASON_KINDS", "KIND_FALLBACK", "by_kind", "packaged_calibration"]
 
-BIC_THRESHOLD = 20.0
-"""dBIC an effect must exceed to be named.  Kass & Raftery (1995) call > 10 very strong evidence
-for independent samples; with the tau-corrected counts the largest candidate dBIC on 20 clean
-perturbed record pairs (bench/bench_diagnose.py, seeds 0-19) was 15.4, 10.9, 9.5, 7.6, ... (2 of 20
-above 10), so the threshold is set at 20 and the false-alarm rate checked on fresh seeds."""
-Z_THRESHOLD = 3.0
-"""|parameter - neutral| / standard error an effect's fit must exceed to be named."""
-WEAK_BIC = 2.0
-"""dBIC above which a candidate short of :data:`BIC_THRESHOLD`, but precise (z) and over its floor,
-is reported ``not_identifiable`` rather than dropped (:func:`evidence_short`): Kass & Raftery
-(1995) call 2-6 "positive" evidence and below 2 "not worth more than a bare mention"."""
+_RULES = {"BIC_THRESHOLD": "bic_threshold", "Z_THRESHOLD": "z_threshold", "WEAK_BIC": "weak_bic"}
+"""The module's names of numbers of the diagnosis rules (:mod:`.rules`), read-only: ``BIC_THRESHOLD``, the dBIC
+an effect must exceed to be named; ``Z_THRESHOLD``, the standard errors its presence parameters must lie from
+neutral; ``WEAK_BIC``, the dBIC above which evidence short of a name is reported (:func:`evidence_short`)."""
+__getattr__ = module_rule(__name__, _RULES)
+
 KINDS = ("turn", "zigzag", "turn_pair", "turn_drift")
 """Kinds of record set the floors are calibrated for: :func:`record_kind`'s three, and ``turn_drift``,
 turns to one side whose baseline freed the hull's drift nonlinearities
@@ -81,7 +78,7 @@ MAGNITUDE_UNITS = {n: c.magnitude_unit for n, c in E.REGISTRY.items()}
 def evidence_short(delta_bic: float, z: float) -> bool:
     """Whether a candidate's evidence is some but short of a name (:data:`WEAK_BIC` < dBIC <=
     :data:`BIC_THRESHOLD`) while its precision would pass (z > :data:`Z_THRESHOLD`)."""
-    return bool(WEAK_BIC < delta_bic <= BIC_THRESHOLD and z > Z_THRESHOLD)
+    return bool(rule("weak_bic") < delta_bic <= rule("bic_threshold") and z > rule("z_threshold"))
 
 
 def magnitude(effect: str, values: dict, L: float) -> float:
@@ -197,7 +194,8 @@ def record_kind(rudders) -> str:
     does), else ``"turn_pair"`` for turns to both sides, diagnosed together (calibrated on pairs of
     35 deg turns: ``bench/bench_diagnose.py --mismatch --trials turn_pair``), else ``"turn"``.
 
-    A record's rudder is on one side when at least 90 % of its samples beyond 2 deg have one sign.
+    A record's rudder is on one side when a share of at least ``side_share`` of its samples beyond
+    ``side_rudder_deg`` have one sign (the diagnosis rules, :mod:`.rules`).
 
     Parameters
     ----------
@@ -205,15 +203,16 @@ def record_kind(rudders) -> str:
         Each record's rudder angle [rad].
     """
     sides = []
+    share, beyond = rule("side_share"), math.radians(rule("side_rudder_deg"))
     for d in rudders:
         d = np.asarray(d, float)
-        big = d[np.abs(d) > math.radians(2.0)]
+        big = d[np.abs(d) > beyond]
         if len(big) == 0:
             continue
         pos = float(np.mean(big > 0))
-        if 0.1 < pos < 0.9:
+        if pos < share and 1.0 - pos < share:
             return "zigzag"
-        sides.append(pos >= 0.9)
+        sides.append(pos >= share)
     return "turn_pair" if len(set(sides)) > 1 else "turn"
 
 

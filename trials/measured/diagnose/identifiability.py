@@ -54,6 +54,7 @@ import numpy as np
 import mmg.effects as E
 
 from .decision import STATISTICAL_REASON
+from .rules import module_rule, rule
 from .report import IDENTIFIABILITY_LEGEND, size_with_unit
 
 __all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_size", "floor_in_fit_unit", "block_confounding",
@@ -62,15 +63,14 @@ __all__ = ["DETECTION_SIZE", "R_CONFOUNDED", "STD_RATIO_CONFOUNDED", "detection_
 DETECTION_SIZE = {n: c.detection_size for n, c in E.REGISTRY.items()}
 """The smallest size of each effect that matters physically, in its fit parameters' unit
 (:attr:`mmg.effects.Effect.detection_size`, where each effect states and explains it)."""
-R_CONFOUNDED = 0.9
-"""Multiple correlation of the effect's parameters with the rest above which confounding, not
-noise, is why the effect cannot be shown."""
-STD_RATIO_CONFOUNDED = 3.0
-"""Marginal / conditional std above which the same holds (equivalent to R >= 0.943)."""
-
-"""The ``reason`` of an entry the statistics report (the console line then gives the std)."""
-_CONFUSED_MIN = 0.5
-"""|correlation| of another parameter with the effect's worst direction to be named as confused with it."""
+_RULES = {"R_CONFOUNDED": "r_confounded", "STD_RATIO_CONFOUNDED": "std_ratio_confounded",
+          "_CONFUSED_MIN": "confused_min"}
+"""The module's names of numbers of the diagnosis rules (:mod:`.rules`), read-only: ``R_CONFOUNDED``, the
+multiple correlation of the effect's parameters with the rest at or above which confounding, not noise, is why
+the effect cannot be shown; ``STD_RATIO_CONFOUNDED``, the marginal / conditional std at or above which the same
+holds; ``_CONFUSED_MIN``, the least |correlation| of another parameter with the effect's worst direction for it
+to be named as confused with it."""
+__getattr__ = module_rule(__name__, _RULES)
 
 
 def _size_of(effect: str) -> tuple:
@@ -363,7 +363,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         others = [(abs(c), _name(free[j])) for j, c in enumerate(b["corr"]) if j not in idx]
         confused = []
         for c, nm in sorted(others, reverse=True):
-            if c >= _CONFUSED_MIN and nm not in confused and len(confused) < 3:
+            if c >= rule("confused_min") and nm not in confused and len(confused) < 3:
                 confused.append(nm)
         det = detection_size(cls.name, L)
         row = {"effect": cls.name, "named": cls.name in named, "correlation": round(b["R"], 3),
@@ -425,10 +425,8 @@ def verdict(b: dict, det: float, fl: float, weak_why: str | None, unit: str, det
         reported; and that reason's kind (:data:`~trials.measured.diagnose.decision.REASON_KINDS`: "statistics",
         "floor", "evidence", "information"; None with it).
     """
-    from .decision import Z_THRESHOLD
-
-    imprecise = bool(max(2.0, Z_THRESHOLD) * b["sd"] > det)
-    if imprecise and (b["R"] >= R_CONFOUNDED or b["ratio"] >= STD_RATIO_CONFOUNDED):
+    imprecise = bool(max(2.0, rule("z_threshold")) * b["sd"] > det)
+    if imprecise and (b["R"] >= rule("r_confounded") or b["ratio"] >= rule("std_ratio_confounded")):
         return True, STATISTICAL_REASON, "statistics"
     if fl > det:
         return True, (f"the ship's own mismatch lends it up to {fl:.3g}{_sp(det_unit)} on such a record (calibrated "

@@ -30,7 +30,8 @@ from __future__ import annotations
 
 import math
 
-from .decision import Z_THRESHOLD, calibration
+from .decision import calibration
+from .rules import rule as _tuned
 
 __all__ = ["STATUS", "rules", "shape_parameters", "effect_form", "reclassify"]
 
@@ -111,7 +112,7 @@ def effect_form(effect: str, values: dict, rule: dict, ship_mismatch: dict | Non
         if v is None or s is None or not math.isfinite(s) or min(v - p.lower, p.upper - v) > tol * (p.upper - p.lower):
             continue
         z = abs(v - p.default) / s if s > 0 else math.inf
-        if z > Z_THRESHOLD:
+        if z > _tuned("z_threshold"):
             shapes[p.name] = {"fitted": float(v), "lower": p.lower, "upper": p.upper, "z": round(z, 2)}
     for name, (lo, hi) in (rule.get("plausible") or {}).get(effect, {}).items():
         v = values.get(name)

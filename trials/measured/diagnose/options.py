@@ -1,13 +1,17 @@
 """How :func:`~trials.measured.diagnose.diagnose` searches: :class:`DiagnoseOptions`."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from .rules import module_rule, rule
 
 __all__ = ["DiagnoseOptions", "SCREEN_NFEV"]
 
 
-SCREEN_NFEV = 6
-"""Evaluation budget of a candidate's first (screening) fit; see :func:`diagnose`."""
+_RULES = {"SCREEN_NFEV": "screen_nfev"}
+"""The module's name of a number of the diagnosis rules (:mod:`.rules`), read-only: ``SCREEN_NFEV``, the
+evaluation budget of a candidate's first (screening) fit; see :func:`diagnose`."""
+__getattr__ = module_rule(__name__, _RULES)
 
 
 @dataclass(frozen=True)
@@ -22,14 +26,16 @@ class DiagnoseOptions:
     candidates : list of str, optional
         Effect names to try (default: every registered effect).
     segment_s : float, optional
-        Segment length [s] (default 52 sqrt(L/g)).
+        Segment length [s] (default ``segment_length`` of the diagnosis rules, :mod:`.rules`, times
+        sqrt(L/g)).
     stride : int, optional
-        Use every ``stride``-th sample in the fits (default: samples 0.36 sqrt(L/g) apart, 0.2 s
-        for the 3 m model, 2 s at 325 m; at least 1).
+        Use every ``stride``-th sample in the fits (default: samples ``stride_spacing`` of the rules
+        times sqrt(L/g) apart; at least 1).
     max_nfev, screen_nfev : int
-        Evaluation budgets of a fit: every candidate is first fitted (warm, from the current
-        model) with ``screen_nfev``; one the budget stopped whose dBIC is positive or whose z
-        clears the threshold is fitted on, up to ``max_nfev`` in all.
+        Evaluation budgets of a fit (defaults: ``max_nfev`` and ``screen_nfev`` of the rules): every
+        candidate is first fitted (warm, from the current model) with ``screen_nfev``; one the budget
+        stopped whose dBIC is positive or whose z clears the threshold is fitted on, up to ``max_nfev``
+        in all.
     per_run : bool
         With several records, also diagnose each alone (``runs``).
     ship_free : sequence of str, optional
@@ -56,11 +62,11 @@ class DiagnoseOptions:
     candidates: object = None
     segment_s: float | None = None
     stride: int | None = None
-    max_nfev: int = 12
+    max_nfev: int = field(default_factory=lambda: rule("max_nfev"))
     per_run: bool = False
     ship_free: object = None
     say: object = None
-    screen_nfev: int = SCREEN_NFEV
+    screen_nfev: int = field(default_factory=lambda: rule("screen_nfev"))
     backend: str = "serial"
     client: object = None
     n_jobs: int | None = None

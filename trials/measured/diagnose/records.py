@@ -12,32 +12,25 @@ from mmg.errors import InputError
 from mmg.model import pack
 from mmg.ship import Ship
 
+from .rules import module_rule, rule
+
 __all__ = ["Prepared", "prepare", "absent_channels", "synthetic_record", "write_frt_csv", "RESTART_SMOOTH",
            "leading_straight_run", "noise_level"]
 
-RESTART_SMOOTH = 6.0
-"""Every segment restarts from the logged state smoothed over this many sqrt(L/g) (quadratic
-Savitzky-Golay: 3.3 s for the 3 m model, 35 s at 325 m): a restart from one noisy sample leaves a
-transient through the segment that a current or heading bias (which shift the restart states)
-would partly fit (clean records: 3/20 named an effect with single-sample restarts)."""
-
-STRAIGHT_YAW = 0.02
-"""Largest non-dimensional yaw rate |r| L / U of a sample of a straight run (the development set's
-yaw-rate noise at 325 m and 10 kn is 0.013)."""
-STRAIGHT_RUDDER_DEG = 1.0
-"""Largest move [deg] of the rudder from its first logged angle within a straight run."""
-STRAIGHT_TRIM_DEG = 3.0
-"""Largest |first logged rudder angle| [deg] of a straight run: a trim helm (the bundled Esso Osaka's
-is 0.3 deg, a 1.5 deg rudder offset shifts the logged one by as much), not a record that opens
-with the helm already over."""
-STRAIGHT_MIN_SAMPLES = 3
-"""Fewest samples of a straight run that is used."""
-STRAIGHT_WIND = 0.5
-"""Largest mean relative wind speed over a straight run, as a fraction of the ship's speed, for it to
-be used: a wind sets a ship on a drift that the model's wind loads would have to predict to a tenth
-of a degree.  At half the ship's speed a VLCC's lateral wind force over its hull's sway stiffness,
-rho_a A_L C_Y / (rho L T Y_v') (V/U)^2, gives about 0.03 deg; the development set's 10-18 m/s winds
-at 10 kn gave 0.3-0.9 deg."""
+_RULES = {"RESTART_SMOOTH": "restart_smooth", "STRAIGHT_YAW": "straight_yaw", "STRAIGHT_RUDDER_DEG": "straight_rudder_deg",
+          "STRAIGHT_TRIM_DEG": "straight_trim_deg", "STRAIGHT_MIN_SAMPLES": "straight_min_samples",
+          "STRAIGHT_WIND": "straight_wind"}
+"""The module's names of numbers of the diagnosis rules (:mod:`.rules`), read-only: ``RESTART_SMOOTH``, the
+window [sqrt(L/g)] of the quadratic Savitzky-Golay smoothing of the logged state every segment restarts from
+(3.3 s for the 3 m model, 35 s at 325 m: a restart from one noisy sample leaves a transient through the
+segment that a current or heading bias, which shift the restart states, would partly fit); and the limits of
+a straight run (:func:`leading_straight_run`): ``STRAIGHT_YAW``, the largest non-dimensional yaw rate
+|r| L / U of its samples; ``STRAIGHT_RUDDER_DEG``, the largest move [deg] of the rudder from its first logged
+angle; ``STRAIGHT_TRIM_DEG``, the largest |first logged rudder angle| [deg] (a trim helm, not a record that
+opens with the helm already over); ``STRAIGHT_MIN_SAMPLES``, its fewest samples; ``STRAIGHT_WIND``, the
+largest mean relative wind speed over it as a fraction of the ship's speed (a wind sets a ship on a drift
+that the model's wind loads would have to predict to a tenth of a degree)."""
+__getattr__ = module_rule(__name__, _RULES)
 
 # --------------------------------------------------------------------------- records
 
@@ -102,7 +95,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from ...files.shipcheck import read_for_ship
 
     L = ship.particulars.L
-    seg_s = segment_s or 52.0 * math.sqrt(L / 9.80665)
+    seg_s = segment_s or rule("segment_length") * math.sqrt(L / 9.80665)
     items = list(items)
     labels = record_labels([it.source if isinstance(it, Prepared) else
                             (it.source or it.name) if isinstance(it, TrialRecord) else it for it in items])
@@ -125,7 +118,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
         # a record without u, v is replayed in one piece: a restart would need the drift it does not log
         seg = Segmented(run.name, run.meas, run.inputs, segment_resets(run.t, math.inf if run.speed_only else seg_s),
                         context=ctx,
-                        start=_smoothed(run.t, run.meas, RESTART_SMOOTH * math.sqrt(L / 9.80665)),
+                        start=_smoothed(run.t, run.meas, rule("restart_smooth") * math.sqrt(L / 9.80665)),
                         fixed=run.effects, speed_only=run.speed_only,
                         straight=_straight(run, rec, ch, L) if straight_run else None)
         out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes), absent_channels(rec)))
@@ -176,13 +169,16 @@ def leading_straight_run(meas: np.ndarray, delta: np.ndarray, L: float, wind_spe
     meas = np.asarray(meas, float)
     d = np.asarray(delta, float)
     U = float(np.hypot(meas[0, 0], meas[0, 1]))
-    if len(meas) < STRAIGHT_MIN_SAMPLES + 2 or not U > 0 or abs(d[0]) > math.radians(STRAIGHT_TRIM_DEG):
+    n_min = rule("straight_min_samples")
+    if len(meas) < n_min + 2 or not U > 0 or abs(d[0]) > math.radians(rule("straight_trim_deg")):
         return None
-    steady = (np.abs(d - d[0]) <= math.radians(STRAIGHT_RUDDER_DEG)) & (np.abs(meas[:, 2]) * L / U <= STRAIGHT_YAW)
+    steady = ((np.abs(d - d[0]) <= math.radians(rule("straight_rudder_deg")))
+              & (np.abs(meas[:, 2]) * L / U <= rule("straight_yaw")))
     n = int(np.argmin(steady)) if not steady.all() else len(steady)
-    if n < STRAIGHT_MIN_SAMPLES:
+    if n < n_min:
         return None
-    if wind_speed_rel is not None and float(np.mean(np.abs(np.asarray(wind_speed_rel, float)[:n]))) > STRAIGHT_WIND * U:
+    wind = rule("straight_wind") * U
+    if wind_speed_rel is not None and float(np.mean(np.abs(np.asarray(wind_speed_rel, float)[:n]))) > wind:
         return None
     sigma = math.hypot(float(noise_level(meas)[1]) / math.sqrt(n), U * STRAIGHT_RUN_DRIFT_SD)
     return StraightRun(n=n, sigma=sigma)

@@ -336,8 +336,9 @@ def summary_lines(diag) -> list[str]:
     (:func:`effect_line`), one per effect reported ``model_form_mismatch``
     (:func:`form_line`), the statistics' legend, a line per effect that cannot be told apart, the
     residual RMS per channel (config, ship fitted, with the named effects), ``unexplained`` when set."""
-    from .decision import BIC_THRESHOLD, Z_THRESHOLD
+    from .rules import rule
 
+    bic, z_min = rule("bic_threshold"), rule("z_threshold")
     lines = []
     for e in diag.named:
         lines.append(effect_line(e, diag.parameters.get(e, {}), (diag.intervals_95 or {}).get(e, {}),
@@ -345,8 +346,8 @@ def summary_lines(diag) -> list[str]:
     if not diag.named:
         lines.append("nothing named")
     lines += [form_line(x) for x in getattr(diag, "model_form_effects", None) or []]
-    lines.append(f"  (dBIC: information gain with the effect, named above {BIC_THRESHOLD:g}; z: the fit's distance from "
-                 f"no effect in standard errors, named above {Z_THRESHOLD:g}; false-alarm p: chance of naming it at "
+    lines.append(f"  (dBIC: information gain with the effect, named above {bic:g}; z: the fit's distance from "
+                 f"no effect in standard errors, named above {z_min:g}; false-alarm p: chance of naming it at "
                  "this dBIC on records without it, n/a: not calibrated)")
     lines += [not_identifiable_line(ni) for ni in diag.not_identifiable or []]
     for k, v in (diag.model_form_mismatch or {}).items():

@@ -11,8 +11,8 @@ import numpy as np
 
 from mmg.parameters import config_values
 
-from . import decision
 from .decision import record_kind, residual_floor
+from .rules import module_rule, rule
 from .fit import _Model
 from .statistics import _effect_report, _r2, _rms, _taus
 
@@ -20,8 +20,12 @@ __all__ = ["Diagnosis", "CHANNELS", "UNEXPLAINED_FACTOR", "MISMATCH_Z", "ship_fi
            "model_form_mismatch", "straight_run_table", "absent_table"]
 
 
-UNEXPLAINED_FACTOR = 5.0
-"""A residual RMS above this many times the channel's noise level is reported as unexplained."""
+_RULES = {"UNEXPLAINED_FACTOR": "unexplained_factor", "MISMATCH_Z": "mismatch_z"}
+"""The module's names of numbers of the diagnosis rules (:mod:`.rules`), read-only: ``UNEXPLAINED_FACTOR``,
+the multiple of the channel's noise level above which a residual RMS is reported unexplained; ``MISMATCH_Z``,
+the prior std from its config value beyond which a fitted ship coefficient is reported as model-form mismatch
+(:attr:`Diagnosis.model_form_mismatch`) and not written to ``--out-ship``."""
+__getattr__ = module_rule(__name__, _RULES)
 
 
 CHANNELS = ("u", "v", "r", "heading", "position")
@@ -32,11 +36,6 @@ def absent_table(recs) -> list:
     """``[{"record", "channel", "column", "compared_instead"}]``: the residual channels each record does not log
     (:func:`trials.measured.diagnose.records.absent_channels`)."""
     return [{"record": r.name, "channel": c, **a} for r in recs for c, a in getattr(r, "absent", {}).items()]
-
-
-MISMATCH_Z = 3.0
-"""A fitted ship coefficient more than this many prior std from its config value is reported as
-model-form mismatch (:attr:`Diagnosis.model_form_mismatch`) and not written to ``--out-ship``."""
 
 
 def ship_fit_table(free, theta) -> list:
@@ -52,7 +51,7 @@ def model_form_mismatch(free, theta) -> dict:
     more than :data:`MISMATCH_Z` prior std from the config: the data ask for another model form (or
     an effect the candidates lack), not for these values."""
     return {r["name"]: {k: r[k] for k in ("config", "fitted", "prior_std", "z")}
-            for r in ship_fit_table(free, theta) if abs(r["z"]) > MISMATCH_Z}
+            for r in ship_fit_table(free, theta) if abs(r["z"]) > rule("mismatch_z")}
 
 
 def _describe(recs, diffs, noise, rms_after, L: float | None = None, kind: str | None = None) -> tuple[bool, str, dict]:
@@ -73,7 +72,7 @@ def _describe(recs, diffs, noise, rms_after, L: float | None = None, kind: str |
     U = float(np.median(np.hypot(M[:, 0], M[:, 1]))) if len(M) else 0.0
     rms = {c: float(np.sqrt(np.mean(D[:, names.index(c)] ** 2))) for c in ("u", "v", "r", "heading")}
     kind = kind or record_kind([r.seg.inputs.delta for r in recs])
-    big = [c for c in ("u", "v", "r", "heading") if ratio[c] > UNEXPLAINED_FACTOR
+    big = [c for c in ("u", "v", "r", "heading") if ratio[c] > rule("unexplained_factor")
            and (L is None or rms[c] > residual_floor(c, U, L, kind))]
     if not big:
         return False, "", ratio
@@ -174,7 +173,7 @@ class Diagnosis:
                "rms_units": {"u": "m/s", "v": "m/s", "r": "deg/s", "heading": "deg", "position": "m"},
                "unexplained": bool(self.unexplained), "unexplained_description": self.unexplained_description,
                "candidates": self.candidates, "rounds": self.rounds,
-               "threshold": {"delta_bic": decision.BIC_THRESHOLD, "z": decision.Z_THRESHOLD},
+               "threshold": {"delta_bic": rule("bic_threshold"), "z": rule("z_threshold")},
                "ship_coefficients": self.ship_values,
                "files": [r.source for r in self.records], "names": [r.name for r in self.records],
                "seconds": round(self.seconds, 2),

@@ -9,11 +9,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import decision
 from .baseline import DRIFT_KIND
-from .decision import MAGNITUDE_UNITS, WEAK_BIC, clears_floor, floor, floor_parts, magnitude
+from .decision import MAGNITUDE_UNITS, clears_floor, floor, floor_parts, magnitude
 from .fit import _Model
 from .options import DiagnoseOptions
+from .rules import rule
 from .report import fmt3, format_values, round_header, size_with_unit
 from .statistics import _COLS, _chi2, _delta_bic, _effect_index, _effect_report, _taus
 
@@ -47,10 +47,7 @@ def _covered(fitter, cand, say) -> tuple[list, list]:
     """(the candidates to fit, ``not_identifiable`` entries of those left out): a coefficient effect
     whose every changed coefficient (:meth:`mmg.effects.Effect.changed_coefficients`) the baseline
     frees is a change of the ship's own coefficients there, not something the records can tell from
-    them, and is not fitted.  Shallow water on a turn whose drift terms are freed (:data:`DRIFT_KIND`):
-    over 169 such candidate fits of the calibration and check draws of the ``turn_drift`` floors its dBIC never passed
-    18.1 and its z never 1.73 (a name needs 20 and 3), and not fitting it takes a 3500 s turn from
-    17.7 s to under the 15 s asked (``bench/bench_diagnose.py --timing-only``)."""
+    them, and is not fitted (shallow water on a turn whose drift terms are freed, :data:`DRIFT_KIND`)."""
     free = {f.name for f in fitter.ship_free}
     keep, out = [], []
     for cls in cand:
@@ -77,7 +74,7 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
     k = len(cls.fit_parameters())
     dbic = _delta_bic(current, m, k, taus, o.stride)
     vals, se, z = _effect_report(m, cls, inflate)
-    if m.fit.iterations >= o.screen_nfev and o.max_nfev > o.screen_nfev and (dbic > 0 or z > decision.Z_THRESHOLD):
+    if m.fit.iterations >= o.screen_nfev and o.max_nfev > o.screen_nfev and (dbic > 0 or z > rule("z_threshold")):
         m = fitter.fit(effs, start=m.theta, max_nfev=o.max_nfev - o.screen_nfev)
         dbic = _delta_bic(current, m, k, taus, o.stride)
         vals, se, z = _effect_report(m, cls, inflate)
@@ -85,7 +82,7 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
     if ship0 is None and ns > 0 and _retry_from_current(fitter, cls, dbic, z, vals):
         m, dbic, vals, se, z = _nested_start(fitter, current, cls, taus, inflate, ns, o, (m, dbic, vals, se, z))
     mag = magnitude(cls.name, vals, L)
-    ok = (dbic > decision.BIC_THRESHOLD and z > decision.Z_THRESHOLD
+    ok = (dbic > rule("bic_threshold") and z > rule("z_threshold")
           and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
           and not straight_contradicts(current.straight, m.straight))
     return dbic, ok, cls, m, vals, se, z, mag, _confounding(m, cls)
@@ -97,12 +94,11 @@ def _retry_from_current(fitter, cls, dbic: float, z: float, vals: dict) -> bool:
     below 0) though its precision and size would name it; on a turn whose baseline freed the drift
     nonlinearities (:data:`TURN_HULL_TERMS`, :data:`DRIFT_KIND`) wherever it falls short of the
     evidence to name it: from the config's values a budget of a few evaluations does not
-    bring them and the effect's own parameters together (a 10 m/s wind on a cross-flow member's port
-    turn: z 0.07 from the config, dBIC 76 and z 6.6 from the baseline fit)."""
+    bring them and the effect's own parameters together."""
     if fitter.kind == DRIFT_KIND:
-        return dbic <= decision.BIC_THRESHOLD
+        return dbic <= rule("bic_threshold")
     L = fitter.ship.particulars.L
-    return dbic < 0 and z > decision.Z_THRESHOLD and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
+    return dbic < 0 and z > rule("z_threshold") and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
 
 
 def straight_contradicts(before, after) -> bool:
@@ -110,10 +106,9 @@ def straight_contradicts(before, after) -> bool:
     :data:`~trials.measured.diagnose.decision.Z_THRESHOLD` of its standard errors off, and further off than the
     model it was tested against: the straight run reads a heading bias plus a current's cross part
     directly, so an effect whose fit it contradicts is asked for by the rest of the record (the
-    ship's own mismatch on a turn), not by itself.  (Fresh family seed 21000: a 0.5 deg rudder offset
-    on a port turn was named as a -0.56 deg heading bias, the straight run reading 0.06 +- 0.11 deg.)"""
+    ship's own mismatch on a turn), not by itself."""
     b, a = np.abs(np.asarray(before, float)), np.abs(np.asarray(after, float))
-    return bool(len(a) and np.any((a > decision.Z_THRESHOLD) & (a > b)))
+    return bool(len(a) and np.any((a > rule("z_threshold")) & (a > b)))
 
 
 def _nested_start(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions, first):
@@ -121,8 +116,7 @@ def _nested_start(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions, f
     itself with the effect at its neutral start.  ``current`` plus the effect holds ``current`` (the
     effect at neutral), so a dBIC below zero says the fit from the config's ship terms stopped short
     of it within its budget; a candidate whose precision and size would name it is then not judged on
-    that unfinished fit (fresh family seed 18000: a 1 deg bias on a port turn, z 4.5 and over its
-    floor, at dBIC -7 from the config's start)."""
+    that unfinished fit."""
     effs = current.effects + [cls]
     m = fitter.fit(effs, start_ship=current.theta[:ns], start_eff=list(current.theta[ns:]), max_nfev=o.max_nfev)
     dbic = _delta_bic(current, m, len(cls.fit_parameters()), taus, o.stride)
@@ -185,11 +179,7 @@ def _polish(fitter, current, o: DiagnoseOptions):
     another ``max_nfev`` evaluations from where it stopped (the
     better of the two kept): a candidate there is fitted again from ``current``
     (:func:`_retry_from_current`), and its dBIC must not count the further convergence of the ship's
-    own terms that its longer fit reached as evidence for the effect.  (Calibration seed 1200: a
-    0.25 m/s current on a cross-flow member's turn, named at 0.251 m/s in round 1, was joined in
-    round 2 by a -1.14 deg heading bias at dBIC 39, the current pushed to 0.349 m/s, and a rudder
-    offset and shallow water at dBIC 36 and 24 with z under 1: evidence of the longer fit alone.
-    Against the null fitted on, the bias had dBIC 12 and z 1.8, and the current stayed 0.247 m/s.)"""
+    own terms that its longer fit reached as evidence for the effect."""
     if fitter.kind != DRIFT_KIND:
         return current
     m = fitter.fit(current.effects, start=current.theta, max_nfev=o.max_nfev)
@@ -200,7 +190,7 @@ def _rival(results, r):
     """The candidate of the round's ``results`` that did not clear the naming tests though its dBIC
     cleared the threshold and is within :data:`~trials.measured.diagnose.decision.WEAK_BIC` of ``r``'s or above
     (the most evidence of such), or None: the records hold as much evidence for it as for ``r``."""
-    rivals = [x for x in results if not x[1] and x[0] > decision.BIC_THRESHOLD and x[0] > r[0] - WEAK_BIC]
+    rivals = [x for x in results if not x[1] and x[0] > rule("bic_threshold") and x[0] > r[0] - rule("weak_bic")]
     return max(rivals, key=lambda x: x[0]) if rivals else None
 
 
@@ -213,8 +203,7 @@ def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptio
     drift is a heading bias or a current's cross part, and a current too small for its floor still
     drifts the circle.  The named one must then still clear dBIC, z and its floor with the rival in
     the model; else it is withheld (``rnd["withheld"]``, reported ``not_identifiable`` by
-    :func:`withheld`).  (Fresh family seed 20000: 0.05-0.1 m/s currents on turns, fitted at dBIC
-    111-152 but under the current's floor, were named as 0.56-1.08 deg heading biases.)"""
+    :func:`withheld`)."""
     for r in sorted((x for x in results if x[1]), key=lambda x: -x[0]):
         rival = _rival(results, r)
         if rival is None:
@@ -226,7 +215,7 @@ def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptio
                        max_nfev=o.max_nfev)
         dbic = _delta_bic(with_rival, m, len(cls.fit_parameters()), taus, o.stride)
         stands, z, vals = _holds(fitter, m, cls, inflate)
-        stands = stands and dbic > decision.BIC_THRESHOLD and not straight_contradicts(with_rival.straight, m.straight)
+        stands = stands and dbic > rule("bic_threshold") and not straight_contradicts(with_rival.straight, m.straight)
         rnd.setdefault("withheld" if not stands else "beside_rival", []).append(
             {"effect": cls.name, "rival": rival[2].name, "delta_bic": round(dbic, 2), "z": round(z, 2),
              "parameters": vals})
@@ -240,7 +229,7 @@ def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptio
 def _holds(fitter, model: _Model, cls, inflate: float) -> tuple[bool, float, dict]:
     """(whether a named effect still clears z and its floor in ``model``, its z, its values)."""
     vals, _, z = _effect_report(model, cls, inflate)
-    ok = z > decision.Z_THRESHOLD and clears_floor(cls.name, vals, fitter.ship.particulars.L, fitter.kind, fitter.heading)
+    ok = z > rule("z_threshold") and clears_floor(cls.name, vals, fitter.ship.particulars.L, fitter.kind, fitter.heading)
     return ok, z, vals
 
 

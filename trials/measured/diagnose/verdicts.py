@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import decision
 from .decision import MAGNITUDE_UNITS, evidence_short, over_floor
 from .options import DiagnoseOptions
+from .rules import rule
 from .statistics import _effect_index, _taus
 
 __all__ = ["verdicts", "to_demote", "withheld", "rivals_withheld", "weak_evidence", "within_mismatch"]
@@ -27,12 +27,9 @@ def _demote(fitter, current, named, demote, rounds, o: DiagnoseOptions, say):
     cannot separate from the ship's own coefficients (the statistics reason of
     :func:`trials.measured.diagnose.identifiability.verdict`: its marginal sd could not have shown its detection
     size, and confounding is why) on a kind of record whose calibrated floor for it is above that size
-    (the ship's own mismatch lends it more than matters), which the issue asks to be reported
-    ``not_identifiable`` rather than named as a guess (fresh family seeds 19000 and 23000: a 1.5 deg
-    rudder offset on a single port turn named at 6.0-7.0 deg, sd 1.0 deg, R 0.999 with the hull
-    terms, floor 5.8 deg).  Without the floor condition a 18 m/s wind on a 20/20 zigzag of the
-    development set (dev_29) was demoted: the wind is judged present on its loads, its scale alone
-    trades with the shape factors.  Logged in the last round's ``demoted``."""
+    (the ship's own mismatch lends it more than matters): reported ``not_identifiable`` rather than named
+    as a guess.  The floor condition keeps an effect judged present on its loads (a wind whose scale
+    alone trades with its shape factors) named.  Logged in the last round's ``demoted``."""
     drop = [cls for cls in current.effects if cls.name in demote]
     keep = [e for e in current.effects if e not in drop]
     idx = {i for cls in drop for i in _effect_index(current, cls)}
@@ -107,7 +104,7 @@ def weak_evidence(rounds) -> dict:
     for c in last["candidates"]:
         if c.get("clears_threshold") or not evidence_short(c["delta_bic"], c["z"]) or not _over_floor(c):
             continue
-        out[c["effect"]] = (f"at dBIC {c['delta_bic']:.3g} (a name needs {decision.BIC_THRESHOLD:.3g}), z {c['z']:.3g}, "
+        out[c["effect"]] = (f"at dBIC {c['delta_bic']:.3g} (a name needs {rule('bic_threshold'):.3g}), z {c['z']:.3g}, "
                             f"{_size_text(c, MAGNITUDE_UNITS.get(c['effect'], ''))}: the record holds too little "
                             "evidence to tell it from the ship's own mismatch")
     return out
@@ -136,7 +133,7 @@ def within_mismatch(rounds, L: float) -> list:
     out = []
     last = rounds[-1] if rounds else {"candidates": []}
     for c in last["candidates"]:
-        if c["delta_bic"] > decision.BIC_THRESHOLD and c["z"] > decision.Z_THRESHOLD and not c["clears_threshold"]:
+        if c["delta_bic"] > rule("bic_threshold") and c["z"] > rule("z_threshold") and not c["clears_threshold"]:
             unit = MAGNITUDE_UNITS.get(c["effect"], "")
             if c.get("straight_contradicts") and _over_floor(c):
                 z = max(abs(x) for x in c["straight_z"])

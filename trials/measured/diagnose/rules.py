@@ -1,0 +1,100 @@
+"""The tuned numbers of ``mmg diagnose`` (its thresholds, gates, budgets and windows), read from the packaged
+``configs/calibration/diagnose_rules.yaml``, where each is written once with its unit, its meaning and where it
+came from.  The environment variable ``MMG_DIAGNOSE_RULES`` names another file (a whole file, every entry).
+
+The naming floors and residual floors are not here: they are the calibration
+(:func:`trials.measured.diagnose.decision.calibration`, ``configs/calibration/diagnose.yaml``).
+"""
+from __future__ import annotations
+
+import math
+import os
+from functools import lru_cache
+
+from mmg.resources import config_dir
+
+__all__ = ["ENV", "ENTRIES", "INTEGER_ENTRIES", "rules", "rule", "rules_path", "module_rule"]
+
+ENV = "MMG_DIAGNOSE_RULES"
+"""The environment variable that names a rules file in place of the packaged one."""
+
+ENTRIES = ("bic_threshold", "z_threshold", "weak_bic", "r_confounded", "std_ratio_confounded", "confused_min",
+           "unexplained_factor", "mismatch_z", "drift_fall_min", "restart_smooth", "segment_length",
+           "stride_spacing", "screen_nfev", "max_nfev", "side_rudder_deg", "side_share", "straight_yaw",
+           "straight_rudder_deg", "straight_trim_deg", "straight_min_samples", "straight_wind", "min_passing",
+           "residual_quantile")
+"""The entries a rules file holds, every one (the code reads each)."""
+
+INTEGER_ENTRIES = ("screen_nfev", "max_nfev", "straight_min_samples", "min_passing")
+"""Entries whose value is a count: a whole number."""
+
+_TEXT = ("unit", "meaning", "source")
+
+
+def rules_path():
+    """The rules file in use: ``MMG_DIAGNOSE_RULES``'s, else the packaged one."""
+    from pathlib import Path
+
+    env = os.environ.get(ENV)
+    return Path(env) if env else config_dir() / "calibration" / "diagnose_rules.yaml"
+
+
+@lru_cache(maxsize=1)
+def rules() -> dict:
+    """``{entry: value}`` of the rules file (:func:`rules_path`), read and checked once per process (clear
+    with ``rules.cache_clear()``).  A file that is missing or not YAML, an entry missing, unknown, without a
+    finite number as its ``value`` (a whole one for :data:`INTEGER_ENTRIES`) or without its ``unit``,
+    ``meaning`` and ``source``: one-line :class:`~mmg.errors.InputError` naming the file and the entry."""
+    import yaml
+
+    from mmg.errors import InputError
+
+    p = rules_path()
+    if not p.is_file():
+        raise InputError(str(p), ENV, "no such diagnosis rules file")
+    try:
+        data = yaml.safe_load(p.read_text())
+    except yaml.YAMLError as e:
+        raise InputError(str(p), "", f"not a rules YAML: {str(e).splitlines()[0]}") from None
+    if not isinstance(data, dict):
+        raise InputError(str(p), "", "a rules file maps entry -> {value, unit, meaning, source}")
+    for name in data:
+        if name not in ENTRIES:
+            raise InputError(str(p), str(name), f"not an entry of the diagnosis rules ({', '.join(ENTRIES)})")
+    return {name: _checked(p, name, data.get(name)) for name in ENTRIES}
+
+
+def _checked(p, name: str, ent):
+    """The value of entry ``name`` of file ``p`` (module rules of :func:`rules`)."""
+    from mmg.errors import InputError
+
+    if ent is None:
+        raise InputError(str(p), name, "missing (every entry of the diagnosis rules is needed)")
+    if not isinstance(ent, dict):
+        raise InputError(str(p), name, "expected {value: number, unit, meaning, source}")
+    for key in _TEXT:
+        if not isinstance(ent.get(key), str) or not ent[key].strip():
+            raise InputError(str(p), f"{name}.{key}", "missing (a text)")
+    v = ent.get("value")
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise InputError(str(p), f"{name}.value", f"{v!r} is not a finite number")
+    if name in INTEGER_ENTRIES:
+        if v != int(v) or v < 1:
+            raise InputError(str(p), f"{name}.value", f"{v!r} is not a whole number of at least 1")
+        return int(v)
+    return float(v)
+
+
+def rule(name: str):
+    """The value of rules entry ``name`` (:data:`ENTRIES`), from :func:`rules`."""
+    return rules()[name]
+
+
+def module_rule(module_name: str, names: dict):
+    """A module ``__getattr__`` that gives the module's constant names of ``names`` ({NAME: entry}) as
+    read-only views of :func:`rule`, read when asked for (a rules file named after import counts)."""
+    def __getattr__(attr):
+        if attr in names:
+            return rule(names[attr])
+        raise AttributeError(f"module {module_name!r} has no attribute {attr!r}")
+    return __getattr__
