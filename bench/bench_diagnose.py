@@ -104,6 +104,8 @@ def _refuse_bad_options(ap, a) -> None:
         ap.error("--summarise: reads runs already made; --only, --max-nfev and --trials are not used with it")
     if a.wide and (not a.mismatch or a.trials is not None or a.summarise):
         ap.error("--wide: draws its own trials for a --mismatch run; not with --trials or --summarise")
+    if a.wind_curve != "fujiwara" and not a.mismatch:
+        ap.error("--wind-curve: the shape of the --mismatch family's wind loads; give --mismatch with it")
     if a.max_nfev is not None and a.max_nfev <= SCREEN_NFEV:
         ap.error(f"--max-nfev: {a.max_nfev} is not more than the screening budget of {SCREEN_NFEV} evaluations")
 
@@ -143,6 +145,9 @@ def main(argv=None):
                     help="--mismatch: the wider draw: either hand first, turns 15-35 deg, zigzags 10/10-20/20, "
                          "approach 6-15 kn per record, winds 8-25 m/s alone and 15-25 m/s beside each other effect "
                          "(diagnose_mismatch.wide_jobs); prints the per-class table")
+    ap.add_argument("--wind-curve", choices=("fujiwara", "harmonic", "mixed"), default="fujiwara",
+                    help="--mismatch: the shape of the members' wind loads (MismatchSpec.wind_curve): the model's own "
+                         "(fujiwara, default), a loaded tanker's measured curve drawn per member (harmonic), or half each")
     ap.add_argument("--summarise", nargs="+", default=None, metavar="JSON",
                     help="--mismatch: print the summary of runs already made (bench/out/diagnose_mismatch<tag>.json), "
                          "pooled, their not_identifiable lists completed by the evidence rule of the code as it is "

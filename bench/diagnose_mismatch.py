@@ -4,7 +4,9 @@ Records: the development set's trials (:data:`trials.measured.mismatch.TRIALS`: 
 starboard and port, 10/10, 15/15, 20/20 zigzags; 10 kn, constant revolutions, 1 s, uniform noise
 of the set's half-widths) of members of the mismatch family (:mod:`trials.measured.mismatch`:
 hull +-10 % linear, +-25 % nonlinear, a quarter with the cross-flow hull form, rudder and propeller
-+-15 %, added masses +-10 %, wind loads +-30 %), each diagnosed alone as a user would
++-15 %, added masses +-10 %, wind loads +-30 %; ``--wind-curve harmonic`` or ``mixed``: all or half
+of the members' wind loads on a loaded tanker's measured curve instead of the model's regression,
+:mod:`trials.measured.wind_curves`), each diagnosed alone as a user would
 (``diagnose(load_ship(ship_path(SHIP)), [record])``, SHIP ``--ship``, default ``esso_osaka``; a
 model-scale config such as ``kvlcc2_l7`` sails the same full-scale trials Froude-scaled to it,
 :func:`trials.measured.mismatch.froude_scaled`; sizes stay full-scale in the tables).  Clean records give the false-alarm
@@ -75,11 +77,11 @@ SHIP = "esso_osaka"
 
 
 @functools.lru_cache(maxsize=4)
-def _family(seed0: int, ship: str = SHIP):
+def _family(seed0: int, ship: str = SHIP, wind_curve: str = "fujiwara"):
     import mmg
-    from trials.measured.mismatch import mismatch_family
+    from trials.measured.mismatch import MismatchSpec, mismatch_family
 
-    return mismatch_family(mmg.load_ship(mmg.ship_path(ship)), FAMILY_SIZE, seed0)
+    return mismatch_family(mmg.load_ship(mmg.ship_path(ship)), FAMILY_SIZE, seed0, MismatchSpec(wind_curve=wind_curve))
 
 
 def jobs(nclean: int, seeds: int, effects, seed0: int, trials=None) -> list[dict]:
@@ -187,9 +189,10 @@ def run_one(job: dict, seed0: int) -> dict:
 
     ship = job.get("ship", SHIP)
     config = mmg.load_ship(mmg.ship_path(ship))
-    member, factors = _family(seed0, ship)[job["member"]]
+    member, factors = _family(seed0, ship, job.get("wind_curve", "fujiwara"))[job["member"]]
     recs = [trial_records(config, member, t, job["spec"], seed=job["seed"] + 1000003 * k, true_wind=job["true_wind"],
-                          speed_kn=job.get("speed_kn", 10.0), name=f"{job['id']}_{t}" if k else job["id"])
+                          speed_kn=job.get("speed_kn", 10.0), name=f"{job['id']}_{t}" if k else job["id"],
+                          wind_curve=factors.get("wind_curve"))
             for k, t in enumerate(PAIRS.get(job["trial"], (job["trial"],)))]
     rec = recs[0]
     t0 = time.perf_counter()
@@ -199,7 +202,8 @@ def run_one(job: dict, seed0: int) -> dict:
     truth = {k: dict(v) for k, v in rec.meta["effects"].items()}          # as the record holds them (fit units)
     if "wind" in truth:
         w = rec.meta["effects"]["wind"]
-        truth["wind"] = {"speed_mps": w["true_speed_mps"], "from_deg": w["true_from_deg"], **member.wind.values()}
+        truth["wind"] = {"speed_mps": w["true_speed_mps"], "from_deg": w["true_from_deg"], **member.wind.values(),
+                         **({"curve": factors["wind_curve"]} if "wind_curve" in factors else {})}
     return {**{k: job[k] for k in ("id", "seed", "member", "trial", "effect", "size")},
             "speed_kn": job.get("speed_kn", 10.0), "ship": ship, "froude_scale": config.froude_scale,
             "family_seed": seed0, "factors": factors, "truth": truth, "named": list(d.named),
@@ -461,11 +465,14 @@ def main_mismatch(a) -> None:
             else jobs(nclean, seeds, effects, a.seed0, a.trials))
     if a.only:                                   # the same records as a full run of these options, by id
         todo = [j for j in todo if j["id"] in set(a.only)]
-    todo = [{**j, "candidate_start": a.candidate_start, "max_nfev": a.max_nfev, "ship": a.ship} for j in todo]
+    curve = getattr(a, "wind_curve", "fujiwara")
+    todo = [{**j, "candidate_start": a.candidate_start, "max_nfev": a.max_nfev, "ship": a.ship, "wind_curve": curve}
+            for j in todo]
     path = out / f"diagnose_mismatch{a.tag}.json"
     wide = getattr(a, "wide", False)
     head = {"ship": a.ship, "family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds,
-            "effects": effects, "sizes": {e: (WIDE_SIZES if wide else SIZES)[e] for e in effects}, "wide": wide}
+            "effects": effects, "sizes": {e: (WIDE_SIZES if wide else SIZES)[e] for e in effects}, "wide": wide,
+            "wind_curve": curve}
     save = lambda rows: path.write_text(json.dumps({**head, "records": rows}, indent=1, default=float))  # noqa: E731
     t0 = time.perf_counter()
     nc = sum(j["effect"] is None for j in todo)

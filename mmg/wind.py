@@ -204,13 +204,14 @@ AMPLITUDES = ("X0", "X1", "X3", "X5", "Y1", "Y3", "Y5", "N1", "N2", "N3")
 
 
 def amplitude_vector(particulars: WindParticulars = ESSO_OSAKA_MODEL, sway_factor: float = 1.0,
-                     yaw_factor: float = 1.0) -> np.ndarray:
-    """The ten Fujiwara amplitudes as an array in the order of :data:`AMPLITUDES`, with the shape factors.
+                     yaw_factor: float = 1.0, yaw_sin: float = 0.0) -> np.ndarray:
+    """The ten Fujiwara amplitudes as an array in the order of :data:`AMPLITUDES`, with the shape terms.
 
-    The one place the wind effect's shape factors act (:class:`mmg.effects.Wind`): the sway amplitudes
+    The one place the wind effect's shape terms act (:class:`mmg.effects.Wind`): the sway amplitudes
     Y1, Y3, Y5 times ``sway_factor`` and the yaw amplitudes N1, N2, N3 times ``yaw_factor`` (the series
     is linear in them, so C_Y and C_N are the published ones times the factors at every angle; C_X
-    unchanged).  Used by :func:`wind_forces` (the replay's loads from the measured wind) and by the
+    unchanged), and ``yaw_sin`` sin(gamma) added to C_N (in N1: the lateral load's centre moved along
+    the ship by about ``yaw_sin`` / |C_Y| of L, aft when positive: the bow turned towards the wind).  Used by :func:`wind_forces` (the replay's loads from the measured wind) and by the
     simulator's steady wind (the ``P_WIND_AMP`` slots of :mod:`mmg.model`, written by
     :meth:`mmg.effects.Wind.pack`).
 
@@ -220,6 +221,8 @@ def amplitude_vector(particulars: WindParticulars = ESSO_OSAKA_MODEL, sway_facto
         Above-water geometry of the ship.
     sway_factor, yaw_factor : float
         Factors on the sway force and the yaw moment (1: as published).
+    yaw_sin : float
+        Yaw-moment coefficient added times sin(gamma) (0: as published).
 
     Returns
     -------
@@ -227,7 +230,9 @@ def amplitude_vector(particulars: WindParticulars = ESSO_OSAKA_MODEL, sway_facto
     """
     A = fujiwara_amplitudes(particulars)
     f = {"Y": float(sway_factor), "N": float(yaw_factor)}
-    return np.array([A[k] * f.get(k[0], 1.0) for k in AMPLITUDES])
+    out = np.array([A[k] * f.get(k[0], 1.0) for k in AMPLITUDES])
+    out[AMPLITUDES.index("N1")] -= float(yaw_sin)            # C_N = -(N1 sin g + ...): the regression's angle is -g
+    return out
 
 
 def fujiwara_series(c, s, A):
@@ -263,7 +268,7 @@ def fujiwara_series(c, s, A):
 
 def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODEL,
                 rho_air: float = RHO_AIR, scale: float = 1.0, sway_factor: float = 1.0,
-                yaw_factor: float = 1.0):
+                yaw_factor: float = 1.0, yaw_sin: float = 0.0):
     """Wind surge force, sway force and yaw moment about midship from the relative wind.
 
     Parameters
@@ -282,6 +287,8 @@ def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODE
         Overall factor on all three loads (1 = as published).
     sway_factor, yaw_factor : float
         Further factors on the sway force and the yaw moment alone (:func:`amplitude_vector`).
+    yaw_sin : float
+        Yaw-moment coefficient added times sin(gamma) (:func:`amplitude_vector`).
 
     Returns
     -------
@@ -303,7 +310,7 @@ def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODE
         raise ValueError("V_rel must be >= 0")
     p = particulars
     a = np.asarray(angle_rel, dtype=float)
-    cx, cy, cn = fujiwara_series(np.cos(a), np.sin(a), amplitude_vector(p, sway_factor, yaw_factor))
+    cx, cy, cn = fujiwara_series(np.cos(a), np.sin(a), amplitude_vector(p, sway_factor, yaw_factor, yaw_sin))
     q = 0.5 * rho_air * V**2 * scale
     return q * p.A_T * cx, q * p.A_L * cy, q * p.A_L * p.L * cn
 

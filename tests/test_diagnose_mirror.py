@@ -41,7 +41,7 @@ MIRROR = {
     "current": {"speed_mps": "same", "direction_deg": "angle"},
     "heading_bias": {"bias_deg": "negated"},
     "rudder_offset": {"offset_deg": "negated"},
-    "wind": {"scale": "same", "sway_factor": "same", "yaw_factor": "same", "true_speed_mps": "same",
+    "wind": {"scale": "same", "sway_factor": "same", "yaw_factor": "same", "yaw_sin": "same", "true_speed_mps": "same",
              "true_from_deg": "angle"},
     "shallow_water": {"depth_to_draft": "same", "draft_to_depth": "same"},
 }

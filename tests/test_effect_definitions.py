@@ -100,9 +100,11 @@ def _load_cov(theta, load_var):
     """The covariance of (scale, sway_factor, yaw_factor) when the fit knows the three loads (surge
     scale, sway scale*sway_factor, yaw scale*yaw_factor) independently with variances ``load_var``:
     the loads' Jacobian inverted by hand."""
-    s, a, b = theta
+    s, a, b = theta[:3]
     Ginv = np.array([[1.0, 0.0, 0.0], [-a / s, 1.0 / s, 0.0], [-b / s, 0.0, 1.0 / s]])
-    return Ginv @ np.diag(load_var) @ Ginv.T
+    cov = np.eye(len(theta)) * 0.01                     # yaw_sin (4th): known on its own, not a load's presence
+    cov[:3, :3] = Ginv @ np.diag(load_var) @ Ginv.T
+    return cov
 
 
 def test_wind_presence_is_judged_on_its_three_loads():
@@ -116,11 +118,11 @@ def test_wind_presence_is_judged_on_its_three_loads():
 
     W = get("wind")
     var = np.array([4.0, 0.01, 0.01])
-    th = np.array([1.0, 1.0, 1.0])
+    th = np.array([1.0, 1.0, 1.0, 0.0])
     cov = _load_cov(th, var)
     x = 1.0 / 4.0 + 1.0 / 0.01 + 1.0 / 0.01                       # the loads' Wald statistic, 3 dof
     assert W.presence_z(th, cov) == pytest.approx(norm.isf(0.5 * chi2.sf(x, 3)), rel=1e-6)
     assert W.presence_z(th, cov) > 10.0
     assert Effect.presence_z.__func__(W, th, cov) == pytest.approx(0.5, rel=1e-6)   # the scale alone
-    small = np.array([0.1, 0.5, 0.5])                              # loads 0.1, 0.05, 0.05
+    small = np.array([0.1, 0.5, 0.5, 0.0])                         # loads 0.1, 0.05, 0.05
     assert W.presence_z(small, _load_cov(small, var)) < 3.0

@@ -12,10 +12,10 @@ from mmg.errors import InputError
 def test_registry_names_and_parameters():
     assert E.names() == ["current", "wind", "rudder_offset", "heading_bias", "shallow_water"]
     assert [p.name for p in E.Current.parameters] == ["speed_mps", "direction_deg"]
-    assert [p.name for p in E.Wind.parameters] == ["scale", "sway_factor", "yaw_factor", "true_speed_mps",
+    assert [p.name for p in E.Wind.parameters] == ["scale", "sway_factor", "yaw_factor", "yaw_sin", "true_speed_mps",
                                                    "true_from_deg"]
     # the steady wind is given, not fitted; the scale and the shape factors are
-    assert [p.name for p in E.Wind.fit_parameters()] == ["scale", "sway_factor", "yaw_factor"]
+    assert [p.name for p in E.Wind.fit_parameters()] == ["scale", "sway_factor", "yaw_factor", "yaw_sin"]
     assert [p.name for p in E.RudderOffset.parameters] == ["offset_deg"]
     assert [p.name for p in E.HeadingBias.parameters] == ["bias_deg"]
     assert [p.name for p in E.ShallowWater.parameters] == ["depth_to_draft"]

@@ -80,6 +80,36 @@ def test_steady_wind_loads_of_the_simulator_take_the_same_factors(ship):
             assert np.allclose(got, [float(w) for w in want], rtol=1e-10), (sway, yaw, u, v, psi)
 
 
+def test_yaw_sin_adds_its_sine_to_the_yaw_moment_alone(ship):
+    """``yaw_sin`` c: N gains scale q A_L L c sin(gamma) at every angle (the same sign as the wind's side:
+    positive turns the bow towards a wind from starboard), in the measured-wind loads and in the
+    simulator's steady wind; X and Y are unchanged."""
+    from mmg.model import pack, wind_loads
+
+    t = np.linspace(0.0, 10.0, 73)
+    gamma = np.linspace(-math.pi, math.pi, 73)
+    V = np.full_like(t, 3.0)
+    g = ship.wind.particulars()
+    scale, c = 1.3, 0.07
+    es = E.effect_set({"wind": {"scale": scale, "sway_factor": 0.9, "yaw_factor": 1.2, "yaw_sin": c}})
+    got = es.external(_ctx(ship, t, V, gamma))
+    X, Y, N = plain_loads(V, gamma, g, scale, 0.9, 1.2)
+    N = N + scale * 0.5 * RHO_AIR * V ** 2 * g.A_L * g.L * c * np.sin(gamma)
+    want = np.column_stack([X, Y, N])
+    assert np.allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
+    beam = es.external(_ctx(ship, t[:1], V[:1], np.array([math.pi / 2])))
+    plain = E.effect_set({"wind": {"scale": scale, "sway_factor": 0.9, "yaw_factor": 1.2}}).external(
+        _ctx(ship, t[:1], V[:1], np.array([math.pi / 2])))
+    assert beam[0, 2] > plain[0, 2] and beam[0, 1] == plain[0, 1]
+    steady = E.effect_set({"wind": {"scale": scale, "yaw_sin": c, "true_speed_mps": 4.0, "true_from_deg": 90.0}})
+    p = steady.pack(pack(ship), ship).p
+    V2 = 4.0 ** 2 + 0.4 ** 2                              # beam wind, u = 0.4 m/s, v = 0, heading 0
+    gam = math.atan2(4.0, 0.4)
+    want = plain_loads(math.sqrt(V2), gam, g, scale)
+    want_n = float(want[2]) + scale * 0.5 * RHO_AIR * V2 * g.A_L * g.L * c * math.sin(gam)
+    assert np.allclose(wind_loads(0.4, 0.0, 0.0, p), [float(want[0]), float(want[1]), want_n], rtol=1e-10)
+
+
 # ----------------------------------------------------------------------------- configs
 
 def _ship_yaml(tmp_path, name, edit):
@@ -178,9 +208,9 @@ def test_presence_of_the_wind_needs_its_scale():
 
     assert E.Wind.presence_parameters() == ("scale",)
     assert E.Current.presence_parameters() == tuple(q.name for q in E.Current.fit_parameters())
-    _, _, z = _report(E.Wind, [0.0, 1.3, 1.3], [0.1, 0.1, 0.1])       # no wind, shape factors off 1
+    _, _, z = _report(E.Wind, [0.0, 1.3, 1.3, 0.1], [0.1, 0.1, 0.1, 0.05])   # no wind, shape terms off neutral
     assert z == pytest.approx(0.0, abs=1e-9) and z < Z_THRESHOLD
-    vals, _, z = _report(E.Wind, [0.8, 1.0, 1.0], [0.1, 0.05, 0.05])  # a wind of 0.8 the published
+    vals, _, z = _report(E.Wind, [0.8, 1.0, 1.0, 0.0], [0.1, 0.05, 0.05, 0.03])  # a wind of 0.8 the published
     assert z > 2 * Z_THRESHOLD and vals["scale"] == 0.8
 
 

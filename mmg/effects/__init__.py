@@ -3,15 +3,15 @@
 Registry: :data:`REGISTRY` maps the effect name to its class; adding an effect is one new
 module with an :class:`~mmg.effects.base.Effect` subclass plus one :func:`register` line here.
 
-========================  =============  =================================================
+========================  =============  =========================================================
 name                      kind           parameters
-========================  =============  =================================================
+========================  =============  =========================================================
 ``current``               kinematic      ``speed_mps``, ``direction_deg`` (sets towards)
-``wind``                  force          ``scale``, ``sway_factor``, ``yaw_factor``
+``wind``                  force          ``scale``, ``sway_factor``, ``yaw_factor``, ``yaw_sin``
 ``rudder_offset``         force          ``offset_deg``
 ``heading_bias``          measurement    ``bias_deg``
 ``shallow_water``         coefficients   ``depth_to_draft``
-========================  =============  =================================================
+========================  =============  =========================================================
 
 :func:`effect_set` builds an :class:`~mmg.effects.base.EffectSet` from a mapping such as a
 config section ``{"current": {"speed_mps": 0.05, "direction_deg": 90}, "rudder_offset": {...}}``

@@ -88,6 +88,12 @@ class MismatchSpec:
         The surge, sway and yaw wind loads, each on its own (ships with a ``wind`` section).
     crossflow_fraction : float
         Probability that a member's hull nonlinear part is of the cross-flow form.
+    wind_curve : str
+        The shape of the members' wind loads (:data:`trials.measured.wind_curves.WIND_CURVES`):
+        ``"fujiwara"``, the model's own regression with the ``wind`` factors; ``"harmonic"``, every
+        member's loads on a loaded tanker's measured curve
+        (:data:`trials.measured.wind_curves.TANKER_LOADED`), each coefficient times its own factor of
+        half-width ``wind``; ``"mixed"``: half of the members (at random places) so.
     beta_max_deg, r_max : float
         The operating range the cross-flow form is fitted over: |beta| <= beta_max_deg, |r'| <= r_max.
     """
@@ -99,6 +105,7 @@ class MismatchSpec:
     added_mass: float = 0.10
     wind: float = 0.30
     crossflow_fraction: float = 0.25
+    wind_curve: str = "fujiwara"
     beta_max_deg: float = 25.0
     r_max: float = 0.8
 
@@ -246,10 +253,27 @@ def mismatch_ship(ship: Ship, rng: np.random.Generator, spec: MismatchSpec = Mis
 def mismatch_family(ship: Ship, n: int, seed: int, spec: MismatchSpec = MismatchSpec()) -> list:
     """``n`` members drawn from ``seed``: a list of (Ship, factors) (:func:`mismatch_member`).
 
-    Exactly ``round(n * spec.crossflow_fraction)`` of them, at random places, have the cross-flow hull."""
+    Exactly ``round(n * spec.crossflow_fraction)`` of them, at random places, have the cross-flow hull.
+    With ``spec.wind_curve`` other than ``"fujiwara"``, the members whose wind loads follow another
+    curve (all, or half at random places) carry it as ``factors["wind_curve"]``
+    (:meth:`~trials.measured.wind_curves.HarmonicWindCurve.to_dict`), drawn from a stream of its own
+    after the members, so the members themselves are those of the ``"fujiwara"`` family of the seed."""
+    from .wind_curves import TANKER_LOADED, WIND_CURVES
+
+    if spec.wind_curve not in WIND_CURVES:
+        raise ValueError(f"MismatchSpec.wind_curve {spec.wind_curve!r}: one of {WIND_CURVES}")
     rng = np.random.default_rng(seed)
     cross = set(rng.permutation(n)[:round(n * spec.crossflow_fraction)].tolist())
-    return [mismatch_member(ship, rng, spec, crossflow=i in cross) for i in range(n)]
+    family = [mismatch_member(ship, rng, spec, crossflow=i in cross) for i in range(n)]
+    if spec.wind_curve == "fujiwara" or ship.wind is None:
+        return family
+    crng = np.random.default_rng([seed, 1])
+    other = set(range(n)) if spec.wind_curve == "harmonic" else set(crng.permutation(n)[:n // 2].tolist())
+    for i, (member, factors) in enumerate(family):
+        curve = TANKER_LOADED.drawn(crng, spec.wind)
+        if i in other:
+            factors["wind_curve"] = curve.to_dict()
+    return family
 
 
 def trial_hand(kind: str) -> str:
@@ -288,7 +312,7 @@ def froude_scaled(effects: dict, true_wind, noise, lam: float):
 
 
 def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 0, true_wind=(0.0, 0.0),
-                  speed_kn: float = 10.0, noise=DEV_NOISE_HALF_WIDTHS, name: str | None = None):
+                  speed_kn: float = 10.0, noise=DEV_NOISE_HALF_WIDTHS, name: str | None = None, wind_curve=None):
     """A full-scale trial of ``truth`` logged as the development set's are.
 
     10 s straight run at heading 0, then the execute; a turn runs 1500 s after it, a zigzag to its
@@ -320,6 +344,11 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     noise : sequence of 6 floats
         Uniform half-widths.
     name : str, optional
+    wind_curve : dict, optional
+        A member's ``factors["wind_curve"]`` (:func:`mismatch_family`): its wind loads follow that
+        curve (:class:`~trials.measured.wind_curves.HarmonicWindCurve`, on ``truth``'s wind geometry)
+        in the logged states instead of ``truth``'s regression (which still acts in the closed-loop run
+        that makes a zigzag's rudder history).
 
     Returns
     -------
@@ -337,13 +366,19 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
         eff["wind"] = {**truth.wind.values(), **eff["wind"], "true_speed_mps": float(true_wind[0]),
                        "true_from_deg": math.degrees(true_wind[1])}
     rpm = replace(truth, engine=replace(truth.engine, mode="constant_rpm"))
+    loads = None
+    if wind_curve is not None and "wind" in eff:
+        from .wind_curves import HarmonicWindCurve
+
+        curve, geometry = HarmonicWindCurve.from_dict(wind_curve), truth.wind.particulars()
+        loads = lambda V, g: curve.loads(V, g, geometry)  # noqa: E731
     te = 10.0 * ts
     zig = tr["kind"] == "zigzag"
     rec = synthetic_record(ship, tr["kind"], eff, truth_ship=rpm, speed=speed_kn * KNOT * ts,
                            duration=(4000.0 * max(1.0, 10.0 / speed_kn) if zig else 10.0 + 1500.0) * ts, dt=ts,
                            rudder_deg=tr["rudder_deg"],
                            heading_deg=tr.get("heading_deg"), t_execute=te, true_wind=true_wind, noise=noise,
-                           noise_dist="uniform", seed=seed, name=name or kind)
+                           noise_dist="uniform", seed=seed, name=name or kind, wind_loads=loads)
     if zig:
         rec = rec.slice_time(-math.inf, _zigzag_end(rec, te, 9, 60.0 * ts) + 1e-9 * ts)
     return replace(rec, meta={**rec.meta, "trial": kind, "effects": eff})

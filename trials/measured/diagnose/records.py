@@ -207,7 +207,8 @@ def _smoothed(t: np.ndarray, meas: np.ndarray, window_s: float) -> np.ndarray:
 def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | None = None, speed: float | None = None,
                      duration: float | None = None, dt: float = 0.5, rudder_deg: float = 20.0,
                      true_wind=(0.0, 0.0), noise=None, seed: int = 0, name: str | None = None,
-                     heading_deg: float | None = None, t_execute: float | None = None, noise_dist: str = "normal"):
+                     heading_deg: float | None = None, t_execute: float | None = None, noise_dist: str = "normal",
+                     wind_loads=None):
     """A record as a trial would log it, with hidden effects: a turning or zigzag of ``truth_ship``
     (default ``ship``) simulated closed loop (the rudder orders from its own heading), then
     replayed with its rudder and revolutions and the ``effects`` (an :class:`mmg.effects.EffectSet`
@@ -223,7 +224,10 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     execute (default 5 sqrt(L/g) for a turning, 0 for a zigzag); ``noise_dist="uniform"`` draws
     the noise uniform with ``noise`` as the half-widths instead of the standard deviations.  A
     steady true wind in the effects (``true_speed_mps`` > 0) acts in the closed-loop run too, so
-    a zigzag's rudder answers the wind as a helmsman's would."""
+    a zigzag's rudder answers the wind as a helmsman's would.  ``wind_loads``, a callable
+    (V_rel [m/s], gamma [rad]) -> (X, Y [N], N [N m]), replaces the wind effect's loads in the
+    logged states (a ship whose wind loads follow another curve); the closed-loop run that makes the
+    rudder history keeps the effect's own."""
     import mmg.effects as E
     from mmg.integrate import CommandLaw
     from mmg.replay import ReplayInputs, replay_states
@@ -274,7 +278,8 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
             wind_rel = (Vr, np.mod(ang, 2 * np.pi))
             ctx = E.Context(t=t, delta=delta, n=n, channels=dict(zip(("wind_speed_rel", "wind_dir_rel"), wind_rel)),
                             ship=truth)
-            ext = wind_eff[0][0].external(wind_eff[0][1], ctx)
+            ext = (wind_eff[0][0].external(wind_eff[0][1], ctx) if wind_loads is None
+                   else np.column_stack(wind_loads(Vr, ang)))
             states = replay_states(pk, ReplayInputs(t, delta, n, ext), s0)
     else:
         states = replay_states(pk, ReplayInputs(t, delta, n), s0)
