@@ -38,11 +38,15 @@ def _records(ship, truth, effects, wind=(0.0, 0.0)):
             synthetic_record(ship, "zigzag", effects, truth_ship=truth, true_wind=wind, seed=2, name="zigzag")]
 
 
-def _check_fall(d, effect):
+def _check_fall(d, effect, clean=None):
+    """Each channel the effect acts on: its residual falls by half, or (``clean`` given: the diagnosis of
+    the same records, same noise, without the effect) to within 10 % of what the clean records leave --
+    the noise and the ship's own mismatch, which no effect can remove."""
     import mmg.effects as E
 
     for c in E.get(effect).affects:
-        assert d.rms_after[c] <= 0.5 * d.rms_before[c], (c, d.rms_before[c], d.rms_after[c])
+        floor = 1.1 * clean.rms_after[c] if clean is not None else 0.0
+        assert d.rms_after[c] <= max(0.5 * d.rms_before[c], floor), (c, d.rms_before[c], d.rms_after[c], floor)
 
 
 @pytest.fixture(scope="module")
@@ -90,23 +94,23 @@ def test_shallow_water_found(ship, truth):
 
 
 @pytest.mark.slow
-def test_rudder_offset_found(ship, truth):
+def test_rudder_offset_found(ship, truth, clean):
     from trials.measured.diagnose import diagnose
 
     d = diagnose(ship, _records(ship, truth, {"rudder_offset": {"offset_deg": 1.0}}))
     assert d.named == ["rudder_offset"]
     assert abs(d.parameters["rudder_offset"]["offset_deg"] - 1.0) <= 0.3
-    _check_fall(d, "rudder_offset")
+    _check_fall(d, "rudder_offset", clean)
 
 
 @pytest.mark.slow
-def test_heading_bias_found(ship, truth):
+def test_heading_bias_found(ship, truth, clean):
     from trials.measured.diagnose import diagnose
 
     d = diagnose(ship, _records(ship, truth, {"heading_bias": {"bias_deg": 1.0}}))
     assert d.named == ["heading_bias"]
     assert abs(d.parameters["heading_bias"]["bias_deg"] - 1.0) <= 0.3
-    _check_fall(d, "heading_bias")
+    _check_fall(d, "heading_bias", clean)
 
 
 @pytest.mark.slow
