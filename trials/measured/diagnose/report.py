@@ -63,7 +63,7 @@ def size_in_si(value: float, unit: str, L: float, T: float, U: float | None = No
 def size_with_unit(value: float, unit: str, L: float, T: float, U: float | None = None) -> str:
     """``value`` with its ``unit`` and, for a ship-relative one, its SI value beside it
     (:func:`size_in_si`; ``U`` [m/s] the records' speed, for a size in U): ``"0.0259 sqrt(gL) = 0.140 m/s"``,
-    ``"0.015 U = 0.116 m/s at U = 7.72 m/s"``, ``"0.0893 T/H, H = 33.6 m"``, ``"0.738 deg"``."""
+    ``"0.0150 U = 0.116 m/s at U = 7.72 m/s"``, ``"0.0893 T/H, H = 33.6 m"``, ``"0.738 deg"``."""
     text = f"{fmt3(value)} {unit}".rstrip()
     si = size_in_si(value, unit, L, T, U)
     return text if not si else f"{text} = {si}" if unit in ("sqrt(gL)", SPEED_UNIT) else f"{text}, {si}"
