@@ -147,3 +147,23 @@ def test_a_size_in_U_is_printed_with_its_speed():
 
     assert size_with_unit(0.015, "U", L, 20.0, 7.72) == "0.0150 U = 0.116 m/s at U = 7.72 m/s"
     assert size_with_unit(0.002, "sqrt(gL)", L, 20.0, 7.72) == "0.00200 sqrt(gL) = 0.113 m/s"
+
+
+def test_a_rounds_parts_carry_their_units_into_the_reason(monkeypatch):
+    """The search logs each part with its unit; the not_identifiable reason says a part in U in U."""
+    from types import SimpleNamespace
+
+    import trials.measured.diagnose.decision as D
+    from trials.measured.diagnose.search import _parts
+    from trials.measured.diagnose.verdicts import within_mismatch
+
+    monkeypatch.setattr(D, "calibration", lambda: _table("U", 0.02, 0.0005))
+    fitter = SimpleNamespace(ship=SimpleNamespace(particulars=SimpleNamespace(L=L)), kind="zigzag", heading=0.0,
+                             speed=14 * KN)
+    p = _parts(fitter, "current", {"speed_mps": 0.12, "direction_deg": 0.0})
+    assert p["part_units"] == {"along": "U", "across": "sqrt(gL)"}
+    assert p["parts"]["along"][0] == pytest.approx(0.016662, rel=1e-3)
+    cand = {"effect": "current", "delta_bic": 50.0, "z": 9.0, "magnitude": 0.12 / G, "floor": 0.1 / G,
+            "clears_threshold": False, **p}
+    (entry,) = within_mismatch([{"candidates": [cand]}], L)
+    assert "along 0.0167 (floor 0.02) U" in entry["reason"] and "across 0 (floor 0.0005) sqrt(gL)" in entry["reason"]
