@@ -8,7 +8,7 @@ with no floor: ``MMG_DIAGNOSE_CALIBRATION=none``), and runs with effects.  The f
 afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the records that set them.
 
     python bench/calibrate_diagnose.py bench/out/diagnose_mismatch_cal.json[:KIND] ... [--alpha 0.05] [--write]
-        [--kinds turn turn_pair] [--ship esso_osaka] [--out FILE]
+        [--kinds turn turn_pair [--effects EFFECT ...]] [--ship esso_osaka] [--out FILE]
 
 ``--ship`` is the config the runs diagnosed (``bench_diagnose.py --mismatch --ship``; its length
 makes the floors' sqrt(gL) units); ``--out`` writes another file than the packaged one (a
@@ -18,7 +18,9 @@ calibration of another ship, used through ``MMG_DIAGNOSE_CALIBRATION=FILE``).
 the diagnosis of the other kind was another (the rudder's inflow freed on zigzags too, variant 6
 in ``docs/diagnose.md``) still calibrates this one.  ``--kinds`` writes only those kinds' floors
 (:func:`trials.measured.calibration.merge_kinds`), the others kept from the packaged file: where
-the diagnosis of one kind of record changes, its runs recalibrate that kind alone.
+the diagnosis of one kind of record changes, its runs recalibrate that kind alone; ``--effects``
+with it writes only those effects' floors of those kinds (``--kinds zigzag --effects current_along
+current_across``: the floors of a current's parts on zigzags, in their units, the rest kept).
 """
 from __future__ import annotations
 
@@ -45,9 +47,14 @@ def main(argv=None):
     ap.add_argument("--write", action="store_true", help=f"write {OUT.relative_to(REPO)}")
     ap.add_argument("--kinds", nargs="+", default=None, metavar="KIND",
                     help="write only these kinds' floors (turn, zigzag, turn_pair); the others kept from the packaged file")
+    ap.add_argument("--effects", nargs="+", default=None, metavar="EFFECT",
+                    help="with --kinds: write only these effects' floors, clean samples and units (e.g. current_along "
+                         "current_across); every other figure kept from the packaged file")
     ap.add_argument("--ship", default="esso_osaka", help="the config the runs diagnosed (default esso_osaka)")
     ap.add_argument("--out", type=Path, default=OUT, help="the file --write writes (default the packaged one)")
     a = ap.parse_args(argv)
+    if a.effects and not a.kinds:
+        ap.error("--effects: writes those effects' floors of the --kinds given; give --kinds with it")
     import yaml
 
     import mmg
@@ -67,7 +74,8 @@ def main(argv=None):
     for row in cal.to_pandas().itertuples():
         v = np.asarray(cal.clean[row.effect][row.kind])
         print(f"{row.effect:14s} {row.kind:7s} n {row.samples:3d}  passing dBIC,z {row.passing:3d}  max {row.max_passing:.4g}  "
-              f"rms of passing {np.sqrt(np.mean(v[v > 0] ** 2)) if np.any(v > 0) else 0.0:.4g}  floor {row.floor:.4g}")
+              f"rms of passing {np.sqrt(np.mean(v[v > 0] ** 2)) if np.any(v > 0) else 0.0:.4g}  floor {row.floor:.4g} "
+              f"{row.unit}")
     doc = {"source": f"python bench/calibrate_diagnose.py {' '.join(Path(p).name for p in a.bench_json)} --alpha {a.alpha} "
                      f"({cal.n_clean} clean records and {cal.n_effects} with effects of the mismatch family, seeds of "
                      f"those bench runs; {datetime.date.today().isoformat()})", **cal.to_json()}
@@ -76,8 +84,9 @@ def main(argv=None):
     print(f"clean records with a candidate short of a name (reported not_identifiable; packaged floors): {k} of {n}")
     if a.kinds:
         old = yaml.safe_load(a.out.read_text()) if a.out.exists() else {}
-        source = f"{old.get('source', '')}; then for {', '.join(a.kinds)} only: {doc['source']}".lstrip("; ")
-        doc = {"source": source, **{k: v for k, v in merge_kinds(old, doc, a.kinds).items() if k != "source"}}
+        what = ", ".join(a.kinds) + (f" ({', '.join(a.effects)})" if a.effects else "")
+        source = f"{old.get('source', '')}; then for {what} only: {doc['source']}".lstrip("; ")
+        doc = {"source": source, **{k: v for k, v in merge_kinds(old, doc, a.kinds, a.effects).items() if k != "source"}}
     if a.write:
         kept = (yaml.safe_load(a.out.read_text()) or {}) if a.out.exists() else {}
         if "model_form" in kept:             # chosen on principle, not calibrated here: carried over as it is

@@ -191,10 +191,10 @@ def test_mirrored_record_gets_the_mirrored_diagnosis(config, truth, tmp_path, ca
 
 def _floor_on_starboard_offsets(real):
     """A one-handed rule: a rudder offset to starboard must also exceed 3 deg to be named."""
-    def rule(effect, values, L, kind, heading=None):
+    def rule(effect, values, L, kind, heading=None, speed=None):
         if effect == "rudder_offset" and values["offset_deg"] > 0 and values["offset_deg"] < 3.0:
             return False
-        return real(effect, values, L, kind, heading)
+        return real(effect, values, L, kind, heading, speed)
     return rule
 
 

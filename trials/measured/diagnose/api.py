@@ -12,7 +12,7 @@ from mmg.model import pack
 from mmg.ship import Ship
 
 from .baseline import _ship_free, fit_baseline
-from .decision import calibration, mean_heading, record_kind
+from .decision import calibration, mean_heading, record_kind, typical_speed
 from .fit import _Fitter
 from .options import DiagnoseOptions
 from .records import noise_level, prepare
@@ -80,17 +80,17 @@ def _first_fitter(ship: Ship, recs, o: DiagnoseOptions) -> _Fitter:
     """The fitter of the baseline's first fit: the ship's own parameters of the kind of record set
     (:func:`~.baseline._ship_free`, ``o.ship_free`` or the default ones), residual scales of 5 % of the
     records' median speed U (at least 0.05 sqrt(g L)) for u, v, 5 % of U / L for r, 2 deg for the
-    heading and 5 % of L for the position, the records' mean heading."""
+    heading and 5 % of L for the position, the records' mean heading and typical speed."""
     from ekf.identify import Scales
 
     L = ship.particulars.L
     packed = pack(ship)
-    U = float(np.median(np.concatenate([np.hypot(r.seg.meas[:, 0], r.seg.meas[:, 1]) for r in recs])))
-    U = max(U, 0.05 * math.sqrt(9.80665 * L))
+    speed = typical_speed([r.seg.meas for r in recs])
+    U = max(speed, 0.05 * math.sqrt(9.80665 * L))
     kind = record_kind([r.seg.inputs.delta for r in recs])
     sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
     return _Fitter(ship, packed, recs, sc0, o.stride, o.max_nfev, _ship_free(ship, packed, o.ship_free, kind, drift=False),
-                   kind=kind, heading=mean_heading([r.seg.meas[:, 5] for r in recs]))
+                   kind=kind, heading=mean_heading([r.seg.meas[:, 5] for r in recs]), speed=speed)
 
 
 def _diagnose_one(task) -> "Diagnosis":

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .decision import MAGNITUDE_UNITS
+from .decision import MAGNITUDE_UNITS, PART_UNITS
 from .rules import module_rule, rule
 
 __all__ = [
@@ -55,8 +55,9 @@ __all__ = [
     "short_of_name",
 ]
 
-UNITS = {**MAGNITUDE_UNITS, "current_along": MAGNITUDE_UNITS["current"], "current_across": MAGNITUDE_UNITS["current"]}
-"""Units of the floors and clean magnitudes, per effect (and per part of a current on zigzags)."""
+UNITS = {**MAGNITUDE_UNITS, **PART_UNITS}
+"""Units of the floors and clean magnitudes, per effect (and per part of a current on zigzags: along the
+heading a fraction of the records' speed U, across it over sqrt(gL))."""
 RESIDUAL_UNITS = {"u": "fraction of U", "v": "fraction of U", "r": "r L / U", "heading": "deg"}
 """Units of the residual floors, per channel."""
 
@@ -80,7 +81,7 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
     kind as the ship's own mismatch, and a name given for it is a wrong name."""
     import math
 
-    from .decision import COMPONENT_FLOORS, current_components, magnitude
+    from .decision import COMPONENT_FLOORS, current_components, magnitude, part_size
 
     bic, z_min = rule("bic_threshold"), rule("z_threshold")
     out: dict = {}
@@ -100,7 +101,8 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
                 if c["effect"] == "current" and kind in COMPONENT_FLOORS:
                     # bench runs of the family sail at heading 0 (trials.measured.mismatch.trial_records)
                     parts = current_components(c["parameters"], L, math.radians(rd.get("heading_deg", 0.0)))
-                    sizes += [(k, abs(x)) for k, x in zip(COMPONENT_FLOORS[kind], parts)]
+                    speed = rd.get("speed_mps") or rec.get("speed_mps")
+                    sizes += [(k, abs(part_size(x, PART_UNITS[k], L, speed))) for k, x in zip(COMPONENT_FLOORS[kind], parts)]
                 for e, m in sizes:
                     out.setdefault(e, {}).setdefault(kind, []).append(float(m) if ok else 0.0)
                     passes.setdefault(e, {}).setdefault(kind, []).append(ok)
@@ -261,25 +263,31 @@ class Calibration:
         return pd.DataFrame(rows)
 
 
-def merge_kinds(old: dict, new: dict, kinds) -> dict:
+def merge_kinds(old: dict, new: dict, kinds, effects=None) -> dict:
     """The calibration document ``old`` with the floors, residual floors and clean samples of the
     record ``kinds`` (e.g. ``("turn", "turn_pair")``) taken from ``new``, the other kinds' kept: a
     change of the diagnosis of one kind of record (its baseline) is recalibrated on that kind's runs
     alone.  A kind ``new`` has no floor for is dropped from ``old`` too: no floor of the diagnosis it
-    replaced survives."""
+    replaced survives.  With ``effects`` (e.g. ``("current_along",)``) only those effects' floors,
+    clean samples and units are taken from ``new``; every other figure of ``old`` (its residual
+    floors too) is kept."""
     kinds = set(kinds)
+    take = (lambda e: True) if effects is None else set(effects).__contains__
     out = dict(old)                                       # the old document's keys, in its order
-    out.update({k: v for k, v in new.items() if k not in ("floors", "residual_floors", "clean", "source")})
+    out.update({k: v for k, v in new.items() if k not in ("floors", "residual_floors", "clean", "source", "units")})
+    out["units"] = {**old.get("units", {}), **{e: u for e, u in new.get("units", {}).items() if take(e)}}
     for key in ("floors", "clean"):
         merged = {}
         for e in dict.fromkeys([*old.get(key, {}), *new.get(key, {})]):     # old's effects first, in order
-            row = {k: v for k, v in old.get(key, {}).get(e, {}).items() if k not in kinds}
-            row.update({k: v for k, v in new.get(key, {}).get(e, {}).items() if k in kinds})
+            row = {k: v for k, v in old.get(key, {}).get(e, {}).items() if k not in kinds or not take(e)}
+            if take(e):
+                row.update({k: v for k, v in new.get(key, {}).get(e, {}).items() if k in kinds})
             if row:
                 merged[e] = row
         out[key] = merged
-    res = {k: v for k, v in old.get("residual_floors", {}).items() if k not in kinds}
-    res.update({k: v for k, v in new.get("residual_floors", {}).items() if k in kinds})
+    res = {k: v for k, v in old.get("residual_floors", {}).items() if k not in kinds or effects is not None}
+    if effects is None:
+        res.update({k: v for k, v in new.get("residual_floors", {}).items() if k in kinds})
     out["residual_floors"] = res
     return out
 
@@ -306,7 +314,8 @@ def short_of_name(records, L: float) -> tuple[int, int]:
         n += 1
         first = (r.get("rounds") or [{}])[0]
         kind, head = record_kind_of(r), math.radians(first.get("heading_deg") or 0.0)
-        k += any(evidence_short(c["delta_bic"], c["z"]) and clears_floor(c["effect"], c["parameters"], L, kind, head)
+        speed = first.get("speed_mps") or r.get("speed_mps")
+        k += any(evidence_short(c["delta_bic"], c["z"]) and clears_floor(c["effect"], c["parameters"], L, kind, head, speed)
                  for c in first.get("candidates", []))
     return k, n
 

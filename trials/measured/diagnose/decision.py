@@ -42,7 +42,8 @@ from .rules import module_rule, rule
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
-           "REASON_KINDS", "KIND_FALLBACK", "by_kind", "packaged_calibration"]
+           "REASON_KINDS", "KIND_FALLBACK", "by_kind", "packaged_calibration", "PART_UNITS", "SPEED_UNIT",
+           "part_units", "part_size", "typical_speed"]
 
 _RULES = {"BIC_THRESHOLD": "bic_threshold", "Z_THRESHOLD": "z_threshold", "WEAK_BIC": "weak_bic"}
 """The module's names of numbers of the diagnosis rules (:mod:`.rules`), read-only: ``BIC_THRESHOLD``, the dBIC
@@ -123,15 +124,50 @@ COMPONENT_FLOORS = {"zigzag": ("current_along", "current_across")}
 """Kinds of record on which a current's size is judged by its components along and across the mean
 heading, each against a floor of its own (the calibration's ``current_along``, ``current_across``).
 On a zigzag the ship's own speed mismatch (resistance, thrust, wake) lends a current along the
-heading: on the family's clean zigzags up to 0.11 m/s along, never above 0.011 m/s across (see
-``bench/calibrate_diagnose.py``); a turn sweeps every heading and keeps the speed's floor."""
+heading, hardly any across it (see ``bench/calibrate_diagnose.py``); a turn sweeps every heading and
+keeps the speed's floor."""
+
+SPEED_UNIT = "U"
+"""The unit of a part floor that scales with the ship's speed: a fraction of the records'
+:func:`typical_speed` U (a part of 0.015 U is 0.116 m/s at U = 7.72 m/s, 15 kn)."""
+PART_UNITS = {"current_along": SPEED_UNIT, "current_across": MAGNITUDE_UNITS["current"]}
+"""The units :mod:`.calibration` sets the part floors in.  Along the heading a fraction of the speed U:
+a resistance, thrust or wake mismatch of the ship errs its speed by a share of that speed, which the fit
+takes for a current along the heading; across it over sqrt(g L), as the current's :func:`magnitude`.
+A calibration file says its own (its ``units``): a part floor in sqrt(gL) is read as that."""
 
 
-def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float | None = None) -> bool:
+def typical_speed(meas) -> float:
+    """The records' typical speed U [m/s]: the median over every sample of every record of the logged
+    speed over ground, hypot(u, v) (``meas`` a sequence of (N, >=2) arrays, u, v [m/s] their first
+    columns); 0 where no sample is finite."""
+    a = np.concatenate([np.hypot(np.asarray(m, float)[:, 0], np.asarray(m, float)[:, 1]) for m in meas])
+    a = a[np.isfinite(a)]
+    return float(np.median(a)) if len(a) else 0.0
+
+
+def part_units(kind: str, units: dict | None = None) -> dict:
+    """``{part floor: unit}`` of the parts a current is judged by on ``kind`` (:data:`COMPONENT_FLOORS`),
+    as ``units`` (the calibration's by default) says them; a part it does not name is in sqrt(gL)."""
+    units = (calibration().get("units") or {}) if units is None else units
+    return {c: str(units.get(c, MAGNITUDE_UNITS["current"])) for c in COMPONENT_FLOORS.get(kind, ())}
+
+
+def part_size(x: float, unit: str, L: float, speed: float | None) -> float:
+    """A current's part ``x`` (over sqrt(g L), :func:`current_components`) in a part floor's ``unit``:
+    itself for sqrt(gL), x sqrt(g L) / U for :data:`SPEED_UNIT` (U = ``speed`` [m/s], the records'
+    :func:`typical_speed`; NaN without a speed).  ``L``: ship length [m]."""
+    if unit != SPEED_UNIT:
+        return x
+    return x * math.sqrt(9.80665 * L) / speed if speed and speed > 0 else math.nan
+
+
+def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float | None = None,
+                 speed: float | None = None) -> bool:
     """Whether an effect's size exceeds the calibrated floor on a record set of ``kind``: its
     :func:`magnitude` over :func:`floor`, or, for a current on a kind of :data:`COMPONENT_FLOORS`
-    with its component floors calibrated and ``heading`` given, either component
-    (:func:`current_components`) over its own floor.
+    with its component floors calibrated and ``heading`` given (and ``speed`` where a part's floor is
+    in :data:`SPEED_UNIT`), either component (:func:`floor_parts`) over its own floor.
 
     Parameters
     ----------
@@ -144,8 +180,10 @@ def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float 
         :func:`record_kind`.
     heading : float, optional
         The records' mean heading [rad] (:func:`mean_heading`).
+    speed : float, optional
+        The records' typical speed U [m/s] (:func:`typical_speed`).
     """
-    parts = floor_parts(effect, values, L, kind, heading)
+    parts = floor_parts(effect, values, L, kind, heading, speed)
     return over_floor(magnitude(effect, values, L), floor(effect, kind), parts)
 
 
@@ -159,25 +197,42 @@ def over_floor(size: float, fl: float, parts: dict | None = None) -> bool:
     return not size <= fl
 
 
-def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float | None = None) -> dict:
+def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float | None = None,
+                speed: float | None = None) -> dict:
     """``{part: (size, floor)}`` of a current judged by its parts (:func:`clears_floor`): ``along`` and
-    ``across`` over sqrt(gL); empty where the effect is judged by its :func:`magnitude` alone."""
+    ``across``, each in its floor's unit (:func:`part_units`: over sqrt(gL), or over the records' speed
+    ``speed`` [m/s] for :data:`SPEED_UNIT`); empty where the effect is judged by its :func:`magnitude`
+    alone, or where a part's floor is in :data:`SPEED_UNIT` and no speed is given."""
     comp = _component_floors(effect, kind, calibration().get("floors") or {})
     if not comp or heading is None:
         return {}
+    units = part_units(kind)
+    if any(units[c] == SPEED_UNIT for c in comp) and not (speed and speed > 0):
+        return {}
     parts = current_components(values, L, heading)
-    return {c.split("_")[-1]: (float(f"{x:.4g}"), floor(c, kind)) for x, c in zip(parts, comp)}
+    return {c.split("_")[-1]: (float(f"{part_size(x, units[c], L, speed):.4g}"), floor(c, kind))
+            for x, c in zip(parts, comp)}
 
 
-def least_floor(effect: str, kind: str, floors: dict | None = None) -> float:
+def least_floor(effect: str, kind: str, floors: dict | None = None, froude: float | None = None,
+                units: dict | None = None) -> float:
     """The least size of ``effect`` that can clear its floor on a record set of ``kind``, in the unit
     of :func:`magnitude`: its floor, or, for a current judged by its parts there
     (:data:`COMPONENT_FLOORS`, :func:`clears_floor`), the smaller part's floor (a current that size
-    across the heading clears it).  ``floors`` ({effect: {kind: floor}}): the calibration's by default."""
-    floors = (calibration().get("floors") or {}) if floors is None else floors
+    across the heading clears it); a part floor in :data:`SPEED_UNIT` counts as floor * ``froude``
+    (the records' U / sqrt(g L)), and not at all without it.  ``floors`` ({effect: {kind: floor}}) and
+    ``units`` ({part floor: unit}): the calibration's by default; ``units`` defaults to
+    :data:`PART_UNITS` where ``floors`` is given."""
+    if floors is None:
+        floors = calibration().get("floors") or {}
+    elif units is None:
+        units = PART_UNITS
+    units = part_units(kind, units)
     comp = _component_floors(effect, kind, floors)
-    if comp:
-        return float(min(by_kind(floors[c], kind) for c in comp))
+    sizes = [float(by_kind(floors[c], kind)) * (froude if units[c] == SPEED_UNIT else 1.0)
+             for c in comp if units[c] != SPEED_UNIT or froude]
+    if sizes:
+        return float(min(sizes))
     return float(by_kind(floors.get(effect), kind, 0.0))
 
 
@@ -255,6 +310,14 @@ def _read_calibration(p) -> dict:
         raise InputError(str(p), "", f"not a calibration YAML: {str(e).splitlines()[0]}") from None
     if not isinstance(data, dict) or not isinstance(data.get("floors", {}), dict):
         raise InputError(str(p), "floors", "a calibration file maps effect -> kind -> floor")
+    units = data.get("units") or {}
+    if not isinstance(units, dict):
+        raise InputError(str(p), "units", "a calibration file maps effect -> unit")
+    for c in sorted({c for cs in COMPONENT_FLOORS.values() for c in cs} & set(units)):
+        if units[c] not in (SPEED_UNIT, MAGNITUDE_UNITS["current"]):
+            raise InputError(str(p), f"units.{c}", f"{units[c]!r} is not a unit of a current's part floor "
+                                                   f"({SPEED_UNIT!r}: a fraction of the records' speed, or "
+                                                   f"{MAGNITUDE_UNITS['current']!r})")
     return data
 
 

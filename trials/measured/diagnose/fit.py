@@ -36,9 +36,10 @@ class _Fitter:
     """What a fit is made of: the ship (and its packed form), the records (:class:`~.records.Prepared`),
     the residual scales (:class:`ekf.identify.Scales`), the sample stride and evaluation budget, the
     ship's own parameters fitted with every model (:func:`~.baseline._ship_free`), the kind of record
-    set whose floors judge a name (:func:`~.decision.record_kind`), the records' mean heading [rad], and
-    the straight runs' weight in the fit (:attr:`ekf.identify.FitOptions.straight_weight`: sqrt(tau_v)
-    of the round's model, 1 before the search)."""
+    set whose floors judge a name (:func:`~.decision.record_kind`), the records' mean heading [rad], the
+    straight runs' weight in the fit (:attr:`ekf.identify.FitOptions.straight_weight`: sqrt(tau_v)
+    of the round's model, 1 before the search), and the records' typical speed U [m/s]
+    (:func:`~.decision.typical_speed`; a floor in a fraction of U needs it, 0 where not known)."""
 
     ship: object
     packed: object
@@ -50,6 +51,7 @@ class _Fitter:
     kind: str
     heading: float
     straight_weight: float = 1.0
+    speed: float = 0.0
 
     def diffs(self, effects, free, theta):
         from ekf.identify import predict_logged

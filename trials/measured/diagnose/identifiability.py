@@ -373,7 +373,8 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         if not table[:-1]:
             say(IDENTIFIABILITY_LEGEND)
         say(identifiability_line(row, b["R"], _unit(cls) or _size_unit(cls), _size_unit(cls), fitter.ship.particulars))
-        fl = floor_in_fit_unit(cls.name, least_floor(cls.name, getattr(fitter, "kind", "")), L)
+        froude = getattr(fitter, "speed", 0.0) / math.sqrt(9.80665 * L)
+        fl = floor_in_fit_unit(cls.name, least_floor(cls.name, getattr(fitter, "kind", ""), froude=froude), L)
         row["confounded"], reason, kind = verdict(b, det, fl, (weak or {}).get(cls.name), _unit(cls), _size_unit(cls))
         row["floor"], row["reason_kind"] = fl, kind
         if cls.name in named or reason is None:

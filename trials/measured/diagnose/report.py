@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from .decision import SPEED_UNIT
 from .decision import false_alarm_probability  # noqa: F401  (re-exported: the report's evidence)
 
 __all__ = ["Z95", "effect_estimate", "effect_intervals", "polar_interval", "effect_evidence",
@@ -44,23 +45,28 @@ IDENTIFIABILITY_LEGEND = ("(identifiability: R, the multiple correlation of the 
 """The one-line legend printed before the first identifiability line of a diagnosis."""
 
 
-def size_in_si(value: float, unit: str, L: float, T: float) -> str:
+def size_in_si(value: float, unit: str, L: float, T: float, U: float | None = None) -> str:
     """A size in a ship-relative unit said in SI, to print beside it: ``"0.140 m/s"`` for ``value``
-    sqrt(g L) (speed = value * sqrt(g L), ``L`` [m]), ``"H = 33.6 m"`` for a ratio T/H (depth H = T / value,
-    ``T`` the draft [m]; ``"H infinite"`` at 0); ``""`` for any other unit (already SI-like: m/s, deg)."""
+    sqrt(g L) (speed = value * sqrt(g L), ``L`` [m]) and ``"0.116 m/s at U = 7.72 m/s"`` for ``value`` U
+    (a fraction of the records' speed ``U`` [m/s]: :data:`~trials.measured.diagnose.decision.SPEED_UNIT`),
+    ``"H = 33.6 m"`` for a ratio T/H (depth H = T / value, ``T`` the draft [m]; ``"H infinite"`` at 0);
+    ``""`` for any other unit (already SI-like: m/s, deg), and for U without a speed."""
     if unit == "sqrt(gL)":
         return f"{fmt3(abs(value) * math.sqrt(GRAVITY * L))} m/s"
+    if unit == SPEED_UNIT:
+        return f"{fmt3(abs(value) * U)} m/s at U = {fmt3(U)} m/s" if U else ""
     if unit == "T/H":
         return "H infinite" if value == 0 else f"H = {fmt3(T / abs(value))} m"
     return ""
 
 
-def size_with_unit(value: float, unit: str, L: float, T: float) -> str:
+def size_with_unit(value: float, unit: str, L: float, T: float, U: float | None = None) -> str:
     """``value`` with its ``unit`` and, for a ship-relative one, its SI value beside it
-    (:func:`size_in_si`): ``"0.0259 sqrt(gL) = 0.140 m/s"``, ``"0.0893 T/H, H = 33.6 m"``, ``"0.738 deg"``."""
+    (:func:`size_in_si`; ``U`` [m/s] the records' speed, for a size in U): ``"0.0259 sqrt(gL) = 0.140 m/s"``,
+    ``"0.0150 U = 0.116 m/s at U = 7.72 m/s"``, ``"0.0893 T/H, H = 33.6 m"``, ``"0.738 deg"``."""
     text = f"{fmt3(value)} {unit}".rstrip()
-    si = size_in_si(value, unit, L, T)
-    return text if not si else f"{text} = {si}" if unit == "sqrt(gL)" else f"{text}, {si}"
+    si = size_in_si(value, unit, L, T, U)
+    return text if not si else f"{text} = {si}" if unit in ("sqrt(gL)", SPEED_UNIT) else f"{text}, {si}"
 
 
 def round_header(number: int, named) -> str:

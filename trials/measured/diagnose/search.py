@@ -10,7 +10,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .baseline import DRIFT_KIND
-from .decision import MAGNITUDE_UNITS, clears_floor, floor, floor_parts, magnitude
+from .decision import MAGNITUDE_UNITS, clears_floor, floor, floor_parts, magnitude, part_units
 from .fit import _Model
 from .options import DiagnoseOptions
 from .rules import rule
@@ -83,7 +83,7 @@ def _try_candidate(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions):
         m, dbic, vals, se, z = _nested_start(fitter, current, cls, taus, inflate, ns, o, (m, dbic, vals, se, z))
     mag = magnitude(cls.name, vals, L)
     ok = (dbic > rule("bic_threshold") and z > rule("z_threshold")
-          and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
+          and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading, fitter.speed)
           and not straight_contradicts(current.straight, m.straight))
     return dbic, ok, cls, m, vals, se, z, mag, _confounding(m, cls)
 
@@ -98,7 +98,7 @@ def _retry_from_current(fitter, cls, dbic: float, z: float, vals: dict) -> bool:
     if fitter.kind == DRIFT_KIND:
         return dbic <= rule("bic_threshold")
     L = fitter.ship.particulars.L
-    return dbic < 0 and z > rule("z_threshold") and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading)
+    return dbic < 0 and z > rule("z_threshold") and clears_floor(cls.name, vals, L, fitter.kind, fitter.heading, fitter.speed)
 
 
 def straight_contradicts(before, after) -> bool:
@@ -126,10 +126,14 @@ def _nested_start(fitter, current, cls, taus, inflate, ns, o: DiagnoseOptions, f
 
 
 def _parts(fitter, name: str, values: dict) -> dict:
-    """``{"parts": {part: [size, floor]}}`` of a candidate judged by its parts (a current on a
-    zigzag: :func:`~trials.measured.diagnose.decision.floor_parts`), else ``{}``."""
-    p = floor_parts(name, values, fitter.ship.particulars.L, fitter.kind, fitter.heading)
-    return {"parts": {k: list(v) for k, v in p.items()}} if p else {}
+    """``{"parts": {part: [size, floor]}, "part_units": {part: unit}}`` of a candidate judged by its
+    parts (a current on a zigzag: :func:`~trials.measured.diagnose.decision.floor_parts`,
+    :func:`~trials.measured.diagnose.decision.part_units`), else ``{}``."""
+    p = floor_parts(name, values, fitter.ship.particulars.L, fitter.kind, fitter.heading, fitter.speed)
+    if not p:
+        return {}
+    units = {c.split("_")[-1]: u for c, u in part_units(fitter.kind).items()}
+    return {"parts": {k: list(v) for k, v in p.items()}, "part_units": {k: units[k] for k in p}}
 
 
 def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
@@ -149,14 +153,15 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
             results.append(_try_candidate(fitter, current, cls, taus, inflate, ns, o))
             dbic, _, _, _, vals, _, z, mag, _ = results[-1]
             parts.append(_parts(fitter, cls.name, vals))
-            pt = parts[-1].get("parts")
-            sz = lambda x: size_with_unit(x, MAGNITUDE_UNITS.get(cls.name, ''), *lt)     # noqa: E731
-            size = (", ".join(f"{k} {sz(abs(a))} (floor {sz(f)})" for k, (a, f) in pt.items()) if pt else
-                    f"{sz(mag)} (floor {sz(floor(cls.name, fitter.kind))})")
+            pt, pu = parts[-1].get("parts"), parts[-1].get("part_units") or {}
+            sz = lambda x, u=MAGNITUDE_UNITS.get(cls.name, ''): size_with_unit(x, u, *lt, fitter.speed)  # noqa: E731
+            size = (", ".join(f"{k} {sz(abs(a), pu[k])} (floor {sz(f, pu[k])})" for k, (a, f) in pt.items()) if pt
+                    else f"{sz(mag)} (floor {sz(floor(cls.name, fitter.kind))})")
             say(f"  {cls.name}: dBIC {fmt3(dbic)}, z {fmt3(z)}, {format_values(cls.name, vals)}, size {size}")
         rounds.append({"round": len(rounds) + 1, "model": [e.name for e in current.effects],
                        "tau_samples": {c: round(float(t), 1) for c, t in zip(_COLS, taus)},
                        "kind": fitter.kind, "heading_deg": round(math.degrees(fitter.heading), 2),
+                       "speed_mps": round(float(fitter.speed), 4),
                        "candidates": [{"effect": c.name, "delta_bic": round(d, 2), "z": round(z, 2),
                                        "magnitude": float(f"{g:.4g}"), "floor": floor(c.name, fitter.kind),
                                        **pa, "R": round(rr, 4) if math.isfinite(rr) else None,
@@ -229,7 +234,7 @@ def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptio
 def _holds(fitter, model: _Model, cls, inflate: float) -> tuple[bool, float, dict]:
     """(whether a named effect still clears z and its floor in ``model``, its z, its values)."""
     vals, _, z = _effect_report(model, cls, inflate)
-    ok = z > rule("z_threshold") and clears_floor(cls.name, vals, fitter.ship.particulars.L, fitter.kind, fitter.heading)
+    ok = z > rule("z_threshold") and clears_floor(cls.name, vals, fitter.ship.particulars.L, fitter.kind, fitter.heading, fitter.speed)
     return ok, z, vals
 
 

@@ -119,10 +119,12 @@ def _over_floor(c: dict) -> bool:
 
 def _size_text(c: dict, unit: str) -> str:
     """A stored candidate's size against its floor(s), in ``unit``: its parts along and across the
-    heading each with its floor where it was judged by them, else its size and floor."""
+    heading each with its floor, in the part's unit (``part_units``, else ``unit``), where it was judged
+    by them, else its size and floor."""
     if c.get("parts"):
-        sizes = ", ".join(f"{k} {abs(v[0]):.3g} (floor {v[1]:.3g})" for k, v in c["parts"].items())
-        return f"its parts along and across the heading, {sizes} {unit}"
+        pu = c.get("part_units") or {}
+        sizes = ", ".join(f"{k} {abs(v[0]):.3g} (floor {v[1]:.3g}) {pu.get(k, unit)}" for k, v in c["parts"].items())
+        return f"its parts along and across the heading, {sizes}"
     return f"size {c['magnitude']:.3g} {unit} (floor {c.get('floor') or 0.0:.3g} {unit})"
 
 
