@@ -111,6 +111,8 @@ def _refuse_bad_options(ap, a) -> None:
 
 
 def main(argv=None):
+    from trials.measured.wind_curves import WIND_CURVES
+
     ap = argparse.ArgumentParser()
     ap.add_argument("--clean", type=int, default=None,
                     help="clean record pairs (false alarms; default 20), with --mismatch clean records (default 40)")
@@ -145,7 +147,7 @@ def main(argv=None):
                     help="--mismatch: the wider draw: either hand first, turns 15-35 deg, zigzags 10/10-20/20, "
                          "approach 6-15 kn per record, winds 8-25 m/s alone and 15-25 m/s beside each other effect "
                          "(diagnose_mismatch.wide_jobs); prints the per-class table")
-    ap.add_argument("--wind-curve", choices=("fujiwara", "harmonic", "mixed"), default="fujiwara",
+    ap.add_argument("--wind-curve", choices=WIND_CURVES, default="fujiwara",
                     help="--mismatch: the shape of the members' wind loads (MismatchSpec.wind_curve): the model's own "
                          "(fujiwara, default), a loaded tanker's measured curve drawn per member (harmonic), or half each")
     ap.add_argument("--summarise", nargs="+", default=None, metavar="JSON",

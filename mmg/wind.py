@@ -58,6 +58,7 @@ __all__ = [
     "amplitude_vector",
     "AMPLITUDES",
     "wind_forces",
+    "coefficient_loads",
     "angle_from_dataset",
     "true_wind_from_relative",
     "relative_wind_from_true",
@@ -311,7 +312,33 @@ def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODE
     p = particulars
     a = np.asarray(angle_rel, dtype=float)
     cx, cy, cn = fujiwara_series(np.cos(a), np.sin(a), amplitude_vector(p, sway_factor, yaw_factor, yaw_sin))
-    q = 0.5 * rho_air * V**2 * scale
+    return coefficient_loads(V, cx, cy, cn, p, rho_air, scale)
+
+
+def coefficient_loads(V_rel, cx, cy, cn, particulars: WindParticulars, rho_air: float = RHO_AIR,
+                      scale: float = 1.0):
+    """Wind loads from their non-dimensional coefficients: X = q A_T C_X, Y = q A_L C_Y, N = q A_L L C_N.
+
+    Parameters
+    ----------
+    V_rel : array_like
+        Apparent wind speed [m/s].
+    cx, cy, cn : array_like
+        Surge, sway and yaw-moment coefficients [-] at the relative wind angle.
+    particulars : WindParticulars
+        Its ``A_T``, ``A_L`` [m^2] and ``L`` [m] (the moment's arm).
+    rho_air : float
+        Air density [kg/m^3].
+    scale : float
+        Factor on all three loads (1 = as the coefficients give).
+
+    Returns
+    -------
+    X, Y, N : float or ndarray
+        Surge force [N], sway force [N] and yaw moment about midship [N m], q = rho_air V_rel^2 / 2.
+    """
+    q = 0.5 * rho_air * np.asarray(V_rel, dtype=float) ** 2 * scale
+    p = particulars
     return q * p.A_T * cx, q * p.A_L * cy, q * p.A_L * p.L * cn
 
 

@@ -1,10 +1,11 @@
 """Wind-load curves of another shape than the model's: a truncated Fourier series in the relative wind angle.
 
 The diagnosis's wind candidate (:class:`mmg.effects.Wind`) is the Fujiwara, Ueno & Nimura (1998)
-regression with a scale and two shape factors.  A real ship's wind loads are measured curves of
-their own; a family of ships whose loads all follow the candidate's own curve would never show what
-a diagnosis leaves behind when they do not.  This module gives the mismatch family
-(:mod:`trials.measured.mismatch`) such other curves, written independently of :mod:`mmg.wind`:
+regression with a scale and three shape terms (``sway_factor``, ``yaw_factor``, ``yaw_sin``).  A real
+ship's wind loads are measured curves of their own; a family of ships whose loads all follow the
+candidate's own curve would never show what a diagnosis leaves behind when they do not.  This module
+gives the mismatch family (:mod:`trials.measured.mismatch`) such other curves, their coefficients
+independent of :mod:`mmg.wind` (the loads from the coefficients: :func:`mmg.wind.coefficient_loads`):
 
     C_X(gamma) = sum_k a_k cos(k gamma),   k = 0 .. K
     C_Y(gamma) = sum_k b_k sin(k gamma),   k = 1 .. K
@@ -25,7 +26,7 @@ L/2 either side, wind from starboard pushing to port).  The fit leaves 0.024 (C_
 0.003 (C_N) rms at the table's angles.  Its shape differs from Fujiwara's: the side force has a
 sin 2 gamma part (the bow and stern are not alike), and the yaw moment turns the bow into the wind
 at every angle (the accommodation aft: C_N about 0.10 at the beam), where Fujiwara's regression on
-the Esso Osaka geometry gives a moment of a few hundredths that changes sign near 60 deg.  OCIMF's
+the Esso Osaka geometry gives a moment of a few hundredths that changes sign near 73 deg.  OCIMF's
 coefficients refer to the wind 10 m above the water; here they act on the anemometer's wind.
 """
 from __future__ import annotations
@@ -34,15 +35,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mmg.wind import RHO_AIR, coefficient_loads
+
 __all__ = ["TANKER_LOADED", "WIND_CURVES", "HarmonicWindCurve"]
 
 WIND_CURVES = ("fujiwara", "harmonic", "mixed")
 """The mismatch family's wind-curve options: every member's loads on the model's own (Fujiwara) curve,
 every member's on a drawn :class:`HarmonicWindCurve`, or half of the members (at random places) each."""
-
-_RHO_AIR = 1.225
-"""Air density at 15 deg C, sea level [kg/m^3]."""
-
 
 @dataclass(frozen=True)
 class HarmonicWindCurve:
@@ -70,7 +69,7 @@ class HarmonicWindCurve:
         cn = sum(ck * np.sin((k + 1) * g) for k, ck in enumerate(self.c))
         return cx + 0.0 * g, cy + 0.0 * g, cn + 0.0 * g
 
-    def loads(self, V_rel, gamma, particulars, rho_air: float = _RHO_AIR):
+    def loads(self, V_rel, gamma, particulars, rho_air: float = RHO_AIR):
         """Surge force X [N], sway force Y [N] and yaw moment N [N m] about midship.
 
         Parameters
@@ -84,9 +83,7 @@ class HarmonicWindCurve:
         rho_air : float
             Air density [kg/m^3].
         """
-        cx, cy, cn = self.coefficients(gamma)
-        q = 0.5 * rho_air * np.asarray(V_rel, dtype=float) ** 2
-        return q * particulars.A_T * cx, q * particulars.A_L * cy, q * particulars.A_L * particulars.L * cn
+        return coefficient_loads(V_rel, *self.coefficients(gamma), particulars, rho_air)
 
     def drawn(self, rng: np.random.Generator, half_width: float) -> "HarmonicWindCurve":
         """A curve of the same form, every coefficient times its own 1 + u, u uniform in [-half_width, half_width]."""
