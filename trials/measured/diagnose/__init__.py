@@ -94,6 +94,7 @@ from .baseline import (CONSTANTS_FREE, DRIFT_KIND, MASS_FREE, SHIP_FREE_TERMS,  
 from .fit import _Model  # noqa: F401
 from .options import DiagnoseOptions  # noqa: F401
 from .records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
+from .rules import module_rule
 from .result import (CHANNELS, Diagnosis, absent_table, model_form_mismatch, ship_fit_table,  # noqa: F401
                      straight_run_table, _describe)
 from .search import _covered, _rival, straight_contradicts  # noqa: F401
@@ -110,10 +111,4 @@ _RULES = {"BIC_THRESHOLD": "bic_threshold", "Z_THRESHOLD": "z_threshold", "DRIFT
 """The package's names of numbers of the diagnosis rules (:mod:`.rules`), read-only (their meanings: the
 modules that use them, :mod:`.decision`, :mod:`.baseline`, :mod:`.options`)."""
 
-
-def __getattr__(name):
-    from .rules import rule
-
-    if name in _RULES:
-        return rule(_RULES[name])
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = module_rule(__name__, _RULES)
