@@ -14,9 +14,9 @@ afterwards on fresh seeds (the bench's ``--seed0`` differs), never on the record
 makes the floors' sqrt(gL) units); ``--out`` writes another file than the packaged one (a
 calibration of another ship, used through ``MMG_DIAGNOSE_CALIBRATION=FILE``).
 
-``PATH:KIND`` takes only the records of one kind of a run (``turn``, ``zigzag``): a run made while
-the diagnosis of the other kind was another (the rudder's inflow freed on zigzags too, variant 6
-in ``docs/diagnose.md``) still calibrates this one.  ``--kinds`` writes only those kinds' floors
+``PATH:KIND`` takes only the records of one kind of a run (``turn``, ``zigzag``): a run made with
+another diagnosis of the other kind (e.g. the rudder's inflow also freed on zigzags) still calibrates
+this one.  ``--kinds`` writes only those kinds' floors
 (:func:`trials.measured.calibration.merge_kinds`), the others kept from the packaged file: where
 the diagnosis of one kind of record changes, its runs recalibrate that kind alone; ``--effects``
 with it writes only those effects' floors of those kinds (``--kinds zigzag --effects current_along

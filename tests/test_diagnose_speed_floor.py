@@ -21,7 +21,7 @@ def _table(along_unit: str, along: float, across: float) -> dict:
 def test_a_current_along_the_heading_is_judged_against_the_speed(monkeypatch):
     """0.12 m/s along the heading (north, the current setting north): at 14 kn (U = 7.2022 m/s) it is
     0.12 / 7.2022 = 0.01666 of U, at 7 kn (3.6011 m/s) 0.03332 of U.  Against a floor of 0.02 U it is
-    named at 7 kn and not at 14 kn; against today's kind of floor, 0.002017 sqrt(gL) = 0.1139 m/s,
+    named at 7 kn and not at 14 kn; against a floor in sqrt(gL), as packaged, 0.002017 sqrt(gL) = 0.1139 m/s,
     it clears at both speeds.  Across the heading the floor stays 0.0005 sqrt(gL) = 0.0282 m/s at
     either speed."""
     import trials.measured.diagnose.decision as D
