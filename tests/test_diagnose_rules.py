@@ -151,7 +151,9 @@ def test_the_residual_quantile_and_the_budgets_come_from_the_file(diagnose_rules
     recs = [{"trial": "zigzag", "speed_mps": 1.0, "L_m": 1.0, "rms_after": {"u": 0, "v": 0, "r": 0, "heading": h}}
             for h in head]
     assert residual_floors(recs)["zigzag"]["heading"] == pytest.approx(float(np.percentile(head, 95.0)))
-    assert (DiagnoseOptions().screen_nfev, DiagnoseOptions().max_nfev) == (6, 12)
+    doc = _doc()
+    assert (DiagnoseOptions().screen_nfev, DiagnoseOptions().max_nfev) == (doc["screen_nfev"]["value"],
+                                                                          doc["max_nfev"]["value"])
     diagnose_rules(residual_quantile=50.0, screen_nfev=3, max_nfev=7)
     assert residual_floors(recs)["zigzag"]["heading"] == pytest.approx(1.05)
     assert (DiagnoseOptions().screen_nfev, DiagnoseOptions().max_nfev) == (3, 7)
