@@ -37,6 +37,7 @@ sys.path.insert(0, str(REPO))
 OUT = REPO / "configs" / "calibration" / "diagnose.yaml"
 
 from trials.measured.calibration import calibrate, merge_kinds, only_kind, short_of_name
+from trials.measured.diagnose.decision import speed_part_units
 
 
 def main(argv=None):
@@ -50,6 +51,9 @@ def main(argv=None):
     ap.add_argument("--effects", nargs="+", default=None, metavar="EFFECT",
                     help="with --kinds: write only these effects' floors, clean samples and units (e.g. current_along "
                          "current_across); every other figure kept from the packaged file")
+    ap.add_argument("--along-unit", choices=("sqrt(gL)", "U"), default="sqrt(gL)",
+                    help="the unit of a current's part along the heading on zigzags: sqrt(gL) (default, as packaged) "
+                         "or U (a fraction of the records' median speed over ground)")
     ap.add_argument("--ship", default="esso_osaka", help="the config the runs diagnosed (default esso_osaka)")
     ap.add_argument("--out", type=Path, default=OUT, help="the file --write writes (default the packaged one)")
     a = ap.parse_args(argv)
@@ -69,7 +73,7 @@ def main(argv=None):
     ships = {r.get("ship", "esso_osaka") for r in records}
     if ships != {a.ship}:
         ap.error(f"--ship {a.ship}: the runs diagnosed {sorted(ships)}")
-    cal = calibrate(records, L, a.alpha)
+    cal = calibrate(records, L, a.alpha, speed_part_units() if a.along_unit == "U" else None)
     print("not named at the size to detect (floor above it):", {k: sorted(v) for k, v in cal.hidden.items()})
     for row in cal.to_pandas().itertuples():
         v = np.asarray(cal.clean[row.effect][row.kind])

@@ -60,7 +60,7 @@ def test_the_least_floor_counts_a_speed_floor_at_the_records_froude_number(monke
     assert D.least_floor("current", "zigzag", froude=14 * KN / G) == pytest.approx(0.002551, rel=1e-3)
     assert D.least_floor("current", "zigzag") == pytest.approx(0.005)        # no speed: the across part alone
     fl = {"current_along": {"zigzag": 0.02}, "current_across": {"zigzag": 0.005}}
-    assert D.least_floor("current", "zigzag", fl, froude=7 * KN / G) == pytest.approx(0.0012757, rel=1e-3)
+    assert D.least_floor("current", "zigzag", fl, froude=7 * KN / G, units=D.speed_part_units()) == pytest.approx(0.0012757, rel=1e-3)
     assert D.least_floor("current", "zigzag", fl, froude=7 * KN / G, units={}) == pytest.approx(0.005)
 
 
@@ -112,18 +112,22 @@ def test_calibration_samples_the_along_part_over_the_rounds_speed():
     """A clean zigzag whose first round's current, 0.1 m/s setting 30 deg off a heading of 10 deg, clears
     dBIC and z at U = 4 m/s: along 0.1 cos 20 deg / 4 = 0.023492 U, across 0.1 sin 20 deg / 56.457 =
     0.00060577 sqrt(gL).  A round without its speed takes the record's."""
-    from trials.measured.calibration import UNITS, clean_magnitudes
+    from trials.measured.calibration import UNITS, calibrate, clean_magnitudes
+    from trials.measured.diagnose.decision import speed_part_units
 
     cand = {"effect": "current", "delta_bic": 50.0, "z": 10.0, "parameters": {"speed_mps": 0.1, "direction_deg": 30.0}}
     rec = {"trial": "zz20", "truth": {}, "speed_mps": 2.0,
            "rounds": [{"round": 1, "model": [], "kind": "zigzag", "heading_deg": 10.0, "speed_mps": 4.0,
                        "candidates": [cand]}]}
-    clean, _, _ = clean_magnitudes([rec], L)
+    clean, _, _ = clean_magnitudes([rec], L, part_units=speed_part_units())
     assert clean["current_along"]["zigzag"] == [pytest.approx(0.023492, rel=1e-4)]
     assert clean["current_across"]["zigzag"] == [pytest.approx(0.00060577, rel=1e-4)]
-    assert UNITS["current_along"] == "U" and UNITS["current_across"] == "sqrt(gL)"
+    assert calibrate([rec], L, part_units=speed_part_units()).units["current_along"] == "U"
+    plain, _, _ = clean_magnitudes([rec], L)       # the default: both parts over sqrt(gL)
+    assert plain["current_along"]["zigzag"] == [pytest.approx(0.1 * math.cos(math.radians(20)) / G, rel=1e-4)]
+    assert UNITS["current_along"] == "sqrt(gL)" and calibrate([rec], L).units["current_along"] == "sqrt(gL)"
     del rec["rounds"][0]["speed_mps"]
-    clean, _, _ = clean_magnitudes([rec], L)
+    clean, _, _ = clean_magnitudes([rec], L, part_units=speed_part_units())
     assert clean["current_along"]["zigzag"] == [pytest.approx(0.046985, rel=1e-4)]
 
 

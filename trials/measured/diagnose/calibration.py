@@ -62,7 +62,7 @@ RESIDUAL_UNITS = {"u": "fraction of U", "v": "fraction of U", "r": "r L / U", "h
 """Units of the residual floors, per channel."""
 
 
-def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
+def clean_magnitudes(records, L: float, hidden: dict | None = None, part_units: dict | None = None) -> tuple:
     """({effect: {kind: [clean magnitude]}}, the same of whether dBIC and z cleared, the same of
     the magnitudes whether or not they cleared).
 
@@ -84,6 +84,7 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
     from .decision import COMPONENT_FLOORS, current_components, magnitude, part_size
 
     bic, z_min = rule("bic_threshold"), rule("z_threshold")
+    units = PART_UNITS if part_units is None else part_units
     out: dict = {}
     passes: dict = {}
     raw: dict = {}
@@ -102,7 +103,7 @@ def clean_magnitudes(records, L: float, hidden: dict | None = None) -> tuple:
                     # bench runs of the family sail at heading 0 (trials.measured.mismatch.trial_records)
                     parts = current_components(c["parameters"], L, math.radians(rd.get("heading_deg", 0.0)))
                     speed = rd.get("speed_mps") or rec.get("speed_mps")
-                    sizes += [(k, abs(part_size(x, PART_UNITS[k], L, speed))) for k, x in zip(COMPONENT_FLOORS[kind], parts)]
+                    sizes += [(k, abs(part_size(x, units[k], L, speed))) for k, x in zip(COMPONENT_FLOORS[kind], parts)]
                 for e, m in sizes:
                     out.setdefault(e, {}).setdefault(kind, []).append(float(m) if ok else 0.0)
                     passes.setdefault(e, {}).setdefault(kind, []).append(ok)
@@ -320,7 +321,7 @@ def short_of_name(records, L: float) -> tuple[int, int]:
     return k, n
 
 
-def calibrate(records, L: float, alpha: float = 0.05) -> Calibration:
+def calibrate(records, L: float, alpha: float = 0.05, part_units: dict | None = None) -> Calibration:
     """The naming floors from bench records (module docstring): a first pass over the clean
     records, then a second in which the records of effects a kind of record cannot show
     (:func:`hidden_effects`) count as clean samples for the other candidates.
@@ -333,11 +334,16 @@ def calibrate(records, L: float, alpha: float = 0.05) -> Calibration:
         Length of the config's ship [m] (the current's sqrt(g L) unit).
     alpha : float
         False-alarm rate per clean record.
+    part_units : dict, optional
+        {part floor: unit} of a current's parts on zigzags (default :data:`PART_UNITS`; e.g.
+        :func:`~trials.measured.diagnose.decision.speed_part_units`).
     """
     records = list(records)
-    clean, passes, raw = clean_magnitudes(records, L)
+    units = PART_UNITS if part_units is None else part_units
+    clean, passes, raw = clean_magnitudes(records, L, part_units=units)
     hidden = hidden_effects(floors(clean, alpha, raw), L)
-    clean, passes, raw = clean_magnitudes(records, L, hidden)
+    clean, passes, raw = clean_magnitudes(records, L, hidden, units)
     n = sum(1 for r in records if not r.get("truth"))
     return Calibration(floors=floors(clean, alpha, raw), residual_floors=residual_floors(records), clean=clean,
-                       passes=passes, hidden=hidden, n_clean=n, n_effects=len(records) - n, alpha=alpha)
+                       passes=passes, hidden=hidden, n_clean=n, n_effects=len(records) - n, alpha=alpha,
+                       units={**UNITS, **units})

@@ -42,7 +42,7 @@ from .rules import module_rule, rule
 __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS", "magnitude", "record_kind", "floor",
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
-           "REASON_KINDS", "KIND_FALLBACK", "by_kind", "packaged_calibration", "PART_UNITS", "SPEED_UNIT",
+           "REASON_KINDS", "KIND_FALLBACK", "by_kind", "packaged_calibration", "PART_UNITS", "SPEED_UNIT", "speed_part_units",
            "part_units", "part_size", "typical_speed"]
 
 _RULES = {"BIC_THRESHOLD": "bic_threshold", "Z_THRESHOLD": "z_threshold", "WEAK_BIC": "weak_bic"}
@@ -130,11 +130,16 @@ keeps the speed's floor."""
 SPEED_UNIT = "U"
 """The unit of a part floor that scales with the ship's speed: a fraction of the records'
 :func:`typical_speed` U (a part of 0.015 U is 0.116 m/s at U = 7.72 m/s, 15 kn)."""
-PART_UNITS = {"current_along": SPEED_UNIT, "current_across": MAGNITUDE_UNITS["current"]}
-"""The units :mod:`.calibration` sets the part floors in.  Along the heading a fraction of the speed U:
-a resistance, thrust or wake mismatch of the ship errs its speed by a share of that speed, which the fit
-takes for a current along the heading; across it over sqrt(g L), as the current's :func:`magnitude`.
-A calibration file says its own (its ``units``): a part floor in sqrt(gL) is read as that."""
+PART_UNITS = {"current_along": MAGNITUDE_UNITS["current"], "current_across": MAGNITUDE_UNITS["current"]}
+"""The units :mod:`.calibration` sets the part floors in by default: both over sqrt(g L), as the current's
+:func:`magnitude`.  :func:`speed_part_units` sets the part along the heading in :data:`SPEED_UNIT`
+instead (a resistance, thrust or wake mismatch errs the speed by a share of that speed).  A calibration
+file says its own (its ``units``)."""
+
+
+def speed_part_units() -> dict:
+    """:data:`PART_UNITS` with the part along the heading in :data:`SPEED_UNIT`."""
+    return {**PART_UNITS, "current_along": SPEED_UNIT}
 
 
 def typical_speed(meas) -> float:
