@@ -138,8 +138,8 @@ def test_values_stated_once_in_each_config_act_together(tmp_path):
 
     sp = _ship_file(tmp_path, wind={"scale": 2.0})
     t = mmg.load_trial(_trial_file(tmp_path, ship=sp, effects={"wind": {"true_speed_mps": 2.0, "true_from_deg": 45.0}}))
-    assert t.effect_set().get("wind") == {"scale": 2.0, "sway_factor": 1.0, "yaw_factor": 1.0, "true_speed_mps": 2.0,
-                                          "true_from_deg": 45.0}
+    assert t.effect_set().get("wind") == {"scale": 2.0, "sway_factor": 1.0, "yaw_factor": 1.0, "yaw_sin": 0.0,
+                                          "true_speed_mps": 2.0, "true_from_deg": 45.0}
     pk, _ = prepare(t.ship, t.u0, t.n0, t.trim, t.effects)
     ship = mmg.load_ship(sp)
     want = effect_set({"wind": {"scale": 2.0, "true_speed_mps": 2.0, "true_from_deg": 45.0}}).pack(pack(ship, 0.0), ship)
