@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 
 from mmg.errors import InputError
-from mmg.model import pack
+from mmg.model import G, pack
 from mmg.ship import Ship
 
 from .baseline import _ship_free, fit_baseline
@@ -28,7 +28,7 @@ __all__ = ["diagnose", "diagnose_each"]
 def _default_stride(recs, L: float) -> int:
     """Samples ``stride_spacing`` (the diagnosis rules) times sqrt(L/g) apart, at least every one."""
     dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
-    return max(1, int(round(rule("stride_spacing") * math.sqrt(L / 9.80665) / dt)))
+    return max(1, int(round(rule("stride_spacing") * math.sqrt(L / G) / dt)))
 
 
 def diagnose(ship: Ship, items, options: DiagnoseOptions | None = None, **kwargs) -> Diagnosis:
@@ -86,7 +86,7 @@ def _first_fitter(ship: Ship, recs, o: DiagnoseOptions) -> _Fitter:
     L = ship.particulars.L
     packed = pack(ship)
     speed = typical_speed([r.seg.meas for r in recs])
-    U = max(speed, 0.05 * math.sqrt(9.80665 * L))
+    U = max(speed, 0.05 * math.sqrt(G * L))
     kind = record_kind([r.seg.inputs.delta for r in recs])
     sc0 = Scales(u=0.05 * U, v=0.05 * U, r=0.05 * U / L, psi=math.radians(2.0), pos=0.05 * L)
     return _Fitter(ship, packed, recs, sc0, o.stride, o.max_nfev, _ship_free(ship, packed, o.ship_free, kind, drift=False),

@@ -36,6 +36,7 @@ from functools import lru_cache
 import numpy as np
 
 import mmg.effects as E
+from mmg.model import G
 
 from .rules import module_rule, rule
 
@@ -108,7 +109,7 @@ def current_components(values: dict, L: float, heading: float) -> tuple[float, f
     (float, float)
         Along (positive ahead) and across (positive to starboard) components over sqrt(g L).
     """
-    s = float(values["speed_mps"]) / math.sqrt(9.80665 * L)
+    s = float(values["speed_mps"]) / math.sqrt(G * L)
     a = math.radians(float(values["direction_deg"])) - heading
     return s * math.cos(a), s * math.sin(a)
 
@@ -164,7 +165,7 @@ def part_size(x: float, unit: str, L: float, speed: float | None) -> float:
     :func:`typical_speed`; NaN without a speed).  ``L``: ship length [m]."""
     if unit != SPEED_UNIT:
         return x
-    return x * math.sqrt(9.80665 * L) / speed if speed and speed > 0 else math.nan
+    return x * math.sqrt(G * L) / speed if speed and speed > 0 else math.nan
 
 
 def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float | None = None,

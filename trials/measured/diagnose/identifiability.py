@@ -52,6 +52,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 import mmg.effects as E
+from mmg.model import G
 
 from .decision import STATISTICAL_REASON
 from .rules import module_rule, rule
@@ -86,7 +87,7 @@ def detection_size(effect: str, L: float) -> float:
     """The :data:`DETECTION_SIZE` of ``effect`` in its fit unit for a ship of length ``L`` [m]
     (inf for an effect not in the table)."""
     v, unit = _size_of(effect)
-    return v * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else v
+    return v * math.sqrt(G * L) if unit == "sqrt(gL)" else v
 
 
 def floor_in_fit_unit(effect: str, fl: float, L: float) -> float:
@@ -94,7 +95,7 @@ def floor_in_fit_unit(effect: str, fl: float, L: float) -> float:
     :func:`~trials.measured.diagnose.decision.magnitude`: a current's speed over sqrt(g L)) in the unit of
     :func:`detection_size` (the effect's fit parameters: m/s for a current), for a ship of length ``L`` [m]."""
     _, unit = _size_of(effect)
-    return fl * math.sqrt(9.80665 * L) if unit == "sqrt(gL)" else fl
+    return fl * math.sqrt(G * L) if unit == "sqrt(gL)" else fl
 
 
 def block_confounding(cov: np.ndarray, idx) -> dict:
@@ -216,7 +217,7 @@ def _kinds(recs):
 
 def _trial_specs(recs, L):
     """(label, synthetic_record kwargs) of the trials that could add what the records lack."""
-    s = math.sqrt(L / 9.80665)
+    s = math.sqrt(L / G)
     kinds = _kinds(recs)
     turns = {sg for k, sg in kinds if k == "turn"}
     specs = []
@@ -373,7 +374,7 @@ def assess(fitter, current, named, cand, inflate: float, segment_s=None, say=Non
         if not table[:-1]:
             say(IDENTIFIABILITY_LEGEND)
         say(identifiability_line(row, b["R"], _unit(cls) or _size_unit(cls), _size_unit(cls), fitter.ship.particulars))
-        froude = getattr(fitter, "speed", 0.0) / math.sqrt(9.80665 * L)
+        froude = getattr(fitter, "speed", 0.0) / math.sqrt(G * L)
         fl = floor_in_fit_unit(cls.name, least_floor(cls.name, getattr(fitter, "kind", ""), froude=froude), L)
         row["confounded"], reason, kind = verdict(b, det, fl, (weak or {}).get(cls.name), _unit(cls), _size_unit(cls))
         row["floor"], row["reason_kind"] = fl, kind

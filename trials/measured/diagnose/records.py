@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mmg.errors import InputError
-from mmg.model import pack
+from mmg.model import G, pack
 from mmg.ship import Ship
 
 from .rules import module_rule, rule
@@ -95,7 +95,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
     from ...files.shipcheck import read_for_ship
 
     L = ship.particulars.L
-    seg_s = segment_s or rule("segment_length") * math.sqrt(L / 9.80665)
+    seg_s = segment_s or rule("segment_length") * math.sqrt(L / G)
     items = list(items)
     labels = record_labels([it.source if isinstance(it, Prepared) else
                             (it.source or it.name) if isinstance(it, TrialRecord) else it for it in items])
@@ -118,7 +118,7 @@ def prepare(ship: Ship, items, wind: bool | None = False, segment_s: float | Non
         # a record without u, v is replayed in one piece: a restart would need the drift it does not log
         seg = Segmented(run.name, run.meas, run.inputs, segment_resets(run.t, math.inf if run.speed_only else seg_s),
                         context=ctx,
-                        start=_smoothed(run.t, run.meas, rule("restart_smooth") * math.sqrt(L / 9.80665)),
+                        start=_smoothed(run.t, run.meas, rule("restart_smooth") * math.sqrt(L / G)),
                         fixed=run.effects, speed_only=run.speed_only,
                         straight=_straight(run, rec, ch, L) if straight_run else None)
         out.append(Prepared(run.name, run.source or run.name, seg, list(run.notes), absent_channels(rec)))
@@ -239,8 +239,8 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
     es = effects if isinstance(effects, E.EffectSet) else E.effect_set(effects or {})
     truth = truth_ship or ship
     L = truth.particulars.L
-    s = math.sqrt(L / 9.80665)
-    U0 = speed or 0.09 * math.sqrt(9.80665 * L)
+    s = math.sqrt(L / G)
+    U0 = speed or 0.09 * math.sqrt(G * L)
     a = math.radians(rudder_deg)
     if kind == "turning":
         T = duration or 120.0 * s
@@ -283,7 +283,7 @@ def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | Non
             states = replay_states(pk, ReplayInputs(t, delta, n, ext), s0)
     else:
         states = replay_states(pk, ReplayInputs(t, delta, n), s0)
-    sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(9.80665 / L), 0.002 * L,
+    sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(G / L), 0.002 * L,
                                                     0.002 * L, math.radians(0.05)])
     label = name or f"synthetic_{kind}"
     if noise_dist == "uniform":

@@ -19,6 +19,8 @@ import math
 
 import numpy as np
 
+from mmg.model import G
+
 from .decision import SPEED_UNIT
 from .decision import false_alarm_probability  # noqa: F401  (re-exported: the report's evidence)
 
@@ -35,7 +37,7 @@ CHANNEL_UNITS = {"u": "m/s", "v": "m/s", "r": "deg/s", "heading": "deg", "positi
 
 # --------------------------------------------------------------------------- numbers
 
-GRAVITY = 9.80665
+GRAVITY = G
 """g [m/s^2] of a size in sqrt(g L)."""
 
 IDENTIFIABILITY_LEGEND = ("(identifiability: R, the multiple correlation of the effect with the other fitted "
