@@ -20,6 +20,18 @@ from trials.files.data import FRT_MISSING, frt_folder, frt_place  # noqa: E402
 FRT_FOUND = frt_folder()
 """The FRT-DS-ESSO folder (:func:`trials.files.data.frt_folder`), None when no records are found."""
 FRT = frt_place()
+
+
+def load_bench(name: str):
+    """The script ``bench/<name>.py`` imported as module ``bench_<name>`` (registered in ``sys.modules``,
+    so its dataclasses resolve their annotations)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(f"bench_{name}", REPO / "bench" / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod
+    spec.loader.exec_module(mod)
+    return mod
 """Where the records are (or would be): tests marked :func:`needs_frt` run only when they are found."""
 
 

@@ -3,24 +3,20 @@ that it finds a changed number among equal ones (on hand-written outputs; the sc
 two git revisions is in its docstring)."""
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-import sys
 from pathlib import Path
 
 import pytest
+
+from .conftest import load_bench
 
 BENCH = Path(__file__).resolve().parents[1] / "bench"
 
 
 @pytest.fixture(scope="module")
 def ba():
-    spec = importlib.util.spec_from_file_location("bench_before_after", BENCH / "before_after.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod                # its dataclass resolves its annotations there
-    spec.loader.exec_module(mod)
-    return mod
+    return load_bench("before_after")
 
 
 def values(numbers):

@@ -4,23 +4,16 @@ bench/identify_ceiling.py's heading RMS windows, bench/fold_values.py's jackknif
 bench/frt_gap.py's figures by record kind."""
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-BENCH = Path(__file__).resolve().parents[1] / "bench"
+from .conftest import load_bench
 
 
 def _load(name: str):
-    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
+    return load_bench(name)
 
 
 def test_several_prior_widths_make_each_hull_form_at_each_width_a_candidate():

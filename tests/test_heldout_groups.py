@@ -3,22 +3,16 @@ checked against sums done by hand on made-up numbers; the folds keep a run's cut
 no record."""
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 from pathlib import Path
 
 import pytest
 
-BENCH = Path(__file__).resolve().parents[1] / "bench"
+from .conftest import load_bench
 
 
 def _load():
-    spec = importlib.util.spec_from_file_location("bench_heldout_groups", BENCH / "heldout_groups.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
+    return load_bench("heldout_groups")
 
 
 def _row(fold, record, kind, s, i):

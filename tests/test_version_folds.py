@@ -3,19 +3,13 @@ its time limit is stopped and reported, the per-kind means are the hand sums, an
 named."""
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 
-BENCH = Path(__file__).resolve().parents[1] / "bench"
+from .conftest import load_bench
 
 
 def _load():
-    spec = importlib.util.spec_from_file_location("bench_version_folds", BENCH / "version_folds.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
+    return load_bench("version_folds")
 
 
 def _fake_version(root: Path, body: str) -> Path:
