@@ -244,7 +244,8 @@ def summary_lines(res) -> list[str]:
                    f"{100 * s['band_coverage90']:.1f} % of their samples inside; unbounded (over 5 % of the draws "
                    f"diverged) on {100 * s['band_unbounded_share']:.1f} % of them, inside on "
                    f"{100 * s['band_coverage90_where_bounded']:.1f} % of the others; median width "
-                   f"{s['band_median_width_deg']:.3g} deg (median over the records)")
+                   f"{s['band_median_width_deg']:.3g} deg (median over the records); "
+                   f"{100 * s.get('band_rejected_share', 0.0):.1f} % of the candidate ships rejected outside the support")
     for key, words in (("heading_rms_deg", "heading RMS [deg]"), ("yaw_rate_rms_degps", "yaw-rate RMS [deg/s]"),
                        ("speed_rms_mps", "speed RMS [m/s]"), ("final_position_error_L", "final position error [L]")):
         spans = ((key, "whole record"), (key + tag, f"first {res.horizon_s:g} s"), ("window_" + key, "60 s windows"))

@@ -211,6 +211,10 @@ class ParameterCovariance:
         How it was obtained.
     method : str
         The method's short name (e.g. ``"posterior+run-jackknife"``); empty where the file gives none.
+    state_range : tuple
+        ((u_min, u_max), (v_min, v_max), (r_min, r_max)) [m/s, m/s, rad/s]: the states the training records
+        log, over which a drawn ship is checked not to gain energy (:func:`trials.measured.draws.support_of`);
+        empty where the file gives none.
     """
 
     names: tuple
@@ -219,6 +223,7 @@ class ParameterCovariance:
     matrix: tuple
     source: str = ""
     method: str = ""
+    state_range: tuple = ()
 
     def std(self) -> tuple:
         """Standard deviation of each parameter (the square roots of the diagonal), in ``units``."""

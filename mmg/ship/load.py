@@ -191,6 +191,7 @@ class _Covariance(_Strict):
     matrix: list[list[float]]
     source: str = ""
     method: str = ""
+    state_range: Optional[dict[str, list[float]]] = None
 
 
 class _FullScale(_Strict):
@@ -539,7 +540,28 @@ def _covariance(f: _ShipFile, src: str) -> ParameterCovariance | None:
     if float(np.linalg.eigvalsh(np.asarray(c.matrix, dtype=float)).min()) < -1e-9 * big:
         raise InputError(src, "covariance.matrix", "not positive semi-definite (a negative eigenvalue): not a covariance")
     return ParameterCovariance(tuple(c.names), tuple(c.units), tuple(float(v) for v in c.values),
-                               tuple(tuple(float(x) for x in row) for row in c.matrix), c.source, c.method)
+                               tuple(tuple(float(x) for x in row) for row in c.matrix), c.source, c.method,
+                               _state_range(c.state_range, src))
+
+
+STATE_RANGE_KEYS = ("u_mps", "v_mps", "r_radps")
+"""The keys of a covariance's ``state_range`` (each ``[min, max]``)."""
+
+
+def _state_range(d: dict | None, src: str) -> tuple:
+    """covariance.state_range: ``u_mps``, ``v_mps``, ``r_radps``, each a finite [min, max]."""
+    if d is None:
+        return ()
+    out = []
+    for k in STATE_RANGE_KEYS:
+        x = d.get(k)
+        if x is None or len(x) != 2 or not all(math.isfinite(float(v)) for v in x) or float(x[0]) > float(x[1]):
+            raise InputError(src, f"covariance.state_range.{k}", "expected a finite [min, max]")
+        out.append((float(x[0]), float(x[1])))
+    extra = set(d) - set(STATE_RANGE_KEYS)
+    if extra:
+        raise InputError(src, f"covariance.state_range.{sorted(extra)[0]}", f"not one of {', '.join(STATE_RANGE_KEYS)}")
+    return tuple(out)
 
 
 def _effects(f: _ShipFile, wind: Wind | None, src: str):

@@ -103,7 +103,8 @@ def _print_bands(bands) -> None:
             print(f"{b.nominal.run.name}: no band: the {b.draws} draws all replay the nominal ship and start "
                   f"(nothing to draw them from: see the notes), so no width and no coverage")
             continue
-        print(f"{b.nominal.run.name}: 90 % band from {b.draws} draws ({b.diverged} diverged): heading coverage "
+        print(f"{b.nominal.run.name}: 90 % band from {b.draws} draws ({b.diverged} diverged; {b.rejected} candidate ships "
+              f"rejected outside the support): heading coverage "
               f"{100 * b.coverage90:.0f} % of samples, median width {num(b.median_width_deg, 'deg')}; position "
               f"coverage {100 * b.position_coverage90:.0f} %, median radius {num(b.median_radius_m, 'm')}"
               + (f"; heading band unbounded on {100 * b.unbounded_share:.0f} % of samples (inside there; "

@@ -6,7 +6,10 @@ times, each replay with
 * a ship drawn from the covariance of its identified parameters (the ship config's ``covariance:``
   section, :func:`trials.measured.draws.parameter_covariance`, written in by name with
   :func:`trials.measured.identify.ship_with_values`; a wind-load factor scales the record's measured
-  wind loads, relative to the covariance's own value), and
+  wind loads, relative to the covariance's own value), truncated to the ships the estimator and the
+  physics admit (:func:`trials.measured.draws.support_of`: within the fit's hard bounds, and not gaining
+  energy unpowered over the training records' range of states): a candidate outside is never replayed
+  but rejected and the next one drawn (:attr:`Bands.rejected`, ``rejected_draws``), and
 * the record's start state (and a per-record effect) offset by a zero-mean normal draw of the
   between-run spread of a run's own disturbance (the ``run_spread:`` section, :class:`mmg.ship.RunSpread`,
   written by ``mmg identify``: ``start.u``, ``start.v``, ``start.r``, ``start.psi`` added to the first
@@ -25,7 +28,9 @@ linear interpolation) of
 A draw whose replay diverges still counts: from its divergence on its heading is taken as -inf for the
 lower and +inf for the upper quantile, and its distance from the median track as +inf, so divergences
 widen the band (to unbounded where more than 5 % of the draws, 10 % for the position, have diverged),
-never narrow it.  The draws are made from ``seed`` alone (the ship's and the run's from two streams),
+never narrow it; a draw inside the support that diverges counts so too.  The draws are made from ``seed``
+alone (the ship's and the run's from two streams, in batches of ``samples`` candidates, a rejected
+ship's run draw dropped with it: where none is rejected, the draws of the untruncated normal),
 and the replays run on threads (the compiled replay releases the GIL): the same numbers for any
 number of threads.
 """
@@ -42,7 +47,7 @@ from mmg.errors import InputError
 from mmg.replay import STATE
 from mmg.ship import RunSpread, Ship
 
-from .draws import WIND_FACTOR_NAMES, draw, parameter_covariance
+from .draws import WIND_FACTOR_NAMES, parameter_covariance, support_of
 from .predict import MeasuredRun, Replayed, measured_run, replay_record
 
 __all__ = ["Bands", "prediction_bands", "BAND_KEYS", "QUANTILES", "SAMPLE_TRACKS"]
@@ -53,7 +58,9 @@ POSITION_QUANTILE = 0.90
 """The quantile of the distance from the median track that bounds the position band."""
 SAMPLE_TRACKS = 12
 """How many of the drawn tracks a :class:`Bands` keeps for its figure."""
-BAND_KEYS = ("draws", "diverged_draws", "heading_band_deg", "coverage90", "heading_band_median_width_deg",
+MAX_CANDIDATES = 50
+"""At most this many candidates per asked-for draw are tried for the support (fewer draws are said in the notes)."""
+BAND_KEYS = ("draws", "diverged_draws", "rejected_draws", "heading_band_deg", "coverage90", "heading_band_median_width_deg",
              "heading_band_unbounded_share", "coverage90_where_bounded", "position_band_m", "position_coverage90",
              "position_band_median_radius_m")
 """The keys :meth:`Bands.to_json` gives (``mmg predict --samples`` adds them to each run)."""
@@ -85,7 +92,10 @@ class Bands:
     draws, diverged : int
         Replays made, and how many of them diverged somewhere in the record.
     notes : tuple of str
-        What was and was not drawn (no covariance, no run spread, an effect not applied).
+        What was and was not drawn (the support, no covariance, no run spread, an effect not applied).
+    rejected : int
+        Candidate ships drawn outside the support (:func:`trials.measured.draws.support_of`) and not
+        replayed: ``rejected / (draws + rejected)`` is the share of the covariance's normal outside it.
     """
 
     nominal: Replayed
@@ -101,6 +111,7 @@ class Bands:
     draws: int
     diverged: int
     notes: tuple = ()
+    rejected: int = 0
 
     @property
     def coverage90(self) -> float:
@@ -151,11 +162,12 @@ class Bands:
         ``position_band_m`` ``{"t_s", "x_median", "y_median", "radius"}`` at every sample, the coverages,
         median width [deg] and radius [m], the share of samples where the heading band is unbounded and the
         coverage over the others, the
-        draws and how many diverged (unbounded values: null; the coverages null for an :attr:`empty` band)."""
+        draws, how many diverged and how many candidates were rejected outside the support (unbounded values:
+        null; the coverages null for an :attr:`empty` band)."""
         lst = lambda a: [float(x) for x in a]          # noqa: E731
         cov = lambda x: None if self.empty else x      # noqa: E731
         t = lst(self.t)
-        return {"draws": int(self.draws), "diverged_draws": int(self.diverged),
+        return {"draws": int(self.draws), "diverged_draws": int(self.diverged), "rejected_draws": int(self.rejected),
                 "heading_band_deg": {"t_s": t, "lo": lst(self.lo), "hi": lst(self.hi)},
                 "coverage90": cov(self.coverage90), "heading_band_median_width_deg": self.median_width_deg,
                 "heading_band_unbounded_share": self.unbounded_share,
@@ -261,14 +273,47 @@ def _fit_doubts(ship: Ship, names, covariance) -> list:
             "the uncertainty of a finished fit"] if why else []
 
 
-def _ship_draws(ship: Ship, covariance, samples: int, seed: int, notes: list):
-    """(names, rows (samples, k), mean) of the ship's parameter draws; no names where there is no covariance."""
+def _candidates(ship: Ship, covariance, notes: list):
+    """(names, mean, matrix, support) of the ship's draws; no names (and no support) without a covariance."""
     cov = ship.covariance if covariance is None else covariance
     if cov is None:
         notes.append("ship not drawn: the ship config has no covariance: section (the band is the run spread's alone)")
-        return [], np.zeros((samples, 0)), np.zeros(0)
+        return [], np.zeros(0), np.zeros((0, 0)), None
     names, mean, matrix, _ = parameter_covariance(ship, cov)
-    return names, draw(mean, matrix, samples, seed), mean
+    if not len(names):
+        return names, mean, matrix, None
+    support = support_of(ship, names, cov)
+    notes += [support.caveat] if support.caveat else []
+    return names, mean, matrix, support
+
+
+def _draws(ship: Ship, covariance, std, samples: int, seed: int, notes: list):
+    """(names, ship rows (k, n), mean, run rows (k, len(std)), rejected): ``samples`` draws of the ship inside
+    its support (:func:`_candidates`) each with its run draw, batches of ``samples`` candidates from the
+    two streams of ``seed``, at most :data:`MAX_CANDIDATES` times ``samples`` candidates."""
+    names, mean, matrix, support = _candidates(ship, covariance, notes)
+    ship_rng, run_rng = np.random.default_rng(seed), np.random.default_rng([int(seed), 1])
+    rows, runs, tried = [], [], 0
+    while len(rows) < samples and tried < MAX_CANDIDATES * samples:
+        cand = (ship_rng.multivariate_normal(mean, matrix, samples, method="eigh") if len(names)
+                else np.zeros((samples, 0)))
+        run_rows = run_rng.normal(0.0, 1.0, (samples, len(std))) * std
+        for a, b in zip(cand, run_rows):
+            if len(rows) == samples:
+                break
+            tried += 1
+            if support is None or support.contains(ship, a):
+                rows.append(a)
+                runs.append(b)
+    if not rows:
+        raise InputError("covariance", "matrix", f"none of {tried} ships drawn lies in the support ({support.note}): "
+                                                 "the covariance puts next to no weight on an admissible ship")
+    if tried > len(rows):
+        notes.append(f"{tried - len(rows)} of {tried} ships drawn from the covariance rejected, not replayed: outside the "
+                     f"support ({support.note}); the band is the normal truncated to it")
+    if len(rows) < samples:
+        notes.append(f"only {len(rows)} of {samples} draws inside the support after {tried} candidates")
+    return names, np.array(rows), mean, np.array(runs), tried - len(rows)
 
 
 def _one_replay(ship: Ship, run: MeasuredRun, names, row, mean, sp_names, sp_row, notes: set) -> np.ndarray:
@@ -345,15 +390,13 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     run = run if isinstance(run, MeasuredRun) else measured_run(ship, run)
     src = ship.source or ship.name
     notes: list = []
-    names, rows, mean = _ship_draws(ship, covariance, samples, seed, notes)
-    notes += _fit_doubts(ship, names, covariance)
     spread = ship.run_spread if run_spread is None else run_spread
+    sp_names, std = _spread_of(spread, src) if spread is not None else ([], np.zeros(0))
+    names, rows, mean, sp_rows, rejected = _draws(ship, covariance, std, samples, seed, notes)
+    notes += _fit_doubts(ship, names, covariance)
     if spread is None:
         notes.append("start state not drawn: the ship config has no run_spread: section")
-        sp_names, sp_rows = [], np.zeros((samples, 0))
-    else:
-        sp_names, std = _spread_of(spread, src)
-        sp_rows = np.random.default_rng([int(seed), 1]).normal(0.0, 1.0, (samples, len(std))) * std
+    samples = len(rows)
     seen: set = set()
     with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
         preds = list(pool.map(lambda k: _one_replay(ship, run, names, rows[k], mean, sp_names, sp_rows[k], seen),
@@ -366,4 +409,5 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     return Bands(nominal=nominal, t=np.asarray(run.t, float), heading_deg=np.degrees(np.unwrap(run.meas[:, 5])),
                  lo=lo, hi=hi, nominal_deg=_unwrapped_deg(nominal.pred[:, 5], first), x_median=xm, y_median=ym,
                  radius=radius, tracks=P[:SAMPLE_TRACKS, :, :2].copy(), draws=samples,
-                 diverged=int(np.sum(~np.isfinite(P).all(axis=(1, 2)))), notes=tuple(notes + sorted(seen)))
+                  diverged=int(np.sum(~np.isfinite(P).all(axis=(1, 2)))), notes=tuple(notes + sorted(seen)),
+                 rejected=rejected)

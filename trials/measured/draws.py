@@ -5,10 +5,19 @@ The covariance is the ship config's ``covariance:`` section (:class:`mmg.ship.Pa
 and checks it (names, mean, matrix), :func:`draw` samples the multivariate normal with that
 covariance (correlations kept) about those values, and
 :func:`trials.measured.identify.ship_with_values` writes a sample into the ship by name.
+
+:func:`support_of` gives the ships a draw may be (:class:`Support`): the values the fit itself can return
+(its hard bounds, :func:`ekf.identify.free_parameters`) and, where the covariance states the range of
+the states its training records log (``state_range``), a hull that does not gain energy unpowered over
+that range (:func:`mmg.dissipation.power_check` on the grid :func:`mmg.dissipation.state_box` spans: the
+check ``mmg identify`` makes of the fitted ship, :func:`trials.measured.physical.physical_check`).  The
+covariance is the linearisation of the fit about its estimate; truncated to this support it is that
+normal conditioned on the ship being one the estimator and the physics admit.
 """
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -16,7 +25,8 @@ from mmg.errors import InputError
 from mmg.parameters import WIND_COLUMNS
 from mmg.ship import ParameterCovariance, Ship
 
-__all__ = ["parameter_covariance", "ship_values", "draw", "WIND_FACTOR_NAMES"]
+__all__ = ["parameter_covariance", "ship_values", "draw", "WIND_FACTOR_NAMES", "Support", "support_of",
+           "support_bounds"]
 
 WIND_FACTOR_NAMES = tuple(WIND_COLUMNS)
 """Parameters of a covariance that are factors on the records' wind loads (1: the ship as it is)."""
@@ -87,3 +97,93 @@ def draw(mean, matrix, n: int, seed: int | None = None) -> np.ndarray:
     """``n`` samples (rows) of the normal with ``mean`` and covariance ``matrix`` (correlations kept)."""
     rng = np.random.default_rng(seed)
     return rng.multivariate_normal(np.asarray(mean, float), np.asarray(matrix, float), size=int(n), method="eigh")
+
+
+def support_bounds(ship: Ship, names) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) of each parameter ``names``: the hard bounds a fit of ``ship`` holds it to
+    (:func:`ekf.identify.free_parameters`: the straight-ahead resistance negative, w_P0, epsilon, kappa,
+    the gamma_R, l_R', Y_P_astern and the effects' parameters within theirs, an added mass within
+    0 to 3 times the ship's value); -inf/inf where a parameter has none."""
+    from ekf.identify import free_parameters
+    from mmg.model import pack
+
+    free = free_parameters(pack(ship), ship.hull.names, list(names), hull_terms=ship.hull.terms)
+    return np.array([f.lower for f in free], float), np.array([f.upper for f in free], float)
+
+
+def _state_range(cov) -> tuple:
+    """((u_min, u_max), (v_min, v_max), (r_min, r_max)) of a covariance, () where it gives none."""
+    if isinstance(cov, ParameterCovariance):
+        return tuple(cov.state_range)
+    if isinstance(cov, Mapping) and cov.get("state_range"):
+        d = cov["state_range"]
+        try:
+            out = tuple((float(d[k][0]), float(d[k][1])) for k in ("u_mps", "v_mps", "r_radps"))
+        except (KeyError, IndexError, TypeError, ValueError):
+            raise InputError("covariance", "state_range", "expected u_mps, v_mps, r_radps each [min, max]") from None
+        if not all(np.isfinite(a) and np.isfinite(b) and a <= b for a, b in out):
+            raise InputError("covariance", "state_range", "expected finite [min, max] ranges")
+        return out
+    return ()
+
+
+@dataclass(frozen=True)
+class Support:
+    """The ships a draw may be (module docstring).
+
+    Attributes
+    ----------
+    names : tuple of str
+        The drawn parameters.
+    lower, upper : ndarray
+        Each one's hard bounds (:func:`support_bounds`).
+    states : tuple of ndarray or None
+        (u [m/s], v [m/s], r [rad/s]) of the grid a drawn ship must not gain energy on; None: no energy check.
+    note : str
+        What the support is (for a band's notes where draws were rejected).
+    caveat : str
+        Why the energy check is left out though the covariance gives a range to check over; empty otherwise.
+    """
+
+    names: tuple
+    lower: np.ndarray
+    upper: np.ndarray
+    states: tuple | None
+    note: str
+    caveat: str = ""
+
+    def contains(self, ship: Ship, row) -> bool:
+        """Whether the draw ``row`` (values of :attr:`names`) of ``ship`` lies in the support: every value
+        within its bounds and, with :attr:`states`, the ship with those values gaining no energy there."""
+        row = np.asarray(row, float)
+        if np.any(row < self.lower) or np.any(row > self.upper):
+            return False
+        if self.states is None:
+            return True
+        from mmg.dissipation import power_check
+
+        from .identify import ship_with_values
+
+        s = ship_with_values(ship, {n: float(v) for n, v in zip(self.names, row) if n not in WIND_FACTOR_NAMES})
+        return power_check(s, *self.states).passes
+
+
+def support_of(ship: Ship, names, cov) -> Support:
+    """The :class:`Support` of draws of ``names`` about ``ship`` from the covariance ``cov``: the fit's
+    bounds, and the energy check over the grid spanning the covariance's ``state_range`` where it has one
+    and ``ship`` itself passes it (a fitted ship that gains energy there leaves the check out, said in
+    :attr:`Support.note`: the support must hold the estimate it is about)."""
+    from mmg.dissipation import power_check, state_box
+
+    lower, upper = support_bounds(ship, names)
+    rng = _state_range(cov)
+    bounds = "within the fit's hard bounds"
+    if not rng:
+        return Support(tuple(names), lower, upper, None, f"{bounds} (the covariance has no state_range: no energy check)")
+    states = state_box(*(np.array(r) for r in rng))
+    if not power_check(ship, *states).passes:
+        return Support(tuple(names), lower, upper, None, bounds,
+                       "drawn ships not checked for energy: the identified ship itself gains energy unpowered over "
+                       "the covariance's state_range")
+    return Support(tuple(names), lower, upper, states,
+                   f"{bounds} and gaining no energy unpowered over the covariance's state_range")

@@ -153,7 +153,8 @@ def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None 
     covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
     :func:`trials.measured.bands.prediction_bands`; ``sections``: :func:`band_sections` of ``ident``, made
     once for several runs): ``samples`` (the record's), ``inside`` (of them in the band), ``coverage90``,
-    ``median_width_deg``, ``unbounded_share``, ``draws``, ``diverged_draws``."""
+    ``median_width_deg``, ``unbounded_share``, ``draws``, ``diverged_draws``, ``rejected_draws`` (candidate
+    ships outside the support, not replayed)."""
     from .bands import prediction_bands
 
     cov, spread = band_sections(ident) if sections is None else sections
@@ -163,7 +164,8 @@ def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None 
     inside_b = int(round(b.coverage90_where_bounded * bounded)) if bounded else 0
     return {"samples": n, "inside": int(round(b.coverage90 * n)), "coverage90": b.coverage90,
             "bounded": bounded, "inside_bounded": inside_b, "median_width_deg": b.median_width_deg,
-            "unbounded_share": b.unbounded_share, "draws": b.draws, "diverged_draws": b.diverged}
+            "unbounded_share": b.unbounded_share, "draws": b.draws, "diverged_draws": b.diverged,
+            "rejected_draws": b.rejected}
 
 
 def band_summary(records: list[dict]) -> dict:
@@ -171,7 +173,8 @@ def band_summary(records: list[dict]) -> dict:
     ``band_coverage90`` (samples inside over all samples; a sample where the band is unbounded counts as
     inside), ``band_unbounded_share`` (samples where it is, over all), ``band_coverage90_where_bounded``
     (inside over the bounded samples), ``band_median_width_deg`` (the median over the records of each
-    record's median width), ``band_records``; {} where none carries a band."""
+    record's median width), ``band_records``, ``band_rejected_share`` (candidate ships rejected outside the
+    support over all candidates, pooled over the records); {} where none carries a band."""
     b = [r["band"] for r in records if r.get("band")]
     if not b:
         return {}
@@ -181,7 +184,9 @@ def band_summary(records: list[dict]) -> dict:
             "band_median_width_deg": float(np.median([x["median_width_deg"] for x in b])), "band_records": len(b),
             "band_unbounded_share": 1.0 - nb / n,
             "band_coverage90_where_bounded": (sum(x.get("inside_bounded", x["inside"]) for x in b) / nb) if nb else
-            float("nan")}
+            float("nan"),
+            "band_rejected_share": sum(x.get("rejected_draws", 0) for x in b)
+            / max(sum(x["draws"] + x.get("rejected_draws", 0) for x in b), 1)}
 
 
 def _outer_task(task) -> list[dict]:

@@ -12,7 +12,7 @@ from mmg.parameters import unit_of
 from .fit import Identification, _nuisance_effects, same_run_groups, start_noise
 
 __all__ = ["fit_covariance", "identification_covariance", "run_covariance", "COVARIANCE_METHOD", "run_spread",
-           "START_UNITS"]
+           "START_UNITS", "training_state_range"]
 
 
 def _covariance_section(fit, cov: np.ndarray, note: str, method: str = "") -> dict | None:
@@ -117,7 +117,19 @@ def identification_covariance(ident: Identification, parts: bool = False):
     else:
         note += f"; no run-to-run part ({n_runs} independent run: the jackknife needs two or more)"
         section = _covariance_section(ident.fit, post, note, "posterior")
+    if section is not None:
+        section["state_range"] = training_state_range(ident.runs)
     return (section, post, runs) if parts else section
+
+
+def training_state_range(runs) -> dict:
+    """The ``state_range`` of the covariance section: ``u_mps``, ``v_mps``, ``r_radps``, each [min, max] of
+    the states the records ``runs`` log (those :func:`trials.measured.physical.physical_check` checks), over
+    which a drawn ship is checked not to gain energy (:func:`trials.measured.draws.support_of`)."""
+    from ..physical import _logged_states
+
+    return {k: [float(f"{np.min(a):.6g}"), float(f"{np.max(a):.6g}")]
+            for k, a in zip(("u_mps", "v_mps", "r_radps"), _logged_states(runs))}
 
 
 START_UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "psi": "rad"}
