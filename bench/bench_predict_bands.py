@@ -2,8 +2,9 @@
 
 The record as ``bench/bench_replay.py`` takes it (the longest FRT-DS-ESSO record cut to its first 600 s, or a
 simulated one without the data).  The ship: the 3 m model with a stated covariance (N_r, N_rr, kappa,
-w_P0 at 5 % of their values, the wind scale at 0.1) and a run spread (u, v 0.005 m/s, heading 0.02 rad),
-so every draw changes the ship and the start.  Times :func:`trials.measured.bands.prediction_bands` (the
+w_P0 at 5 % of their values, the wind scale at 0.1; its ``state_range`` the record's own, so every candidate
+ship is checked for energy over it, :func:`trials.measured.draws.support_of`) and a run spread (u, v 0.005 m/s,
+heading 0.02 rad), so every draw changes the ship and the start.  Times :func:`trials.measured.bands.prediction_bands` (the
 numba cache loaded by one replay first), once per ``--jobs`` value, and prints the band's figures too.
 
     python bench/bench_predict_bands.py [--samples N] [--jobs 1 2]
@@ -28,6 +29,7 @@ def main(argv=None) -> int:
     import mmg
     from bench_replay import _record
     from trials.measured.bands import prediction_bands
+    from trials.measured.identify.covariance import training_state_range
     from trials.measured.predict import measured_run, replay_record
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -41,7 +43,7 @@ def main(argv=None) -> int:
     names = ["N_r", "N_rr", "kappa", "w_P0"]
     mean = [ship.hull.value("N_r"), ship.hull.value("N_rr"), ship.rudder.kappa, ship.propeller.w_P0[0]]
     cov = {"names": names + ["wind_scale"], "values": mean + [1.0],
-           "matrix": np.diag([(0.05 * m) ** 2 for m in mean] + [0.01]).tolist()}
+           "matrix": np.diag([(0.05 * m) ** 2 for m in mean] + [0.01]).tolist(), "state_range": training_state_range([run])}
     spread = {"names": ["start.u", "start.v", "start.psi"], "std": [0.005, 0.005, 0.02]}
     print(f"{what}: {len(run.t)} samples, wind {run.wind}; {a.samples} draws")
     for jobs in a.jobs:
@@ -50,7 +52,7 @@ def main(argv=None) -> int:
         dt = time.perf_counter() - t0
         print(f"{jobs} thread(s): {dt:.2f} s ({dt / a.samples * 1e3:.1f} ms a draw); target {TARGET_S:g} s: "
               f"{'meets' if dt <= TARGET_S else 'MISSES'} it; coverage {100 * b.coverage90:.0f} %, median width "
-              f"{b.median_width_deg:.3g} deg, {b.diverged} diverged")
+              f"{b.median_width_deg:.3g} deg, {b.diverged} diverged, {b.rejected} candidates rejected")
     return 0
 
 

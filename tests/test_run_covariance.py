@@ -112,11 +112,14 @@ def test_a_fits_per_record_parts_add_up_and_the_written_covariance_holds_both_pa
 
 def test_kept_out_bands_pool_samples_inside_over_all_samples():
     """The nested cross-validation's pooled band figures by hand: coverage is samples inside over samples (a
-    long record counts by its length), the width the median over the records of their medians."""
+    long record counts by its length), the width the median over the records of their medians, the rejected
+    share the rejected candidates over all candidates."""
     from trials.measured.nested import band_summary
 
-    recs = [{"band": {"samples": 100, "inside": 90, "bounded": 100, "inside_bounded": 90, "median_width_deg": 4.0}},
-            {"band": {"samples": 300, "inside": 150, "bounded": 200, "inside_bounded": 50, "median_width_deg": 10.0}},
+    recs = [{"band": {"samples": 100, "inside": 90, "bounded": 100, "inside_bounded": 90, "median_width_deg": 4.0,
+                      "draws": 200, "rejected_draws": 100}},
+            {"band": {"samples": 300, "inside": 150, "bounded": 200, "inside_bounded": 50, "median_width_deg": 10.0,
+                      "draws": 200, "rejected_draws": 0}},
             {"band": {"samples": 50, "inside": 50, "bounded": 0, "inside_bounded": 0, "median_width_deg": 2.0}},
             {"name": "no band"}]
     s = band_summary(recs)
@@ -124,6 +127,7 @@ def test_kept_out_bands_pool_samples_inside_over_all_samples():
     assert s["band_unbounded_share"] == pytest.approx(150 / 450)
     assert s["band_coverage90_where_bounded"] == pytest.approx(140 / 300)
     assert s["band_records"] == 3 and band_summary([{"name": "x"}]) == {}
+    assert s["band_rejected_share"] == pytest.approx(100 / 500)
 
 
 def test_a_folds_band_of_a_kept_out_record_draws_from_its_fit():

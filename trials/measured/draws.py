@@ -168,22 +168,37 @@ class Support:
         return power_check(s, *self.states).passes
 
 
+def _dissipative_states(ship: Ship, states) -> tuple:
+    """The states of ``states`` (u, v, r arrays) where ``ship`` gains no energy unpowered (within
+    :data:`mmg.dissipation.POWER_TOLERANCE` of :func:`mmg.dissipation.power_scale`)."""
+    from mmg.dissipation import POWER_TOLERANCE, power_scale, unpowered_power
+    from mmg.model import pack
+
+    pk = pack(ship)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        keep = unpowered_power(pk, *states) / power_scale(pk, *states) <= POWER_TOLERANCE
+    return tuple(np.asarray(a)[keep] for a in states)
+
+
 def support_of(ship: Ship, names, cov) -> Support:
     """The :class:`Support` of draws of ``names`` about ``ship`` from the covariance ``cov``: the fit's
-    bounds, and the energy check over the grid spanning the covariance's ``state_range`` where it has one
-    and ``ship`` itself passes it (a fitted ship that gains energy there leaves the check out, said in
-    :attr:`Support.note`: the support must hold the estimate it is about)."""
-    from mmg.dissipation import power_check, state_box
+    bounds, and the energy check over the grid spanning the covariance's ``state_range`` (where it has
+    one), at the grid's states where ``ship`` itself gains none: the support holds the estimate it is about,
+    and a state where the estimate (and, as a rule, its prior: the hull polynomial at large r' = r L / U)
+    gains energy is one the hull form does not describe (said in :attr:`Support.caveat`)."""
+    from mmg.dissipation import state_box
 
     lower, upper = support_bounds(ship, names)
     rng = _state_range(cov)
     bounds = "within the fit's hard bounds"
     if not rng:
         return Support(tuple(names), lower, upper, None, f"{bounds} (the covariance has no state_range: no energy check)")
-    states = state_box(*(np.array(r) for r in rng))
-    if not power_check(ship, *states).passes:
-        return Support(tuple(names), lower, upper, None, bounds,
-                       "drawn ships not checked for energy: the identified ship itself gains energy unpowered over "
-                       "the covariance's state_range")
+    grid = state_box(*(np.array(r) for r in rng))
+    states = _dissipative_states(ship, grid)
+    n, m = len(states[0]), len(grid[0])
+    caveat = (f"drawn ships checked for energy at {n} of the {m} states spanning the covariance's state_range: "
+              "the identified ship itself gains energy unpowered at the others") if n < m else ""
+    if not n:
+        return Support(tuple(names), lower, upper, None, bounds, caveat)
     return Support(tuple(names), lower, upper, states,
-                   f"{bounds} and gaining no energy unpowered over the covariance's state_range")
+                   f"{bounds} and gaining no energy unpowered over the covariance's state_range", caveat)

@@ -186,7 +186,7 @@ def band_summary(records: list[dict]) -> dict:
             "band_coverage90_where_bounded": (sum(x.get("inside_bounded", x["inside"]) for x in b) / nb) if nb else
             float("nan"),
             "band_rejected_share": sum(x.get("rejected_draws", 0) for x in b)
-            / max(sum(x["draws"] + x.get("rejected_draws", 0) for x in b), 1)}
+            / max(sum(x.get("draws", 0) + x.get("rejected_draws", 0) for x in b), 1)}
 
 
 def _outer_task(task) -> list[dict]:

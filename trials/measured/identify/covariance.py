@@ -117,17 +117,21 @@ def identification_covariance(ident: Identification, parts: bool = False):
     else:
         note += f"; no run-to-run part ({n_runs} independent run: the jackknife needs two or more)"
         section = _covariance_section(ident.fit, post, note, "posterior")
-    if section is not None:
-        section["state_range"] = training_state_range(ident.runs)
+    state_range = training_state_range(ident.runs) if section is not None else {}
+    if state_range:
+        section["state_range"] = state_range
     return (section, post, runs) if parts else section
 
 
 def training_state_range(runs) -> dict:
     """The ``state_range`` of the covariance section: ``u_mps``, ``v_mps``, ``r_radps``, each [min, max] of
     the states the records ``runs`` log (those :func:`trials.measured.physical.physical_check` checks), over
-    which a drawn ship is checked not to gain energy (:func:`trials.measured.draws.support_of`)."""
+    which a drawn ship is checked not to gain energy (:func:`trials.measured.draws.support_of`); {} without a
+    finite logged state."""
     from ..physical import _logged_states
 
+    if not any(np.isfinite(r.meas[:, :3]).all(axis=1).any() for r in runs):
+        return {}
     return {k: [float(f"{np.min(a):.6g}"), float(f"{np.max(a):.6g}")]
             for k, a in zip(("u_mps", "v_mps", "r_radps"), _logged_states(runs))}
 
