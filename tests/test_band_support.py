@@ -149,7 +149,12 @@ def test_a_bad_state_range_is_refused_naming_its_field(tmp_path):
         mmg.load_ship(p)
     data["covariance"]["state_range"]["v_mps"] = [-0.1, 0.1]
     p.write_text(yaml.safe_dump(data, sort_keys=False))
-    assert mmg.load_ship(p).covariance.state_range == ((0.2, 0.6), (-0.1, 0.1), (-0.08, 0.08))
+    loaded = mmg.load_ship(p)
+    assert loaded.covariance.state_range == ((0.2, 0.6), (-0.1, 0.1), (-0.08, 0.08))
+    from trials.measured.draws import support_of
+
+    sup = support_of(loaded, ["N_r"], loaded.covariance)              # the config's section, as mmg predict reads it
+    assert sup.states is not None and np.max(sup.states[1]) == pytest.approx(0.1)
 
 
 def test_the_energy_check_leaves_out_the_states_where_the_identified_ship_itself_gains_energy(ship):
