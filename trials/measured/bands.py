@@ -60,9 +60,9 @@ SAMPLE_TRACKS = 12
 """How many of the drawn tracks a :class:`Bands` keeps for its figure."""
 MAX_CANDIDATES = 50
 """At most this many candidates per asked-for draw are tried for the support (fewer draws are said in the notes)."""
-BAND_KEYS = ("draws", "diverged_draws", "rejected_draws", "heading_band_deg", "coverage90", "heading_band_median_width_deg",
-             "heading_band_unbounded_share", "coverage90_where_bounded", "position_band_m", "position_coverage90",
-             "position_band_median_radius_m")
+BAND_KEYS = ("draws", "diverged_draws", "rejected_draws", "heading_band_deg", "coverage90",
+             "heading_band_median_width_deg", "heading_band_unbounded_share", "coverage90_where_bounded",
+             "position_band_m", "position_coverage90", "position_band_median_radius_m")
 """The keys :meth:`Bands.to_json` gives (``mmg predict --samples`` adds them to each run)."""
 
 
@@ -309,8 +309,8 @@ def _draws(ship: Ship, covariance, std, samples: int, seed: int, notes: list):
         raise InputError("covariance", "matrix", f"none of {tried} ships drawn lies in the support ({support.note}): "
                                                  "the covariance puts next to no weight on an admissible ship")
     if tried > len(rows):
-        notes.append(f"{tried - len(rows)} of {tried} ships drawn from the covariance rejected, not replayed: outside the "
-                     f"support ({support.note}); the band is the normal truncated to it")
+        notes.append(f"{tried - len(rows)} of {tried} ships drawn from the covariance rejected, not replayed: "
+                     f"outside the support ({support.note}); the band is the normal truncated to it")
     if len(rows) < samples:
         notes.append(f"only {len(rows)} of {samples} draws inside the support after {tried} candidates")
     return names, np.array(rows), mean, np.array(runs), tried - len(rows)

@@ -192,7 +192,8 @@ def support_of(ship: Ship, names, cov) -> Support:
     rng = _state_range(cov)
     bounds = "within the fit's hard bounds"
     if not rng:
-        return Support(tuple(names), lower, upper, None, f"{bounds} (the covariance has no state_range: no energy check)")
+        return Support(tuple(names), lower, upper, None,
+                       f"{bounds} (the covariance has no state_range: no energy check)")
     grid = state_box(*(np.array(r) for r in rng))
     states = _dissipative_states(ship, grid)
     n, m = len(states[0]), len(grid[0])
