@@ -94,6 +94,8 @@ def _args(argv=None):
     ap.add_argument("--bands", type=int, default=0, metavar="N",
                     help="each kept-out record's 90 %% heading band from N draws of its fold's model (ship from the "
                          "written covariance, start from the run-to-run spread); pooled coverage and median width")
+    ap.add_argument("--band-support", choices=("none", "bounds", "physical"), default="none",
+                    help="truncate the bands' ship draws (mmg predict --support; default none)")
     ap.add_argument("--backend", choices=("serial", "loky"), default="loky")
     ap.add_argument("--jobs", type=int, default=2, help="local workers of the loky backend (default 2)")
     ap.add_argument("--markdown", action="store_true", help="print the tables as Markdown")
@@ -299,7 +301,7 @@ def main(argv=None) -> None:
     t0 = time.perf_counter()
     res = nested_cross_validate(cands, runs, folds=a.folds, inner_folds=a.inner_folds, initial=initial,
                                 folds_by=a.folds_by, backend=a.backend, n_jobs=a.jobs, horizon_s=a.horizon,
-                                band_samples=a.bands, **opts)
+                                band_samples=a.bands, band_support=a.band_support, **opts)
     print(f"\n{time.perf_counter() - t0:.0f} s wall\n")
     print("Per kept-out record (s: scaled esso_osaka_3m, i: identified without it; 'div.': the replay diverged):\n")
     print("\n".join(record_table(res, a.markdown)))

@@ -19,6 +19,7 @@ import yaml
 import mmg
 import trials.measured.bands as bands_mod
 from mmg.dissipation import power_check, state_box
+from mmg.errors import InputError
 from mmg.model import pack
 from mmg.replay import replay
 from trials.measured.bands import prediction_bands
@@ -71,7 +72,7 @@ def test_a_draw_outside_the_fits_bounds_is_never_replayed(ship, monkeypatch):
     n, seed, k0 = 40, 5, ship.rudder.kappa
     seen = _replayed_ships(monkeypatch)
     b = prediction_bands(ship, run, n, seed, covariance={"names": ["kappa"], "matrix": [[0.25]]},
-                         run_spread=SPREAD, jobs=1)
+                         run_spread=SPREAD, jobs=1, support="bounds")
     kap = [s.rudder.kappa for s in seen]
     assert len(kap) == n + 1 and all(0.0 <= x <= 1.0 for x in kap)
     cand, offs = _candidates([k0], [[0.25]], SPREAD["std"], n, seed, batches=3)
@@ -85,6 +86,24 @@ def test_a_draw_outside_the_fits_bounds_is_never_replayed(ship, monkeypatch):
     assert any("rejected" in x and "outside the support" in x for x in b.notes)
 
 
+def test_by_default_the_draws_are_not_truncated(ship, monkeypatch):
+    """Without ``support`` the ship is drawn from the covariance's normal as it is: kappa outside the fit's
+    bounds [0, 1] is replayed too, nothing is rejected, and the band is the first ``n`` draws' quantiles."""
+    run = _run(ship, duration=30.0)
+    n, seed, k0 = 40, 5, ship.rudder.kappa
+    seen = _replayed_ships(monkeypatch)
+    b = prediction_bands(ship, run, n, seed, covariance={"names": ["kappa"], "matrix": [[0.25]]},
+                         run_spread=SPREAD, jobs=1)
+    cand, offs = _candidates([k0], [[0.25]], SPREAD["std"], n, seed, batches=1)
+    assert b.rejected == 0 and b.draws == n
+    assert any(not 0.0 <= s.rudder.kappa <= 1.0 for s in seen)
+    heads = _by_hand(ship, run, cand[:n, 0], offs[:n])
+    np.testing.assert_allclose(b.lo, np.quantile(heads, 0.05, axis=0), atol=1e-9)
+    np.testing.assert_allclose(b.hi, np.quantile(heads, 0.95, axis=0), atol=1e-9)
+    with pytest.raises(InputError, match="support"):
+        prediction_bands(ship, run, 2, seed, support="bound")
+
+
 def test_a_covariance_inside_the_support_gives_the_untruncated_bands(ship):
     """kappa at std 0.02 (never near 0 or 1) and a state range the ship and such neighbours dissipate over:
     nothing is rejected, and the band is that of the untruncated normal's first ``n`` draws replayed by hand
@@ -93,7 +112,7 @@ def test_a_covariance_inside_the_support_gives_the_untruncated_bands(ship):
     n, seed = 30, 2
     cov = {"names": ["kappa"], "matrix": [[0.02 ** 2]], "state_range": RANGE}
     assert power_check(ship, *state_box(*(np.array(v) for v in RANGE.values()))).passes
-    b = prediction_bands(ship, run, n, seed, covariance=cov, run_spread=SPREAD, jobs=2)
+    b = prediction_bands(ship, run, n, seed, covariance=cov, run_spread=SPREAD, jobs=2, support="physical")
     rows = np.random.default_rng(seed).multivariate_normal([ship.rudder.kappa], [[0.02 ** 2]], size=n, method="eigh")
     offs = np.random.default_rng([seed, 1]).normal(0.0, 1.0, (n, 3)) * SPREAD["std"]
     heads = _by_hand(ship, run, rows[:, 0], offs)
@@ -115,7 +134,7 @@ def test_ships_gaining_energy_over_the_state_range_are_not_replayed(ship, monkey
     n, seed = 30, 1
     cov = {"names": ["N_r"], "matrix": [[0.08 ** 2]], "state_range": RANGE}
     seen = _replayed_ships(monkeypatch)
-    b = prediction_bands(ship, run, n, seed, covariance=cov, run_spread=SPREAD, jobs=1)
+    b = prediction_bands(ship, run, n, seed, covariance=cov, run_spread=SPREAD, jobs=1, support="physical")
     grid = state_box(*(np.array(v) for v in RANGE.values()))
     assert len(seen) == n + 1 and all(power_check(s, *grid).passes for s in seen)
     cand, _ = _candidates([ship.hull.value("N_r")], [[0.08 ** 2]], SPREAD["std"], n, seed, batches=4)

@@ -213,7 +213,7 @@ def test_cli_predict_samples_json_keys_and_plots(tmp_path, capsys):
     assert rc == 0, err
     doc = json.loads(js.read_text(), parse_constant=lambda c: pytest.fail(f"JSON holds {c}"))
     assert list(doc) == ["runs", "bands"]
-    assert doc["bands"] == {"samples": 20, "seed": 3, "notes": []}
+    assert doc["bands"] == {"samples": 20, "seed": 3, "support": "none", "notes": []}
     run = doc["runs"][0]
     assert list(run)[-len(BAND_KEYS):] == ["draws", "diverged_draws", "rejected_draws", "heading_band_deg", "coverage90",
                                            "heading_band_median_width_deg", "heading_band_unbounded_share",

@@ -77,7 +77,7 @@ def _bands(args, ship, pred) -> list | None:
 
     out = []
     for i, r in enumerate(pred.runs):
-        out.append(prediction_bands(ship, r.run, args.samples, seed=args.seed))
+        out.append(prediction_bands(ship, r.run, args.samples, seed=args.seed, support=args.support))
         print(f"bands {i + 1}/{len(pred.runs)}: {r.run.name} ({args.samples} draws)", file=sys.stderr, flush=True)
     return out
 
@@ -89,7 +89,7 @@ def _with_bands(doc: dict, bands, args) -> dict:
     for row, b in zip(doc["runs"], bands):
         row.update(b.to_json())
     notes = sorted({n for b in bands for n in b.notes})
-    doc["bands"] = {"samples": int(args.samples), "seed": int(args.seed), "notes": notes}
+    doc["bands"] = {"samples": int(args.samples), "seed": int(args.seed), "support": args.support, "notes": notes}
     return doc
 
 
@@ -103,8 +103,8 @@ def _print_bands(bands) -> None:
             print(f"{b.nominal.run.name}: no band: the {b.draws} draws all replay the nominal ship and start "
                   f"(nothing to draw them from: see the notes), so no width and no coverage")
             continue
-        print(f"{b.nominal.run.name}: 90 % band from {b.draws} draws ({b.diverged} diverged; {b.rejected} candidate ships "
-              f"rejected outside the support): heading coverage "
+        print(f"{b.nominal.run.name}: 90 % band from {b.draws} draws ({b.diverged} diverged"
+              + (f"; {b.rejected} candidate ships rejected outside the support" if b.rejected else "") + "): heading coverage "
               f"{100 * b.coverage90:.0f} % of samples, median width {num(b.median_width_deg, 'deg')}; position "
               f"coverage {100 * b.position_coverage90:.0f} %, median radius {num(b.median_radius_m, 'm')}"
               + (f"; heading band unbounded on {100 * b.unbounded_share:.0f} % of samples (inside there; "
@@ -120,6 +120,10 @@ def _add_band_arguments(p) -> None:
                         "(JSON keys heading_band_deg, coverage90, position_band_m, ...; bands drawn in the plots)")
     p.add_argument("--seed", type=_whole(0, "--seed"), default=0, metavar="S",
                    help="seed of the --samples draws (default 0)")
+    p.add_argument("--support", choices=("none", "bounds", "physical"), default="none",
+                   help="truncate the --samples ship draws: none (default), to the fit's hard bounds, or to those and "
+                        "ships gaining no energy unpowered over the training states (rejected_draws; narrower bands "
+                        "that cover less on held-out real records: docs/prediction_bands.md)")
 
 
 def _first_text(r, horizon) -> str:

@@ -6,10 +6,11 @@ times, each replay with
 * a ship drawn from the covariance of its identified parameters (the ship config's ``covariance:``
   section, :func:`trials.measured.draws.parameter_covariance`, written in by name with
   :func:`trials.measured.identify.ship_with_values`; a wind-load factor scales the record's measured
-  wind loads, relative to the covariance's own value), truncated to the ships the estimator and the
-  physics admit (:func:`trials.measured.draws.support_of`: within the fit's hard bounds, and not gaining
-  energy unpowered over the training records' range of states): a candidate outside is never replayed
-  but rejected and the next one drawn (:attr:`Bands.rejected`, ``rejected_draws``), and
+  wind loads, relative to the covariance's own value), optionally (``support``) truncated to the ships
+  the estimator and the physics admit (:func:`trials.measured.draws.support_of`: within the fit's hard
+  bounds, and not gaining energy unpowered over the training records' range of states): a candidate
+  outside is never replayed but rejected and the next one drawn (:attr:`Bands.rejected`,
+  ``rejected_draws``), and
 * the record's start state (and a per-record effect) offset by a zero-mean normal draw of the
   between-run spread of a run's own disturbance (the ``run_spread:`` section, :class:`mmg.ship.RunSpread`,
   written by ``mmg identify``: ``start.u``, ``start.v``, ``start.r``, ``start.psi`` added to the first
@@ -47,7 +48,7 @@ from mmg.errors import InputError
 from mmg.replay import STATE
 from mmg.ship import RunSpread, Ship
 
-from .draws import WIND_FACTOR_NAMES, parameter_covariance, support_of
+from .draws import SUPPORTS, WIND_FACTOR_NAMES, parameter_covariance, support_of
 from .predict import MeasuredRun, Replayed, measured_run, replay_record
 
 __all__ = ["Bands", "prediction_bands", "BAND_KEYS", "QUANTILES", "SAMPLE_TRACKS"]
@@ -273,25 +274,26 @@ def _fit_doubts(ship: Ship, names, covariance) -> list:
             "the uncertainty of a finished fit"] if why else []
 
 
-def _candidates(ship: Ship, covariance, notes: list):
-    """(names, mean, matrix, support) of the ship's draws; no names (and no support) without a covariance."""
+def _candidates(ship: Ship, covariance, notes: list, support: str = "none"):
+    """(names, mean, matrix, support) of the ship's draws; no support with ``support`` "none" or without a
+    covariance (no names then)."""
     cov = ship.covariance if covariance is None else covariance
     if cov is None:
         notes.append("ship not drawn: the ship config has no covariance: section (the band is the run spread's alone)")
         return [], np.zeros(0), np.zeros((0, 0)), None
     names, mean, matrix, _ = parameter_covariance(ship, cov)
-    if not len(names):
+    if not len(names) or support == "none":
         return names, mean, matrix, None
-    support = support_of(ship, names, cov)
-    notes += [support.caveat] if support.caveat else []
-    return names, mean, matrix, support
+    sup = support_of(ship, names, cov, energy=support == "physical")
+    notes += [sup.caveat] if sup.caveat else []
+    return names, mean, matrix, sup
 
 
-def _draws(ship: Ship, covariance, std, samples: int, seed: int, notes: list):
+def _draws(ship: Ship, covariance, std, samples: int, seed: int, notes: list, support: str = "none"):
     """(names, ship rows (k, n), mean, run rows (k, len(std)), rejected): ``samples`` draws of the ship inside
     its support (:func:`_candidates`) each with its run draw, batches of ``samples`` candidates from the
     two streams of ``seed``, at most :data:`MAX_CANDIDATES` times ``samples`` candidates."""
-    names, mean, matrix, support = _candidates(ship, covariance, notes)
+    names, mean, matrix, support = _candidates(ship, covariance, notes, support)
     ship_rng, run_rng = np.random.default_rng(seed), np.random.default_rng([int(seed), 1])
     rows, runs, tried = [], [], 0
     while len(rows) < samples and tried < MAX_CANDIDATES * samples:
@@ -358,7 +360,7 @@ def _position_band(xy: np.ndarray):
 
 
 def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=None, run_spread=None,
-                     jobs: int | None = None) -> Bands:
+                     jobs: int | None = None, support: str = "none") -> Bands:
     """The 90 % heading and position bands of one record's prediction (module docstring).
 
     Parameters
@@ -379,11 +381,19 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
         neither is.
     jobs : int, optional
         Threads (default every core).
+    support : {"none", "bounds", "physical"}
+        Where the ship's draws are truncated (:data:`trials.measured.draws.SUPPORTS`): nowhere (default: the
+        covariance's normal, a diverging draw widening the band), to the fit's hard bounds, or to those and
+        no energy gained unpowered over the covariance's ``state_range`` (:func:`~trials.measured.draws.support_of`).
+        A truncated band is narrower and bounded more often, and on the held-out real records covers less
+        than 90 % (``docs/prediction_bands.md``).
 
     Returns
     -------
     Bands
     """
+    if support not in SUPPORTS:
+        raise InputError("support", "", f"must be one of {', '.join(SUPPORTS)}, got {support!r}")
     if isinstance(samples, bool) or int(samples) != samples or samples < 1:
         raise InputError("samples", "", f"must be a whole number of 1 or more, got {samples!r}")
     samples = int(samples)
@@ -392,7 +402,7 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     notes: list = []
     spread = ship.run_spread if run_spread is None else run_spread
     sp_names, std = _spread_of(spread, src) if spread is not None else ([], np.zeros(0))
-    names, rows, mean, sp_rows, rejected = _draws(ship, covariance, std, samples, seed, notes)
+    names, rows, mean, sp_rows, rejected = _draws(ship, covariance, std, samples, seed, notes, support)
     notes += _fit_doubts(ship, names, covariance)
     if spread is None:
         notes.append("start state not drawn: the ship config has no run_spread: section")

@@ -26,7 +26,7 @@ from mmg.parameters import WIND_COLUMNS
 from mmg.ship import ParameterCovariance, Ship
 
 __all__ = ["parameter_covariance", "ship_values", "draw", "WIND_FACTOR_NAMES", "Support", "support_of",
-           "support_bounds"]
+           "support_bounds", "SUPPORTS"]
 
 WIND_FACTOR_NAMES = tuple(WIND_COLUMNS)
 """Parameters of a covariance that are factors on the records' wind loads (1: the ship as it is)."""
@@ -180,9 +180,14 @@ def _dissipative_states(ship: Ship, states) -> tuple:
     return tuple(np.asarray(a)[keep] for a in states)
 
 
-def support_of(ship: Ship, names, cov) -> Support:
+SUPPORTS = ("none", "bounds", "physical")
+"""The supports a band's ship draws may be truncated to: none (the covariance's normal as it is), the
+fit's hard bounds, or those and the energy check (:func:`support_of`)."""
+
+
+def support_of(ship: Ship, names, cov, energy: bool = True) -> Support:
     """The :class:`Support` of draws of ``names`` about ``ship`` from the covariance ``cov``: the fit's
-    bounds, and the energy check over the grid spanning the covariance's ``state_range`` (where it has
+    bounds, and (with ``energy``) the energy check over the grid spanning the covariance's ``state_range`` (where it has
     one), at the grid's states where ``ship`` itself gains none: the support holds the estimate it is about,
     and a state where the estimate (and, as a rule, its prior: the hull polynomial at large r' = r L / U)
     gains energy is one the hull form does not describe (said in :attr:`Support.caveat`)."""
@@ -191,6 +196,8 @@ def support_of(ship: Ship, names, cov) -> Support:
     lower, upper = support_bounds(ship, names)
     rng = _state_range(cov)
     bounds = "within the fit's hard bounds"
+    if not energy:
+        return Support(tuple(names), lower, upper, None, bounds)
     if not rng:
         return Support(tuple(names), lower, upper, None,
                        f"{bounds} (the covariance has no state_range: no energy check)")

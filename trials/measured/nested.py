@@ -148,17 +148,18 @@ def band_sections(ident) -> tuple:
     return (cov if cov is not None else {"names": [], "matrix": []}), run_spread(ident)
 
 
-def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None = None) -> dict:
+def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None = None,
+                support: str = "none") -> dict:
     """The 90 % heading band of ``run`` predicted by the identified model ``ident`` (its ship drawn from the
     covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
     :func:`trials.measured.bands.prediction_bands`; ``sections``: :func:`band_sections` of ``ident``, made
     once for several runs): ``samples`` (the record's), ``inside`` (of them in the band), ``coverage90``,
     ``median_width_deg``, ``unbounded_share``, ``draws``, ``diverged_draws``, ``rejected_draws`` (candidate
-    ships outside the support, not replayed)."""
+    ships outside the ``support``, not replayed: :func:`trials.measured.bands.prediction_bands`)."""
     from .bands import prediction_bands
 
     cov, spread = band_sections(ident) if sections is None else sections
-    b = prediction_bands(ident.ship, run, samples, seed, covariance=cov, run_spread=spread, jobs=1)
+    b = prediction_bands(ident.ship, run, samples, seed, covariance=cov, run_spread=spread, jobs=1, support=support)
     n = len(b.t)
     bounded = int(round((1.0 - b.unbounded_share) * n))
     inside_b = int(round(b.coverage90_where_bounded * bounded)) if bounded else 0
@@ -192,7 +193,7 @@ def band_summary(records: list[dict]) -> dict:
 def _outer_task(task) -> list[dict]:
     """One outer fit: the fold's choice fitted on the whole outer training set, the kept-out records scored
     (with ``band_samples`` > 0 also their 90 % heading bands, :func:`band_scores`)."""
-    outer, cand, train, tests, initial, kw, horizon_s, band_samples = task
+    outer, cand, train, tests, initial, kw, horizon_s, (band_samples, band_support) = task
     ident = fit_model(cand.ship, train, initial=initial, **{**kw, **cand.options})
     values = {k: float(v) for k, v in ident.fit.values().items()}
     out = [{"name": r.name, "fold": outer, "choice": cand.name,
@@ -202,7 +203,7 @@ def _outer_task(task) -> list[dict]:
     if band_samples:
         sections = band_sections(ident)                # one covariance and run spread per fold
         for rec, r in zip(out, tests):
-            rec["band"] = band_scores(ident, r, band_samples, seed=outer, sections=sections)
+            rec["band"] = band_scores(ident, r, band_samples, seed=outer, sections=sections, support=band_support)
     return out
 
 
@@ -304,6 +305,7 @@ def _initial(candidates: dict, initial: Ship | None) -> Ship:
 def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int = 4, inner_folds: int = 3,
                           initial: Ship | None = None, folds_by: str = "order", backend: str = "serial",
                           client=None, n_jobs=None, horizon_s: float = HORIZON_S, band_samples: int = 0,
+                          band_support: str = "none",
                           **kw) -> NestedCV:
     """Nested cross-validation (module docstring) of the procedure "choose among ``candidates`` by an
     inner ``inner_folds``-fold cross-validation, then fit the choice".
@@ -329,6 +331,8 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
     band_samples : int
         With > 0, each kept-out record's 90 % heading band from that many draws of its fold's model
         (:func:`band_scores`; records' ``band``).
+    band_support : {"none", "bounds", "physical"}
+        Where the bands' ship draws are truncated (:func:`trials.measured.bands.prediction_bands`).
     **kw
         :func:`~trials.measured.identify.identify`'s options common to every candidate.
     """
@@ -345,7 +349,7 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
             choices[k], tables[k] = choose([r for r in inner_rows if r["outer"] == k], list(candidates))
     else:
         choices = dict.fromkeys(range(n_out), next(iter(candidates)))
-    tasks = [(k, candidates[choices[k]], tr, te, initial, kw, horizon_s, band_samples)
+    tasks = [(k, candidates[choices[k]], tr, te, initial, kw, horizon_s, (band_samples, band_support))
              for k, (tr, te) in enumerate(splits)]
     parts = _sweep(_outer_task, tasks, [f"outer fold {k + 1}/{n_out}: fit {choices[k]} on {len(t[2])} records"
                                         for k, t in enumerate(tasks)], backend, client, n_jobs)
