@@ -121,7 +121,20 @@ class Wind(Effect):
         scale * (1, sway_factor, yaw_factor), the loads being linear in the scale and in each shape factor
         (:func:`mmg.wind.wind_forces`, :func:`mmg.wind.amplitude_vector`).  How a fit that computes a
         record's loads once (``mmg identify --free wind_scale wind_sway_factor wind_yaw_factor``: factors on
-        the loads of the ship's own values) applies its fitted values."""
+        the loads of the ship's own values) applies its fitted values.
+
+        Parameters
+        ----------
+        scale : float
+            Factor on all three loads [-].
+        sway_factor, yaw_factor : float
+            Further factors on the sway force and the yaw moment [-].
+
+        Returns
+        -------
+        ndarray, shape (3,)
+            The factors on X, Y and N [-].
+        """
         return scale * np.array([1.0, sway_factor, yaw_factor])
 
     @classmethod

@@ -146,7 +146,18 @@ def speed_part_units() -> dict:
 def typical_speed(meas) -> float:
     """The records' typical speed U [m/s]: the median over every sample of every record of the logged
     speed over ground, hypot(u, v) (``meas`` a sequence of (N, >=2) arrays, u, v [m/s] their first
-    columns); 0 where no sample is finite."""
+    columns); 0 where no sample is finite.
+
+    Parameters
+    ----------
+    meas : sequence of array_like
+        The records' measured states, each (N, >=2) with u, v [m/s] as its first two columns.
+
+    Returns
+    -------
+    float
+        U [m/s]; 0.0 where no sample is finite.
+    """
     a = np.concatenate([np.hypot(np.asarray(m, float)[:, 0], np.asarray(m, float)[:, 1]) for m in meas])
     a = a[np.isfinite(a)]
     return float(np.median(a)) if len(a) else 0.0
@@ -154,7 +165,21 @@ def typical_speed(meas) -> float:
 
 def part_units(kind: str, units: dict | None = None) -> dict:
     """``{part floor: unit}`` of the parts a current is judged by on ``kind`` (:data:`COMPONENT_FLOORS`),
-    as ``units`` (the calibration's by default) says them; a part it does not name is in sqrt(gL)."""
+    as ``units`` (the calibration's by default) says them; a part it does not name is in sqrt(gL).
+
+    Parameters
+    ----------
+    kind : str
+        The kind of the record set (:func:`record_kind`); a kind without part floors has none.
+    units : dict, optional
+        ``{part floor: unit}``; the calibration file's ``units`` by default.
+
+    Returns
+    -------
+    dict
+        ``{part floor name (e.g. "current_along"): unit}``, the unit ``"sqrt(gL)"`` (as :func:`magnitude`
+        gives a current) or :data:`SPEED_UNIT`; empty for a kind judged by the magnitude alone.
+    """
     units = (calibration().get("units") or {}) if units is None else units
     return {c: str(units.get(c, MAGNITUDE_UNITS["current"])) for c in COMPONENT_FLOORS.get(kind, ())}
 
@@ -162,7 +187,24 @@ def part_units(kind: str, units: dict | None = None) -> dict:
 def part_size(x: float, unit: str, L: float, speed: float | None) -> float:
     """A current's part ``x`` (over sqrt(g L), :func:`current_components`) in a part floor's ``unit``:
     itself for sqrt(gL), x sqrt(g L) / U for :data:`SPEED_UNIT` (U = ``speed`` [m/s], the records'
-    :func:`typical_speed`; NaN without a speed).  ``L``: ship length [m]."""
+    :func:`typical_speed`; NaN without a speed).
+
+    Parameters
+    ----------
+    x : float
+        The part, over sqrt(g L) [-].
+    unit : str
+        The part floor's unit (:func:`part_units`).
+    L : float
+        Ship length [m].
+    speed : float or None
+        The records' typical speed U [m/s]; needed for :data:`SPEED_UNIT` only.
+
+    Returns
+    -------
+    float
+        The part in ``unit`` [-]; NaN for :data:`SPEED_UNIT` without a positive speed.
+    """
     if unit != SPEED_UNIT:
         return x
     return x * math.sqrt(G * L) / speed if speed and speed > 0 else math.nan

@@ -32,7 +32,13 @@ _TEXT = ("unit", "meaning", "source")
 
 
 def rules_path():
-    """The rules file in use: ``MMG_DIAGNOSE_RULES``'s, else the packaged one."""
+    """The rules file in use: ``MMG_DIAGNOSE_RULES``'s, else the packaged one.
+
+    Returns
+    -------
+    pathlib.Path
+        The file (not checked to exist: :func:`rules` does).
+    """
     from pathlib import Path
 
     env = os.environ.get(ENV)
@@ -44,7 +50,19 @@ def rules() -> dict:
     """``{entry: value}`` of the rules file (:func:`rules_path`), read and checked once per process (clear
     with ``rules.cache_clear()``).  A file that is missing or not YAML, an entry missing, unknown, without a
     finite number as its ``value`` (a whole one for :data:`INTEGER_ENTRIES`) or without its ``unit``,
-    ``meaning`` and ``source``: one-line :class:`~mmg.errors.InputError` naming the file and the entry."""
+    ``meaning`` and ``source``: one-line :class:`~mmg.errors.InputError` naming the file and the entry.
+
+    Returns
+    -------
+    dict
+        ``{entry: value}``, every entry of :data:`ENTRIES`: an int for :data:`INTEGER_ENTRIES`, else a float,
+        in the unit the file gives it.
+
+    Raises
+    ------
+    mmg.errors.InputError
+        The file is missing or malformed (the message names the file and the entry).
+    """
     import yaml
 
     from mmg.errors import InputError
@@ -86,13 +104,42 @@ def _checked(p, name: str, ent):
 
 
 def rule(name: str):
-    """The value of rules entry ``name`` (:data:`ENTRIES`), from :func:`rules`."""
+    """The value of rules entry ``name`` (:data:`ENTRIES`), from :func:`rules`.
+
+    Parameters
+    ----------
+    name : str
+        An entry of the rules file (e.g. ``"z_threshold"``).
+
+    Returns
+    -------
+    float or int
+        Its value, in the unit the file gives it.
+
+    Raises
+    ------
+    KeyError
+        ``name`` is not an entry.
+    """
     return rules()[name]
 
 
 def module_rule(module_name: str, names: dict):
     """A module ``__getattr__`` that gives the module's constant names of ``names`` ({NAME: entry}) as
-    read-only views of :func:`rule`, read when asked for (a rules file named after import counts)."""
+    read-only views of :func:`rule`, read when asked for (a rules file named after import counts).
+
+    Parameters
+    ----------
+    module_name : str
+        The module's ``__name__`` (for the AttributeError of another name).
+    names : dict
+        ``{module constant name: rules entry}``.
+
+    Returns
+    -------
+    callable
+        ``__getattr__(attr)``, to be assigned as the module's ``__getattr__``.
+    """
     def __getattr__(attr):
         if attr in names:
             return rule(names[attr])
