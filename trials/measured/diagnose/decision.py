@@ -44,7 +44,7 @@ __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS"
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
            "REASON_KINDS", "KIND_FALLBACK", "by_kind", "packaged_calibration", "PART_UNITS", "SPEED_UNIT", "speed_part_units",
-           "part_units", "part_size", "typical_speed"]
+           "part_units", "part_size", "part_name", "typical_speed"]
 
 _RULES = {"BIC_THRESHOLD": "bic_threshold", "Z_THRESHOLD": "z_threshold", "WEAK_BIC": "weak_bic"}
 """The module's names of numbers of the diagnosis rules (:mod:`.rules`), read-only: ``BIC_THRESHOLD``, the dBIC
@@ -210,6 +210,22 @@ def part_size(x: float, unit: str, L: float, speed: float | None) -> float:
     return x * math.sqrt(G * L) / speed if speed and speed > 0 else math.nan
 
 
+def part_name(part_floor: str) -> str:
+    """The name a part floor's part is reported under: the last word of the floor's name.
+
+    Parameters
+    ----------
+    part_floor : str
+        A part floor's name (:data:`COMPONENT_FLOORS`, e.g. ``"current_along"``).
+
+    Returns
+    -------
+    str
+        The part (``"along"``, ``"across"``): the key of :func:`floor_parts` and of a candidate's ``parts``.
+    """
+    return part_floor.split("_")[-1]
+
+
 def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float | None = None,
                  speed: float | None = None) -> bool:
     """Whether an effect's size exceeds the calibrated floor on a record set of ``kind``: its
@@ -258,7 +274,7 @@ def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float |
     if any(units[c] == SPEED_UNIT for c in comp) and not (speed and speed > 0):
         return {}
     parts = current_components(values, L, heading)
-    return {c.split("_")[-1]: (float(f"{part_size(x, units[c], L, speed):.4g}"), floor(c, kind))
+    return {part_name(c): (float(f"{part_size(x, units[c], L, speed):.4g}"), floor(c, kind))
             for x, c in zip(parts, comp)}
 
 

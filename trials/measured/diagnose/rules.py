@@ -13,20 +13,25 @@ from functools import lru_cache
 
 from mmg.resources import config_dir
 
-__all__ = ["ENV", "ENTRIES", "INTEGER_ENTRIES", "rules", "rule", "rules_path", "module_rule"]
+__all__ = ["ENV", "SCHEMA", "ENTRIES", "INTEGER_ENTRIES", "rules", "rule", "rules_path", "module_rule"]
 
 ENV = "MMG_DIAGNOSE_RULES"
 """The environment variable that names a rules file in place of the packaged one."""
 
-ENTRIES = ("bic_threshold", "z_threshold", "weak_bic", "r_confounded", "std_ratio_confounded", "confused_min",
-           "unexplained_factor", "mismatch_z", "drift_fall_min", "restart_smooth", "segment_length",
-           "stride_spacing", "screen_nfev", "max_nfev", "side_rudder_deg", "side_share", "straight_yaw",
-           "straight_rudder_deg", "straight_trim_deg", "straight_min_samples", "straight_wind", "min_passing",
-           "residual_quantile")
-"""The entries a rules file holds, every one (the code reads each)."""
+SCHEMA = {"bic_threshold": float, "z_threshold": float, "weak_bic": float, "r_confounded": float,
+          "std_ratio_confounded": float, "confused_min": float, "unexplained_factor": float, "mismatch_z": float,
+          "drift_fall_min": float, "restart_smooth": float, "segment_length": float, "stride_spacing": float,
+          "screen_nfev": int, "max_nfev": int, "side_rudder_deg": float, "side_share": float,
+          "straight_yaw": float, "straight_rudder_deg": float, "straight_trim_deg": float,
+          "straight_min_samples": int, "straight_wind": float, "min_passing": int, "residual_quantile": float}
+"""``{entry: type of its value}``: the entries a rules file holds, every one (the code reads each), the one
+place the code names them; ``int``: a count, a whole number of at least 1."""
 
-INTEGER_ENTRIES = ("screen_nfev", "max_nfev", "straight_min_samples", "min_passing")
-"""Entries whose value is a count: a whole number."""
+ENTRIES = tuple(SCHEMA)
+"""The entries' names (:data:`SCHEMA`)."""
+
+INTEGER_ENTRIES = tuple(name for name, kind in SCHEMA.items() if kind is int)
+"""Entries whose value is a count: a whole number (:data:`SCHEMA`)."""
 
 _TEXT = ("unit", "meaning", "source")
 
@@ -96,7 +101,7 @@ def _checked(p, name: str, ent):
     v = ent.get("value")
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
         raise InputError(str(p), f"{name}.value", f"{v!r} is not a finite number")
-    if name in INTEGER_ENTRIES:
+    if SCHEMA[name] is int:
         if v != int(v) or v < 1:
             raise InputError(str(p), f"{name}.value", f"{v!r} is not a whole number of at least 1")
         return int(v)

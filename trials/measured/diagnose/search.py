@@ -10,7 +10,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .baseline import DRIFT_KIND
-from .decision import MAGNITUDE_UNITS, clears_floor, floor, floor_parts, magnitude, part_units
+from .decision import MAGNITUDE_UNITS, clears_floor, floor, floor_parts, magnitude, part_name, part_units
 from .fit import _Model
 from .options import DiagnoseOptions
 from .rules import rule
@@ -132,7 +132,7 @@ def _parts(fitter, name: str, values: dict) -> dict:
     p = floor_parts(name, values, fitter.ship.particulars.L, fitter.kind, fitter.heading, fitter.speed)
     if not p:
         return {}
-    units = {c.split("_")[-1]: u for c, u in part_units(fitter.kind).items()}
+    units = {part_name(c): u for c, u in part_units(fitter.kind).items()}
     return {"parts": {k: list(v) for k, v in p.items()}, "part_units": {k: units[k] for k in p}}
 
 
