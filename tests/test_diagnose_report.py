@@ -141,10 +141,11 @@ def ship():
 
 @pytest.fixture(scope="module")
 def current_record(ship):
-    from trials.measured.diagnose import synthetic_record
+    from trials.measured.diagnose import Manoeuvre, RecordNoise, synthetic_record
 
-    return synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.15, "direction_deg": 200.0}},
-                            duration=60.0, seed=3, name="zz")
+    return synthetic_record(ship, Manoeuvre("zigzag", duration=60.0),
+                            {"current": {"speed_mps": 0.15, "direction_deg": 200.0}}, noise=RecordNoise(seed=3),
+                            name="zz")
 
 
 @pytest.fixture(scope="module")
