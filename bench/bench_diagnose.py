@@ -10,7 +10,7 @@ bench/out/diagnose_detection.png and prints a table.
 
 bench/out/diagnose_bench.json keeps the figures as they come.
 
-``--mismatch`` (issue 26): full-scale trials of the mismatch family (:mod:`trials.measured.mismatch`),
+``--mismatch``: full-scale trials of the mismatch family (:mod:`trials.measured.mismatch`),
 each record diagnosed alone with the bundled config; false alarms over ``--clean`` (default 40) clean
 records, detection per effect and size split zigzag / turn (``bench/diagnose_mismatch.py``):
 
@@ -87,7 +87,7 @@ def timing():
         dt = time.perf_counter() - t0
         worst = max(worst, dt)
         print(f"timing: one diagnose of a {rec.t[-1]:.0f} s full-scale {kind} record at 1 s ({len(rec.t)} samples): "
-              f"{dt:.1f} s wall (issue 26: <= 15 s); named {d.named} {d.parameters}", flush=True)
+              f"{dt:.1f} s wall (target <= 15 s); named {d.named} {d.parameters}", flush=True)
     return worst
 
 

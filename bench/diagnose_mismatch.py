@@ -69,7 +69,7 @@ SPEED_BANDS_KN = ((6.0, 9.0), (9.0, 12.0), (12.0, 15.0))
 """The approach-speed classes of the per-class table [kn] (a band holds its lower end; the last, both)."""
 
 ACCEPT = {"current": 0.15, "wind": 10.0, "heading_bias": 1.0, "rudder_offset": 1.0}
-"""The smallest size whose detection the per-class table counts (the issue's acceptance sizes)."""
+"""The smallest size whose detection the per-class table counts (the sizes the detection figures are stated for)."""
 
 
 SHIP = "esso_osaka"

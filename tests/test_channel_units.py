@@ -1,4 +1,4 @@
-"""Channels checked against what the ship and the other channels imply (issue 24): a channel in a
+"""Channels checked against what the ship and the other channels imply: a channel in a
 wrong unit is refused in one line naming the file and the column (and the likely unit); a heading
 that is cumulative or offset by whole turns is read like the wrapped one; a missing value in a
 column a command does not use does not refuse the record for that command.

@@ -142,7 +142,7 @@ def _mmg(*args):
 
 
 def test_records_named_after_their_files(tmp_path, ship, clean):
-    """Issue 24: records are named after their files in the JSON and the plots (DIR/<name>.png): two
+    """Records are named after their files in the JSON and the plots (DIR/<name>.png): two
     files of one stem (one trial recorded on two days) told apart by their folders, not ``x`` twice."""
     from trials.measured.diagnose import prepare, synthetic_record, write_frt_csv
 

@@ -1,4 +1,4 @@
-"""What mmg diagnose tells a user (issue 26, "an answer a user can trust"): each named effect's value
+"""What mmg diagnose tells a user (an answer a user can trust): each named effect's value
 with a 95 % interval (checked against a Monte Carlo of the fitted normal, computed here), the evidence
 of the round that named it, console lines with units and three significant figures (no raw dict), the
 unexplained residual in units, the summary figure, and a zigzag's track that is not a strip."""

@@ -1,4 +1,4 @@
-"""One definition of each effect (issue 25): the estimators take an effect parameter's prior from its
+"""One definition of each effect: the estimators take an effect parameter's prior from its
 :class:`mmg.effects.Parameter`, the ship coefficients' prior widths come from one table, the replay's
 measured-wind loads are the ``wind`` effect's, and one function turns model states into a logged record (trial runs and the
 diagnosis's synthetic records alike)."""

@@ -1,4 +1,4 @@
-"""What the records cannot tell apart (trials.measured.identifiability, issue 26).
+"""What the records cannot tell apart (trials.measured.identifiability).
 
 The maths against a hand-built covariance; a single full-scale turning circle of a ship that is not
 its model (hull terms 7-25 %, rudder lift and inflow 10-13 % off the config) with a rudder offset of
@@ -121,7 +121,7 @@ def test_single_turn_rudder_offset_not_identifiable(full):
     assert len(line) == 1 and "deg" in line[0]
 
 
-@pytest.mark.xfail(reason="not met (issue 26, several records together): the pair's offset fits 0.28 +- 0.10 deg "
+@pytest.mark.xfail(reason="not met (several records together): the pair's offset fits 0.28 +- 0.10 deg "
                           "(truth 1.5) from every start (0, +-1, 2 deg), dBIC -2.4: the mismatched hull and rudder take "
                           "it; with the 50 % priors of before it was named (1.11 deg) only after a false current "
                           "(0.055 m/s) was named first, its own first-round dBIC -3.4 then too", strict=False)
