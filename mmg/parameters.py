@@ -28,7 +28,7 @@ from .terms import is_resistance
 __all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD",
            "hull_parameter", "parameter", "ship_value", "with_value", "write_yaml_value", "unit_of", "is_resistance",
            "EffectPrior", "WIND_COLUMNS", "config_values", "MASS_NAMES", "to_slot", "to_hull", "to_wake",
-           "not_packed", "to_load_factor", "rule_of_kind"]
+           "not_packed", "to_load_factor", "rule_of_kind", "LINEAR_TERMS"]
 
 PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
 """Prior std of a freed ship coefficient relative to its config value, per family (identification's: the
@@ -49,6 +49,11 @@ rudder's flow-straightening coefficients gamma_R (``rudder``, freed on zigzags) 
 ship's rudder constants about a config's.  The added masses at 20 %: the diagnosis frees them with every
 candidate effect, and an added mass a few % off leaves a residual (surge speed loss in the turn, sway and yaw
 lag) an effect would otherwise take; a wider prior would let them take an effect's residual instead."""
+
+LINEAR_TERMS = ("beta", "r", "v")
+"""Hull terms counted as linear (the sway/yaw derivatives in beta, r, v): their coefficients take the
+diagnosis's ``hull`` width of :data:`DIAGNOSIS_PRIOR_REL_STD`; the straight-ahead resistance
+(:func:`is_resistance`) its ``resistance`` width, every other hull term its ``hull_nonlinear`` one."""
 
 WIND_COLUMNS = {"wind_scale": ("scale", 0), "wind_sway_factor": ("sway_factor", 1), "wind_yaw_factor": ("yaw_factor", 2)}
 """Fit name of a wind value -> (the wind effect's parameter and the ship's ``wind:`` key it multiplies, the
@@ -179,6 +184,18 @@ class ShipParameter:
     loads : callable or None
         ``loads(factors, slot, value)``: where the value acts on the records' external loads instead
         (:func:`to_load_factor`); None: it does not.
+    diagnosis_family : str
+        The key of its relative prior std in :data:`DIAGNOSIS_PRIOR_REL_STD` where the diagnosis sets it
+        apart from the family table (a hull coefficient's by its term, :data:`LINEAR_TERMS`; ``w_P0``
+        relative); ``""``: the diagnosis takes the prior of the family table as it is.
+    diagnosis_floor : float
+        Smallest diagnosis prior std (with ``diagnosis_family``).
+    keeps_sign : bool
+        The diagnosis bounds it to its config value's sign (the signs that define a ship: a positive
+        Y_beta, a negative N_r).
+    multiplies : callable or None
+        ``multiplies(ship)``: the config value a fitted value is a factor on (a wind factor: ship.yaml
+        writes their product, so the product's bounds are the fit's over it); None: not a factor.
     """
 
     name: str
@@ -203,6 +220,10 @@ class ShipParameter:
     config_scale: Callable | None = None
     """``config_scale(ship)``: the config's unit in the fit's (the fit's value over it is the config's), where
     they differ."""
+    diagnosis_family: str = ""
+    diagnosis_floor: float = 0.0
+    keeps_sign: bool = False
+    multiplies: Callable | None = None
 
     def config_value(self, packed: PackedShip) -> float:
         """The value the packed ship carries (the prior's centre), in the fit's unit.
@@ -351,7 +372,7 @@ def _wind(name: str) -> ShipParameter:
     key, col = WIND_COLUMNS[name]
     return ShipParameter(name, "1", "", "wind_scale", col, f"wind.{key}", read=lambda s: 1.0, write=_with_wind(key),
                          write_yaml=_wind_yaml(key), packed=lambda p: 1.0, effect=EffectPrior("wind", key),
-                         apply=not_packed, loads=to_load_factor)
+                         apply=not_packed, loads=to_load_factor, multiplies=lambda s: float(getattr(s.wind, key)))
 
 
 def _constants() -> dict:
@@ -366,7 +387,8 @@ def _constants() -> dict:
     out = [
         ShipParameter("w_P0", "1", "", "w_P0", 0, "propeller.w_P0[0]", read=lambda s: s.propeller.w_P0[0],
                       write=_with_w_P0, write_yaml=set_yaml("propeller", "w_P0", 0),
-                      packed=lambda p: p.poly[POLY_WP0][0], abs_std=0.15, bounds=lambda v: (0.0, 0.8), apply=to_wake),
+                      packed=lambda p: p.poly[POLY_WP0][0], abs_std=0.15, bounds=lambda v: (0.0, 0.8), apply=to_wake,
+                      diagnosis_family="w_P0", diagnosis_floor=0.01),
         _rudder("epsilon", P_EPS, "epsilon", 0.3, 3.0),
         _rudder("kappa", P_KAPPA, "kappa", 0.0, 1.0),
         _wind("wind_scale"), _wind("wind_sway_factor"), _wind("wind_yaw_factor"),
@@ -440,7 +462,9 @@ def hull_parameter(name: str, index: int, term: str = "") -> ShipParameter:
     ShipParameter
         Family and kind ``"hull"``, relative prior with a floor of 0.01, applied by :func:`to_hull`.
     """
-    bounds = (lambda v: (-np.inf, 0.0)) if is_resistance(name, term) else (lambda v: (-np.inf, np.inf))
+    resistance = is_resistance(name, term)
+    bounds = (lambda v: (-np.inf, 0.0)) if resistance else (lambda v: (-np.inf, np.inf))
+    diagnosis = "hull" if term in LINEAR_TERMS else "resistance" if resistance else "hull_nonlinear"
 
     def write_yaml(d, v, path):
         d["hull"]["coefficients"][name]["value"] = float(f"{v:.6g}")
@@ -448,7 +472,8 @@ def hull_parameter(name: str, index: int, term: str = "") -> ShipParameter:
     return ShipParameter(name, "1", "hull", "hull", index, f"hull.coefficients.{name}.value",
                          read=lambda s: s.hull.value(name), write=lambda s, v: s.with_hull({name: float(v)}),
                          write_yaml=write_yaml, packed=lambda p: p.hull_coef[index], floor=0.01, bounds=bounds,
-                         apply=to_hull)
+                         apply=to_hull, diagnosis_family=diagnosis,
+                         diagnosis_floor=DIAGNOSIS_PRIOR_REL_STD["hull_floor"], keeps_sign=True)
 
 
 def parameter(name: str, hull_names=(), hull_terms=()) -> ShipParameter:

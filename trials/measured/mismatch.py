@@ -25,6 +25,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from mmg.parameters import LINEAR_TERMS
 from mmg.ship import Ship
 from mmg.units import KNOT
 
@@ -32,9 +33,9 @@ __all__ = ["DEV_NOISE_HALF_WIDTHS", "DEV_TRIALS", "HULL_LINEAR_TERMS", "RUDDER_C
            "TrialConditions", "WIDE_TRIALS", "crossflow_fit", "froude_scaled", "mismatch_family", "mismatch_member",
            "mismatch_ship", "trial_hand", "trial_records"]
 
-HULL_LINEAR_TERMS = ("beta", "r", "v")
-"""Hull terms counted as linear; with them the straight-ahead resistance (:func:`mmg.terms.is_resistance`:
-``X_uu``'s ``cos(beta)^2``, ``X_0``'s ``1``).  The rest, but the other constants ``"1"``, are nonlinear."""
+HULL_LINEAR_TERMS = LINEAR_TERMS
+"""Hull terms counted as linear (:data:`mmg.parameters.LINEAR_TERMS`); with them the straight-ahead resistance
+(:func:`mmg.terms.is_resistance`: ``X_uu``'s ``cos(beta)^2``, ``X_0``'s ``1``).  The rest, but the other constants ``"1"``, are nonlinear."""
 
 RUDDER_CONSTANTS = ("f_alpha", "epsilon", "kappa", "t_R", "a_H", "x_H_prime", "gamma_R_pos", "gamma_R_neg")
 """The rudder constants the family moves (the geometry, A_R, H_R, eta, x_R', l_R', is kept)."""
