@@ -170,7 +170,7 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
                                            "straight_contradicts": straight_contradicts(current.straight, m.straight)}
                                           if len(m.straight) else {})}
                                       for (d, ok, c, m, v, s, z, g, rr), pa in zip(results, parts)]})
-        best = _best_standing(fitter, current, results, taus, inflate, ns, o, rounds[-1], say)
+        best = _best_standing(fitter, current, results, taus, inflate, o, rounds[-1], say)
         if best is None:
             break
         named.append(best[2].name)
@@ -199,7 +199,7 @@ def _rival(results, r):
     return max(rivals, key=lambda x: x[0]) if rivals else None
 
 
-def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptions, rnd: dict, say):
+def _best_standing(fitter, current, results, taus, inflate, o: DiagnoseOptions, rnd: dict, say):
     """The round's candidate to name: the one with the most evidence among those that clear the tests
     and hold beside their rival (:func:`_rival`), or None.
 
