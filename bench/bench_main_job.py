@@ -1,4 +1,4 @@
-"""The main job, ``mmg reproduce --out DIR`` on the default configs, in a fresh process (issue 13, item 4).
+"""The main job, ``mmg reproduce --out DIR`` on the default configs, in a fresh process.
 
     python bench/bench_main_job.py [--runs 2] [--baseline REV]
 

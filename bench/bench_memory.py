@@ -1,6 +1,6 @@
 """Peak memory (maximum resident set size) of ``mmg estimate`` on a 3000 s log, of the CLI
-refusing the pathological logs of issue 10, and of ``mmg metrics`` / ``mmg nomoto`` on large
-records (issue 24), each command measured by ``/usr/bin/time -v``.
+refusing pathological logs (bad input refused in one line), and of ``mmg metrics`` / ``mmg nomoto`` on
+large records, each command measured by ``/usr/bin/time -v``.
 
     python bench/bench_memory.py [--keep DIR] [--no-large]
 
@@ -9,8 +9,7 @@ Large records: a 110 000 s ZZ20 simulated with its log at 0.1 s (an 85 MB projec
 made of 620 copies of a real zigzag laid end to end; each row prints the peak over the file's size
 (fails above LARGE_RATIO).  ``mmg nomoto`` refuses both as a zigzag (the copies are many zigzags; the
 long ZZ20's analysis finds no counter-rudder) after reading and analysing them: its peak is that
-of the reading and the analysis up to the refusal, as in the issue's report (1.79 GB on the 159 MB
-truth file before).
+of the reading and the analysis up to the refusal.
 
 Runs ``mmg simulate configs/trials/zz20.yaml`` (a 3000 s ZZ20 at 0.1 s; its 5 s log), then
 ``mmg estimate`` on that log, then ``mmg metrics`` / ``mmg estimate`` / ``mmg nomoto`` on logs
@@ -120,7 +119,7 @@ def large(record, work: Path) -> bool:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--keep", help="work in this folder and keep it (default: a temporary folder)")
-    ap.add_argument("--no-large", action="store_true", help="skip the large records (issue 24)")
+    ap.add_argument("--no-large", action="store_true", help="skip the large records")
     args = ap.parse_args()
     if not Path(TIME).exists():
         print(f"{TIME} not found: apt-get update && apt-get install -y time", file=sys.stderr)

@@ -1,4 +1,4 @@
-"""Open-loop replay speed (issue 11): one 600 s record at 10 Hz, after compilation; target <= 0.5 s.
+"""Open-loop replay speed: one 600 s record at 10 Hz, after compilation; target <= 0.5 s.
 
 A real FRT-DS-ESSO record when the data folder is there ($MMG_FRT_DATA, else ../shared/data/frt-ds-esso
 beside the repository): the longest one, cut to its first 600 s, replayed with the 3 m model and the wind

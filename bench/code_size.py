@@ -1,5 +1,5 @@
 """How large the house is, per package: lines, modules, the longest function and the one with the
-most parameters (issue 25's table), for the checkout or a revision.
+most parameters, for the checkout or a revision.
 
     python bench/code_size.py [--rev REV] [--top 5]
 

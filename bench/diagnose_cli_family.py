@@ -44,7 +44,7 @@ def main(argv=None) -> None:
     a = ap.parse_args(argv)
     import mmg
     from trials.measured.diagnose_records import write_frt_csv
-    from trials.measured.mismatch import mismatch_family, trial_records
+    from trials.measured.mismatch import TrialConditions, mismatch_family, trial_records
 
     config = mmg.load_ship(mmg.ship_path(a.ship))
     fam = mismatch_family(config, len(CASES), a.seed0)
@@ -52,7 +52,8 @@ def main(argv=None) -> None:
     right = 0
     for i, (truth, trial, eff, wind) in enumerate(CASES):
         member, factors = fam[i]
-        rec = trial_records(config, member, trial, eff, seed=a.seed0 + i, true_wind=wind, name=f"{truth}_{trial}")
+        rec = trial_records(config, member, trial, TrialConditions(eff, wind), seed=a.seed0 + i,
+                            name=f"{truth}_{trial}")
         log, js = a.out / f"{i}_{truth}_{trial}.csv", a.out / f"{i}_{truth}_{trial}.json"
         write_frt_csv(rec, log)
         t0 = time.perf_counter()

@@ -1,4 +1,4 @@
-"""`mmg diagnose` on the development set of an independent simulator (issue 26, acceptance 1).
+"""`mmg diagnose` on the development set of an independent simulator.
 
 Diagnoses every log of ``../shared/data/diagnose-dev/`` alone, with the bundled full-scale ship
 (``esso_osaka``), as a user would (``mmg diagnose --ship esso_osaka LOG``), and scores the named
@@ -7,7 +7,7 @@ effects against the set's ``manifest.json``:
 * exact: the named set equals the true set (``none`` = nothing named);
 * false alarm: a clean log with anything named;
 * values: current speed within 0.05 m/s and set within 15 deg, rudder offset and heading bias
-  within 0.3 deg (the acceptance's tolerances), for every effect that is both true and named;
+  within 0.3 deg (the tolerances it is scored at), for every effect that is both true and named;
 * ``not_identifiable`` entries, where the diagnosis reports them, are listed beside the named set.
 
 Conventions: the manifest's current ``set_towards_deg`` is the direction it sets towards, like

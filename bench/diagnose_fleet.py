@@ -1,5 +1,5 @@
 """A fleet's records diagnosed one by one, locally and on a Dask cluster: the same named effects and
-values either way, and what each costs (issue 28, "a distributed engine", acceptance 4).
+values either way, and what each costs.
 
 The records: the development set's 32 full-scale logs (``../shared/data/diagnose-dev/``, read in
 place), then trials of the mismatch family (:func:`trials.measured.mismatch.trial_records`, one

@@ -1,4 +1,4 @@
-"""`mmg diagnose` on the real 3 m Esso Osaka records of FRT-DS-ESSO (issue 26, acceptance 4).
+"""`mmg diagnose` on the real 3 m Esso Osaka records of FRT-DS-ESSO.
 
 Diagnoses every record of ``../shared/data/frt-ds-esso/`` (folders ``turning``, ``zigzag``,
 ``random``, ``berthing``) ALONE with the bundled 3 m ship (``esso_osaka_3m``), as a user would

@@ -69,7 +69,7 @@ SPEED_BANDS_KN = ((6.0, 9.0), (9.0, 12.0), (12.0, 15.0))
 """The approach-speed classes of the per-class table [kn] (a band holds its lower end; the last, both)."""
 
 ACCEPT = {"current": 0.15, "wind": 10.0, "heading_bias": 1.0, "rudder_offset": 1.0}
-"""The smallest size whose detection the per-class table counts (the issue's acceptance sizes)."""
+"""The smallest size whose detection the per-class table counts (the sizes the detection figures are stated for)."""
 
 
 SHIP = "esso_osaka"
@@ -185,13 +185,14 @@ def run_one(job: dict, seed0: int) -> dict:
     """Make the job's record, diagnose it with the bundled config as a user would, return the row."""
     import mmg
     from trials.measured.diagnose import diagnose
-    from trials.measured.mismatch import trial_records
+    from trials.measured.mismatch import TrialConditions, trial_records
 
     ship = job.get("ship", SHIP)
     config = mmg.load_ship(mmg.ship_path(ship))
     member, factors = _family(seed0, ship, job.get("wind_curve", "fujiwara"))[job["member"]]
-    recs = [trial_records(config, member, t, job["spec"], seed=job["seed"] + 1000003 * k, true_wind=job["true_wind"],
-                          speed_kn=job.get("speed_kn", 10.0), name=f"{job['id']}_{t}" if k else job["id"],
+    sea = TrialConditions(job["spec"], job["true_wind"], job.get("speed_kn", 10.0))
+    recs = [trial_records(config, member, t, sea, seed=job["seed"] + 1000003 * k,
+                          name=f"{job['id']}_{t}" if k else job["id"],
                           wind_curve=factors.get("wind_curve"))
             for k, t in enumerate(PAIRS.get(job["trial"], (job["trial"],)))]
     rec = recs[0]

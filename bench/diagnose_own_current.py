@@ -1,4 +1,4 @@
-"""Issue 26, acceptance 3's current log: ``mmg simulate`` of the bundled ZZ20 with a 1 kn current
+"""The project's own current log: ``mmg simulate`` of the bundled ZZ20 with a 1 kn current
 setting towards 60 deg (the 5 s sea-trial log: positions, heading, speed over ground; no u, v),
 diagnosed with the ship that made it, at the default fit budgets and at larger ones, to show what
 the budget changes (``tests/test_diagnose_own_logs.py`` holds the acceptance test itself).

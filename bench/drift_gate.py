@@ -3,7 +3,7 @@ clean records: per record the baseline's heading residual, the fall that freeing
 (against the baseline fitted on by as many evaluations: the gate's figure, freed or not) and the
 dBIC of freeing them, on clean turns of the mismatch family and on the main job's
 ST35 files (the ship that made them): the figures the size gate (:data:`~trials.measured.diagnose.DRIFT_FALL_MIN`)
-was checked on, and dBIC beside them (stop 38's gate also asked dBIC > 20; dropped in stop 39).
+was checked on, and dBIC beside them (the gate asks no dBIC of its own).
 
     python bench/drift_gate.py [--seed0 1000] [--n 24] [--jobs 2]
 """

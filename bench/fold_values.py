@@ -1,4 +1,4 @@
-"""How far apart are the fits of a cross-validation's folds? (issue 27: the generalisation gap)
+"""How far apart are the fits of a cross-validation's folds? (the generalisation gap)
 
 Each outer fold of ``bench/identify_cv.py`` fits the model on about three quarters of the records; its JSON
 (``--json``) keeps each fold's fitted values.  Were the identified parameters set by the physics the

@@ -1,4 +1,4 @@
-"""Open-loop replays of the shared FRT-DS-ESSO random and berthing records (issue 27, four quadrants).
+"""Open-loop replays of the shared FRT-DS-ESSO random and berthing records (four quadrants).
 
 Each record of ``random/`` and ``berthing/`` in the data folder ($MMG_FRT_DATA, else
 ../shared/data/frt-ds-esso beside the repository) is replayed open loop from its first sample with

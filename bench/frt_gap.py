@@ -1,6 +1,6 @@
-"""Which records keep the held-out figure of issue 27's acceptance 1 from 3x? (the gap, class by class)
+"""Which records keep the held-out figure from 3x? (the gap, class by class)
 
-Acceptance 1 asks for a mean heading RMS over the kept-out records at least 3 times lower than the
+The target is a mean heading RMS over the kept-out records at least 3 times lower than the
 Froude-scaled model's.  The mean is over records of four kinds (the shared folders: turns, zigzags, random
 runs, berthing runs) whose open-loop heading errors differ by an order of magnitude, so a few kinds may
 decide it.  From a nested cross-validation's JSON (``bench/identify_cv.py --json``) this prints, per kind,

@@ -1,4 +1,4 @@
-"""How well can ``mmg identify`` fit the records it is fitted to? (issue 27: the in-sample ceiling)
+"""How well can ``mmg identify`` fit the records it is fitted to? (the in-sample ceiling)
 
 A held-out figure of a procedure cannot be expected above what the same procedure reaches on its own
 training records.  This fits ``esso_osaka_3m`` in each hull form asked (``--hull``: the Kijima config,

@@ -1,5 +1,5 @@
-"""Nested cross-validation of ``mmg identify`` on the shared FRT-DS-ESSO records (issue 27, "Honest
-evaluation"): one command, every figure held out.
+"""Nested cross-validation of ``mmg identify`` on the shared FRT-DS-ESSO records (honest
+evaluation): one command, every figure held out.
 
 The records (default: all of ``turning/``, ``zigzag/``, ``random/`` and ``berthing/``; a record and its
 cut copies count once and share a fold) are dealt into ``--folds`` outer folds, each kept out once.
@@ -346,7 +346,7 @@ def offset_spread(cv, runs, initial, spread_deg: float, n: int = 9) -> dict:
 
     The identified model is replayed as its scores were (:meth:`trials.measured.identify.Identification.replay`:
     the record's wind loads scaled by the fold's fitted wind factors); a record whose zero-offset replay
-    does not give its scored heading RMS is named (stop 42: before, the fitted wind scale was left out)."""
+    does not give its scored heading RMS is named (a replay without the fitted wind factors would)."""
     from trials.measured.identify import ship_with_values, with_fitted_wind, with_ship_effects
     from trials.measured.predict import replay_record
 

@@ -101,19 +101,20 @@ record and is absorbed by the parameters; not ``mmg identify``'s procedure)."""
 
 def records(prior, truth, seed: int, dt: float = 0.2):
     """The seed's records of ``truth`` as MeasuredRuns of ``prior`` (no wind, calm water)."""
-    from trials.measured.diagnose_records import synthetic_record
+    from trials.measured.diagnose_records import Manoeuvre, RecordNoise, synthetic_record
     from trials.measured.predict import measured_run
 
     out = []
     for k, (kind, rud, dur) in enumerate(RECORDS):
-        rec = synthetic_record(prior, kind, truth_ship=truth, duration=dur, dt=dt, rudder_deg=rud, noise=NOISE,
-                               seed=seed * 100 + k, name=f"{kind}{rud:+g}", noise_dist="uniform")
+        man = Manoeuvre(kind, rudder_deg=rud, duration=dur, dt=dt)
+        rec = synthetic_record(prior, man, truth_ship=truth, noise=RecordNoise(NOISE, "uniform", seed * 100 + k),
+                               name=f"{kind}{rud:+g}")
         run = measured_run(prior, rec, wind=False)
         if EXACT_START:
             from dataclasses import replace
 
-            clean = synthetic_record(prior, kind, truth_ship=truth, duration=dur, dt=dt, rudder_deg=rud,
-                                     noise=(0.0,) * 6, seed=0, name="clean", noise_dist="uniform")
+            clean = synthetic_record(prior, man, truth_ship=truth, noise=RecordNoise((0.0,) * 6, "uniform"),
+                                     name="clean")
             m = run.meas.copy()
             m[0] = measured_run(prior, clean, wind=False).meas[0]
             run = replace(run, meas=m)

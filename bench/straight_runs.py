@@ -1,5 +1,5 @@
 """The leading straight runs of the development set's logs, as `mmg diagnose` finds them, against the
-manifest's hidden effects: what the straight run reads (issue 26, docs/diagnose.md "Stop 37").
+manifest's hidden effects: what the straight run reads (docs/diagnose.md).
 
     python bench/straight_runs.py [--ship esso_osaka]
 

@@ -1,6 +1,6 @@
-"""What yaw moment at low speed does a model leave unexplained, record by record? (issue 27, acceptance 2)
+"""What yaw moment at low speed does a model leave unexplained, record by record?
 
-Issue 27 asks for a heading RMS of at most 5 deg over the first 60 s of every shared random and berthing
+The target is a heading RMS of at most 5 deg over the first 60 s of every shared random and berthing
 record, predicted open loop.  Those first minutes are spent at 0.05-0.2 m/s, where the hull's yaw damping
 is weak: a yaw acceleration the model does not predict is integrated twice, little damped.  An
 unexplained constant yaw acceleration a [deg/s^2] from the start gives, undamped, a heading error

@@ -28,7 +28,7 @@ from .terms import is_resistance
 __all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD",
            "hull_parameter", "parameter", "ship_value", "with_value", "write_yaml_value", "unit_of", "is_resistance",
            "EffectPrior", "WIND_COLUMNS", "config_values", "MASS_NAMES", "to_slot", "to_hull", "to_wake",
-           "not_packed", "to_load_factor", "rule_of_kind"]
+           "not_packed", "to_load_factor", "rule_of_kind", "LINEAR_TERMS"]
 
 PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
 """Prior std of a freed ship coefficient relative to its config value, per family (identification's: the
@@ -50,35 +50,91 @@ ship's rudder constants about a config's.  The added masses at 20 %: the diagnos
 candidate effect, and an added mass a few % off leaves a residual (surge speed loss in the turn, sway and yaw
 lag) an effect would otherwise take; a wider prior would let them take an effect's residual instead."""
 
+LINEAR_TERMS = ("beta", "r", "v")
+"""Hull terms counted as linear (the sway/yaw derivatives in beta, r, v): their coefficients take the
+diagnosis's ``hull`` width of :data:`DIAGNOSIS_PRIOR_REL_STD`; the straight-ahead resistance
+(:func:`is_resistance`) its ``resistance`` width, every other hull term its ``hull_nonlinear`` one."""
+
 WIND_COLUMNS = {"wind_scale": ("scale", 0), "wind_sway_factor": ("sway_factor", 1), "wind_yaw_factor": ("yaw_factor", 2)}
 """Fit name of a wind value -> (the wind effect's parameter and the ship's ``wind:`` key it multiplies, the
 column of the records' external loads X, Y, N it multiplies; 0: all three)."""
 
 
 def to_slot(packed: PackedShip, index: int, value: float) -> None:
-    """Apply rule: ``value`` into the parameter vector at ``index`` (a rudder or propeller constant, an added mass)."""
+    """Apply rule: ``value`` into the parameter vector at ``index`` (a rudder or propeller constant, an added mass).
+
+    Parameters
+    ----------
+    packed : mmg.model.PackedShip
+        The packed ship a fit evaluates (its arrays are the fit's copies, written in place).
+    index : int
+        The entry's :attr:`ShipParameter.slot`: its index in :attr:`mmg.model.PackedShip.p`.
+    value : float
+        The fitted value, in the fit's unit.
+    """
     packed.p[index] = value
 
 
 def to_hull(packed: PackedShip, index: int, value: float) -> None:
-    """Apply rule: ``value`` as hull coefficient ``index`` of the hull model."""
+    """Apply rule: ``value`` as hull coefficient ``index`` of the hull model.
+
+    Parameters
+    ----------
+    packed : mmg.model.PackedShip
+        The packed ship a fit evaluates (its arrays are the fit's copies, written in place).
+    index : int
+        The coefficient's index in :attr:`mmg.model.PackedShip.hull_coef`.
+    value : float
+        The fitted primed coefficient [-].
+    """
     packed.hull_coef[index] = value
 
 
 def to_wake(packed: PackedShip, index: int, value: float) -> None:
-    """Apply rule: ``value`` as the constant term of the wake polynomial (w_P0 at u = 0)."""
+    """Apply rule: ``value`` as the constant term of the wake polynomial (w_P0 at u = 0).
+
+    Parameters
+    ----------
+    packed : mmg.model.PackedShip
+        The packed ship a fit evaluates (its arrays are the fit's copies, written in place).
+    index : int
+        Not used (the term's place is fixed).
+    value : float
+        The fitted wake fraction w_P0 [-].
+    """
     packed.poly[POLY_WP0][0] = value
 
 
 def not_packed(packed: PackedShip, index: int, value: float) -> None:
     """Apply rule of a value that does not go into the packed ship (a factor on the records' loads, an
-    effect's parameter applied through its :class:`mmg.effects.EffectSet`, a record's start offset)."""
+    effect's parameter applied through its :class:`mmg.effects.EffectSet`, a record's start offset): it
+    writes nothing.
+
+    Parameters
+    ----------
+    packed : mmg.model.PackedShip
+        The packed ship a fit evaluates (its arrays are the fit's copies, written in place).
+    index : int
+        Not used.
+    value : float
+        Not used.
+    """
 
 
 def to_load_factor(factors: np.ndarray, index: int, value: float) -> None:
     """Load rule of a wind value: ``value`` as the wind effect's fit parameter ``index`` (scale, sway and yaw
     factor, :meth:`mmg.effects.Wind.fit_parameters`) in ``factors``, which :meth:`mmg.effects.Wind.load_factors`
-    turns into the factor on each column of the records' loads."""
+    turns into the factor on each column of the records' loads.
+
+    Parameters
+    ----------
+    factors : ndarray
+        The wind effect's fit parameters (scale, sway factor, yaw factor), written in place.
+    index : int
+        The entry's :attr:`ShipParameter.slot`: 0 scale, 1 sway factor, 2 yaw factor (:data:`WIND_COLUMNS`).
+    value : float
+        The fitted factor [-] (1: the ship's own wind loads).
+    """
     factors[index] = value
 
 
@@ -128,6 +184,18 @@ class ShipParameter:
     loads : callable or None
         ``loads(factors, slot, value)``: where the value acts on the records' external loads instead
         (:func:`to_load_factor`); None: it does not.
+    diagnosis_family : str
+        The key of its relative prior std in :data:`DIAGNOSIS_PRIOR_REL_STD` where the diagnosis sets it
+        apart from the family table (a hull coefficient's by its term, :data:`LINEAR_TERMS`; ``w_P0``
+        relative); ``""``: the diagnosis takes the prior of the family table as it is.
+    diagnosis_floor : float
+        Smallest diagnosis prior std (with ``diagnosis_family``).
+    keeps_sign : bool
+        The diagnosis bounds it to its config value's sign (the signs that define a ship: a positive
+        Y_beta, a negative N_r).
+    multiplies : callable or None
+        ``multiplies(ship)``: the config value a fitted value is a factor on (a wind factor: ship.yaml
+        writes their product, so the product's bounds are the fit's over it); None: not a factor.
     """
 
     name: str
@@ -152,19 +220,64 @@ class ShipParameter:
     config_scale: Callable | None = None
     """``config_scale(ship)``: the config's unit in the fit's (the fit's value over it is the config's), where
     they differ."""
+    diagnosis_family: str = ""
+    diagnosis_floor: float = 0.0
+    keeps_sign: bool = False
+    multiplies: Callable | None = None
 
     def config_value(self, packed: PackedShip) -> float:
-        """The value the packed ship carries (the prior's centre), in the fit's unit."""
+        """The value the packed ship carries (the prior's centre), in the fit's unit.
+
+        Parameters
+        ----------
+        packed : mmg.model.PackedShip
+            The ship's packed form.
+
+        Returns
+        -------
+        float
+            The value, in :attr:`unit`.
+        """
         return float(self.packed(packed))
 
     def in_config(self, ship, value: float) -> tuple[str, float]:
-        """(the config's key, ``value`` in the config's unit): an added mass [kg] as the primed value."""
+        """(the config's key, ``value`` in the config's unit): an added mass [kg] as the primed value.
+
+        Parameters
+        ----------
+        ship : mmg.ship.Ship
+            The ship whose dimensions give the config's unit (:attr:`config_scale`).
+        value : float
+            A value in the fit's unit (:attr:`unit`).
+
+        Returns
+        -------
+        key : str
+            :attr:`config_key`, or :attr:`name` where the units agree.
+        value : float
+            ``value`` in the config's unit.
+        """
         if self.config_scale is None:
             return self.name, float(value)
         return self.config_key, float(value) / self.config_scale(ship)
 
     def prior_std(self, value: float, rel: dict) -> float:
-        """The prior std about ``value`` from the family table ``rel`` (its floor kept), or the absolute one."""
+        """The prior std about ``value`` from the family table ``rel`` (its floor kept), or the absolute one.
+
+        Parameters
+        ----------
+        value : float
+            The prior's centre (the config's value), in the fit's unit.
+        rel : dict
+            ``{family: relative std}``, e.g. :data:`PRIOR_REL_STD` or :data:`DIAGNOSIS_PRIOR_REL_STD`.
+
+        Returns
+        -------
+        float
+            The prior standard deviation, in the fit's unit: ``rel[family] * |value|`` but at least
+            :attr:`floor` (``rel[family] * value`` where the entry has no floor), or :attr:`abs_std`
+            where :attr:`family` is empty.
+        """
         if not self.family:
             return self.abs_std
         s = rel[self.family] * (abs(value) if self.floor > 0 else value)
@@ -259,7 +372,7 @@ def _wind(name: str) -> ShipParameter:
     key, col = WIND_COLUMNS[name]
     return ShipParameter(name, "1", "", "wind_scale", col, f"wind.{key}", read=lambda s: 1.0, write=_with_wind(key),
                          write_yaml=_wind_yaml(key), packed=lambda p: 1.0, effect=EffectPrior("wind", key),
-                         apply=not_packed, loads=to_load_factor)
+                         apply=not_packed, loads=to_load_factor, multiplies=lambda s: float(getattr(s.wind, key)))
 
 
 def _constants() -> dict:
@@ -274,7 +387,8 @@ def _constants() -> dict:
     out = [
         ShipParameter("w_P0", "1", "", "w_P0", 0, "propeller.w_P0[0]", read=lambda s: s.propeller.w_P0[0],
                       write=_with_w_P0, write_yaml=set_yaml("propeller", "w_P0", 0),
-                      packed=lambda p: p.poly[POLY_WP0][0], abs_std=0.15, bounds=lambda v: (0.0, 0.8), apply=to_wake),
+                      packed=lambda p: p.poly[POLY_WP0][0], abs_std=0.15, bounds=lambda v: (0.0, 0.8), apply=to_wake,
+                      diagnosis_family="w_P0", diagnosis_floor=0.01),
         _rudder("epsilon", P_EPS, "epsilon", 0.3, 3.0),
         _rudder("kappa", P_KAPPA, "kappa", 0.0, 1.0),
         _wind("wind_scale"), _wind("wind_sway_factor"), _wind("wind_yaw_factor"),
@@ -310,7 +424,20 @@ MASS_NAMES = tuple(n for n, p in CONSTANTS.items() if p.kind == "mass")
 def rule_of_kind(kind: str) -> tuple[Callable, Callable | None]:
     """(apply rule, load rule) of the table's entries of ``kind`` (:attr:`ShipParameter.apply`,
     :attr:`ShipParameter.loads`): the rules of a parameter given by its kind alone (a hand-made
-    :class:`ekf.identify.FreeParameter`); a kind not in the table goes into the parameter vector."""
+    :class:`ekf.identify.FreeParameter`); a kind not in the table goes into the parameter vector.
+
+    Parameters
+    ----------
+    kind : str
+        A :attr:`ShipParameter.kind` (``"hull"``, ``"w_P0"``, ``"wind_scale"``, ...).
+
+    Returns
+    -------
+    apply : callable
+        The first entry of that kind's :attr:`ShipParameter.apply` (:func:`to_slot` for an unknown kind).
+    loads : callable or None
+        Its :attr:`ShipParameter.loads` (None for an unknown kind).
+    """
     for p in (*CONSTANTS.values(), hull_parameter("", 0)):
         if p.kind == kind:
             return p.apply, p.loads
@@ -319,8 +446,25 @@ def rule_of_kind(kind: str) -> tuple[Callable, Callable | None]:
 
 def hull_parameter(name: str, index: int, term: str = "") -> ShipParameter:
     """The entry of hull coefficient ``name`` (primed, non-dimensional), at ``index`` of the ship's hull model;
-    the straight-ahead resistance (:func:`is_resistance`) bounded to stay negative."""
-    bounds = (lambda v: (-np.inf, 0.0)) if is_resistance(name, term) else (lambda v: (-np.inf, np.inf))
+    the straight-ahead resistance (:func:`is_resistance`) bounded to stay negative.
+
+    Parameters
+    ----------
+    name : str
+        The coefficient's name in the ship's hull model (e.g. ``"Y_v"``).
+    index : int
+        Its index in the hull model's coefficients (:attr:`mmg.model.PackedShip.hull_coef`).
+    term : str, optional
+        Its term in the hull model (tells the resistance, :func:`is_resistance`).
+
+    Returns
+    -------
+    ShipParameter
+        Family and kind ``"hull"``, relative prior with a floor of 0.01, applied by :func:`to_hull`.
+    """
+    resistance = is_resistance(name, term)
+    bounds = (lambda v: (-np.inf, 0.0)) if resistance else (lambda v: (-np.inf, np.inf))
+    diagnosis = "hull" if term in LINEAR_TERMS else "resistance" if resistance else "hull_nonlinear"
 
     def write_yaml(d, v, path):
         d["hull"]["coefficients"][name]["value"] = float(f"{v:.6g}")
@@ -328,12 +472,26 @@ def hull_parameter(name: str, index: int, term: str = "") -> ShipParameter:
     return ShipParameter(name, "1", "hull", "hull", index, f"hull.coefficients.{name}.value",
                          read=lambda s: s.hull.value(name), write=lambda s, v: s.with_hull({name: float(v)}),
                          write_yaml=write_yaml, packed=lambda p: p.hull_coef[index], floor=0.01, bounds=bounds,
-                         apply=to_hull)
+                         apply=to_hull, diagnosis_family=diagnosis,
+                         diagnosis_floor=DIAGNOSIS_PRIOR_REL_STD["hull_floor"], keeps_sign=True)
 
 
 def parameter(name: str, hull_names=(), hull_terms=()) -> ShipParameter:
     """The table's entry for ``name``: a hull coefficient of ``hull_names`` (its term from ``hull_terms``,
     same order) or a constant of :data:`CONSTANTS`.
+
+    Parameters
+    ----------
+    name : str
+        A fit name (``mmg identify --free``).
+    hull_names : sequence of str
+        The ship's hull coefficient names (:attr:`mmg.ship.HullModel.names`).
+    hull_terms : sequence of str
+        Their terms, in the same order.
+
+    Returns
+    -------
+    ShipParameter
 
     Raises
     ------
@@ -354,13 +512,44 @@ def _of_ship(ship, name: str) -> ShipParameter:
 
 
 def ship_value(ship, name: str) -> float:
-    """The ship's own value of parameter ``name``, in the fit's unit (KeyError for an unknown name)."""
+    """The ship's own value of parameter ``name``, in the fit's unit.
+
+    Parameters
+    ----------
+    ship : mmg.ship.Ship
+    name : str
+        A fit name: a hull coefficient of the ship or a key of :data:`CONSTANTS`.
+
+    Returns
+    -------
+    float
+        The value in the fit's unit (:func:`unit_of`; a wind factor is 1, the ship's own loads).
+
+    Raises
+    ------
+    KeyError
+        An unknown name.
+    """
     return float(_of_ship(ship, name).read(ship))
 
 
 def with_value(ship, name: str, value: float):
     """``ship`` with parameter ``name`` set to ``value`` (the fit's unit; a wind value is a factor on the
-    ship's); an unknown name (a record's own nuisance, an effect's) leaves the ship as it is."""
+    ship's); an unknown name (a record's own nuisance, an effect's) leaves the ship as it is.
+
+    Parameters
+    ----------
+    ship : mmg.ship.Ship
+    name : str
+        A fit name.
+    value : float
+        Its value in the fit's unit.
+
+    Returns
+    -------
+    mmg.ship.Ship
+        A new ship (``ship`` itself for an unknown name).
+    """
     try:
         p = _of_ship(ship, name)
     except KeyError:
@@ -370,7 +559,19 @@ def with_value(ship, name: str, value: float):
 
 def write_yaml_value(data: dict, name: str, value: float, ship_path) -> None:
     """Write parameter ``name``'s fitted ``value`` into ``data``, a ship YAML's mapping (of the file
-    ``ship_path``); an unknown name is left out."""
+    ``ship_path``); an unknown name is left out.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed ship YAML, written in place.
+    name : str
+        A fit name.
+    value : float
+        Its fitted value in the fit's unit (a wind value: a factor on the file's).
+    ship_path : str or path
+        The ship file ``data`` was read from (an added mass's scale needs its dimensions).
+    """
     hull = (data.get("hull") or {}).get("coefficients") or {}
     if name in hull:
         p = hull_parameter(name, 0)
@@ -383,7 +584,19 @@ def write_yaml_value(data: dict, name: str, value: float, ship_path) -> None:
 
 def config_values(ship, values: dict) -> dict:
     """Fitted ``values`` (fit names and units) under the config's keys and in its units
-    (:meth:`ShipParameter.in_config`: the added masses primed); names not in the table as given."""
+    (:meth:`ShipParameter.in_config`: the added masses primed); names not in the table as given.
+
+    Parameters
+    ----------
+    ship : mmg.ship.Ship
+    values : dict
+        ``{fit name: value}`` in the fit's units.
+
+    Returns
+    -------
+    dict
+        ``{config key: value}`` in the config's units.
+    """
     out = {}
     for k, v in values.items():
         try:
@@ -395,5 +608,16 @@ def config_values(ship, values: dict) -> dict:
 
 
 def unit_of(name: str) -> str:
-    """A fitted parameter's unit (``"1"`` for a hull coefficient and any name not in the table)."""
+    """A fitted parameter's unit (``"1"`` for a hull coefficient and any name not in the table).
+
+    Parameters
+    ----------
+    name : str
+        A fit name.
+
+    Returns
+    -------
+    str
+        The unit, SI (``"1"``: non-dimensional; ``"kg"``, ``"kg m^2"``, ``"rad"``).
+    """
     return CONSTANTS[name].unit if name in CONSTANTS else "1"

@@ -57,6 +57,7 @@ __all__ = [
     "fujiwara_series",
     "amplitude_vector",
     "AMPLITUDES",
+    "WindShape",
     "wind_forces",
     "coefficient_loads",
     "angle_from_dataset",
@@ -267,9 +268,27 @@ def fujiwara_series(c, s, A):
     return cx, cy, cn
 
 
+@dataclass(frozen=True)
+class WindShape:
+    """The wind effect's shape terms on the published loads (:func:`amplitude_vector`; all neutral by default).
+
+    Attributes
+    ----------
+    sway_factor : float
+        Factor on the sway force [-] (1: as published).
+    yaw_factor : float
+        Factor on the yaw moment [-] (1: as published).
+    yaw_sin : float
+        Yaw-moment coefficient [-] added times sin(gamma) (0: as published).
+    """
+
+    sway_factor: float = 1.0
+    yaw_factor: float = 1.0
+    yaw_sin: float = 0.0
+
+
 def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODEL,
-                rho_air: float = RHO_AIR, scale: float = 1.0, sway_factor: float = 1.0,
-                yaw_factor: float = 1.0, yaw_sin: float = 0.0):
+                rho_air: float = RHO_AIR, scale: float = 1.0, shape: WindShape | None = None):
     """Wind surge force, sway force and yaw moment about midship from the relative wind.
 
     Parameters
@@ -286,10 +305,9 @@ def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODE
         Air density [kg/m^3].
     scale : float
         Overall factor on all three loads (1 = as published).
-    sway_factor, yaw_factor : float
-        Further factors on the sway force and the yaw moment alone (:func:`amplitude_vector`).
-    yaw_sin : float
-        Yaw-moment coefficient added times sin(gamma) (:func:`amplitude_vector`).
+    shape : WindShape, optional
+        Further factors on the sway force and the yaw moment alone and the added sin(gamma) yaw term
+        (:func:`amplitude_vector`); default: as published.
 
     Returns
     -------
@@ -311,7 +329,8 @@ def wind_forces(V_rel, angle_rel, particulars: WindParticulars = ESSO_OSAKA_MODE
         raise ValueError("V_rel must be >= 0")
     p = particulars
     a = np.asarray(angle_rel, dtype=float)
-    cx, cy, cn = fujiwara_series(np.cos(a), np.sin(a), amplitude_vector(p, sway_factor, yaw_factor, yaw_sin))
+    sh = WindShape() if shape is None else shape
+    cx, cy, cn = fujiwara_series(np.cos(a), np.sin(a), amplitude_vector(p, sh.sway_factor, sh.yaw_factor, sh.yaw_sin))
     return coefficient_loads(V, cx, cy, cn, p, rho_air, scale)
 
 

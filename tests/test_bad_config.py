@@ -1,7 +1,7 @@
-"""Bad configs (issue 10): one line naming the file and the field, exit status 2, nothing written.
+"""Bad configs: one line naming the file and the field, exit status 2, nothing written.
 
-One parametrised test per family of the issue: inputs that used to give a traceback, runs
-that would do unbounded work, nonsense that used to be accepted silently, unitless or
+One parametrised test per family: inputs that could give a traceback, runs
+that would do unbounded work, nonsense that could be accepted silently, unitless or
 wrong-unit numbers, and ship-file errors blamed on the ship file.
 """
 from pathlib import Path
@@ -157,10 +157,10 @@ def test_bad_schedule_csv_names_the_csv_and_column(case, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("sets, field", [
-    (["P0.n=1e300"], "P0.n"),                         # used to be numpy.linalg.LinAlgError: singular matrix
+    (["P0.n=1e300"], "P0.n"),                         # not numpy.linalg.LinAlgError: singular matrix
     (["P0_is=std", "P0.u=1e-300"], "P0.u"),           # a variance that underflows to 0
     (["P0.Y_beta=inf"], "P0.Y_beta"),
-    (["P0=1"], "P0"),                                 # used to be AttributeError
+    (["P0=1"], "P0"),                                 # not AttributeError
     (["R.ZZ20=3"], "R.ZZ20"),
     (["P0_default_relative_std=1e200"], "P0_default_relative_std"),
     (["P0.u=[1"], "P0.u"),
@@ -362,7 +362,7 @@ def test_every_bundled_config_still_loads():
 
 
 # --------------------------------------------------------------------------- approach.rpm against approach.speed
-# (issue 24: "approach.rpm: 5 rpm" exited 0 after a 0.3 s run, the shaft at -7.8 rpm).  Rhee & Kim's
+# (an "approach.rpm: 5 rpm" far below the speed's must be refused, not run with the shaft at -7.8 rpm).  Rhee & Kim's
 # published approach of the Esso Osaka is 54.12 rpm at 10 kn (Table 4); MMG 2015 gives the KVLCC2
 # L7 model 17.95 rps at 1.179 m/s (its model-scale self-propulsion point, which the constant-rpm
 # motor holds while the ship runs to the speed it gives).

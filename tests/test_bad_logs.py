@@ -1,4 +1,4 @@
-"""Bad and wrong-looking logs (issue 10): one InputError line naming the file and the field,
+"""Bad and wrong-looking logs: one InputError line naming the file and the field,
 never a traceback or a silently wrong number; and metrics refused for a record that is not the
 manoeuvre asked for."""
 from dataclasses import replace
@@ -114,7 +114,7 @@ def test_time_in_milliseconds_and_absurd_sampling(zz20, tmp_path):
     d, _ = zz20
     log = d / "log.csv"
     refused(rewrite(log, tmp_path / "ms.csv", "time_s", lambda v: v * 1000), "time_s", "milliseconds", "interval_s")
-    # the unbounded-work case of the issue: 12 rows 1e6 s apart
+    # unbounded work: 12 rows 1e6 s apart
     twelve = rewrite(log, tmp_path / "1e6.csv", "time_s", lambda v: v / 5 * 1e6, rows=lambda r: r[:12])
     refused(twelve, "time_s", "interval_s")
     # without the header's interval the span is refused: more than MAX_STEPS steps of 0.1 s
@@ -172,7 +172,7 @@ def test_truth_channel_in_wrong_unit(zz20, tmp_path, col, fn, field, words):
     ("delta_rudder [rad]", np.degrees, ["beyond the +/-45 deg", "degrees?"]),
     ("r_angvelo [rad/s]", np.degrees, ["deg/s?"]),
     ("t [s]", lambda v: v * 1000, ["10 Hz", "milliseconds"]),
-    ("u_velo [m/s]", lambda v: v * 100, ["times what the track", "cm/s"]),   # named by the track (issue 24)
+    ("u_velo [m/s]", lambda v: v * 100, ["times what the track", "cm/s"]),   # named by the track
     ("x_position_mid [m]", lambda v: v * 1000, ["Froude number"]),
     ("n_prop [rps]", lambda v: v * 60, ["rpm"]),
 ])

@@ -452,7 +452,7 @@ def test_estimate_no_plots_claims_no_png(tmp_path, capsys):
     assert not list(out.glob(".*"))
 
 
-# --------------------------------------------------------------------------- issue 24: every output option
+# --------------------------------------------------------------------------- every output option
 
 
 def _output_options(zz20_log):

@@ -1,4 +1,4 @@
-"""The helpers of the issue-27 limit benches: bench/identify_cv.py's candidate grid (hull form x prior width,
+"""The helpers of the identification limit benches: bench/identify_cv.py's candidate grid (hull form x prior width,
 chosen inside the folds), bench/yaw_residual_check.py's heading bound and model yaw acceleration,
 bench/identify_ceiling.py's heading RMS windows, bench/fold_values.py's jackknife and fold table, and
 bench/frt_gap.py's figures by record kind."""
@@ -51,7 +51,7 @@ def test_heading_bound_of_a_constant_yaw_acceleration_is_the_rms_of_a_t2_over_2(
     t = (np.arange(600000) + 0.5) * (T / 600000)                      # midpoints of a fine grid
     rms = math.sqrt(np.mean((0.5 * a * t ** 2) ** 2))                 # numerically, independent of the closed form
     assert yc.heading_rms_of(a, T) == pytest.approx(rms, rel=1e-6)
-    assert yc.heading_rms_of(a, T) == pytest.approx(5.0, rel=0.01)    # the 5 deg of issue 27 over 60 s
+    assert yc.heading_rms_of(a, T) == pytest.approx(5.0, rel=0.01)    # the 5 deg target over 60 s
     assert yc.heading_rms_of(-a, T) == yc.heading_rms_of(a, T)
 
 
@@ -187,7 +187,7 @@ def _windy_run(ship, k: int = 0):
 def test_offset_scan_replays_the_fold_model_as_its_scores_were_wind_scale_included():
     """A fold model rebuilt from its JSON values (fold_models), its fitted wind scale 0.3: the offset scan's
     zero-offset replay gives the heading RMS that Identification.replay scored, for both models; scanning
-    without the fitted values (the bench before stop 42) replays another model and is named."""
+    without the fitted values replays another model and is named."""
     from types import SimpleNamespace
 
     import mmg

@@ -1,4 +1,4 @@
-"""Compiled code never goes stale (issue 25): the cache key covers every source file the compiled
+"""Compiled code never goes stale: the cache key covers every source file the compiled
 code depends on, found by walking the packages (:func:`mmg._jit.source_key`), not a list of files.
 
 On a temporary copy of the package a physics function the compiled code calls is moved into a new

@@ -43,7 +43,7 @@ def test_a_hidden_effects_record_lends_clean_samples_to_the_others(cal):
 
 def test_hidden_effects_are_those_whose_floor_exceeds_the_size_to_detect(cal):
     """Floors are in the unit of decision.magnitude (a current's speed over sqrt(g L)); the size worth
-    detecting a current is 0.0027 sqrt(g L), 0.152 m/s at 325 m (issue 26: 0.15 m/s)."""
+    detecting a current is 0.0027 sqrt(g L), 0.152 m/s at 325 m (the 0.15 m/s worth detecting)."""
     g = np.sqrt(9.80665 * L)
     fl = {"rudder_offset": {"turn": 4.9, "zigzag": 0.66}, "heading_bias": {"turn": 0.9},
           "current": {"turn": 0.5 * 0.0027, "turn_pair": 0.16 / g, "zigzag": 0.19 / g}}

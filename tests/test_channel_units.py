@@ -1,4 +1,4 @@
-"""Channels checked against what the ship and the other channels imply (issue 24): a channel in a
+"""Channels checked against what the ship and the other channels imply: a channel in a
 wrong unit is refused in one line naming the file and the column (and the likely unit); a heading
 that is cumulative or offset by whole turns is read like the wrapped one; a missing value in a
 column a command does not use does not refuse the record for that command.
@@ -94,10 +94,10 @@ def test_full_scale_record_channel_in_wrong_unit(tmp_path, case):
 def simulated(tmp_path_factory):
     """A zigzag of the 3 m model with a 1.5 m/s true wind, logged in the FRT-DS-ESSO layout at 10 Hz."""
     from mmg.ship import load_ship
-    from trials.measured.diagnose import synthetic_record, write_frt_csv
+    from trials.measured.diagnose import Manoeuvre, RecordNoise, synthetic_record, write_frt_csv
 
-    rec = synthetic_record(load_ship("esso_osaka_3m"), "zigzag", {"wind": {"scale": 1.0}}, true_wind=(1.5, 1.0),
-                           dt=0.1, seed=3, name="sim")
+    rec = synthetic_record(load_ship("esso_osaka_3m"), Manoeuvre("zigzag", dt=0.1), {"wind": {"scale": 1.0}},
+                           true_wind=(1.5, 1.0), noise=RecordNoise(seed=3), name="sim")
     p = tmp_path_factory.mktemp("sim") / "sim.csv"
     write_frt_csv(rec, p)
     return p

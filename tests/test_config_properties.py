@@ -1,4 +1,4 @@
-"""Properties of the trial and ship schema (issue 10): any input gives a result or InputError.
+"""Properties of the trial and ship schema: any input gives a result or InputError.
 
 The inputs are the bundled trials and ships mutated at random (random values of random types
 at random keys, random unit strings, NaN, inf and huge numbers, deleted keys, extra keys), as

@@ -1,4 +1,4 @@
-"""One value given in two places (issue 24): refused, one line naming the file and both places,
+"""One value given in two places: refused, one line naming the file and both places,
 whatever the two values are (equal ones too), through load_ship / load_trial and ``mmg simulate``
 (exit 2, nothing written).
 

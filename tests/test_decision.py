@@ -59,10 +59,11 @@ def test_the_floor_decides(monkeypatch):
     floor is above its size (same fit, same dBIC and z)."""
     import mmg
     import trials.measured.decision as D
-    from trials.measured.diagnose import diagnose, synthetic_record
+    from trials.measured.diagnose import RecordNoise, diagnose, synthetic_record
 
     ship = mmg.load_ship("esso_osaka_3m")
-    rec = synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.012, "direction_deg": 70.0}}, seed=4)
+    rec = synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.012, "direction_deg": 70.0}},
+                           noise=RecordNoise(seed=4))
     L = ship.particulars.L
     size = 0.012 / math.sqrt(9.80665 * L)
     monkeypatch.setattr(D, "calibration", lambda: {})
@@ -197,7 +198,7 @@ def test_an_effect_that_loses_its_evidence_is_dropped(monkeypatch):
     import trials.measured.diagnose.search as S
 
     ship = mmg.load_ship("esso_osaka_3m")
-    rec = G.synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, seed=5)
+    rec = G.synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, noise=G.RecordNoise(seed=5))
     monkeypatch.setattr(D, "calibration", lambda: {})
 
     def forced(fitter, base, cand, ns, o, say):
@@ -312,9 +313,10 @@ def test_an_effect_short_of_the_evidence_is_reported_by_diagnose(diagnose_rules)
     not named and not dropped: ``not_identifiable`` carries it with the figures that decided, and the
     console line says so.  (With the threshold as shipped the same record names it: the control.)"""
     from mmg.ship import load_ship
-    from trials.measured.diagnose import diagnose, synthetic_record
+    from trials.measured.diagnose import Manoeuvre, RecordNoise, diagnose, synthetic_record
     ship = load_ship("esso_osaka_3m")
-    rec = synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, rudder_deg=20.0, seed=4, name="z")
+    rec = synthetic_record(ship, Manoeuvre("zigzag", rudder_deg=20.0), {"heading_bias": {"bias_deg": 1.5}},
+                           noise=RecordNoise(seed=4), name="z")
     opts = {"candidates": ["heading_bias", "current"]}
     assert diagnose(ship, [rec], **opts).named == ["heading_bias"]
     diagnose_rules(bic_threshold=1e7)            # the rules file's threshold, through MMG_DIAGNOSE_RULES

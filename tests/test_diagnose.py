@@ -32,10 +32,12 @@ def truth(ship):
 
 
 def _records(ship, truth, effects, wind=(0.0, 0.0)):
-    from trials.measured.diagnose import synthetic_record
+    from trials.measured.diagnose import RecordNoise, synthetic_record
 
-    return [synthetic_record(ship, "turning", effects, truth_ship=truth, true_wind=wind, seed=1, name="turn"),
-            synthetic_record(ship, "zigzag", effects, truth_ship=truth, true_wind=wind, seed=2, name="zigzag")]
+    return [synthetic_record(ship, "turning", effects, truth_ship=truth, true_wind=wind, noise=RecordNoise(seed=1),
+                             name="turn"),
+            synthetic_record(ship, "zigzag", effects, truth_ship=truth, true_wind=wind, noise=RecordNoise(seed=2),
+                             name="zigzag")]
 
 
 def _check_fall(d, effect, clean=None):
@@ -140,7 +142,7 @@ def _mmg(*args):
 
 
 def test_records_named_after_their_files(tmp_path, ship, clean):
-    """Issue 24: records are named after their files in the JSON and the plots (DIR/<name>.png): two
+    """Records are named after their files in the JSON and the plots (DIR/<name>.png): two
     files of one stem (one trial recorded on two days) told apart by their folders, not ``x`` twice."""
     from trials.measured.diagnose import prepare, synthetic_record, write_frt_csv
 

@@ -12,14 +12,14 @@ import pytest
 @pytest.fixture(scope="module")
 def records():
     import mmg
-    from trials.measured.diagnose import synthetic_record
+    from trials.measured.diagnose import RecordNoise, synthetic_record
 
     ship = mmg.load_ship("esso_osaka_3m")
-    recs = [synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.012, "direction_deg": 70.0}}, seed=4,
-                             name="zz_current"),
-            synthetic_record(ship, "zigzag", {}, seed=5, name="zz_clean"),
-            synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.02, "direction_deg": 200.0}}, seed=6,
-                             name="zz_current2")]
+    recs = [synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.012, "direction_deg": 70.0}},
+                             noise=RecordNoise(seed=4), name="zz_current"),
+            synthetic_record(ship, "zigzag", {}, noise=RecordNoise(seed=5), name="zz_clean"),
+            synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.02, "direction_deg": 200.0}},
+                             noise=RecordNoise(seed=6), name="zz_current2")]
     return ship, recs
 
 

@@ -20,11 +20,12 @@ import pytest
 def case():
     import mmg
     from trials.measured.diagnose import diagnose
-    from trials.measured.mismatch import mismatch_member, trial_records
+    from trials.measured.mismatch import TrialConditions, mismatch_member, trial_records
 
     ship = mmg.load_ship("esso_osaka")
     member, factors = mismatch_member(ship, np.random.default_rng(3), crossflow=True)
-    rec = trial_records(ship, member, "turn35p", {"wind": {}}, seed=3, true_wind=(10.0, math.radians(300.0)), name="t")
+    rec = trial_records(ship, member, "turn35p", TrialConditions({"wind": {}}, (10.0, math.radians(300.0))), seed=3,
+                        name="t")
     lines = []
     d = diagnose(ship, [rec], candidates=["wind", "current", "heading_bias"], say=lines.append)
     return ship, member, factors, d, lines

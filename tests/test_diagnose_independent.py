@@ -1,4 +1,4 @@
-"""``mmg diagnose`` on records it did not write (issue 26, "Tests that can fail").
+"""``mmg diagnose`` on records it did not write (tests that can fail).
 
 The records here are NOT made by :mod:`mmg.effects` (the code the diagnosis inverts): the clean
 ship is simulated by :func:`mmg.simulation.simulate`, and each effect is applied afterwards by the
@@ -75,7 +75,7 @@ def test_writer_conventions(truth, tmp_path):
 def test_clean_mismatched_ship_names_nothing_by_the_threshold(truth, config, tmp_path):
     """A clean turn and a 20/20 zigzag of six reversals (300 sqrt(L/g)) of a ship 5 % off its config:
     nothing named, every candidate tried; and the threshold is what keeps one out (a candidate with a
-    positive dBIC whose z clears Z_THRESHOLD: on the code of issue 26 shallow water at dBIC 16, z 11),
+    positive dBIC whose z clears Z_THRESHOLD: shallow water at dBIC 16, z 11, has been seen),
     so the decision rule without its threshold or its BIC penalty fails here."""
     from trials.measured.diagnose import Z_THRESHOLD
 
@@ -89,8 +89,8 @@ def test_clean_mismatched_ship_names_nothing_by_the_threshold(truth, config, tmp
 
 def test_clean_full_zigzag_names_nothing(truth, config, tmp_path):
     """The same ship on a turn and a full 20/20 zigzag (nine reversals and more, 400 sqrt(L/g), as a
-    sea trial runs it): nothing named.  On the code of issue 26 this names a rudder offset
-    (dBIC 38): the ship's own 5 % mismatch taken for an effect (the issue's defect 2)."""
+    sea trial runs it): nothing named; a diagnosis that takes the ship's own 5 % mismatch for an effect
+    names a rudder offset here (dBIC 38)."""
     d = _diagnose(config, _records(tmp_path, truth, zigzag_s=400.0))
     assert d.named == [], d.rounds
 
@@ -145,9 +145,9 @@ def _asymmetric(truth, pos=1.15, neg=0.85):
 @pytest.mark.parametrize("offset", [1.0])
 def test_rudder_offset_beside_an_asymmetric_rudder_inflow(truth, config, tmp_path, offset):
     """A 1 deg offset on a zigzag of a ship whose gamma_R differ by 30 % between the two sides, which
-    the config has equal: the offset named at its value within 0.3 deg (the issue's tolerance).  The
+    the config has equal: the offset named at its value within 0.3 deg (the tolerance).  The
     asymmetry makes the rudder's force one-sided in the swing, what an offset does; with gamma_R held
-    at the config's (``ZIGZAG_CONSTANTS_FREE`` empty, the code before stop 40) the offset took it:
+    at the config's (``ZIGZAG_CONSTANTS_FREE`` empty) the offset takes it:
     +1 deg fitted 0.22 deg and not named, -1 deg fitted -1.75 deg (0.85 and -1.27 deg with them
     freed).  -1 deg is left out of the fast suite: its 0.03 deg margin on the tolerance is too thin
     for a test meant to catch a lost gamma_R, and the sign is checked at 2 deg above."""

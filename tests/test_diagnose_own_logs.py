@@ -1,4 +1,4 @@
-"""Issue 26, acceptance 3: the project's own sea-trial logs (``mmg simulate`` of the bundled ST35 and
+"""The project's own sea-trial logs (``mmg simulate`` of the bundled ST35 and
 ZZ20 trials: the 5 s log with its noise and the truth file), diagnosed with the very ship that made
 them: nothing named, nothing unexplained, every freed ship coefficient within 2 prior std of its
 config value; the ZZ20 with a 1 kn current (an ``effects:`` section in the trial): the current alone,

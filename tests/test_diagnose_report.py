@@ -1,4 +1,4 @@
-"""What mmg diagnose tells a user (issue 26, "an answer a user can trust"): each named effect's value
+"""What mmg diagnose tells a user (an answer a user can trust): each named effect's value
 with a 95 % interval (checked against a Monte Carlo of the fitted normal, computed here), the evidence
 of the round that named it, console lines with units and three significant figures (no raw dict), the
 unexplained residual in units, the summary figure, and a zigzag's track that is not a strip."""
@@ -141,10 +141,11 @@ def ship():
 
 @pytest.fixture(scope="module")
 def current_record(ship):
-    from trials.measured.diagnose import synthetic_record
+    from trials.measured.diagnose import Manoeuvre, RecordNoise, synthetic_record
 
-    return synthetic_record(ship, "zigzag", {"current": {"speed_mps": 0.15, "direction_deg": 200.0}},
-                            duration=60.0, seed=3, name="zz")
+    return synthetic_record(ship, Manoeuvre("zigzag", duration=60.0),
+                            {"current": {"speed_mps": 0.15, "direction_deg": 200.0}}, noise=RecordNoise(seed=3),
+                            name="zz")
 
 
 @pytest.fixture(scope="module")

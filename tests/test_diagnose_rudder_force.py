@@ -14,12 +14,12 @@ import pytest
 @pytest.fixture(scope="module")
 def case():
     import mmg
-    from trials.measured.diagnose import diagnose, synthetic_record
+    from trials.measured.diagnose import Manoeuvre, RecordNoise, diagnose, synthetic_record
 
     ship = mmg.load_ship("esso_osaka")
     truth = replace(ship, rudder=replace(ship.rudder, epsilon=ship.rudder.epsilon * 0.9))
-    rec = synthetic_record(ship, "turning", {"wind": {}}, truth_ship=truth, dt=1.0, duration=1200.0,
-                           rudder_deg=35.0, seed=4, true_wind=(10.0, 1.0))
+    rec = synthetic_record(ship, Manoeuvre("turning", rudder_deg=35.0, duration=1200.0, dt=1.0), {"wind": {}},
+                           truth_ship=truth, true_wind=(10.0, 1.0), noise=RecordNoise(seed=4))
     return ship, truth, diagnose(ship, [rec], candidates=["wind"])
 
 

@@ -166,10 +166,11 @@ def test_a_higher_z_threshold_stops_an_effect_being_named(diagnose_rules):
     """End to end: a 1.5 deg heading bias on a zigzag is named with the packaged rules and not named
     with a rules file whose z threshold is out of reach; the JSON reports the threshold used."""
     from mmg.ship import load_ship
-    from trials.measured.diagnose import diagnose, synthetic_record
+    from trials.measured.diagnose import Manoeuvre, RecordNoise, diagnose, synthetic_record
 
     ship = load_ship("esso_osaka_3m")
-    rec = synthetic_record(ship, "zigzag", {"heading_bias": {"bias_deg": 1.5}}, rudder_deg=20.0, seed=4, name="z")
+    rec = synthetic_record(ship, Manoeuvre("zigzag", rudder_deg=20.0), {"heading_bias": {"bias_deg": 1.5}},
+                           noise=RecordNoise(seed=4), name="z")
     opts = {"candidates": ["heading_bias"]}
     assert diagnose(ship, [rec], **opts).named == ["heading_bias"]
     diagnose_rules(z_threshold=1e6)

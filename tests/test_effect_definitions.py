@@ -1,4 +1,4 @@
-"""One definition of each effect (issue 25): the estimators take an effect parameter's prior from its
+"""One definition of each effect: the estimators take an effect parameter's prior from its
 :class:`mmg.effects.Parameter`, the ship coefficients' prior widths come from one table, the replay's
 measured-wind loads are the ``wind`` effect's, and one function turns model states into a logged record (trial runs and the
 diagnosis's synthetic records alike)."""
@@ -79,7 +79,7 @@ def test_replay_wind_loads_are_the_wind_effects(ship, monkeypatch):
 def test_one_record_generator(ship, monkeypatch):
     """TrialRun.record and trials.measured.diagnose.synthetic_record both log through trials.files.records.logged_record."""
     import trials.files.records as R
-    from trials.measured.diagnose import synthetic_record
+    from trials.measured.diagnose import Manoeuvre, synthetic_record
 
     calls = []
     real = R.logged_record
@@ -89,7 +89,7 @@ def test_one_record_generator(ship, monkeypatch):
         return real(*a, **k)
 
     monkeypatch.setattr(R, "logged_record", spy)
-    rec = synthetic_record(ship, "turning", {"rudder_offset": {"offset_deg": 1.0}}, duration=20.0, name="syn")
+    rec = synthetic_record(ship, Manoeuvre("turning", duration=20.0), {"rudder_offset": {"offset_deg": 1.0}}, name="syn")
     run = mmg.simulate(mmg.load_trial("zz20"))
     log = run.record()
     assert calls == ["syn", run.trial.name]

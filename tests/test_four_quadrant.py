@@ -1,4 +1,4 @@
-"""Four quadrants (issue 27): propeller thrust and rudder force for any sign of n and u, hull forces at
+"""Four quadrants: propeller thrust and rudder force for any sign of n and u, hull forces at
 any drift angle (``mmg.fourquadrant``, ``mmg.model.propeller`` / ``rudder`` / ``kinematics``).
 
 * the published B4-70 four-quadrant series, evaluated here by a plain sum of cosines and sines,

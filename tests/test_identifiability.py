@@ -1,4 +1,4 @@
-"""What the records cannot tell apart (trials.measured.identifiability, issue 26).
+"""What the records cannot tell apart (trials.measured.identifiability).
 
 The maths against a hand-built covariance; a single full-scale turning circle of a ship that is not
 its model (hull terms 7-25 %, rudder lift and inflow 10-13 % off the config) with a rudder offset of
@@ -86,12 +86,12 @@ def full():
 
 
 def _turn(full, rudder_deg, seed):
-    from trials.measured.diagnose import synthetic_record
+    from trials.measured.diagnose import Manoeuvre, RecordNoise, synthetic_record
 
     ship, truth = full
-    return synthetic_record(ship, "turning", {"rudder_offset": {"offset_deg": 1.5}}, truth_ship=truth,
-                            rudder_deg=rudder_deg, duration=500.0, dt=1.0, noise=NOISE, seed=seed, speed=5.14,
-                            name="stbd" if rudder_deg > 0 else "port")
+    return synthetic_record(ship, Manoeuvre("turning", rudder_deg=rudder_deg, duration=500.0, dt=1.0, speed=5.14),
+                            {"rudder_offset": {"offset_deg": 1.5}}, truth_ship=truth,
+                            noise=RecordNoise(NOISE, seed=seed), name="stbd" if rudder_deg > 0 else "port")
 
 
 def test_single_turn_rudder_offset_not_identifiable(full):
@@ -121,7 +121,7 @@ def test_single_turn_rudder_offset_not_identifiable(full):
     assert len(line) == 1 and "deg" in line[0]
 
 
-@pytest.mark.xfail(reason="not met (issue 26, several records together): the pair's offset fits 0.28 +- 0.10 deg "
+@pytest.mark.xfail(reason="not met (several records together): the pair's offset fits 0.28 +- 0.10 deg "
                           "(truth 1.5) from every start (0, +-1, 2 deg), dBIC -2.4: the mismatched hull and rudder take "
                           "it; with the 50 % priors of before it was named (1.11 deg) only after a false current "
                           "(0.055 m/s) was named first, its own first-round dBIC -3.4 then too", strict=False)
@@ -167,11 +167,12 @@ def test_trial_advice_with_a_named_wind_in_the_model(monkeypatch):
     (detection size lowered so that the heading bias is reported and the trial path runs)."""
     import trials.measured.identifiability as I
     from mmg.ship import load_ship
-    from trials.measured.diagnose import diagnose, synthetic_record
+    from trials.measured.diagnose import Manoeuvre, RecordNoise, diagnose, synthetic_record
 
     ship = load_ship("esso_osaka_3m")
-    rec = synthetic_record(ship, "turning", {"wind": {"scale": 1.0}, "rudder_offset": {"offset_deg": 1.0}},
-                           true_wind=(3.0, math.radians(40.0)), seed=1, name="t", rudder_deg=35.0)
+    rec = synthetic_record(ship, Manoeuvre("turning", rudder_deg=35.0),
+                           {"wind": {"scale": 1.0}, "rudder_offset": {"offset_deg": 1.0}},
+                           true_wind=(3.0, math.radians(40.0)), noise=RecordNoise(seed=1), name="t")
     monkeypatch.setitem(I.DETECTION_SIZE, "heading_bias", (1e-3, "deg"))
     d = diagnose(ship, [rec])
     assert "wind" in d.named

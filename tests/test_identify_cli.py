@@ -1,6 +1,6 @@
 """mmg identify end to end on slices of real records: DIR/ship.yaml is a ship config every command
 takes (mmg simulate through a trial file naming it, mmg predict), and mmg predict with it gives
-the report's numbers (issue 11, acceptance 3)."""
+the report's numbers."""
 from __future__ import annotations
 
 import contextlib
@@ -178,7 +178,7 @@ def test_velocity_weight_reaches_the_fit_and_the_report(identified, tmp_path):
 
 
 def test_max_nfev_stages_labelled_and_explained(tmp_path, capsys):
-    """Issue 24: the fit's evaluation limit is an option (--max-nfev, reaching each stage); the progress
+    """The fit's evaluation limit is an option (--max-nfev, reaching each stage); the progress
     names each stage (its iterations labelled by it: the second series is another cost, not a restart);
     the report says what each stage fitted in words (no "segment length inf s") and how it stopped."""
     a = _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv", tmp_path / "zz.csv", 40.0)

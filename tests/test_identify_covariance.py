@@ -1,4 +1,4 @@
-"""mmg identify's start states and written covariance (issue 28, acceptance 2): each record's replay starts
+"""mmg identify's start states and written covariance: each record's replay starts
 from a fitted state, not its one noisy first sample, and the covariance written into ship.yaml keeps the
 prior at its stated std (the data's information alone scaled by their residual variance)."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Nested cross-validation (issue 27): the kept-out records never reach a fit or a choice of their fold,
+"""Nested cross-validation: the kept-out records never reach a fit or a choice of their fold,
 the hull form is chosen by held-out prediction, a non-finite replay is a divergence with its time and
 state, and ``mmg identify --hull`` refuses what it cannot do in one line."""
 from __future__ import annotations

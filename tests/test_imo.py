@@ -3,7 +3,7 @@
 The limits are checked against the standard's table written out here (not read from the code), the
 full-scale Esso Osaka's figures against the same manoeuvres simulated through ``mmg.simulate`` from
 the bundled trial YAMLs and the trial builders (another path: other durations, other construction),
-the CLI's JSON against the schema the issue spells out.
+the CLI's JSON against its schema.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The fast transition Jacobian (issue 13, item 3): tangent-linear RK4 with analytic hull-coefficient columns.
+"""The fast transition Jacobian: tangent-linear RK4 with analytic hull-coefficient columns.
 
 :func:`ekf.kernels.jacobian_step` must give the F of the brute-force complex step
 (:func:`ekf.kernels.jacobian_step_reference`, one complex RK4 step per column) to rounding, for

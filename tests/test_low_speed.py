@@ -1,4 +1,4 @@
-"""The equations of motion are well-posed down to rest (issue 11, "Low speed"; ``mmg.model.kinematics``).
+"""The equations of motion are well-posed down to rest (``mmg.model.kinematics``).
 
 Every measured record starts at rest, where beta = atan(-v/u) and r' = r L / U are undefined.
 The model floors the hull's speed scale smoothly below U_low = ``p[P_ULOW]`` (Fn 0.02).  Checked

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 import mmg
-from trials.measured.mismatch import MismatchSpec, mismatch_family, trial_records
+from trials.measured.mismatch import MismatchSpec, TrialConditions, mismatch_family, trial_records
 
 REPO = Path(__file__).resolve().parents[1]
 YAML = yaml.safe_load((REPO / "configs" / "ships" / "esso_osaka.yaml").read_text())
@@ -133,7 +133,7 @@ def test_zigzag_ends_sixty_seconds_after_its_ninth_reversal(config, family):
 
 
 def test_port_first_zigzag_puts_port_rudder_first_and_swings_to_port_first(config, family):
-    rec = trial_records(config, family[3][0], "zz15p", {}, seed=4, speed_kn=7.0, noise=(0.0,) * 6)
+    rec = trial_records(config, family[3][0], "zz15p", TrialConditions(speed_kn=7.0), seed=4, noise=(0.0,) * 6)
     d = np.asarray(rec.delta)
     big = d[np.abs(d) > math.radians(5.0)]
     assert big[0] < 0.0                                                      # port rudder first

@@ -1,4 +1,4 @@
-"""Replay of records against their own inputs (``trials.measured.predict``, ``mmg predict``): issue 11.
+"""Replay of records against their own inputs (``trials.measured.predict``, ``mmg predict``).
 
 * Acceptance 4: the full-scale simulator's own truth files replayed with their true rudder and
   revolutions reproduce the truth (heading RMS < 0.05 deg), through the project's writers and
@@ -67,7 +67,7 @@ def test_replay_of_the_simulators_truth_file_reproduces_it(simulated, name):
 
     The simulator integrates the steering gear and the shaft inside its RK4 step; the replay
     interpolates the rudder and revolutions linearly between the 0.1 s samples, which costs
-    ~1e-5 deg of heading over 3000 s, far inside the issue's 0.05 deg."""
+    ~1e-5 deg of heading over 3000 s, far inside the 0.05 deg asked."""
     from trials.files.logio import read_record
     from trials.measured.predict import replay_record
 
@@ -179,7 +179,7 @@ def test_cli_predict_end_to_end(slices, tmp_path, ship3m, capsys):
 
 @needs_frt
 def test_two_records_of_one_trial_are_named_after_their_files(tmp_path, capsys):
-    """Issue 24: two records of one trial wrote ST35.png and ST35_2.png and printed "ST35" twice: every
+    """Two records of one trial, not ST35.png and ST35_2.png with "ST35" printed twice: every
     output and printed line is named after the file, two files of one stem told apart by their folders
     (the same file given again numbered), the same names in the JSON, the lines and the plots."""
     a, b = tmp_path / "day1", tmp_path / "day2"
@@ -408,7 +408,7 @@ def test_a_diverged_replay_says_where_and_scores_null(simulated, tmp_path, capsy
     lines = out.strip().splitlines()
     said = (f": the replay diverged at t = {t_div:.1f} s (the predicted state is not finite from there; scores null), "
             f"wind {rep.run.wind}")
-    stem = Path(truth).stem                                             # runs named after their file (issue 24)
+    stem = Path(truth).stem                                             # runs named after their file
     assert lines[:2] == [stem + said, f"{stem}_2" + said]
     assert not any(ln.startswith("mean over") for ln in lines)          # nothing finite to average
     doc = json.loads(js.read_text())

@@ -1,7 +1,7 @@
 """A record without a channel an effect of the ship config needs (the measured relative wind of a
 wind-on ship): every command that replays records skips that effect with one line saying so on
-stderr and finishes; none crashes on the missing channel (issue 24: ``mmg identify`` raised
-AttributeError in mmg/effects/wind.py).
+stderr and finishes; none crashes on the missing channel (with an AttributeError in mmg/effects/wind.py,
+say).
 
 The records are real FRT-DS-ESSO zigzags with their wind columns dropped (the data set is not made
 by this project), cut to 40 s to keep the tests short."""

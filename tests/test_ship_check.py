@@ -1,4 +1,4 @@
-"""Records checked against their ship (issue 24; :mod:`trials.files.shipcheck`).
+"""Records checked against their ship (:mod:`trials.files.shipcheck`).
 
 * Every command that reads a record and analyses it with a ship or a length (predict, identify,
   diagnose, metrics, nomoto, estimate with --truth) refuses a record of another ship in one line
@@ -94,7 +94,7 @@ def model3m(tmp_path_factory, sims):
 
 @pytest.fixture(scope="module")
 def full_frt(tmp_path_factory, sims):
-    """ZZ20's truth (325 m, 5.14 m/s) in the FRT layout, and moved to a 120 m ship at 6 m/s (the issue's record)."""
+    """ZZ20's truth (325 m, 5.14 m/s) in the FRT layout, and moved to a 120 m ship at 6 m/s."""
     from trials.files.logio import read_record
 
     d = tmp_path_factory.mktemp("full_frt")
@@ -106,8 +106,8 @@ def full_frt(tmp_path_factory, sims):
 
 
 def test_frt_full_scale_with_length_accepted(full_frt, tmp_path, capsys):
-    """The issue's 120 m ship at 6 m/s in the FRT layout: metrics and nomoto with --length 120 run (exit 0);
-    on the old code both exit 2 ('Froude number 1.11 for a 3 m ship')."""
+    """A 120 m ship at 6 m/s in the FRT layout: metrics and nomoto with --length 120 run (exit 0), not
+    refused as a 3 m ship ('Froude number 1.11 for a 3 m ship')."""
     rec120 = full_frt[1]
     rc, out, err = _cli(["metrics", rec120, "--length", "120", "--json", tmp_path / "m.json"], capsys)
     assert rc == 0, err

@@ -1,7 +1,7 @@
 """A sea-trial log (positions, heading, speed over ground; no u, v) replayed with a known cross
 current: the replay must start with no sway through the water (the ship was on a straight
 approach), not with the stand-in zero of the logged sway turned into a sway of minus the current's
-cross part (issue 26, acceptance 3: the 1 kn current on ZZ20)."""
+cross part (the 1 kn current on ZZ20)."""
 from __future__ import annotations
 
 import subprocess

@@ -108,7 +108,7 @@ def test_replay_figure_readable(make):
 
 @pytest.mark.parametrize("make", [turn], ids=["turn"])
 def test_diagnose_figure_readable(make):
-    """A turn to scale; a long zigzag is drawn against its mean course, cross-track enlarged (issue 26):
+    """A turn to scale; a long zigzag is drawn against its mean course, cross-track enlarged:
     tests/test_diagnose_report.py::test_zigzag_track_not_a_strip."""
     rep, meas, pred = _replayed(make)
     after = 0.5 * (meas + pred)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import mmg
-from trials.measured.mismatch import MismatchSpec, mismatch_family, trial_records
+from trials.measured.mismatch import MismatchSpec, TrialConditions, mismatch_family, trial_records
 from trials.measured.wind_curves import TANKER_LOADED, HarmonicWindCurve
 
 SIMPLE = HarmonicWindCurve(a=(0.1, -0.8, 0.05, -0.02), b=(-0.7, 0.05, -0.02), c=(0.13, -0.06, 0.03))
@@ -87,8 +87,9 @@ def test_trial_record_sails_the_member_curve(families):
     member, f = fam["harmonic"][0]
     wind = {"wind": {}}
     tw = (15.0, math.radians(90.0))
-    fuji = trial_records(ship, member, "zz10", wind, seed=1, true_wind=tw, noise=(0.0,) * 6)
-    harm = trial_records(ship, member, "zz10", wind, seed=1, true_wind=tw, noise=(0.0,) * 6, wind_curve=f["wind_curve"])
+    fuji = trial_records(ship, member, "zz10", TrialConditions(wind, tw), seed=1, noise=(0.0,) * 6)
+    harm = trial_records(ship, member, "zz10", TrialConditions(wind, tw), seed=1, noise=(0.0,) * 6,
+                         wind_curve=f["wind_curve"])
     n = min(len(fuji.t), len(harm.t))
     assert np.max(np.abs(np.asarray(fuji.r[:n]) - np.asarray(harm.r[:n]))) > 1e-5
     calm = trial_records(ship, member, "zz10", {}, seed=1, noise=(0.0,) * 6, wind_curve=f["wind_curve"])

@@ -1,4 +1,4 @@
-"""The wind effect's shape factors (issue 26, "wind on every bundled ship"): the effect stands for *a*
+"""The wind effect's shape factors (wind on every bundled ship): the effect stands for *a*
 wind load, the published Fujiwara et al. (1998) curves times ``scale`` (X) and ``scale * sway_factor``
 (Y), ``scale * yaw_factor`` (N).
 

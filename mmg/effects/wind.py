@@ -121,7 +121,20 @@ class Wind(Effect):
         scale * (1, sway_factor, yaw_factor), the loads being linear in the scale and in each shape factor
         (:func:`mmg.wind.wind_forces`, :func:`mmg.wind.amplitude_vector`).  How a fit that computes a
         record's loads once (``mmg identify --free wind_scale wind_sway_factor wind_yaw_factor``: factors on
-        the loads of the ship's own values) applies its fitted values."""
+        the loads of the ship's own values) applies its fitted values.
+
+        Parameters
+        ----------
+        scale : float
+            Factor on all three loads [-].
+        sway_factor, yaw_factor : float
+            Further factors on the sway force and the yaw moment [-].
+
+        Returns
+        -------
+        ndarray, shape (3,)
+            The factors on X, Y and N [-].
+        """
         return scale * np.array([1.0, sway_factor, yaw_factor])
 
     @classmethod
@@ -158,8 +171,8 @@ class Wind(Effect):
         """The Fujiwara amplitudes with the values' shape terms (:func:`mmg.wind.amplitude_vector`)."""
         from ..wind import amplitude_vector
 
-        return amplitude_vector(particulars, float(values.get("sway_factor", 1.0)),
-                                float(values.get("yaw_factor", 1.0)), float(values.get("yaw_sin", 0.0)))
+        s = _shape(values)
+        return amplitude_vector(particulars, s.sway_factor, s.yaw_factor, s.yaw_sin)
 
     @classmethod
     def unavailable(cls, ctx: Context):
@@ -209,7 +222,13 @@ class Wind(Effect):
 
         X, Y, N = wind_forces(np.asarray(ctx.channels["wind_speed_rel"], float),
                               angle_from_dataset(ctx.channels["wind_dir_rel"]), ctx.ship.wind.particulars(),
-                              scale=float(values["scale"]), sway_factor=float(values.get("sway_factor", 1.0)),
-                              yaw_factor=float(values.get("yaw_factor", 1.0)),
-                              yaw_sin=float(values.get("yaw_sin", 0.0)))
+                              scale=float(values["scale"]), shape=_shape(values))
         return np.column_stack([X, Y, N])
+
+
+def _shape(values):
+    """The shape terms of the wind effect's ``values`` (:class:`mmg.wind.WindShape`; a term not given: neutral)."""
+    from ..wind import WindShape
+
+    return WindShape(float(values.get("sway_factor", 1.0)), float(values.get("yaw_factor", 1.0)),
+                     float(values.get("yaw_sin", 0.0)))

@@ -25,16 +25,17 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from mmg.parameters import LINEAR_TERMS
 from mmg.ship import Ship
 from mmg.units import KNOT
 
 __all__ = ["DEV_NOISE_HALF_WIDTHS", "DEV_TRIALS", "HULL_LINEAR_TERMS", "RUDDER_CONSTANTS", "TRIALS", "MismatchSpec",
-           "WIDE_TRIALS", "crossflow_fit", "froude_scaled", "mismatch_family", "mismatch_member", "mismatch_ship",
-           "trial_hand", "trial_records"]
+           "TrialConditions", "WIDE_TRIALS", "crossflow_fit", "froude_scaled", "mismatch_family", "mismatch_member",
+           "mismatch_ship", "trial_hand", "trial_records"]
 
-HULL_LINEAR_TERMS = ("beta", "r", "v")
-"""Hull terms counted as linear; with them the straight-ahead resistance (:func:`mmg.terms.is_resistance`:
-``X_uu``'s ``cos(beta)^2``, ``X_0``'s ``1``).  The rest, but the other constants ``"1"``, are nonlinear."""
+HULL_LINEAR_TERMS = LINEAR_TERMS
+"""Hull terms counted as linear (:data:`mmg.parameters.LINEAR_TERMS`); with them the straight-ahead resistance
+(:func:`mmg.terms.is_resistance`: ``X_uu``'s ``cos(beta)^2``, ``X_0``'s ``1``).  The rest, but the other constants ``"1"``, are nonlinear."""
 
 RUDDER_CONSTANTS = ("f_alpha", "epsilon", "kappa", "t_R", "a_H", "x_H_prime", "gamma_R_pos", "gamma_R_neg")
 """The rudder constants the family moves (the geometry, A_R, H_R, eta, x_R', l_R', is kept)."""
@@ -311,17 +312,38 @@ def froude_scaled(effects: dict, true_wind, noise, lam: float):
     return eff, (true_wind[0] * k, true_wind[1]), (du * k, dv * k, dr / k, dx / lam, dy / lam, dpsi)
 
 
-def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 0, true_wind=(0.0, 0.0),
-                  speed_kn: float = 10.0, noise=DEV_NOISE_HALF_WIDTHS, name: str | None = None, wind_curve=None):
+@dataclass(frozen=True)
+class TrialConditions:
+    """The conditions a trial of :func:`trial_records` is sailed in, at full scale.
+
+    Attributes
+    ----------
+    effects : dict or None
+        ``{effect: {parameter: value}}`` (mmg.effects); a ``wind`` entry gets the steady ``true_wind`` and
+        the truth ship's own wind-load factors (its ``wind`` section), so the wind acts through the member's
+        loads, not the config's.
+    true_wind : (float, float)
+        True wind speed [m/s] and the direction it comes from [rad, clockwise from north].
+    speed_kn : float
+        Approach speed [kn].
+    """
+
+    effects: dict | None = None
+    true_wind: tuple = (0.0, 0.0)
+    speed_kn: float = 10.0
+
+
+def trial_records(ship: Ship, truth: Ship, kind: str, conditions=None, seed: int = 0,
+                  noise=DEV_NOISE_HALF_WIDTHS, name: str | None = None, wind_curve=None):
     """A full-scale trial of ``truth`` logged as the development set's are.
 
     10 s straight run at heading 0, then the execute; a turn runs 1500 s after it, a zigzag to its
     ninth reversal plus 60 s (simulated for 4000 s, longer below 10 kn in proportion); constant propeller
-    revolutions (the approach's, at ``speed_kn``); 1 s samples; uniform noise of half-widths ``noise`` (u, v,
-    r, x, y, psi).  For a model-scale ``ship`` (``ship.froude_scale`` = lambda > 1) the trial is the
-    full-scale one Froude-scaled: ``speed_kn``, ``effects``, ``true_wind`` and ``noise`` are given at full
-    scale and taken to the model by :func:`froude_scaled`, the times (execute, length, tail, sampling) by
-    1/sqrt(lambda); the record's ``meta["effects"]`` holds the model-scale effects.
+    revolutions (the approach's, at the conditions' ``speed_kn``); 1 s samples; uniform noise of half-widths
+    ``noise`` (u, v, r, x, y, psi).  For a model-scale ``ship`` (``ship.froude_scale`` = lambda > 1) the trial
+    is the full-scale one Froude-scaled: the conditions and ``noise`` are given at full scale and taken to the
+    model by :func:`froude_scaled`, the times (execute, length, tail, sampling) by 1/sqrt(lambda); the
+    record's ``meta["effects"]`` holds the model-scale effects.
 
     Parameters
     ----------
@@ -331,18 +353,12 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
         The ship that sails (a family member).
     kind : str
         A key of :data:`TRIALS`.
-    effects : dict, optional
-        ``{effect: {parameter: value}}`` (mmg.effects); a ``wind`` entry gets the steady
-        ``true_wind`` and ``truth``'s own wind-load factors (its ``wind`` section), so the wind acts
-        through the member's loads, not the config's.
+    conditions : TrialConditions or dict, optional
+        The effects, true wind and approach speed; a dict: the effects alone, in calm air at 10 kn.
     seed : int
         Noise seed.
-    true_wind : (float, float)
-        True wind speed [m/s, full scale] and the direction it comes from [rad, clockwise from north].
-    speed_kn : float
-        Approach speed [kn, full scale].
     noise : sequence of 6 floats
-        Uniform half-widths.
+        Uniform half-widths, full scale.
     name : str, optional
     wind_curve : dict, optional
         A member's ``factors["wind_curve"]`` (:func:`mismatch_family`): its wind loads follow that
@@ -354,11 +370,12 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
     -------
     trials.files.records.TrialRecord
     """
-    from .diagnose.records import synthetic_record
+    from .diagnose.records import Manoeuvre, RecordNoise, synthetic_record
 
+    c = conditions if isinstance(conditions, TrialConditions) else TrialConditions(conditions)
     tr = TRIALS[kind]
     lam = ship.froude_scale
-    eff, true_wind, noise = froude_scaled(effects, true_wind, noise, lam)
+    eff, true_wind, noise = froude_scaled(c.effects, c.true_wind, noise, lam)
     ts = 1.0 / math.sqrt(lam)                              # model time / full-scale time
     if "wind" in eff:
         if truth.wind is None:
@@ -374,11 +391,11 @@ def trial_records(ship: Ship, truth: Ship, kind: str, effects=None, seed: int = 
         loads = lambda V, g: curve.loads(V, g, geometry)  # noqa: E731
     te = 10.0 * ts
     zig = tr["kind"] == "zigzag"
-    rec = synthetic_record(ship, tr["kind"], eff, truth_ship=rpm, speed=speed_kn * KNOT * ts,
-                           duration=(4000.0 * max(1.0, 10.0 / speed_kn) if zig else 10.0 + 1500.0) * ts, dt=ts,
-                           rudder_deg=tr["rudder_deg"],
-                           heading_deg=tr.get("heading_deg"), t_execute=te, true_wind=true_wind, noise=noise,
-                           noise_dist="uniform", seed=seed, name=name or kind, wind_loads=loads)
+    man = Manoeuvre(tr["kind"], rudder_deg=tr["rudder_deg"], speed=c.speed_kn * KNOT * ts,
+                    duration=(4000.0 * max(1.0, 10.0 / c.speed_kn) if zig else 10.0 + 1500.0) * ts, dt=ts,
+                    heading_deg=tr.get("heading_deg"), t_execute=te)
+    rec = synthetic_record(ship, man, eff, truth_ship=rpm, true_wind=true_wind,
+                           noise=RecordNoise(noise, "uniform", seed), name=name or kind, wind_loads=loads)
     if zig:
         rec = rec.slice_time(-math.inf, _zigzag_end(rec, te, 9, 60.0 * ts) + 1e-9 * ts)
     return replace(rec, meta={**rec.meta, "trial": kind, "effects": eff})

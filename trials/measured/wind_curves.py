@@ -86,7 +86,20 @@ class HarmonicWindCurve:
         return coefficient_loads(V_rel, *self.coefficients(gamma), particulars, rho_air)
 
     def drawn(self, rng: np.random.Generator, half_width: float) -> "HarmonicWindCurve":
-        """A curve of the same form, every coefficient times its own 1 + u, u uniform in [-half_width, half_width]."""
+        """A curve of the same form, every coefficient times its own 1 + u, u uniform in [-half_width, half_width].
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The draws' source (one uniform number per coefficient, in the order a, b, c).
+        half_width : float
+            The largest relative change of a coefficient [-] (0.3: each within 30 % of its value).
+
+        Returns
+        -------
+        HarmonicWindCurve
+            The drawn curve; the same number of harmonics as this one.
+        """
         f = lambda xs: tuple(float(x * (1.0 + rng.uniform(-half_width, half_width))) for x in xs)  # noqa: E731
         return HarmonicWindCurve(f(self.a), f(self.b), f(self.c))
 

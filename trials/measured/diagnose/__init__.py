@@ -93,7 +93,8 @@ from .baseline import (CONSTANTS_FREE, DRIFT_KIND, MASS_FREE, SHIP_FREE_TERMS,  
                        TURN_CONSTANTS_FREE, TURN_HULL_TERMS, ZIGZAG_CONSTANTS_FREE, _ship_free)
 from .fit import _Model  # noqa: F401
 from .options import DiagnoseOptions  # noqa: F401
-from .records import Prepared, noise_level, prepare, synthetic_record, write_frt_csv  # noqa: F401
+from .records import (Manoeuvre, Prepared, RecordNoise, noise_level, prepare, synthetic_record,  # noqa: F401
+                      write_frt_csv)
 from .rules import module_rule
 from .result import (CHANNELS, Diagnosis, absent_table, model_form_mismatch, ship_fit_table,  # noqa: F401
                      straight_run_table, _describe)
@@ -102,7 +103,8 @@ from .statistics import _delta_bic, _effect_report, _tau  # noqa: F401
 from .verdicts import _demote, rivals_withheld, to_demote, weak_evidence, withheld, within_mismatch  # noqa: F401
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "straight_contradicts",
-           "prepare", "synthetic_record", "write_frt_csv", "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
+           "prepare", "synthetic_record", "Manoeuvre", "RecordNoise", "write_frt_csv",
+           "diagnose_each", "SHIP_FREE_TERMS", "MASS_FREE",
            "CONSTANTS_FREE", "TURN_CONSTANTS_FREE", "ZIGZAG_CONSTANTS_FREE", "TURN_HULL_TERMS", "DRIFT_FALL_MIN",
            "BIC_THRESHOLD", "Z_THRESHOLD", "CHANNELS"]
 

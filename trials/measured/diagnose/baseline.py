@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 
 from mmg.terms import is_resistance
-from mmg.parameters import MASS_NAMES
+from mmg.parameters import LINEAR_TERMS, MASS_NAMES, parameter  # noqa: F401 (LINEAR_TERMS: in __all__)
 from mmg.ship import Ship
 
 from .fit import _config_model
@@ -80,26 +80,20 @@ in the one table of prior widths): an added mass a few % off leaves a residual (
 the turn, sway and yaw lag) that an effect would otherwise take."""
 
 
-LINEAR_TERMS = ("beta", "r", "v")
-"""Hull terms whose coefficients take the ``hull`` (linear) width of
-:data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`; the straight-ahead resistance (:func:`mmg.terms.is_resistance`)
-takes its ``resistance`` width, every other freed hull term its ``hull_nonlinear`` one."""
-
-
-def _baseline_prior(f, term):
-    """``f`` (a :class:`ekf.identify.FreeParameter`) with the diagnosis's prior width
-    (:data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD`, by the term's family) and, for a hull coefficient,
-    its config sign kept as a bound (the signs that define the ship: a positive Y_beta, a negative N_r)."""
+def _baseline_prior(f, entry):
+    """``f`` (a :class:`ekf.identify.FreeParameter`) with the diagnosis's prior of its parameter-table
+    ``entry`` (:class:`mmg.parameters.ShipParameter`): the width of its ``diagnosis_family`` in
+    :data:`ekf.identify.DIAGNOSIS_PRIOR_REL_STD` (floored at its ``diagnosis_floor``) and, where it
+    ``keeps_sign``, its config sign as a bound; ``f`` as it is for an entry without a diagnosis family."""
     from ekf.identify import DIAGNOSIS_PRIOR_REL_STD as P
 
-    if f.kind == "hull":
-        fam = "hull" if term in LINEAR_TERMS else "resistance" if is_resistance(f.name, term) else "hull_nonlinear"
-        lo, hi = (0.0, np.inf) if f.prior > 0 else (-np.inf, 0.0) if f.prior < 0 else (f.lower, f.upper)
-        return replace(f, sigma=max(P[fam] * abs(f.prior), P["hull_floor"]), lower=max(lo, f.lower),
-                       upper=min(hi, f.upper))
-    if f.kind == "w_P0":
-        return replace(f, sigma=max(P["w_P0"] * abs(f.prior), 0.01))
-    return f
+    if not entry.diagnosis_family:
+        return f
+    sigma = max(P[entry.diagnosis_family] * abs(f.prior), entry.diagnosis_floor)
+    if not entry.keeps_sign:
+        return replace(f, sigma=sigma)
+    lo, hi = (0.0, np.inf) if f.prior > 0 else (-np.inf, 0.0) if f.prior < 0 else (f.lower, f.upper)
+    return replace(f, sigma=sigma, lower=max(lo, f.lower), upper=min(hi, f.upper))
 
 
 def _ship_free(ship: Ship, packed, names=None, kind: str = "zigzag", drift: bool = False):
@@ -123,8 +117,7 @@ def _ship_free(ship: Ship, packed, names=None, kind: str = "zigzag", drift: bool
         names = [n for n in names if n not in MASS_FREE]
     free = free_parameters(packed, ship.hull.names, names + mass, priors=DIAGNOSIS_PRIOR_REL_STD,
                            hull_terms=ship.hull.terms)
-    terms = dict(zip(ship.hull.names, ship.hull.terms))
-    return [_baseline_prior(f, terms.get(f.name)) for f in free]
+    return [_baseline_prior(f, parameter(f.name, ship.hull.names, ship.hull.terms)) for f in free]
 
 
 def _baseline(fitter, noise, say):

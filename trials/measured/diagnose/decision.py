@@ -44,7 +44,7 @@ __all__ = ["BIC_THRESHOLD", "Z_THRESHOLD", "WEAK_BIC", "evidence_short", "KINDS"
            "false_alarm_probability", "calibration", "residual_floor", "current_components", "mean_heading",
            "clears_floor", "over_floor", "floor_parts", "least_floor", "COMPONENT_FLOORS", "STATISTICAL_REASON",
            "REASON_KINDS", "KIND_FALLBACK", "by_kind", "packaged_calibration", "PART_UNITS", "SPEED_UNIT", "speed_part_units",
-           "part_units", "part_size", "typical_speed"]
+           "part_units", "part_size", "part_name", "typical_speed"]
 
 _RULES = {"BIC_THRESHOLD": "bic_threshold", "Z_THRESHOLD": "z_threshold", "WEAK_BIC": "weak_bic"}
 """The module's names of numbers of the diagnosis rules (:mod:`.rules`), read-only: ``BIC_THRESHOLD``, the dBIC
@@ -146,7 +146,18 @@ def speed_part_units() -> dict:
 def typical_speed(meas) -> float:
     """The records' typical speed U [m/s]: the median over every sample of every record of the logged
     speed over ground, hypot(u, v) (``meas`` a sequence of (N, >=2) arrays, u, v [m/s] their first
-    columns); 0 where no sample is finite."""
+    columns); 0 where no sample is finite.
+
+    Parameters
+    ----------
+    meas : sequence of array_like
+        The records' measured states, each (N, >=2) with u, v [m/s] as its first two columns.
+
+    Returns
+    -------
+    float
+        U [m/s]; 0.0 where no sample is finite.
+    """
     a = np.concatenate([np.hypot(np.asarray(m, float)[:, 0], np.asarray(m, float)[:, 1]) for m in meas])
     a = a[np.isfinite(a)]
     return float(np.median(a)) if len(a) else 0.0
@@ -154,7 +165,21 @@ def typical_speed(meas) -> float:
 
 def part_units(kind: str, units: dict | None = None) -> dict:
     """``{part floor: unit}`` of the parts a current is judged by on ``kind`` (:data:`COMPONENT_FLOORS`),
-    as ``units`` (the calibration's by default) says them; a part it does not name is in sqrt(gL)."""
+    as ``units`` (the calibration's by default) says them; a part it does not name is in sqrt(gL).
+
+    Parameters
+    ----------
+    kind : str
+        The kind of the record set (:func:`record_kind`); a kind without part floors has none.
+    units : dict, optional
+        ``{part floor: unit}``; the calibration file's ``units`` by default.
+
+    Returns
+    -------
+    dict
+        ``{part floor name (e.g. "current_along"): unit}``, the unit ``"sqrt(gL)"`` (as :func:`magnitude`
+        gives a current) or :data:`SPEED_UNIT`; empty for a kind judged by the magnitude alone.
+    """
     units = (calibration().get("units") or {}) if units is None else units
     return {c: str(units.get(c, MAGNITUDE_UNITS["current"])) for c in COMPONENT_FLOORS.get(kind, ())}
 
@@ -162,10 +187,43 @@ def part_units(kind: str, units: dict | None = None) -> dict:
 def part_size(x: float, unit: str, L: float, speed: float | None) -> float:
     """A current's part ``x`` (over sqrt(g L), :func:`current_components`) in a part floor's ``unit``:
     itself for sqrt(gL), x sqrt(g L) / U for :data:`SPEED_UNIT` (U = ``speed`` [m/s], the records'
-    :func:`typical_speed`; NaN without a speed).  ``L``: ship length [m]."""
+    :func:`typical_speed`; NaN without a speed).
+
+    Parameters
+    ----------
+    x : float
+        The part, over sqrt(g L) [-].
+    unit : str
+        The part floor's unit (:func:`part_units`).
+    L : float
+        Ship length [m].
+    speed : float or None
+        The records' typical speed U [m/s]; needed for :data:`SPEED_UNIT` only.
+
+    Returns
+    -------
+    float
+        The part in ``unit`` [-]; NaN for :data:`SPEED_UNIT` without a positive speed.
+    """
     if unit != SPEED_UNIT:
         return x
     return x * math.sqrt(G * L) / speed if speed and speed > 0 else math.nan
+
+
+def part_name(part_floor: str) -> str:
+    """The name a part floor's part is reported under: the last word of the floor's name.
+
+    Parameters
+    ----------
+    part_floor : str
+        A part floor's name (:data:`COMPONENT_FLOORS`, e.g. ``"current_along"``).
+
+    Returns
+    -------
+    str
+        The part (``"along"``, ``"across"``): the key of :func:`floor_parts` and of a candidate's ``parts``.
+    """
+    return part_floor.split("_")[-1]
 
 
 def clears_floor(effect: str, values: dict, L: float, kind: str, heading: float | None = None,
@@ -216,7 +274,7 @@ def floor_parts(effect: str, values: dict, L: float, kind: str, heading: float |
     if any(units[c] == SPEED_UNIT for c in comp) and not (speed and speed > 0):
         return {}
     parts = current_components(values, L, heading)
-    return {c.split("_")[-1]: (float(f"{part_size(x, units[c], L, speed):.4g}"), floor(c, kind))
+    return {part_name(c): (float(f"{part_size(x, units[c], L, speed):.4g}"), floor(c, kind))
             for x, c in zip(parts, comp)}
 
 

@@ -239,14 +239,14 @@ def _trial_segments(fitter, specs, segment_s):
     """The candidate trials simulated with the config ship at the records' approach speed, prepared."""
     from dataclasses import replace
 
-    from .records import prepare, synthetic_record
+    from .records import Manoeuvre, prepare, synthetic_record
 
     recs = fitter.recs
     U = float(np.median([math.hypot(p.seg.meas[0, 0], p.seg.meas[0, 1]) for p in recs]))
     dt = float(np.median(np.diff(recs[0].seg.inputs.t)))
     out = []
     for label, kw in specs:
-        rec = synthetic_record(fitter.ship, effects=None, speed=U, dt=dt, seed=0, name=f"trial{len(out)}", **kw)
+        rec = synthetic_record(fitter.ship, Manoeuvre(speed=U, dt=dt, **kw), name=f"trial{len(out)}")
         calm = np.zeros_like(rec.t)              # a trial in calm air: a named wind effect's loads are zero in it
         rec = replace(rec, wind_speed_rel=calm, wind_dir_rel=calm)
         out.append((label, prepare(fitter.ship, [rec], segment_s=segment_s)[0].seg))

@@ -14,8 +14,8 @@ from mmg.ship import Ship
 
 from .rules import module_rule, rule
 
-__all__ = ["Prepared", "prepare", "absent_channels", "synthetic_record", "write_frt_csv", "RESTART_SMOOTH",
-           "leading_straight_run", "noise_level"]
+__all__ = ["Prepared", "prepare", "absent_channels", "synthetic_record", "Manoeuvre", "RecordNoise", "write_frt_csv",
+           "RESTART_SMOOTH", "leading_straight_run", "noise_level"]
 
 _RULES = {"RESTART_SMOOTH": "restart_smooth", "STRAIGHT_YAW": "straight_yaw", "STRAIGHT_RUDDER_DEG": "straight_rudder_deg",
           "STRAIGHT_TRIM_DEG": "straight_trim_deg", "STRAIGHT_MIN_SAMPLES": "straight_min_samples",
@@ -204,96 +204,198 @@ def _smoothed(t: np.ndarray, meas: np.ndarray, window_s: float) -> np.ndarray:
 # --------------------------------------------------------------------------- synthetic records
 
 
-def synthetic_record(ship: Ship, kind: str, effects=None, truth_ship: Ship | None = None, speed: float | None = None,
-                     duration: float | None = None, dt: float = 0.5, rudder_deg: float = 20.0,
-                     true_wind=(0.0, 0.0), noise=None, seed: int = 0, name: str | None = None,
-                     heading_deg: float | None = None, t_execute: float | None = None, noise_dist: str = "normal",
-                     wind_loads=None):
-    """A record as a trial would log it, with hidden effects: a turning or zigzag of ``truth_ship``
-    (default ``ship``) simulated closed loop (the rudder orders from its own heading), then
-    replayed with its rudder and revolutions and the ``effects`` (an :class:`mmg.effects.EffectSet`
-    or a ``{name: {parameter: value}}`` mapping; wind from the constant ``true_wind`` (speed
-    [m/s], direction it comes from [rad]) by a fixed-point iteration on the relative wind) and
-    logged (u, v over ground resolved in the logged heading, heading with its bias) with white
-    noise (``noise``: std per column u, v, r, x, y, psi; default small).  Returns a
-    :class:`trials.files.records.TrialRecord` with rudder, revolutions and, when wind is on, the relative
-    and true wind channels.
+@dataclass(frozen=True)
+class Manoeuvre:
+    """The manoeuvre a synthetic record logs (:func:`synthetic_record`).
 
-    A negative ``rudder_deg`` turns to port (a zigzag: port first); ``heading_deg`` is a zigzag's
-    switching heading change (default ``|rudder_deg|``); ``t_execute`` [s] the time of the rudder
-    execute (default 5 sqrt(L/g) for a turning, 0 for a zigzag); ``noise_dist="uniform"`` draws
-    the noise uniform with ``noise`` as the half-widths instead of the standard deviations.  A
-    steady true wind in the effects (``true_speed_mps`` > 0) acts in the closed-loop run too, so
-    a zigzag's rudder answers the wind as a helmsman's would.  ``wind_loads``, a callable
-    (V_rel [m/s], gamma [rad]) -> (X, Y [N], N [N m]), replaces the wind effect's loads in the
-    logged states (a ship whose wind loads follow another curve); the closed-loop run that makes the
-    rudder history keeps the effect's own."""
+    Attributes
+    ----------
+    kind : str
+        ``"turning"`` or ``"zigzag"``.
+    rudder_deg : float
+        Rudder angle [deg]; negative turns to port (a zigzag: port first).
+    speed : float or None
+        Approach speed [m/s]; None: 0.09 sqrt(g L).
+    duration : float or None
+        Length of the record [s]; None: 120 sqrt(L/g) for a turning, 160 sqrt(L/g) for a zigzag.
+    dt : float
+        Sampling interval of the record [s].
+    heading_deg : float or None
+        A zigzag's switching heading change [deg]; None: ``|rudder_deg|``.
+    t_execute : float or None
+        Time of the rudder execute [s]; None: 5 sqrt(L/g) for a turning, 0 for a zigzag.
+    """
+
+    kind: str
+    rudder_deg: float = 20.0
+    speed: float | None = None
+    duration: float | None = None
+    dt: float = 0.5
+    heading_deg: float | None = None
+    t_execute: float | None = None
+
+    def law(self, L: float):
+        """The rudder's command law and the record's length.
+
+        Parameters
+        ----------
+        L : float
+            Ship length [m] (the default times scale with sqrt(L/g)).
+
+        Returns
+        -------
+        law : mmg.integrate.CommandLaw
+            The rudder schedule (turning) or the heading-switching autopilot (zigzag).
+        T : float
+            The record's length [s].
+
+        Raises
+        ------
+        ValueError
+            An unknown ``kind``.
+        """
+        from mmg.integrate import CommandLaw
+
+        s = math.sqrt(L / G)
+        a = math.radians(self.rudder_deg)
+        if self.kind == "turning":
+            T = self.duration or 120.0 * s
+            te = 5.0 * s if self.t_execute is None else self.t_execute
+            return CommandLaw.schedule([0.0, te, te + 1e-6, max(T, te + 1.0)], [0.0, 0.0, a, a]), T
+        if self.kind == "zigzag":
+            h = abs(a) if self.heading_deg is None else math.radians(self.heading_deg)
+            law = CommandLaw.heading_switch(abs(a), h, -h, 1.0 if a >= 0 else -1.0, psi0=0.0,
+                                            t_start=self.t_execute or 0.0)
+            return law, self.duration or 160.0 * s
+        raise ValueError(self.kind)
+
+
+@dataclass(frozen=True)
+class RecordNoise:
+    """The white noise on a synthetic record's logged states (:func:`synthetic_record`).
+
+    Attributes
+    ----------
+    widths : sequence of 6 floats or None
+        Per column u [m/s], v [m/s], r [rad/s], x [m], y [m], psi [rad]: the standard deviations (``"normal"``)
+        or the half-widths (``"uniform"``); None: small, 0.002 U for u and v, 1.2e-4 sqrt(g/L) for r,
+        0.002 L for x and y, 0.05 deg for psi.
+    dist : str
+        ``"normal"`` or ``"uniform"``.
+    seed : int
+        Seed of the noise draws.
+    """
+
+    widths: tuple | None = None
+    dist: str = "normal"
+    seed: int = 0
+
+    def scales(self, U0: float, L: float) -> np.ndarray:
+        """The widths (6,) in SI, the default's at approach speed ``U0`` [m/s] and ship length ``L`` [m]."""
+        if self.widths is not None:
+            return np.array(self.widths)
+        return np.array([0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(G / L), 0.002 * L, 0.002 * L, math.radians(0.05)])
+
+
+def synthetic_record(ship: Ship, manoeuvre, effects=None, truth_ship: Ship | None = None, true_wind=(0.0, 0.0),
+                     noise: RecordNoise | None = None, name: str | None = None, wind_loads=None):
+    """A record as a trial would log it, with hidden effects: a turning or zigzag of ``truth_ship``
+    simulated closed loop (the rudder orders from its own heading), then replayed with its rudder and
+    revolutions and the ``effects`` and logged (u, v over ground resolved in the logged heading, heading
+    with its bias) with white noise.
+
+    A steady true wind in the effects (``true_speed_mps`` > 0) acts in the closed-loop run too, so a
+    zigzag's rudder answers the wind as a helmsman's would.
+
+    Parameters
+    ----------
+    ship : Ship
+        The config ship (the ship that sails where ``truth_ship`` is None).
+    manoeuvre : Manoeuvre or str
+        The manoeuvre; a kind alone (``"turning"``, ``"zigzag"``) for its defaults.
+    effects : mmg.effects.EffectSet or dict, optional
+        The hidden effects (``{name: {parameter: value}}``); a wind effect's loads come from the constant
+        ``true_wind`` by a fixed-point iteration on the relative wind.
+    truth_ship : Ship, optional
+        The ship that sails (default ``ship``).
+    true_wind : (float, float)
+        True wind speed [m/s] and the direction it comes from [rad].
+    noise : RecordNoise, optional
+        The noise on the logged states (default :class:`RecordNoise`'s: small, normal, seed 0).
+    name : str, optional
+        The record's name and source (default ``"synthetic_<kind>"``).
+    wind_loads : callable, optional
+        ``(V_rel [m/s], gamma [rad]) -> (X, Y [N], N [N m])``: replaces the wind effect's loads in the logged
+        states (a ship whose wind loads follow another curve); the closed-loop run that makes the rudder
+        history keeps the effect's own.
+
+    Returns
+    -------
+    trials.files.records.TrialRecord
+        With rudder, revolutions and, when wind is on, the relative and true wind channels.
+    """
     import mmg.effects as E
-    from mmg.integrate import CommandLaw
-    from mmg.replay import ReplayInputs, replay_states
     from mmg.simulation import simulate
-    from mmg.wind import relative_wind_from_true
 
     from ...files.records import logged_record
 
+    m = Manoeuvre(manoeuvre) if isinstance(manoeuvre, str) else manoeuvre
+    noise = RecordNoise() if noise is None else noise
+    if noise.dist not in ("normal", "uniform"):
+        raise ValueError(f"noise dist {noise.dist!r}: 'normal' or 'uniform'")
     es = effects if isinstance(effects, E.EffectSet) else E.effect_set(effects or {})
     truth = truth_ship or ship
     L = truth.particulars.L
-    s = math.sqrt(L / G)
-    U0 = speed or 0.09 * math.sqrt(G * L)
-    a = math.radians(rudder_deg)
-    if kind == "turning":
-        T = duration or 120.0 * s
-        te = 5.0 * s if t_execute is None else t_execute
-        law = CommandLaw.schedule([0.0, te, te + 1e-6, max(T, te + 1.0)], [0.0, 0.0, a, a])
-    elif kind == "zigzag":
-        T = duration or 160.0 * s
-        h = abs(a) if heading_deg is None else math.radians(heading_deg)
-        law = CommandLaw.heading_switch(abs(a), h, -h, 1.0 if a >= 0 else -1.0, psi0=0.0, t_start=t_execute or 0.0)
-    else:
-        raise ValueError(kind)
+    U0 = m.speed or 0.09 * math.sqrt(G * L)
+    law, T = m.law(L)
     # the closed-loop run that makes the rudder history has the effects that act on the dynamics
     # through the parameter vector (current, rudder offset, a steady true wind); the record's states
     # are the replay's below
     acts = lambda c, v: bool(c.slots(v)) or (c.name == "wind" and c.steady(v))  # noqa: E731
-    sim = simulate(truth, law, T, min(dt, 0.05 * s), U0, trim=False,
+    sim = simulate(truth, law, T, min(m.dt, 0.05 * math.sqrt(L / G)), U0, trim=False,
                    effects=E.EffectSet(tuple(it for it in es.items if acts(*it))))
-    t = np.arange(0.0, T + 1e-9, dt)
-    idx = np.searchsorted(sim.t, t - 1e-9)
-    idx = np.minimum(idx, len(sim.t) - 1)
+    t = np.arange(0.0, T + 1e-9, m.dt)
+    idx = np.minimum(np.searchsorted(sim.t, t - 1e-9), len(sim.t) - 1)
     delta, n = sim.states[idx, 6], sim.states[idx, 7]
-    s0 = sim.states[0, :6].copy()
     pk = es.pack(pack(truth, sim.equilibrium.power_W), truth)
-    wind_on = any(c.name == "wind" for c, _ in es.items)
-    Vt, dt_ = true_wind
-    wind_rel = None
-    if wind_on:
-        wind_eff = [(c, v) for c, v in es.items if c.name == "wind"]
-        rest = E.EffectSet(tuple(it for it in es.items if it[0].name != "wind"))
-        states = replay_states(pk, ReplayInputs(t, delta, n), s0)
-        for _ in range(4):
-            # the anemometer is aboard: the relative wind from the true one and the true motion over ground
-            og = E.EffectSet(tuple(it for it in rest.items if it[0].kind != "measurement")).to_logged(states)
-            Vr, ang = relative_wind_from_true(Vt, dt_, og[:, 0], og[:, 1], states[:, 5])
-            wind_rel = (Vr, np.mod(ang, 2 * np.pi))
-            ctx = E.Context(t=t, delta=delta, n=n, channels=dict(zip(("wind_speed_rel", "wind_dir_rel"), wind_rel)),
-                            ship=truth)
-            ext = (wind_eff[0][0].external(wind_eff[0][1], ctx) if wind_loads is None
-                   else np.column_stack(wind_loads(Vr, ang)))
-            states = replay_states(pk, ReplayInputs(t, delta, n, ext), s0)
-    else:
-        states = replay_states(pk, ReplayInputs(t, delta, n), s0)
-    sd = np.array(noise if noise is not None else [0.002 * U0, 0.002 * U0, 1.2e-4 * math.sqrt(G / L), 0.002 * L,
-                                                    0.002 * L, math.radians(0.05)])
-    label = name or f"synthetic_{kind}"
-    if noise_dist == "uniform":
+    states, wind_rel = _replayed(pk, es, truth, (t, delta, n), sim.states[0, :6].copy(), true_wind, wind_loads)
+    sd = noise.scales(U0, L)
+    label = name or f"synthetic_{m.kind}"
+    if noise.dist == "uniform":
         rec = logged_record(t, states, delta, n, es, None, None, wind_rel, name=label, source=label,
                             meta={"format": "synthetic"})
-        return _uniform_noise(rec, sd, np.random.default_rng(seed))
-    if noise_dist != "normal":
-        raise ValueError(f"noise_dist {noise_dist!r}: 'normal' or 'uniform'")
-    return logged_record(t, states, delta, n, es, sd, np.random.default_rng(seed), wind_rel,
+        return _uniform_noise(rec, sd, np.random.default_rng(noise.seed))
+    return logged_record(t, states, delta, n, es, sd, np.random.default_rng(noise.seed), wind_rel,
                          name=label, source=label, meta={"format": "synthetic"})
+
+
+def _replayed(pk, es, truth: Ship, inputs, s0, true_wind, wind_loads):
+    """(states, relative wind) of the replay of ``inputs`` = (t, delta, n) from ``s0`` on the packed ship
+    ``pk`` with the effects ``es``: with a wind effect, its loads from the relative wind that the true
+    wind and the replayed motion over ground give, iterated four times (``wind_loads`` in place of the
+    effect's where given); else no wind (None)."""
+    import mmg.effects as E
+    from mmg.replay import ReplayInputs, replay_states
+    from mmg.wind import relative_wind_from_true
+
+    t, delta, n = inputs
+    states = replay_states(pk, ReplayInputs(t, delta, n), s0)
+    wind_eff = [(c, v) for c, v in es.items if c.name == "wind"]
+    if not wind_eff:
+        return states, None
+    Vt, dt_ = true_wind
+    rest = E.EffectSet(tuple(it for it in es.items if it[0].name != "wind"))
+    for _ in range(4):
+        # the anemometer is aboard: the relative wind from the true one and the true motion over ground
+        og = E.EffectSet(tuple(it for it in rest.items if it[0].kind != "measurement")).to_logged(states)
+        Vr, ang = relative_wind_from_true(Vt, dt_, og[:, 0], og[:, 1], states[:, 5])
+        wind_rel = (Vr, np.mod(ang, 2 * np.pi))
+        ctx = E.Context(t=t, delta=delta, n=n, channels=dict(zip(("wind_speed_rel", "wind_dir_rel"), wind_rel)),
+                        ship=truth)
+        ext = (wind_eff[0][0].external(wind_eff[0][1], ctx) if wind_loads is None
+               else np.column_stack(wind_loads(Vr, ang)))
+        states = replay_states(pk, ReplayInputs(t, delta, n, ext), s0)
+    return states, wind_rel
 
 
 def _uniform_noise(rec, half_widths, rng):

@@ -10,7 +10,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .baseline import DRIFT_KIND
-from .decision import MAGNITUDE_UNITS, clears_floor, floor, floor_parts, magnitude, part_units
+from .decision import MAGNITUDE_UNITS, clears_floor, floor, floor_parts, magnitude, part_name, part_units
 from .fit import _Model
 from .options import DiagnoseOptions
 from .rules import rule
@@ -132,7 +132,7 @@ def _parts(fitter, name: str, values: dict) -> dict:
     p = floor_parts(name, values, fitter.ship.particulars.L, fitter.kind, fitter.heading, fitter.speed)
     if not p:
         return {}
-    units = {c.split("_")[-1]: u for c, u in part_units(fitter.kind).items()}
+    units = {part_name(c): u for c, u in part_units(fitter.kind).items()}
     return {"parts": {k: list(v) for k, v in p.items()}, "part_units": {k: units[k] for k in p}}
 
 
@@ -170,7 +170,7 @@ def _search(fitter, base, cand, ns, o: DiagnoseOptions, say):
                                            "straight_contradicts": straight_contradicts(current.straight, m.straight)}
                                           if len(m.straight) else {})}
                                       for (d, ok, c, m, v, s, z, g, rr), pa in zip(results, parts)]})
-        best = _best_standing(fitter, current, results, taus, inflate, ns, o, rounds[-1], say)
+        best = _best_standing(fitter, current, results, taus, inflate, o, rounds[-1], say)
         if best is None:
             break
         named.append(best[2].name)
@@ -199,7 +199,7 @@ def _rival(results, r):
     return max(rivals, key=lambda x: x[0]) if rivals else None
 
 
-def _best_standing(fitter, current, results, taus, inflate, ns, o: DiagnoseOptions, rnd: dict, say):
+def _best_standing(fitter, current, results, taus, inflate, o: DiagnoseOptions, rnd: dict, say):
     """The round's candidate to name: the one with the most evidence among those that clear the tests
     and hold beside their rival (:func:`_rival`), or None.
 

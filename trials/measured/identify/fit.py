@@ -371,18 +371,21 @@ def _training_runs(ship: Ship, paths_or_runs, o: IdentifyOptions) -> list[Measur
 
 
 def _bounded_wind(ship: Ship, fp: list) -> list:
-    """``fp`` with the bounds of the fitted wind values divided by the config's own (the fitted ones are
-    factors on the records' loads, which carry the config's; ship.yaml writes their product, which must
-    stay within the config's range: scale 0-10, shape factors 0.2-3)."""
+    """``fp`` with the bounds of each fitted factor divided by the config value it multiplies (its
+    parameter-table entry's :attr:`~mmg.parameters.ShipParameter.multiplies`: the wind values, factors on the
+    records' loads, which carry the config's; ship.yaml writes their product, which must stay within the
+    config's range: scale 0-10, shape factors 0.2-3)."""
     from dataclasses import replace
+
+    from mmg.parameters import CONSTANTS
 
     if ship.wind is None:
         return fp
-    keys, out = _wind_keys(), []
+    out = []
     for f in fp:
-        key = keys.get(f.name) if f.kind == "wind_scale" else None
-        c = float(getattr(ship.wind, key)) if key else 1.0
-        out.append(replace(f, lower=f.lower / c, upper=f.upper / c) if key and c > 0 and c != 1.0 else f)
+        entry = CONSTANTS.get(f.name)
+        c = entry.multiplies(ship) if entry is not None and entry.multiplies is not None else 1.0
+        out.append(replace(f, lower=f.lower / c, upper=f.upper / c) if c > 0 and c != 1.0 else f)
     return out
 
 
