@@ -12,8 +12,9 @@ from trials.measured.hybrid import (Correction, fit_correction, hybrid_states, r
                                     residual_samples)
 from trials.measured.predict import MeasuredRun  # noqa: E402
 
-DY_R = 0.03
-"""The hull's Y_r' of the records' ship minus the model's: the residual force the correction must learn."""
+DY_R, DN_R = 0.03, -0.01
+"""The hull's Y_r', N_r' of the records' ship minus the model's: the residual sway force and yaw moment
+the correction must learn."""
 
 
 def _constant(b2, lo=-1.0, hi=1.0) -> Correction:
@@ -42,8 +43,8 @@ def _records(ship, k_list):
 @pytest.fixture(scope="module")
 def truth(esso3m_ship):
     ship = esso3m_ship
-    y_r = dict(zip(ship.hull.names, ship.hull.values))["Y_r"]
-    return ship, ship.with_hull({"Y_r": y_r + DY_R})
+    h = dict(zip(ship.hull.names, ship.hull.values))
+    return ship, ship.with_hull({"Y_r": h["Y_r"] + DY_R, "N_r": h["N_r"] + DN_R})
 
 
 @pytest.fixture(scope="module")
@@ -92,8 +93,9 @@ def test_outside_flag_and_damping():
 
 
 def test_residual_of_a_known_hull_term_is_recovered(truth):
-    """Records of a ship whose Y_r' is the model's + 0.03: the residual sway force is 0.03 r' 1/2 rho L T U^2,
-    i.e. Y' = 0.03 (r L / V)(U / V) in the correction's units (an independent formula); X', N' are zero."""
+    """Records of a ship whose Y_r', N_r' are the model's + 0.03, - 0.01: the residual sway force is
+    0.03 r' 1/2 rho L T U^2, i.e. Y' = 0.03 (r L / V)(U / V) in the correction's units (an independent
+    formula), the yaw moment N' = -0.01 (r L / V)(U / V); X' is zero."""
     model, rec_ship = truth
     runs = _records(rec_ship, [0, 1, 2, 3])
     p = pack(model)
@@ -101,14 +103,16 @@ def test_residual_of_a_known_hull_term_is_recovered(truth):
     u, v, r = (np.concatenate([x.meas[::1, j] for x in runs]) for j in range(3))
     n = np.concatenate([x.inputs.n for x in runs])
     V = np.sqrt(u ** 2 + v ** 2 + (n * p.p[P_D]) ** 2 + p.p[P_ULOW] ** 2)
-    want = DY_R * (r * p.p[P_L] / V) * (np.hypot(u, v) / V)
+    shape = (r * p.p[P_L] / V) * (np.hypot(u, v) / V)
     inner = np.abs(np.arange(len(u)) % 1500 - 750) < 700                   # away from each record's ends
-    err = s.target[inner, 1] - want[inner]
-    assert np.sqrt(np.mean(err ** 2)) < 0.05 * np.sqrt(np.mean(want[inner] ** 2))
-    assert np.abs(s.target[inner][:, [0, 2]]).max() < 0.05 * np.abs(want[inner]).max()
     c = fit_correction(p, runs, "ridge", degree=2, stride=3)
-    pred = c.predict(s.features)[:, 1]
-    assert np.sqrt(np.mean((pred - want) ** 2)) < 0.2 * np.sqrt(np.mean(want ** 2))
+    for axis, d in ((1, DY_R), (2, DN_R)):
+        want = d * shape
+        err = s.target[inner, axis] - want[inner]
+        assert np.sqrt(np.mean(err ** 2)) < 0.05 * np.sqrt(np.mean(want[inner] ** 2))
+        pred = c.predict(s.features)[:, axis]
+        assert np.sqrt(np.mean((pred - want) ** 2)) < 0.2 * np.sqrt(np.mean(want ** 2))
+    assert np.abs(s.target[inner, 0]).max() < 0.05 * np.abs(DY_R * shape[inner]).max()
     assert c.records == ["rec0", "rec1", "rec2", "rec3"]
 
 
