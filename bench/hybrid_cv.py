@@ -7,14 +7,14 @@ read when present, else fitted here and written there) gets a correction of its 
 (:func:`trials.measured.hybrid.fit_correction`) fitted on the same training records only, with its penalty
 chosen by a grouped cross-validation over those records.  The kept-out records are replayed open loop with
 the Froude-scaled model, the identified one and the identified one plus each correction (``--variants``:
-``ridge-D`` a ridge polynomial of degree D, ``mlp-H`` a network of H tanh units).  No variant is chosen by
-its held-out figures: every one is reported; ``ridge-2`` is the one named before the run as the primary.
+``ridge-D`` a ridge polynomial of degree D, ``mlp-H`` a network of H tanh units; :data:`VARIANTS`).  No
+variant is chosen by its held-out figures: every one is reported.
 
 Per kind of record (``frt_gap.kind_of``) and pooled: mean whole-record heading RMS [deg] and mean heading
 RMS over 60 s windows every 30 s from the measured state [deg] (over the records every model kept finite),
 the divergences, and the mean share of the kept-out records' samples outside the correction's training box.
 
-Run: ``python bench/hybrid_cv.py --folds-dir DIR [--variants ridge-2 ridge-3 mlp-16] [--jobs 2] [--json out.json]``.
+Run: ``python bench/hybrid_cv.py --folds-dir DIR [--variants ridge-2/windows ridge-2 ...] [--jobs 2] [--json out.json]``.
 """
 from __future__ import annotations
 
@@ -32,8 +32,12 @@ sys.path.insert(1, str(Path(__file__).resolve().parent))
 
 from frt_gap import KINDS, kind_of  # noqa: E402
 
-VARIANTS = ("ridge-2", "ridge-3", "mlp-16")
-"""The corrections judged by default (``ridge-2`` the primary, named before the run)."""
+VARIANTS = ("ridge-2/windows", "ridge-2", "ridge-3", "mlp-16", "ridge-2/output")
+"""The corrections judged by default: ``FORM-SIZE[/windows]`` fitted to the residual forces, the penalty chosen
+by the grouped held-out residual forces or, with ``/windows``, by the grouped held-out 60 s-window replays with
+"no correction" a candidate (:func:`trials.measured.hybrid.fit_correction` ``select``); ``ridge-D/output``
+fitted by output error on the training records' windows, its penalty (or none) chosen by the same grouped
+window replays (:func:`trials.measured.hybrid.fit_output_correction`).  ``ridge-2/windows`` is the primary."""
 SCALED, IDENT = "scaled", "identified"
 
 
@@ -48,11 +52,14 @@ def _args(argv=None):
 
 
 def variant_options(label: str) -> dict:
-    """``ridge-2`` -> {"kind": "ridge", "degree": 2}; ``mlp-16`` -> {"kind": "mlp", "hidden": 16}."""
-    kind, _, size = label.partition("-")
-    if kind not in ("ridge", "mlp") or not size.isdigit():
-        raise SystemExit(f"--variants: {label!r} is not ridge-D or mlp-H")
-    return {"kind": kind, ("degree" if kind == "ridge" else "hidden"): int(size)}
+    """``ridge-2`` -> {"kind": "ridge", "degree": 2, "select": "forces"}; ``mlp-16/windows`` -> {"kind": "mlp",
+    "hidden": 16, "select": "windows"}."""
+    form, _, select = label.partition("/")
+    kind, _, size = form.partition("-")
+    if kind not in ("ridge", "mlp") or not size.isdigit() or select not in ("", "windows", "forces", "output") or (
+            select == "output" and kind != "ridge"):
+        raise SystemExit(f"--variants: {label!r} is not ridge-D or mlp-H, optionally with /windows (or ridge-D/output)")
+    return {"kind": kind, ("degree" if kind == "ridge" else "hidden"): int(size), "select": select or "forces"}
 
 
 def _scores(rep, windows) -> dict:
@@ -80,7 +87,7 @@ def _fold_ident(k: int, splits, folds_dir: Path, initial):
 def one_fold(task) -> dict:
     """Fit each correction on fold ``k``'s training records, replay its kept-out records with every model."""
     from mmg.model import pack
-    from trials.measured.hybrid import fit_correction, hybrid_window_scores, replay_hybrid
+    from trials.measured.hybrid import fit_correction, fit_output_correction, hybrid_window_scores, replay_hybrid
     from trials.measured.identify import with_fitted_wind, with_ship_effects
     from trials.measured.predict import replay_record
     from trials.measured.window import window_scores
@@ -94,7 +101,11 @@ def one_fold(task) -> dict:
     corr, fits = {}, {}
     for v in variants:
         t0 = time.perf_counter()
-        corr[v] = fit_correction(packed, [prep(r) for r in tr], **variant_options(v))
+        o = variant_options(v)
+        if o["select"] == "output":
+            corr[v] = fit_output_correction(packed, [prep(r) for r in tr], degree=o["degree"])
+        else:
+            corr[v] = fit_correction(packed, [prep(r) for r in tr], **o)
         fits[v] = {**corr[v].to_json(), "fit_s": time.perf_counter() - t0}
     rows = []
     for r in te:

@@ -162,3 +162,18 @@ def test_bench_summary_by_kind():
     assert out["turn"]["ridge-2"]["window_heading_rms_deg"] == pytest.approx(15.0)
     assert out["all"]["scaled"]["heading_rms_deg"] == pytest.approx(25.0)
     assert out["all"]["ridge-2"]["outside_share"] == pytest.approx(0.1)
+
+
+def test_output_error_correction_of_a_known_hull_term(truth):
+    """The output-error fit on three records of the altered ship replays a fourth closer than the model alone,
+    and its cross-validation over the training records prefers a correction to none."""
+    from trials.measured.hybrid import fit_output_correction
+
+    model, rec_ship = truth
+    train, (test,) = _records(rec_ship, [0, 1, 3]), _records(rec_ship, [2])
+    p = pack(model)
+    c = fit_output_correction(p, train, degree=1)
+    assert np.isfinite(c.alpha)
+    assert c.cv[c.alpha]["mean_window_heading_rms_deg"] < c.cv[float("inf")]["mean_window_heading_rms_deg"]
+    rms = lambda a: float(np.sqrt(np.mean(np.degrees(a[:, 5] - test.meas[:, 5]) ** 2)))  # noqa: E731
+    assert rms(replay_hybrid(model, test, c, p).pred) < 0.5 * rms(replay_states(p, test.inputs, test.meas[0]))

@@ -56,7 +56,8 @@ from .predict import MeasuredRun, Replayed
 from .window import EVERY_S, WINDOW_S, WindowScores, _window_run, window_bounds
 
 __all__ = ["Correction", "ResidualSamples", "residual_samples", "fit_correction", "hybrid_states", "replay_hybrid",
-           "hybrid_window_scores", "speed_scale", "FEATURES", "KINDS", "SMOOTH_L", "TAPER_SD", "ALPHAS"]
+           "hybrid_window_scores", "speed_scale", "FEATURES", "KINDS", "SMOOTH_L", "TAPER_SD", "ALPHAS", "SELECT",
+           "fit_output_correction", "OUTPUT_ALPHAS"]
 
 FEATURES = ("u/V", "v/V", "rL/V", "nD/V", "delta")
 """The correction's inputs, in order: u/V, v/V, r L/V, n D/V (V: :func:`speed_scale`), rudder angle [rad]."""
@@ -121,6 +122,8 @@ class ResidualSamples:
         V^4 [m^4/s^4]: the fit's sample weight (normalised there).
     group : ndarray (N,) of int
         The sample's record group (a record and its cut copies share one).
+    record : ndarray (N,) of int
+        The sample's record, an index into ``names``.
     names : list of str
         The records, in order of their samples.
     """
@@ -129,7 +132,14 @@ class ResidualSamples:
     target: np.ndarray
     weight: np.ndarray
     group: np.ndarray
+    record: np.ndarray
     names: list
+
+    def of(self, records) -> "ResidualSamples":
+        """The samples of the records of indices ``records`` only."""
+        keep = np.isin(self.record, list(records))
+        return ResidualSamples(self.features[keep], self.target[keep], self.weight[keep], self.group[keep],
+                               self.record[keep], [self.names[i] for i in sorted(set(records))])
 
 
 def _check_run(run: MeasuredRun) -> None:
@@ -168,8 +178,8 @@ def residual_samples(packed: PackedShip, runs: list[MeasuredRun], stride: int = 
     minv = np.array(inverse_mass(packed.p, np.zeros(8)))
     M = np.linalg.inv(minv.reshape(3, 3))
     groups = same_run_groups(runs)
-    F, Y, W, G = [], [], [], []
-    for run, g in zip(runs, groups):
+    F, Y, W, G, R = [], [], [], [], []
+    for j, (run, g) in enumerate(zip(runs, groups)):
         _check_run(run)
         m, inp = run.meas, run.inputs
         a_mod = np.empty((len(run.t), 3))
@@ -183,8 +193,9 @@ def residual_samples(packed: PackedShip, runs: list[MeasuredRun], stride: int = 
         keep[::stride] = True
         keep &= np.isfinite(f).all(axis=1) & np.isfinite(y).all(axis=1)
         F.append(f[keep]); Y.append(y[keep]); W.append(V[keep] ** 4); G.append(np.full(int(keep.sum()), g))  # noqa: E702
+        R.append(np.full(int(keep.sum()), j))
     return ResidualSamples(np.concatenate(F), np.concatenate(Y), np.concatenate(W), np.concatenate(G),
-                           [r.name for r in runs])
+                           np.concatenate(R), [r.name for r in runs])
 
 
 @dataclass(frozen=True)
@@ -393,25 +404,6 @@ def hybrid_window_scores(ship, run: MeasuredRun, correction: Correction, window_
                         heading_rms_deg=a[:, 2], position_error_m=a[:, 3], position_error_L=a[:, 4], short=short)
 
 
-def _grouped_cv(make, z, y, w, groups, alphas, folds: int) -> dict:
-    """{alpha: the held-out weighted mean square of the standardised residuals over a ``GroupKFold``}."""
-    from sklearn.model_selection import GroupKFold
-
-    k = min(folds, len(np.unique(groups)))
-    if k < 2:
-        raise ValueError("the grouped cross-validation of the penalty needs records of 2 or more runs")
-    out = {}
-    for a in alphas:
-        err, tot = 0.0, 0.0
-        for tr, te in GroupKFold(n_splits=k).split(z, y, groups):
-            model = make(a).fit(z[tr], y[tr], sample_weight=w[tr])
-            e = (model.predict(z[te]) - y[te]) ** 2
-            err += float(np.sum(w[te, None] * e))
-            tot += float(np.sum(w[te])) * y.shape[1]
-        out[float(a)] = err / tot
-    return out
-
-
 def _maker(kind: str, degree: int, hidden: int, seed: int):
     from sklearn.linear_model import Ridge
     from sklearn.neural_network import MLPRegressor
@@ -422,7 +414,7 @@ def _maker(kind: str, degree: int, hidden: int, seed: int):
         return lambda a: _Weighted(make_pipeline(PolynomialFeatures(degree, include_bias=False), Ridge(alpha=a)),
                                    "ridge__sample_weight")
     if kind == "mlp":
-        return lambda a: MLPRegressor((hidden,), activation="tanh", alpha=a, max_iter=300, tol=1e-5,
+        return lambda a: MLPRegressor(hidden_layer_sizes=(hidden,), activation="tanh", alpha=a, max_iter=300, tol=1e-5,
                                       random_state=seed)
     raise ValueError(f"kind {kind!r}: one of {', '.join(KINDS)}")
 
@@ -441,8 +433,13 @@ class _Weighted:
         return self.pipe.predict(z)
 
 
+SELECT = ("forces", "windows")
+"""How :func:`fit_correction` chooses the penalty: by the grouped held-out residual forces, or by the grouped
+held-out replays (60 s windows from the measured state; "off", no correction, a candidate too)."""
+
+
 def fit_correction(packed: PackedShip, runs: list[MeasuredRun], kind: str = "ridge", degree: int = 2, hidden: int = 16,
-                   alphas=None, folds: int = 3, stride: int = 2, seed: int = 0) -> Correction:
+                   alphas=None, folds: int = 3, stride: int = 2, seed: int = 0, select: str = "forces") -> Correction:
     """Fit the correction of ``packed``'s residual forces on the training records ``runs`` (module docstring).
 
     Parameters
@@ -456,29 +453,109 @@ def fit_correction(packed: PackedShip, runs: list[MeasuredRun], kind: str = "rid
     alphas : sequence of float, optional
         The penalties to choose among (:data:`ALPHAS` of the form when omitted).
     folds : int
-        Folds of the grouped cross-validation that chooses the penalty (over the training records' groups).
+        Folds of the grouped cross-validation over the training records' groups that chooses the penalty.
     stride : int
         Every ``stride``-th sample (the residuals are smoothed over :data:`SMOOTH_L` sqrt(L/g) anyway).
     seed : int
         The network's initial weights.
+    select : str
+        ``"forces"``: the penalty with the lowest held-out weighted mean square of the standardised residual
+        forces; ``"windows"``: the one (or no correction, ``alpha`` inf) whose held-out records' 60 s windows
+        replayed from the measured state have the fewest divergences, then the lowest mean heading RMS
+        (:data:`SELECT`).
 
     Returns
     -------
     Correction
+        With ``cv``: each penalty's cross-validated figure.
     """
+    if select not in SELECT:
+        raise ValueError(f"select {select!r}: one of {', '.join(SELECT)}")
     s = residual_samples(packed, runs, stride)
+    make = _maker(kind, degree, hidden, seed)
+    grid = tuple(ALPHAS[kind] if alphas is None else alphas)
+    if select == "forces":
+        cv = _grouped_cv(make, s, grid, folds)
+        alpha = min(cv, key=cv.get)
+    else:
+        cv = _window_cv(make, s, packed, runs, grid, folds, (kind, degree, hidden))
+        alpha = min(cv, key=lambda a: (cv[a]["diverged_windows"], cv[a]["mean_window_heading_rms_deg"]))
+    c = _fit_fixed(make, s, alpha, (kind, degree, hidden)) if np.isfinite(alpha) else _off(s, (kind, degree, hidden))
+    return replace(c, cv=cv)
+
+
+def _standardised(s: ResidualSamples):
+    """The fit's inputs: box, feature and target scales, standardised features and targets, normalised weights."""
     f = s.features
     lo, hi = np.percentile(f, 0.1, axis=0), np.percentile(f, 99.9, axis=0)
+    w = s.weight / s.weight.mean()
     mu, sd = f.mean(axis=0), f.std(axis=0)
     sd = np.where(sd > 0, sd, 1.0)
-    z = (np.clip(f, lo, hi) - mu) / sd
-    ys = s.target.std(axis=0)
+    ys = np.sqrt(np.average((s.target - np.average(s.target, 0, w)) ** 2, 0, w))     # the weighted spread
     ys = np.where(ys > 0, ys, 1.0)
-    y = s.target / ys
-    w = s.weight / s.weight.mean()
-    make = _maker(kind, degree, hidden, seed)
-    cv = _grouped_cv(make, z, y, w, s.group, ALPHAS[kind] if alphas is None else alphas, folds)
-    alpha = min(cv, key=cv.get)
+    return lo, hi, mu, sd, ys, (np.clip(f, lo, hi) - mu) / sd, s.target / ys, w
+
+
+def _grouped_cv(make, s: ResidualSamples, alphas, folds: int) -> dict:
+    """{alpha: the held-out weighted mean square of the standardised residuals over a ``GroupKFold``}."""
+    from sklearn.model_selection import GroupKFold
+
+    _, _, _, _, _, z, y, w = _standardised(s)
+    k = _n_splits(s.group, folds)
+    out = {}
+    for a in alphas:
+        err, tot = 0.0, 0.0
+        for tr, te in GroupKFold(n_splits=k).split(z, y, s.group):
+            model = make(a).fit(z[tr], y[tr], sample_weight=w[tr])
+            err += float(np.sum(w[te, None] * (model.predict(z[te]) - y[te]) ** 2))
+            tot += float(np.sum(w[te])) * y.shape[1]
+        out[float(a)] = err / tot
+    return out
+
+
+def _n_splits(groups, folds: int) -> int:
+    k = min(folds, len(np.unique(groups)))
+    if k < 2:
+        raise ValueError("the grouped cross-validation of the penalty needs records of 2 or more runs")
+    return k
+
+
+def _window_cv(make, s: ResidualSamples, packed, runs, alphas, folds: int, form) -> dict:
+    """{alpha (inf: no correction): {"mean_window_heading_rms_deg", "diverged_windows"}} of the held-out records
+    of a ``GroupKFold`` over the training records, each replayed over its 60 s windows from the measured state."""
+    from sklearn.model_selection import GroupKFold
+
+    from .identify import same_run_groups
+
+    groups = np.asarray(same_run_groups(runs))
+    idx = np.arange(len(runs))
+    rows = {float(a): [] for a in (*alphas, np.inf)}
+    for tr, te in GroupKFold(n_splits=_n_splits(groups, folds)).split(idx, idx, groups):
+        sub = s.of(tr)
+        for a in rows:
+            c = _fit_fixed(make, sub, a, form) if np.isfinite(a) else _off(sub, form)
+            for j in te:
+                rows[a].append(_window_headings(packed, runs[j], c))
+    return {a: {"mean_window_heading_rms_deg": float(np.nanmean([np.nanmean(h) if np.isfinite(h).any() else np.nan
+                                                                 for h in v])),
+                "diverged_windows": int(sum(np.sum(~np.isfinite(h)) for h in v))} for a, v in rows.items()}
+
+
+def _window_headings(packed: PackedShip, run: MeasuredRun, c: Correction) -> np.ndarray:
+    """Heading RMS [deg] of each 60 s window of ``run`` replayed from its measured start with the correction."""
+    bounds, _ = window_bounds(run.t)
+    out = []
+    for i0, i1 in bounds:
+        w = _window_run(run, i0, i1)
+        p = hybrid_states(packed, w.inputs, w.meas[0], c)
+        out.append(float(np.sqrt(np.mean(np.degrees(p[:, 5] - w.meas[:, 5]) ** 2))))
+    return np.array(out)
+
+
+def _fit_fixed(make, s: ResidualSamples, alpha: float, form) -> Correction:
+    """The correction of penalty ``alpha`` fitted on all of ``s``."""
+    kind, degree, hidden = form
+    lo, hi, mu, sd, ys, z, y, w = _standardised(s)
     model = make(alpha).fit(z, y, sample_weight=w)
     pred = model.predict(z)
     r2 = 1.0 - float(np.sum(w[:, None] * (pred - y) ** 2) / np.sum(w[:, None] * (y - np.average(y, 0, w)) ** 2))
@@ -488,6 +565,107 @@ def fit_correction(packed: PackedShip, runs: list[MeasuredRun], kind: str = "rid
     else:
         A, b1, W2, b2 = model.coefs_[0].T, model.intercepts_[0], model.coefs_[1], model.intercepts_[1]
     return Correction(kind=kind, mu=mu, sd=sd, lo=lo, hi=hi, A=np.asarray(A, float), b1=np.asarray(b1, float),
-                      W2=np.asarray(W2, float) * ys, b2=np.asarray(b2, float) * ys, alpha=float(alpha), cv=cv,
+                      W2=np.asarray(W2, float) * ys, b2=np.asarray(b2, float) * ys, alpha=float(alpha),
                       degree=degree if kind == "ridge" else 0, hidden=hidden if kind == "mlp" else 0,
                       records=list(s.names), r2=r2)
+
+
+def _off(s: ResidualSamples, form) -> Correction:
+    """No correction (zero everywhere; ``alpha`` inf), with the training box of ``s`` (still a flag)."""
+    kind, degree, hidden = form
+    lo, hi, mu, sd = *np.percentile(s.features, [0.1, 99.9], axis=0), s.features.mean(0), s.features.std(0)
+    return Correction(kind=kind, mu=mu, sd=np.where(sd > 0, sd, 1.0), lo=lo, hi=hi, A=np.zeros((1, 5)), b1=np.zeros(1),
+                      W2=np.zeros((1, 3)), b2=np.zeros(3), alpha=float("inf"), degree=degree if kind == "ridge" else 0,
+                      hidden=hidden if kind == "mlp" else 0, records=list(s.names), r2=0.0)
+
+
+OUTPUT_ALPHAS = (1e-3, 1e-2, 1e-1, 1.0, 10.0)
+"""Penalties of :func:`fit_output_correction`, relative to the mean diagonal of J^T J."""
+
+
+def fit_output_correction(packed: PackedShip, runs: list[MeasuredRun], degree: int = 2, alphas=OUTPUT_ALPHAS,
+                          folds: int = 3, stride: int = 5) -> Correction:
+    """A ridge-polynomial correction fitted by output error: its coefficients minimise the replayed 60 s windows'
+    errors on the training records ``runs``, not the residual forces.
+
+    The coefficients theta (the monomials up to ``degree`` of the standardised features, :class:`Correction`
+    ``"ridge"``; each output in units of the weighted spread of the residual forces, :func:`residual_samples`)
+    are one Gauss-Newton step from zero (the MMG model alone): with r0 the windows' residuals at theta = 0 (u,
+    v, r, heading at every ``stride``-th sample, scaled as :func:`trials.measured.identify.identify` scales
+    them) and J their Jacobian (forward differences), theta = -(J^T J + alpha mean(diag J^T J) I)^-1 J^T r0.
+    The penalty (``alphas``, relative) or no correction is chosen by a grouped cross-validation over the
+    training records (:func:`fit_correction` ``select="windows"``: the held-out records' windows replayed
+    with the step fitted on the others).  The basis (feature scales, box) is the training records' features.
+
+    Returns
+    -------
+    Correction
+        With ``cv``: each relative penalty's (and ``inf``: no correction's) held-out windows.
+    """
+    from sklearn.model_selection import GroupKFold
+    from sklearn.preprocessing import PolynomialFeatures
+
+    from .identify import same_run_groups
+
+    s = residual_samples(packed, runs, 2)
+    lo, hi, mu, sd, ys, *_ = _standardised(s)
+    A = PolynomialFeatures(degree).fit(np.zeros((1, _K))).powers_.astype(float)
+    base = Correction(kind="ridge", mu=mu, sd=sd, lo=lo, hi=hi, A=A, b1=np.zeros(len(A)), W2=np.zeros((len(A), 3)),
+                      b2=np.zeros(3), alpha=float("inf"), degree=degree, records=list(s.names), r2=0.0)
+
+    def with_theta(theta, alpha):
+        return replace(base, W2=theta.reshape(len(A), 3) * ys, alpha=float(alpha))
+
+    scales = _output_scales(runs, float(packed.p[P_L]))
+    r0, rec = _window_residuals(packed, runs, base, stride, scales)
+    J = _window_jacobian(packed, runs, base, stride, scales, r0, len(A) * 3, with_theta)
+    groups = np.asarray(same_run_groups(runs))
+    idx = np.arange(len(runs))
+    rows = {float(a): [] for a in (*alphas, np.inf)}
+    for tr, te in GroupKFold(n_splits=_n_splits(groups, folds)).split(idx, idx, groups):
+        keep = np.isin(rec, tr)
+        for a in rows:
+            c = base if not np.isfinite(a) else with_theta(_ridge_step(J[keep], r0[keep], a), a)
+            rows[a] += [_window_headings(packed, runs[j], c) for j in te]
+    cv = {a: {"mean_window_heading_rms_deg": float(np.nanmean([np.nanmean(h) if np.isfinite(h).any() else np.nan
+                                                               for h in v])),
+              "diverged_windows": int(sum(np.sum(~np.isfinite(h)) for h in v))} for a, v in rows.items()}
+    alpha = min(cv, key=lambda a: (cv[a]["diverged_windows"], cv[a]["mean_window_heading_rms_deg"]))
+    c = base if not np.isfinite(alpha) else with_theta(_ridge_step(J, r0, alpha), alpha)
+    return replace(c, cv=cv)
+
+
+def _ridge_step(J, r0, alpha: float) -> np.ndarray:
+    """-(J^T J + alpha mean(diag J^T J) I)^-1 J^T r0."""
+    H = J.T @ J
+    return -np.linalg.solve(H + alpha * np.mean(np.diag(H)) * np.eye(len(H)), J.T @ r0)
+
+
+def _output_scales(runs, L: float) -> np.ndarray:
+    """u, v [m/s], r [rad/s], heading [rad] residual scales: 5 % of the median speed, that over L, 2 deg."""
+    U = float(np.median(np.concatenate([np.hypot(r.meas[:, 0], r.meas[:, 1]) for r in runs])))
+    return np.array([0.05 * U, 0.05 * U, 0.05 * U / L, np.radians(2.0)])
+
+
+def _window_residuals(packed, runs, c: Correction, stride: int, scales) -> tuple[np.ndarray, np.ndarray]:
+    """The scaled u, v, r, heading errors of every 60 s window of ``runs`` replayed from its measured start with
+    ``c`` (every ``stride``-th sample; a diverged sample's error 0), and each residual's record index."""
+    out, rec = [], []
+    for j, run in enumerate(runs):
+        for i0, i1 in window_bounds(run.t)[0]:
+            w = _window_run(run, i0, i1)
+            p = hybrid_states(packed, w.inputs, w.meas[0], c)
+            e = ((p[::stride] - w.meas[::stride])[:, [0, 1, 2, 5]] / scales).ravel()
+            out.append(np.where(np.isfinite(e), e, 0.0))
+            rec.append(np.full(len(e), j))
+    return np.concatenate(out), np.concatenate(rec)
+
+
+def _window_jacobian(packed, runs, base, stride, scales, r0, n: int, with_theta, h: float = 1e-2) -> np.ndarray:
+    """Forward-difference Jacobian (len(r0), n) of :func:`_window_residuals` in theta at zero, step ``h``."""
+    J = np.empty((len(r0), n))
+    for k in range(n):
+        th = np.zeros(n)
+        th[k] = h
+        J[:, k] = (_window_residuals(packed, runs, with_theta(th, 0.0), stride, scales)[0] - r0) / h
+    return J
