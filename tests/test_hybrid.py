@@ -177,3 +177,22 @@ def test_output_error_correction_of_a_known_hull_term(truth):
     assert c.cv[c.alpha]["mean_window_heading_rms_deg"] < c.cv[float("inf")]["mean_window_heading_rms_deg"]
     rms = lambda a: float(np.sqrt(np.mean(np.degrees(a[:, 5] - test.meas[:, 5]) ** 2)))  # noqa: E731
     assert rms(replay_hybrid(model, test, c, p).pred) < 0.5 * rms(replay_states(p, test.inputs, test.meas[0]))
+
+
+def test_window_choice_turns_on_a_correction_that_helps(truth):
+    """Chosen by the grouped held-out window replays, the correction of a real residual is on (a finite
+    penalty whose windows beat no correction's), and a bad select name is refused."""
+    model, rec_ship = truth
+    c = fit_correction(pack(model), _records(rec_ship, [0, 1, 2, 3]), "ridge", degree=2, stride=3, select="windows")
+    assert np.isfinite(c.alpha)
+    assert c.cv[c.alpha]["mean_window_heading_rms_deg"] < 0.5 * c.cv[float("inf")]["mean_window_heading_rms_deg"]
+    with pytest.raises(ValueError, match="select"):
+        fit_correction(pack(model), _records(rec_ship, [0, 1]), select="best")
+
+
+def test_bench_variant_names():
+    b = load_bench("hybrid_cv")
+    assert b.variant_options("ridge-3") == {"kind": "ridge", "degree": 3, "select": "forces"}
+    assert b.variant_options("mlp-16/windows") == {"kind": "mlp", "hidden": 16, "select": "windows"}
+    with pytest.raises(SystemExit):
+        b.variant_options("mlp-16/output")

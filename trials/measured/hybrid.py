@@ -319,7 +319,7 @@ def _eval_rows(f, kind, mu, sd, lo, hi, A, b1, W2, b2, taper, out):
 def _hybrid_rhs(y, tau, args):
     """The replay's right-hand side (:func:`mmg.replay` ``_replay_rhs``) plus the correction's accelerations."""
     base, corr = args
-    k, m, i, delta, n, ext, minv, p = base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7]
+    k, m, i, delta, n, minv, p = base[0], base[1], base[2], base[3], base[4], base[6], base[7]
     d0 = _replay_rhs(y, tau, base)
     a = (k + tau) / m
     d = delta[i] + a * (delta[i + 1] - delta[i])
