@@ -212,6 +212,8 @@ def run_one(job: dict, seed0: int) -> dict:
             "not_identifiable_reasons": {n["effect"]: n.get("reason") for n in d.not_identifiable},
             "not_identifiable_kinds": {n["effect"]: n.get("reason_kind") for n in d.not_identifiable},
             "not_identifiable_correlation": {n["effect"]: n.get("correlation") for n in d.not_identifiable},
+            "model_form": {x["effect"]: {"reason": x["reason"], "parameters": x.get("parameters", {})}
+                           for x in d.model_form_effects},
             "unexplained": bool(d.unexplained), "rounds": js["rounds"], "duration_s": float(sum(r.t[-1] for r in recs)),
             "rms_after": js["rms_after"], "rms_before": js["rms_before"], "rms_config": js["rms_config"],
             "speed_mps": float(np.median(np.hypot(rec.u, rec.v))), "L_m": float(config.particulars.L),
@@ -280,10 +282,25 @@ def summarise(rows: list) -> dict:
     allr = _rate(rows, lambda r: set(r["named"]) == true_effects(r))
     print(f"\nexact (named set == true set) over all records: {_pct(*allr)}")
     table["exact"] = list(allr)
+    table["model_form"] = model_form_lines(rows)
     table["per_trial"] = _per_trial(rows)
     table["reasons"] = _reason_counts(rows)
     table["classes"] = class_table(rows)
     return table
+
+
+def model_form_lines(rows: list) -> dict:
+    """Print and return the records where an effect was reported ``model_form_mismatch`` (fitted, kept in the
+    model, not named: :mod:`trials.measured.diagnose.model_form`): on clean records, and on records with an
+    effect, whether it was the true one (rows of runs made before the field existed count as none)."""
+    mf = [r for r in rows if r.get("model_form")]
+    clean = [r for r in mf if r["effect"] is None]
+    true = [r for r in mf if r["effect"] is not None and set(r["model_form"]) & true_effects(r)]
+    print(f"\nreported model_form_mismatch: {len(mf)}/{len(rows)} records ({len(clean)} clean; the true effect on "
+          f"{len(true)} of the {len(mf) - len(clean)} others)")
+    for r in mf:
+        print(f"  {r['id']} {r['trial']}: named {r['named']}, model_form_mismatch {sorted(r['model_form'])}")
+    return {"records": len(mf), "clean": len(clean), "true_effect": len(true), "ids": [r["id"] for r in mf]}
 
 
 def record_class(r: dict) -> tuple[str, str, str]:
