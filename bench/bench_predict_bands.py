@@ -2,8 +2,8 @@
 
 The record as ``bench/bench_replay.py`` takes it (the longest FRT-DS-ESSO record cut to its first 600 s, or a
 simulated one without the data).  The ship: the 3 m model with a stated covariance (N_r, N_rr, kappa,
-w_P0 at 5 % of their values, the wind scale at 0.1; its ``state_range`` the record's own, so every candidate
-ship is checked for energy over it, :func:`trials.measured.draws.support_of`) and a run spread (u, v 0.005 m/s,
+w_P0 at 5 % of their values, the wind scale at 0.1; its ``state_range`` the record's own, what
+``--support physical`` would check ships over, :func:`trials.measured.draws.support_of`) and a run spread (u, v 0.005 m/s,
 heading 0.02 rad), so every draw changes the ship and the start.  Times :func:`trials.measured.bands.prediction_bands` (the
 numba cache loaded by one replay first), once per ``--jobs`` value, and prints the band's figures too.
 

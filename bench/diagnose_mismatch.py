@@ -292,7 +292,7 @@ def summarise(rows: list) -> dict:
 def model_form_lines(rows: list) -> dict:
     """Print and return the records where an effect was reported ``model_form_mismatch`` (fitted, kept in the
     model, not named: :mod:`trials.measured.diagnose.model_form`): on clean records, and on records with an
-    effect, whether it was the true one (rows of runs made before the field existed count as none)."""
+    effect, whether it was the true one (a row without a ``model_form`` field counts as none)."""
     mf = [r for r in rows if r.get("model_form")]
     clean = [r for r in mf if r["effect"] is None]
     true = [r for r in mf if r["effect"] is not None and set(r["model_form"]) & true_effects(r)]

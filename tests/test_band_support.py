@@ -144,7 +144,7 @@ def test_ships_gaining_energy_over_the_state_range_are_not_replayed(ship, monkey
     assert max(s.hull.value("N_r") for s in seen) < 0.05        # a strongly yaw-feeding N_r is not among them
 
 
-def test_identify_writes_the_training_records_state_range():
+def test_the_training_records_state_range_spans_their_logged_states():
     from trials.measured.identify.covariance import training_state_range
 
     runs = [_run(mmg.load_ship(SHIP), duration=20.0, k=k, amp_deg=10.0 + 10 * k) for k in range(2)]
@@ -190,3 +190,15 @@ def test_the_energy_check_leaves_out_the_states_where_the_identified_ship_itself
     assert sup.contains(feeding, [ship.rudder.kappa]) and not sup.contains(feeding, [1.2])   # kappa's bounds: 0 to 1
     plain = support_of(ship, ["kappa"], {"names": ["kappa"], "matrix": [[1e-4]], "state_range": RANGE})
     assert plain.caveat == "" and len(plain.states[0]) == len(grid[0])
+
+
+def test_physical_without_a_state_range_says_the_energy_check_is_left_out(ship):
+    """A covariance with no ``state_range``: the physical support can only be the fit's bounds, and its caveat
+    (a band's note, shown whether or not a draw is rejected) says so; the bounds-only support has none."""
+    from trials.measured.draws import support_of
+
+    cov = {"names": ["kappa"], "matrix": [[1e-4]]}
+    phys, plain = support_of(ship, ["kappa"], cov), support_of(ship, ["kappa"], cov, energy=False)
+    assert phys.states is None and "state_range" in phys.caveat
+    assert plain.caveat == ""
+    np.testing.assert_array_equal([phys.lower[0], phys.upper[0]], [0.0, 1.0])     # kappa's range, mmg.parameters

@@ -196,3 +196,18 @@ def test_bench_variant_names():
     assert b.variant_options("mlp-16/windows") == {"kind": "mlp", "hidden": 16, "select": "windows"}
     with pytest.raises(SystemExit):
         b.variant_options("mlp-16/output")
+
+
+def test_a_subset_of_the_samples_indexes_its_own_records():
+    """``ResidualSamples.of`` keeps the chosen records' samples, and ``record`` then indexes the subset's
+    ``names``: the first kept record is 0, the next 1, whatever their indices before."""
+    from trials.measured.hybrid import ResidualSamples
+
+    rec = np.array([0, 0, 1, 1, 1, 2])
+    s = ResidualSamples(features=np.arange(12.0).reshape(6, 2), target=np.zeros((6, 3)), weight=np.ones(6),
+                        group=rec.copy(), record=rec, names=["a", "b", "c"])
+    sub = s.of([2, 0])
+    assert sub.names == ["a", "c"]
+    np.testing.assert_array_equal(sub.record, [0, 0, 1])
+    np.testing.assert_array_equal(sub.features[:, 0], [0.0, 2.0, 10.0])
+    assert all(sub.names[i] in ("a", "c") for i in sub.record)

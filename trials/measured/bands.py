@@ -308,8 +308,9 @@ def _draws(ship: Ship, covariance, std, samples: int, seed: int, notes: list, su
                 rows.append(a)
                 runs.append(b)
     if not rows:
-        raise InputError("covariance", "matrix", f"none of {tried} ships drawn lies in the support ({support.note}): "
-                                                 "the covariance puts next to no weight on an admissible ship")
+        raise InputError(ship.source or ship.name, "covariance.matrix",
+                         f"none of {tried} ships drawn lies in the support ({support.note}): the covariance puts next "
+                         "to no weight on an admissible ship")
     if tried > len(rows):
         notes.append(f"{tried - len(rows)} of {tried} ships drawn from the covariance rejected, not replayed: "
                      f"outside the support ({support.note}); the band is the normal truncated to it")
@@ -393,7 +394,7 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     Bands
     """
     if support not in SUPPORTS:
-        raise InputError("support", "", f"must be one of {', '.join(SUPPORTS)}, got {support!r}")
+        raise InputError("prediction_bands", "support", f"must be one of {', '.join(SUPPORTS)}, got {support!r}")
     if isinstance(samples, bool) or int(samples) != samples or samples < 1:
         raise InputError("samples", "", f"must be a whole number of 1 or more, got {samples!r}")
     samples = int(samples)

@@ -103,11 +103,14 @@ def support_bounds(ship: Ship, names) -> tuple[np.ndarray, np.ndarray]:
     """(lower, upper) of each parameter ``names``: the hard bounds a fit of ``ship`` holds it to
     (:func:`ekf.identify.free_parameters`: the straight-ahead resistance negative, w_P0, epsilon, kappa,
     the gamma_R, l_R', Y_P_astern and the effects' parameters within theirs, an added mass within
-    0 to 3 times the ship's value); -inf/inf where a parameter has none."""
+    0 to 3 times the ship's value, a wind factor's divided by the
+    config value it multiplies as the fit's are); -inf/inf where a parameter has none."""
     from ekf.identify import free_parameters
     from mmg.model import pack
 
-    free = free_parameters(pack(ship), ship.hull.names, list(names), hull_terms=ship.hull.terms)
+    from .identify.fit import _bounded_wind
+
+    free = _bounded_wind(ship, free_parameters(pack(ship), ship.hull.names, list(names), hull_terms=ship.hull.terms))
     return np.array([f.lower for f in free], float), np.array([f.upper for f in free], float)
 
 
@@ -199,8 +202,9 @@ def support_of(ship: Ship, names, cov, energy: bool = True) -> Support:
     if not energy:
         return Support(tuple(names), lower, upper, None, bounds)
     if not rng:
-        return Support(tuple(names), lower, upper, None,
-                       f"{bounds} (the covariance has no state_range: no energy check)")
+        return Support(tuple(names), lower, upper, None, f"{bounds} (the covariance has no state_range: no energy check)",
+                       "support 'physical' without the energy check: the covariance states no state_range, so the "
+                       "draws are truncated to the fit's hard bounds alone")
     grid = state_box(*(np.array(r) for r in rng))
     states = _dissipative_states(ship, grid)
     n, m = len(states[0]), len(grid[0])

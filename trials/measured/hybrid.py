@@ -49,7 +49,7 @@ import numpy as np
 
 from mmg._jit import carray, njit
 from mmg.kernel import rk4_step
-from mmg.model import P_D, P_L, P_RHO, P_T, P_ULOW, PackedShip, inverse_mass, pack
+from mmg.model import G, P_D, P_L, P_RHO, P_T, P_ULOW, PackedShip, inverse_mass, pack
 from mmg.replay import ZERO6, ReplayInputs, _axpy, _deriv, _replay_rhs, default_dt_max
 
 from .predict import MeasuredRun, Replayed
@@ -137,9 +137,12 @@ class ResidualSamples:
 
     def of(self, records) -> "ResidualSamples":
         """The samples of the records of indices ``records`` only."""
-        keep = np.isin(self.record, list(records))
+        kept = sorted(set(int(i) for i in records))
+        keep = np.isin(self.record, kept)
+        renumber = {old: new for new, old in enumerate(kept)}
         return ResidualSamples(self.features[keep], self.target[keep], self.weight[keep], self.group[keep],
-                               self.record[keep], [self.names[i] for i in sorted(set(records))])
+                               np.array([renumber[int(i)] for i in self.record[keep]], dtype=self.record.dtype),
+                               [self.names[i] for i in kept])
 
 
 def _check_run(run: MeasuredRun) -> None:
@@ -152,7 +155,7 @@ def _measured_accelerations(run: MeasuredRun, L: float) -> np.ndarray:
     from scipy.signal import savgol_filter
 
     dt = float(np.median(np.diff(run.t)))
-    w = max(5, int(round(SMOOTH_L * np.sqrt(L / 9.80665) / dt)) | 1)
+    w = max(5, int(round(SMOOTH_L * np.sqrt(L / G) / dt)) | 1)
     w = min(w, len(run.t) - (1 - len(run.t) % 2))           # odd, within the record
     if w <= 3:
         return np.gradient(run.meas[:, :3], run.t, axis=0)
