@@ -48,7 +48,7 @@ from frt_gap import KINDS, kind_of  # noqa: E402  (the record kinds, defined onc
 
 import mmg  # noqa: E402
 from trials.measured.identify import load_runs  # noqa: E402
-from trials.measured.nested import HULL_FORMS, SCORE_NAMES, hull_candidates, nested_cross_validate  # noqa: E402
+from trials.measured.nested import HULL_FORMS, SCORE_NAMES, BandSpec, hull_candidates, nested_cross_validate  # noqa: E402
 from trials.files.data import frt_folder  # noqa: E402
 
 SHIP = "esso_osaka_3m"
@@ -301,7 +301,7 @@ def main(argv=None) -> None:
     t0 = time.perf_counter()
     res = nested_cross_validate(cands, runs, folds=a.folds, inner_folds=a.inner_folds, initial=initial,
                                 folds_by=a.folds_by, backend=a.backend, n_jobs=a.jobs, horizon_s=a.horizon,
-                                band_samples=a.bands, band_support=a.band_support, **opts)
+                                bands=BandSpec(a.bands, a.band_support), **opts)
     print(f"\n{time.perf_counter() - t0:.0f} s wall\n")
     print("Per kept-out record (s: scaled esso_osaka_3m, i: identified without it; 'div.': the replay diverged):\n")
     print("\n".join(record_table(res, a.markdown)))

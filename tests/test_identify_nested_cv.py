@@ -296,3 +296,26 @@ def test_bench_prints_every_kept_out_record_the_choices_and_the_summary(tmp_path
     res = json.loads(js.read_text())
     assert sorted(r["name"] for r in res["records"]) == names
     assert {(r["name"], str(r["fold"]), r["choice"]) for r in res["records"]} == set(rows)
+
+
+def test_the_band_spec_reaches_every_kept_out_records_band_and_none_by_default(monkeypatch, forms):
+    """``bands=BandSpec(7, "bounds")``: each kept-out record's band from 7 draws truncated to the fit's bounds,
+    seeded by its outer fold; the default asks for none."""
+    runs = _runs(forms["kijima"].ship, n=4)[:4]
+    calls = []
+    monkeypatch.setattr(N, "fit_model", _Watch())
+    monkeypatch.setattr(N, "band_sections", lambda ident: (None, None))
+    monkeypatch.setattr(N, "band_scores", lambda ident, run, samples, seed=0, sections=None, support="none":
+                        calls.append((run.name, samples, seed, support)) or {"samples": 1})
+    one = {"kijima": forms["kijima"]}
+    N.nested_cross_validate(one, runs, folds=2)
+    assert calls == []
+    res = N.nested_cross_validate(one, runs, folds=2, bands=N.BandSpec(samples=7, support="bounds"))
+    assert sorted(calls) == sorted((r["name"], 7, r["fold"], "bounds") for r in res.records)
+    assert len(calls) == 4 and all(r["band"] == {"samples": 1} for r in res.records)
+
+
+@pytest.mark.parametrize("bad", [dict(samples=-1), dict(samples=2.5), dict(support="energy")])
+def test_a_band_spec_outside_its_range_is_refused(bad):
+    with pytest.raises(ValueError, match="BandSpec"):
+        N.BandSpec(**bad)

@@ -30,7 +30,7 @@ from mmg.ship import Ship
 
 from .predict import MeasuredRun, replay_record
 
-__all__ = ["Candidate", "NestedCV", "Selection", "nested_cross_validate", "select_candidate", "choose",
+__all__ = ["BandSpec", "Candidate", "NestedCV", "Selection", "nested_cross_validate", "select_candidate", "choose",
            "replay_scores", "fit_model", "check_choosable", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES",
            "band_scores", "band_sections", "band_summary"]
 
@@ -190,20 +190,50 @@ def band_summary(records: list[dict]) -> dict:
             / max(sum(x.get("draws", 0) + x.get("rejected_draws", 0) for x in b), 1)}
 
 
+@dataclass(frozen=True)
+class BandSpec:
+    """The 90 % heading bands :func:`nested_cross_validate` gives each kept-out record (:func:`band_scores`).
+
+    Attributes
+    ----------
+    samples : int
+        Draws of the fold's model per record; 0: no bands.
+    support : {"none", "bounds", "physical"}
+        Where the bands' ship draws are truncated (:data:`trials.measured.draws.SUPPORTS`,
+        :func:`trials.measured.bands.prediction_bands`).
+
+    Raises
+    ------
+    ValueError
+        A negative ``samples`` or a ``support`` not in :data:`~trials.measured.draws.SUPPORTS`.
+    """
+
+    samples: int = 0
+    support: str = "none"
+
+    def __post_init__(self):
+        from .draws import SUPPORTS
+
+        if int(self.samples) != self.samples or self.samples < 0:
+            raise ValueError(f"BandSpec.samples must be a whole number >= 0, got {self.samples!r}")
+        if self.support not in SUPPORTS:
+            raise ValueError(f"BandSpec.support must be one of {SUPPORTS}, got {self.support!r}")
+
+
 def _outer_task(task) -> list[dict]:
     """One outer fit: the fold's choice fitted on the whole outer training set, the kept-out records scored
-    (with ``band_samples`` > 0 also their 90 % heading bands, :func:`band_scores`)."""
-    outer, cand, train, tests, initial, kw, horizon_s, (band_samples, band_support) = task
+    (with ``bands.samples`` > 0 also their 90 % heading bands, :func:`band_scores`)."""
+    outer, cand, train, tests, initial, kw, horizon_s, bands = task
     ident = fit_model(cand.ship, train, initial=initial, **{**kw, **cand.options})
     values = {k: float(v) for k, v in ident.fit.values().items()}
     out = [{"name": r.name, "fold": outer, "choice": cand.name,
             "scaled": replay_scores(replay_record(initial, r), horizon_s, initial),
             "identified": replay_scores(ident.replay(r), horizon_s, ident.ship), "ship": ident.ship, "values": values}
            for r in tests]
-    if band_samples:
+    if bands.samples:
         sections = band_sections(ident)                # one covariance and run spread per fold
         for rec, r in zip(out, tests):
-            rec["band"] = band_scores(ident, r, band_samples, seed=outer, sections=sections, support=band_support)
+            rec["band"] = band_scores(ident, r, bands.samples, seed=outer, sections=sections, support=bands.support)
     return out
 
 
@@ -304,9 +334,8 @@ def _initial(candidates: dict, initial: Ship | None) -> Ship:
 
 def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int = 4, inner_folds: int = 3,
                           initial: Ship | None = None, folds_by: str = "order", backend: str = "serial",
-                          client=None, n_jobs=None, horizon_s: float = HORIZON_S, band_samples: int = 0,
-                          band_support: str = "none",
-                          **kw) -> NestedCV:
+                          client=None, n_jobs=None, horizon_s: float = HORIZON_S,
+                          bands: BandSpec = BandSpec(), **kw) -> NestedCV:
     """Nested cross-validation (module docstring) of the procedure "choose among ``candidates`` by an
     inner ``inner_folds``-fold cross-validation, then fit the choice".
 
@@ -328,11 +357,9 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
         in one sweep, then the outer fits in another; the same numbers on every backend.
     horizon_s : float
         The short-horizon window [s] of the scores.
-    band_samples : int
-        With > 0, each kept-out record's 90 % heading band from that many draws of its fold's model
-        (:func:`band_scores`; records' ``band``).
-    band_support : {"none", "bounds", "physical"}
-        Where the bands' ship draws are truncated (:func:`trials.measured.bands.prediction_bands`).
+    bands : BandSpec
+        With ``bands.samples`` > 0, each kept-out record's 90 % heading band from that many draws of its
+        fold's model, truncated to ``bands.support`` (:func:`band_scores`; records' ``band``); none by default.
     **kw
         :func:`~trials.measured.identify.identify`'s options common to every candidate.
     """
@@ -349,7 +376,7 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
             choices[k], tables[k] = choose([r for r in inner_rows if r["outer"] == k], list(candidates))
     else:
         choices = dict.fromkeys(range(n_out), next(iter(candidates)))
-    tasks = [(k, candidates[choices[k]], tr, te, initial, kw, horizon_s, (band_samples, band_support))
+    tasks = [(k, candidates[choices[k]], tr, te, initial, kw, horizon_s, bands)
              for k, (tr, te) in enumerate(splits)]
     parts = _sweep(_outer_task, tasks, [f"outer fold {k + 1}/{n_out}: fit {choices[k]} on {len(t[2])} records"
                                         for k, t in enumerate(tasks)], backend, client, n_jobs)
