@@ -35,7 +35,7 @@ from frt_gap import KINDS, kind_of  # noqa: E402
 VARIANTS = ("ridge-2/windows", "ridge-2", "ridge-3", "mlp-16", "ridge-2/output")
 """The corrections judged by default: ``FORM-SIZE[/windows]`` fitted to the residual forces, the penalty chosen
 by the grouped held-out residual forces or, with ``/windows``, by the grouped held-out 60 s-window replays with
-"no correction" a candidate (:func:`trials.measured.hybrid.fit_correction` ``select``); ``ridge-D/output``
+"no correction" a candidate (:attr:`trials.measured.hybrid.CorrectionSelection.select`); ``ridge-D/output``
 fitted by output error on the training records' windows, its penalty (or none) chosen by the same grouped
 window replays (:func:`trials.measured.hybrid.fit_output_correction`).  ``ridge-2/windows`` is the primary."""
 SCALED, IDENT = "scaled", "identified"
@@ -87,7 +87,8 @@ def _fold_ident(k: int, splits, folds_dir: Path, initial):
 def one_fold(task) -> dict:
     """Fit each correction on fold ``k``'s training records, replay its kept-out records with every model."""
     from mmg.model import pack
-    from trials.measured.hybrid import fit_correction, fit_output_correction, hybrid_window_scores, replay_hybrid
+    from trials.measured.hybrid import (CorrectionForm, CorrectionSelection, fit_correction, fit_output_correction,
+                                        hybrid_window_scores, replay_hybrid)
     from trials.measured.identify import with_fitted_wind, with_ship_effects
     from trials.measured.predict import replay_record
     from trials.measured.window import window_scores
@@ -105,7 +106,8 @@ def one_fold(task) -> dict:
         if o["select"] == "output":
             corr[v] = fit_output_correction(packed, [prep(r) for r in tr], degree=o["degree"])
         else:
-            corr[v] = fit_correction(packed, [prep(r) for r in tr], **o)
+            form = CorrectionForm(**{key: x for key, x in o.items() if key != "select"})
+            corr[v] = fit_correction(packed, [prep(r) for r in tr], form, CorrectionSelection(select=o["select"]))
         fits[v] = {**corr[v].to_json(), "fit_s": time.perf_counter() - t0}
     rows = []
     for r in te:

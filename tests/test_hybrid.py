@@ -8,8 +8,8 @@ pytest.importorskip("sklearn")
 
 from mmg.model import P_D, P_L, P_RHO, P_T, P_ULOW, pack  # noqa: E402
 from mmg.replay import ReplayInputs, replay_states  # noqa: E402
-from trials.measured.hybrid import (Correction, fit_correction, hybrid_states, replay_hybrid,  # noqa: E402
-                                    residual_samples)
+from trials.measured.hybrid import (Correction, CorrectionForm, CorrectionSelection, fit_correction,  # noqa: E402
+                                    hybrid_states, replay_hybrid, residual_samples)
 from trials.measured.predict import MeasuredRun  # noqa: E402
 
 DY_R, DN_R = 0.03, -0.01
@@ -105,7 +105,7 @@ def test_residual_of_a_known_hull_term_is_recovered(truth):
     V = np.sqrt(u ** 2 + v ** 2 + (n * p.p[P_D]) ** 2 + p.p[P_ULOW] ** 2)
     shape = (r * p.p[P_L] / V) * (np.hypot(u, v) / V)
     inner = np.abs(np.arange(len(u)) % 1500 - 750) < 700                   # away from each record's ends
-    c = fit_correction(p, runs, "ridge", degree=2, stride=3)
+    c = fit_correction(p, runs, CorrectionForm("ridge", degree=2), CorrectionSelection(stride=3))
     for axis, d in ((1, DY_R), (2, DN_R)):
         want = d * shape
         err = s.target[inner, axis] - want[inner]
@@ -122,7 +122,7 @@ def test_corrected_replay_of_a_kept_out_record(truth):
     model, rec_ship = truth
     train, (test,) = _records(rec_ship, [0, 1, 3]), _records(rec_ship, [2])
     p = pack(model)
-    c = fit_correction(p, train, "ridge", degree=2, stride=3)
+    c = fit_correction(p, train, CorrectionForm("ridge", degree=2), CorrectionSelection(stride=3))
     assert "rec2" not in c.records
     rms = lambda a: float(np.sqrt(np.mean(np.degrees(a[:, 5] - test.meas[:, 5]) ** 2)))  # noqa: E731
     plain = rms(replay_states(p, test.inputs, test.meas[0]))
@@ -181,13 +181,16 @@ def test_output_error_correction_of_a_known_hull_term(truth):
 
 def test_window_choice_turns_on_a_correction_that_helps(truth):
     """Chosen by the grouped held-out window replays, the correction of a real residual is on (a finite
-    penalty whose windows beat no correction's), and a bad select name is refused."""
+    penalty whose windows beat no correction's), and a bad select name or form kind is refused."""
     model, rec_ship = truth
-    c = fit_correction(pack(model), _records(rec_ship, [0, 1, 2, 3]), "ridge", degree=2, stride=3, select="windows")
+    c = fit_correction(pack(model), _records(rec_ship, [0, 1, 2, 3]), CorrectionForm("ridge", degree=2),
+                       CorrectionSelection(stride=3, select="windows"))
     assert np.isfinite(c.alpha)
     assert c.cv[c.alpha]["mean_window_heading_rms_deg"] < 0.5 * c.cv[float("inf")]["mean_window_heading_rms_deg"]
     with pytest.raises(ValueError, match="select"):
-        fit_correction(pack(model), _records(rec_ship, [0, 1]), select="best")
+        CorrectionSelection(select="best")
+    with pytest.raises(ValueError, match="kind"):
+        CorrectionForm(kind="forest")
 
 
 def test_bench_variant_names():

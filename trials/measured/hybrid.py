@@ -55,7 +55,8 @@ from mmg.replay import ZERO6, ReplayInputs, _axpy, _deriv, _replay_rhs, default_
 from .predict import MeasuredRun, Replayed
 from .window import EVERY_S, WINDOW_S, WindowScores, _window_run, window_bounds
 
-__all__ = ["Correction", "ResidualSamples", "residual_samples", "fit_correction", "hybrid_states", "replay_hybrid",
+__all__ = ["Correction", "CorrectionForm", "CorrectionSelection", "ResidualSamples", "residual_samples",
+           "fit_correction", "hybrid_states", "replay_hybrid",
            "hybrid_window_scores", "speed_scale", "FEATURES", "KINDS", "SMOOTH_L", "TAPER_SD", "ALPHAS", "SELECT",
            "fit_output_correction", "OUTPUT_ALPHAS"]
 
@@ -441,8 +442,70 @@ SELECT = ("forces", "windows")
 held-out replays (60 s windows from the measured state; "off", no correction, a candidate too)."""
 
 
-def fit_correction(packed: PackedShip, runs: list[MeasuredRun], kind: str = "ridge", degree: int = 2, hidden: int = 16,
-                   alphas=None, folds: int = 3, stride: int = 2, seed: int = 0, select: str = "forces") -> Correction:
+@dataclass(frozen=True)
+class CorrectionForm:
+    """The regressor form of a correction (module docstring, :data:`KINDS`).
+
+    Attributes
+    ----------
+    kind : {"ridge", "mlp"}
+        Ridge regression on the monomials of the standardised features, or one hidden layer of tanh units.
+    degree : int
+        Highest degree of the monomials (``"ridge"``).
+    hidden : int
+        Number of hidden tanh units (``"mlp"``).
+
+    Raises
+    ------
+    ValueError
+        A ``kind`` not in :data:`KINDS`.
+    """
+
+    kind: str = "ridge"
+    degree: int = 2
+    hidden: int = 16
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f"kind {self.kind!r}: one of {', '.join(KINDS)}")
+
+
+@dataclass(frozen=True)
+class CorrectionSelection:
+    """How :func:`fit_correction` samples the training records and chooses the penalty.
+
+    Attributes
+    ----------
+    alphas : sequence of float or None
+        The penalties to choose among (:data:`ALPHAS` of the form when None).
+    folds : int
+        Folds of the grouped cross-validation over the training records' groups that chooses the penalty.
+    stride : int
+        Every ``stride``-th sample is fitted (the residuals are smoothed over :data:`SMOOTH_L` sqrt(L/g) anyway).
+    select : {"forces", "windows"}
+        ``"forces"``: the penalty with the lowest held-out weighted mean square of the standardised residual
+        forces; ``"windows"``: the one (or no correction, ``alpha`` inf) whose held-out records' 60 s windows
+        replayed from the measured state have the fewest divergences, then the lowest mean heading RMS
+        (:data:`SELECT`).
+
+    Raises
+    ------
+    ValueError
+        A ``select`` not in :data:`SELECT`.
+    """
+
+    alphas: tuple | None = None
+    folds: int = 3
+    stride: int = 2
+    select: str = "forces"
+
+    def __post_init__(self):
+        if self.select not in SELECT:
+            raise ValueError(f"select {self.select!r}: one of {', '.join(SELECT)}")
+
+
+def fit_correction(packed: PackedShip, runs: list[MeasuredRun], form: CorrectionForm = CorrectionForm(),
+                   selection: CorrectionSelection = CorrectionSelection(), seed: int = 0) -> Correction:
     """Fit the correction of ``packed``'s residual forces on the training records ``runs`` (module docstring).
 
     Parameters
@@ -451,39 +514,30 @@ def fit_correction(packed: PackedShip, runs: list[MeasuredRun], kind: str = "rid
         The MMG model the correction adds to (the identified ship, packed).
     runs : list of MeasuredRun
         The training records only, their wind loads as the model replays them.
-    kind : str
-        ``"ridge"`` (polynomial of ``degree``) or ``"mlp"`` (``hidden`` tanh units).
-    alphas : sequence of float, optional
-        The penalties to choose among (:data:`ALPHAS` of the form when omitted).
-    folds : int
-        Folds of the grouped cross-validation over the training records' groups that chooses the penalty.
-    stride : int
-        Every ``stride``-th sample (the residuals are smoothed over :data:`SMOOTH_L` sqrt(L/g) anyway).
+    form : CorrectionForm
+        The regressor: a ridge polynomial of degree 2 by default.
+    selection : CorrectionSelection
+        The samples fitted and how the penalty is chosen: by the grouped held-out residual forces over 3
+        folds, every 2nd sample, by default.
     seed : int
         The network's initial weights.
-    select : str
-        ``"forces"``: the penalty with the lowest held-out weighted mean square of the standardised residual
-        forces; ``"windows"``: the one (or no correction, ``alpha`` inf) whose held-out records' 60 s windows
-        replayed from the measured state have the fewest divergences, then the lowest mean heading RMS
-        (:data:`SELECT`).
 
     Returns
     -------
     Correction
         With ``cv``: each penalty's cross-validated figure.
     """
-    if select not in SELECT:
-        raise ValueError(f"select {select!r}: one of {', '.join(SELECT)}")
-    s = residual_samples(packed, runs, stride)
-    make = _maker(kind, degree, hidden, seed)
-    grid = tuple(ALPHAS[kind] if alphas is None else alphas)
-    if select == "forces":
-        cv = _grouped_cv(make, s, grid, folds)
+    sel = selection
+    s = residual_samples(packed, runs, sel.stride)
+    make = _maker(form.kind, form.degree, form.hidden, seed)
+    grid = tuple(ALPHAS[form.kind] if sel.alphas is None else sel.alphas)
+    if sel.select == "forces":
+        cv = _grouped_cv(make, s, grid, sel.folds)
         alpha = min(cv, key=cv.get)
     else:
-        cv = _window_cv(make, s, packed, runs, grid, folds, (kind, degree, hidden))
+        cv = _window_cv(make, s, packed, runs, grid, sel.folds, form)
         alpha = min(cv, key=lambda a: (cv[a]["diverged_windows"], cv[a]["mean_window_heading_rms_deg"]))
-    c = _fit_fixed(make, s, alpha, (kind, degree, hidden)) if np.isfinite(alpha) else _off(s, (kind, degree, hidden))
+    c = _fit_fixed(make, s, alpha, form) if np.isfinite(alpha) else _off(s, form)
     return replace(c, cv=cv)
 
 
@@ -556,8 +610,8 @@ def _window_headings(packed: PackedShip, run: MeasuredRun, c: Correction) -> np.
 
 
 def _fit_fixed(make, s: ResidualSamples, alpha: float, form) -> Correction:
-    """The correction of penalty ``alpha`` fitted on all of ``s``."""
-    kind, degree, hidden = form
+    """The correction of penalty ``alpha`` fitted on all of ``s`` (``form``: :class:`CorrectionForm`)."""
+    kind, degree, hidden = form.kind, form.degree, form.hidden
     lo, hi, mu, sd, ys, z, y, w = _standardised(s)
     model = make(alpha).fit(z, y, sample_weight=w)
     pred = model.predict(z)
@@ -575,7 +629,7 @@ def _fit_fixed(make, s: ResidualSamples, alpha: float, form) -> Correction:
 
 def _off(s: ResidualSamples, form) -> Correction:
     """No correction (zero everywhere; ``alpha`` inf), with the training box of ``s`` (still a flag)."""
-    kind, degree, hidden = form
+    kind, degree, hidden = form.kind, form.degree, form.hidden
     lo, hi, mu, sd = *np.percentile(s.features, [0.1, 99.9], axis=0), s.features.mean(0), s.features.std(0)
     return Correction(kind=kind, mu=mu, sd=np.where(sd > 0, sd, 1.0), lo=lo, hi=hi, A=np.zeros((1, 5)), b1=np.zeros(1),
                       W2=np.zeros((1, 3)), b2=np.zeros(3), alpha=float("inf"), degree=degree if kind == "ridge" else 0,
