@@ -26,7 +26,8 @@ from .kernel import rk4_step
 
 from .model import P_L, PackedShip, accelerations_of, forces_of, inverse_mass, track_of, with_steady_wind
 
-__all__ = ["ReplayInputs", "replay", "replay_states", "default_dt_max", "STATE"]
+__all__ = ["ReplayInputs", "replay", "replay_states", "default_dt_max", "STATE", "deriv", "replay_rhs", "axpy6",
+           "ZERO6"]
 
 STATE = ("u", "v", "r", "x", "y", "psi")
 """Replayed state, in this order: u, v [m/s], r [rad/s], x0, y0 [m] (north, east), psi [rad]."""
@@ -68,9 +69,27 @@ def default_dt_max(L: float) -> float:
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef):
-    """d/dt of the replayed state ``s`` (a 6-tuple, :data:`STATE`) with the rudder ``d`` [rad], the
-    revolutions ``n`` [rps] and the external loads fx, fy [N], fn [N m] prescribed, as a 6-tuple."""
+def deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef):
+    """d/dt of the replayed state with the rudder, revolutions and external loads prescribed.
+
+    Parameters
+    ----------
+    s : tuple of 6 float
+        The state (:data:`STATE`).
+    d, n : float
+        Rudder angle [rad] and propeller revolutions [rps].
+    fx, fy, fn : float
+        External surge, sway force [N] and yaw moment [N m] about midship, ship axes.
+    minv : ndarray (9,)
+        The inverse mass matrix of the rigid body and added masses (:func:`mmg.model.inverse_mass`), row-major.
+    p, poly, hull_axis, hull_term, hull_coef
+        The packed ship (:meth:`mmg.model.PackedShip.args`).
+
+    Returns
+    -------
+    tuple of 6 float
+        du/dt, dv/dt [m/s^2], dr/dt [rad/s^2], dx0/dt, dy0/dt [m/s], dpsi/dt [rad/s].
+    """
     u, v, r, psi = s[0], s[1], s[2], s[5]
     X, Y, N, _ = forces_of(u, v, r, d, n, p, poly, hull_axis, hull_term, hull_coef)
     du, dv, dr = accelerations_of(X, Y, N, u, v, r, p)
@@ -82,7 +101,7 @@ def _deriv(s, d, n, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _axpy(a, c, b):
+def axpy6(a, c, b):
     """a + c b of two 6-tuples (the state and a stage derivative), as a tuple."""
     return (a[0] + c * b[0], a[1] + c * b[1], a[2] + c * b[2], a[3] + c * b[3], a[4] + c * b[4],
             a[5] + c * b[5])
@@ -92,9 +111,26 @@ ZERO6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _replay_rhs(y, tau, args):
-    """The replay's right-hand side for :func:`mmg.kernel.rk4_step`: :func:`_deriv` with the inputs
-    linear in the sample interval, at the fraction (k + tau) / m of it (sub-step k of m)."""
+def replay_rhs(y, tau, args):
+    """The replay's right-hand side for :func:`mmg.kernel.rk4_step`: :func:`deriv` with the inputs
+    linear in the sample interval, at the fraction (k + tau) / m of it (sub-step k of m).
+
+    Parameters
+    ----------
+    y : tuple of 6 float
+        The stage state (:data:`STATE`).
+    tau : float
+        The stage's fraction of the sub-step (0, 1/2 or 1).
+    args : tuple
+        (k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef): sub-step k of m in the
+        interval from sample i, the record's rudder [rad], revolutions [rps] and external loads (N, 3) at
+        its samples, then :func:`deriv`'s ``minv`` and packed ship.
+
+    Returns
+    -------
+    tuple of 6 float
+        :func:`deriv` at that instant.
+    """
     k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef = args
     a = (k + tau) / m
     d = delta[i] + a * (delta[i + 1] - delta[i])
@@ -102,7 +138,7 @@ def _replay_rhs(y, tau, args):
     fx = ext[i, 0] + a * (ext[i + 1, 0] - ext[i, 0])
     fy = ext[i, 1] + a * (ext[i + 1, 1] - ext[i, 1])
     fn = ext[i, 2] + a * (ext[i + 1, 2] - ext[i, 2])
-    return _deriv(y, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef)
+    return deriv(y, d, nn, fx, fy, fn, minv, p, poly, hull_axis, hull_term, hull_coef)
 
 
 @njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
@@ -124,7 +160,7 @@ def _replay(t, delta, n, ext, s0, meas, reset, dt_max, minv, p, poly, hull_axis,
             m = 1
         dt = h / m
         for k in range(m):                       # the simulator's RK4 step (one inlined copy of the model)
-            s = rk4_step(_replay_rhs, _axpy, ZERO6, s, dt,
+            s = rk4_step(replay_rhs, axpy6, ZERO6, s, dt,
                          (k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef))
         ok = True
         for j in range(6):

@@ -8,7 +8,7 @@ force, what the measured motion needed beyond what the model gives at the measur
 ``M`` the model's mass matrix about midship (rigid body and added mass: the inverse of
 :func:`mmg.model.inverse_mass`), ``a_meas`` the measured accelerations (du/dt, dv/dt, dr/dt: a
 Savitzky-Golay derivative of the logged u, v, r over :data:`SMOOTH_L` sqrt(L/g), cubic) and ``a_MMG``
-the model's right-hand side (:func:`mmg.replay` ``_deriv``: hull, propeller, rudder, the run's wind
+the model's right-hand side (:func:`mmg.replay.deriv`: hull, propeller, rudder, the run's wind
 loads).  It is made nondimensional with the speed scale
 
     V^2 = u^2 + v^2 + (n D)^2 + U_low^2
@@ -50,7 +50,7 @@ import numpy as np
 from mmg._jit import carray, njit
 from mmg.kernel import rk4_step
 from mmg.model import G, P_D, P_L, P_RHO, P_T, P_ULOW, PackedShip, inverse_mass, pack
-from mmg.replay import ZERO6, ReplayInputs, _axpy, _deriv, _replay_rhs, default_dt_max
+from mmg.replay import ZERO6, ReplayInputs, axpy6, default_dt_max, deriv, replay_rhs
 
 from .predict import MeasuredRun, Replayed
 from .window import EVERY_S, WINDOW_S, WindowScores, _window_run, window_bounds
@@ -105,7 +105,7 @@ def _model_accelerations(meas, delta, n, ext, minv, p, poly, hull_axis, hull_ter
     """The model's du/dt, dv/dt, dr/dt at each measured state (rows of ``meas``) with the sample's inputs."""
     for i in range(meas.shape[0]):
         s = (meas[i, 0], meas[i, 1], meas[i, 2], meas[i, 3], meas[i, 4], meas[i, 5])
-        d = _deriv(s, delta[i], n[i], ext[i, 0], ext[i, 1], ext[i, 2], minv, p, poly, hull_axis, hull_term, hull_coef)
+        d = deriv(s, delta[i], n[i], ext[i, 0], ext[i, 1], ext[i, 2], minv, p, poly, hull_axis, hull_term, hull_coef)
         out[i, 0], out[i, 1], out[i, 2] = d[0], d[1], d[2]
 
 
@@ -321,10 +321,10 @@ def _eval_rows(f, kind, mu, sd, lo, hi, A, b1, W2, b2, taper, out):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _hybrid_rhs(y, tau, args):
-    """The replay's right-hand side (:func:`mmg.replay` ``_replay_rhs``) plus the correction's accelerations."""
+    """The replay's right-hand side (:func:`mmg.replay.replay_rhs`) plus the correction's accelerations."""
     base, corr = args
     k, m, i, delta, n, minv, p = base[0], base[1], base[2], base[3], base[4], base[6], base[7]
-    d0 = _replay_rhs(y, tau, base)
+    d0 = replay_rhs(y, tau, base)
     a = (k + tau) / m
     d = delta[i] + a * (delta[i + 1] - delta[i])
     nn = n[i] + a * (n[i + 1] - n[i])
@@ -353,7 +353,7 @@ def _hybrid_replay(t, delta, n, ext, s0, dt_max, minv, p, poly, hull_axis, hull_
         m = max(1, int(np.ceil(h / dt_max - 1e-9)))
         dt = h / m
         for k in range(m):
-            s = rk4_step(_hybrid_rhs, _axpy, ZERO6, s, dt,
+            s = rk4_step(_hybrid_rhs, axpy6, ZERO6, s, dt,
                          ((k, m, i, delta, n, ext, minv, p, poly, hull_axis, hull_term, hull_coef), corr))
         bad = False
         for j in range(6):
