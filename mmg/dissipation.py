@@ -28,7 +28,8 @@ import numpy as np
 from .model import (P_IZ, P_JZ, P_L, P_M, P_MX, P_MY, P_RHO, P_T, P_ULOW, P_XG, R_, U_, V_,
                     hull_regressors, pack, rhs)
 
-__all__ = ["PowerCheck", "unpowered_power", "hull_term_power", "power_check", "power_scale", "state_box"]
+__all__ = ["PowerCheck", "unpowered_power", "hull_term_power", "power_check", "power_scale", "state_box",
+           "relative_power", "gains_no_energy"]
 
 POWER_TOLERANCE = 1e-4
 """A state fails when dT/dt exceeds this fraction of :func:`power_scale` (rounding of the force
@@ -133,6 +134,40 @@ class PowerCheck:
                 "feeding_W": self.feeding}
 
 
+def relative_power(ship_or_packed, u, v, r) -> tuple[np.ndarray, np.ndarray]:
+    """(dT/dt over :func:`power_scale` [-], judged) at the states u, v [m/s], r [rad/s] (flattened):
+    the unpowered power relative to its scale at every state, and whether the state is judged (its scale
+    above the hull's low-speed floor, :func:`power_check`; below it the ratio is that of vanishing forces).
+
+    Parameters
+    ----------
+    ship_or_packed : Ship or PackedShip
+    u, v, r : array_like
+        States (broadcast together) [m/s, m/s, rad/s].
+
+    Returns
+    -------
+    rel : ndarray
+        dT/dt / (1/2 rho L T U_t^3) at each state (NaN at rest).
+    judged : ndarray of bool
+        True where the state's scale is above the low-speed floor.
+    """
+    pk = _packed(ship_or_packed)
+    uu, vv, rr, _ = _states(u, v, r)
+    sc = power_scale(pk, uu, vv, rr)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = unpowered_power(pk, uu, vv, rr) / sc
+    return rel, sc > power_scale(pk, pk.p[P_ULOW], 0.0, 0.0)
+
+
+def gains_no_energy(ship_or_packed, u, v, r, tol: float = POWER_TOLERANCE) -> bool:
+    """Whether the ship gains no energy unpowered at any judged state of u, v [m/s], r [rad/s]:
+    :attr:`PowerCheck.passes` of :func:`power_check` without its diagnosis of the worst state (for
+    checking many ships over one grid)."""
+    rel, judged = relative_power(ship_or_packed, u, v, r)
+    return not bool(np.any(judged & (rel > tol)))
+
+
 def power_check(ship, u, v, r, tol: float = POWER_TOLERANCE) -> PowerCheck:
     """:class:`PowerCheck` of ``ship`` at the states u, v [m/s], r [rad/s] (arrays broadcast
     together).  States whose U_t (:func:`power_scale`) is below the hull's low-speed floor
@@ -141,10 +176,8 @@ def power_check(ship, u, v, r, tol: float = POWER_TOLERANCE) -> PowerCheck:
     speed) outweighs a vanishing scale without feeding any motion."""
     uu, vv, rr, _ = _states(u, v, r)
     pk = pack(ship)
-    sc = power_scale(pk, uu, vv, rr)
-    ok = sc > power_scale(pk, pk.p[P_ULOW], 0.0, 0.0)
-    uu, vv, rr, sc = uu[ok], vv[ok], rr[ok], sc[ok]
-    rel = unpowered_power(pk, uu, vv, rr) / sc
+    rel, ok = relative_power(pk, uu, vv, rr)
+    uu, vv, rr, rel = uu[ok], vv[ok], rr[ok], rel[ok]
     i = int(np.argmax(rel))
     bad = int(np.sum(rel > tol))
     feeding = {}

@@ -163,23 +163,22 @@ class Support:
             return False
         if self.states is None:
             return True
-        from mmg.dissipation import power_check
+        from mmg.dissipation import gains_no_energy
 
         from .identify import ship_with_values
 
         s = ship_with_values(ship, {n: float(v) for n, v in zip(self.names, row) if n not in WIND_FACTOR_NAMES})
-        return power_check(s, *self.states).passes
+        return gains_no_energy(s, *self.states)
 
 
 def _dissipative_states(ship: Ship, states) -> tuple:
     """The states of ``states`` (u, v, r arrays) where ``ship`` gains no energy unpowered (within
     :data:`mmg.dissipation.POWER_TOLERANCE` of :func:`mmg.dissipation.power_scale`)."""
-    from mmg.dissipation import POWER_TOLERANCE, power_scale, unpowered_power
-    from mmg.model import pack
+    from mmg.dissipation import POWER_TOLERANCE, relative_power
 
-    pk = pack(ship)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        keep = unpowered_power(pk, *states) / power_scale(pk, *states) <= POWER_TOLERANCE
+    rel, _ = relative_power(ship, *states)
+    with np.errstate(invalid="ignore"):
+        keep = rel <= POWER_TOLERANCE
     return tuple(np.asarray(a)[keep] for a in states)
 
 
