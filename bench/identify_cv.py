@@ -96,6 +96,10 @@ def _args(argv=None):
                          "written covariance, start from the run-to-run spread); pooled coverage and median width")
     ap.add_argument("--band-support", choices=("none", "bounds", "physical"), default="none",
                     help="truncate the bands' ship draws (mmg predict --support; default none)")
+    ap.add_argument("--band-model-form", choices=("training", "kept-out", "none"), default="training",
+                    help="the model-form term of the bands: from each fold's training replays (as mmg identify "
+                         "writes it; default), from the kept-out replays of a cross-validation inside the fold (as "
+                         "mmg identify --cv writes it: --inner-folds more fits per fold), or none")
     ap.add_argument("--backend", choices=("serial", "loky"), default="loky")
     ap.add_argument("--jobs", type=int, default=2, help="local workers of the loky backend (default 2)")
     ap.add_argument("--markdown", action="store_true", help="print the tables as Markdown")
@@ -301,7 +305,7 @@ def main(argv=None) -> None:
     t0 = time.perf_counter()
     res = nested_cross_validate(cands, runs, folds=a.folds, inner_folds=a.inner_folds, initial=initial,
                                 folds_by=a.folds_by, backend=a.backend, n_jobs=a.jobs, horizon_s=a.horizon,
-                                bands=BandSpec(a.bands, a.band_support), **opts)
+                                bands=BandSpec(a.bands, a.band_support, a.band_model_form), **opts)
     print(f"\n{time.perf_counter() - t0:.0f} s wall\n")
     print("Per kept-out record (s: scaled esso_osaka_3m, i: identified without it; 'div.': the replay diverged):\n")
     print("\n".join(record_table(res, a.markdown)))

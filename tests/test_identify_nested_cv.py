@@ -305,17 +305,21 @@ def test_the_band_spec_reaches_every_kept_out_records_band_and_none_by_default(m
     calls = []
     monkeypatch.setattr(N, "fit_model", _Watch())
     monkeypatch.setattr(N, "band_sections", lambda ident: (None, None))
-    monkeypatch.setattr(N, "band_scores", lambda ident, run, samples, seed=0, sections=None, support="none":
-                        calls.append((run.name, samples, seed, support)) or {"samples": 1})
+    specs = []
+    monkeypatch.setattr(N, "band_ship", lambda ident, spec, initial=None, kw=None: specs.append(spec) or "with its term")
+    monkeypatch.setattr(N, "band_scores", lambda ident, run, samples, seed=0, sections=None, support="none", ship=None:
+                        calls.append((run.name, samples, seed, support, ship)) or {"samples": 1})
     one = {"kijima": forms["kijima"]}
     N.nested_cross_validate(one, runs, folds=2)
-    assert calls == []
-    res = N.nested_cross_validate(one, runs, folds=2, bands=N.BandSpec(samples=7, support="bounds"))
-    assert sorted(calls) == sorted((r["name"], 7, r["fold"], "bounds") for r in res.records)
+    assert calls == [] and specs == []
+    res = N.nested_cross_validate(one, runs, folds=2, inner_folds=3, folds_by="manoeuvre",
+                                  bands=N.BandSpec(samples=7, support="bounds", model_form="kept-out"))
+    assert sorted(calls) == sorted((r["name"], 7, r["fold"], "bounds", "with its term") for r in res.records)
     assert len(calls) == 4 and all(r["band"] == {"samples": 1} for r in res.records)
+    assert [(s.model_form, s.folds, s.folds_by) for s in specs] == [("kept-out", 3, "manoeuvre")] * 2
 
 
-@pytest.mark.parametrize("bad", [dict(samples=-1), dict(samples=2.5), dict(support="energy")])
+@pytest.mark.parametrize("bad", [dict(samples=-1), dict(samples=2.5), dict(support="energy"), dict(model_form="cv")])
 def test_a_band_spec_outside_its_range_is_refused(bad):
     with pytest.raises(ValueError, match="BandSpec"):
         N.BandSpec(**bad)

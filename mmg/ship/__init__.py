@@ -7,7 +7,7 @@ messages).
 from __future__ import annotations
 
 from .data import (Particulars, MassProperties, HullModel, Propeller, Rudder, SteeringGear, Engine, Wind,
-                   ParameterCovariance, FullScale, IdentificationNotes, RunSpread, Ship)
+                   ParameterCovariance, FullScale, IdentificationNotes, RunSpread, ModelForm, Ship)
 from .yamlfile import one_line, field_path, MAX_CONFIG_BYTES, parse_yaml, read_yaml, ConfigError
 from .load import Length, Quantity, pydantic_message, ship_from_dict, load_ship
 

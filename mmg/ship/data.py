@@ -299,6 +299,35 @@ class RunSpread:
 
 
 @dataclass(frozen=True)
+class ModelForm:
+    """How far a replay's heading strays from a record's with elapsed time, beyond what the parameters'
+    covariance and the run spread carry: the ``model_form:`` section, the model-form term of a prediction band.
+
+    ``mmg identify`` writes it (:func:`trials.measured.modelform.heading_error_growth`) from the heading
+    errors of replays of records; ``mmg predict --samples`` adds to each drawn replay's heading a
+    zero-mean normal error whose 90 % half-width grows as ``heading_q90_deg`` over ``elapsed_froude``.
+
+    Attributes
+    ----------
+    elapsed_froude : tuple of float
+        Elapsed times from a replay's start, in units of sqrt(L/g) (Froude time: the same numbers for a
+        model and its full-scale ship), increasing.
+    heading_q90_deg : tuple of float
+        At each, the 90 % quantile of the absolute heading error [deg], non-decreasing; linear between
+        the nodes, zero at the start, held beyond the last node.
+    records : int
+        The records the errors came from.
+    source : str
+        How it was made (which replays: kept out of the fit, or its own training records).
+    """
+
+    elapsed_froude: tuple
+    heading_q90_deg: tuple
+    records: int = 0
+    source: str = ""
+
+
+@dataclass(frozen=True)
 class Ship:
     """A ship: everything the simulator needs, in SI and primes."""
 
@@ -334,6 +363,9 @@ class Ship:
         return 1.0 if self.full_scale is None else self.full_scale.L / self.particulars.L
     run_spread: RunSpread | None = field(default=None, compare=False, repr=False)
     """The spread of a run's own disturbance between runs (the ``run_spread:`` section), or None."""
+    model_form: ModelForm | None = field(default=None, compare=False, repr=False)
+    """The heading error a replay gains with elapsed time beyond its parameters' doubt (the ``model_form:``
+    section), or None."""
 
     def effect_set(self):
         """:attr:`effects` as an :class:`mmg.effects.EffectSet` (an empty one when None)."""

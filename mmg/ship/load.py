@@ -31,6 +31,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Literal, Optional
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from ..errors import InputError
@@ -38,7 +39,7 @@ from ..terms import AXES, TERMS
 from ..units import (DENSITY_RANGE, MAX_RUDDER, MAX_STEERING_RATE, MAX_STEERING_TIME_CONSTANT, SHIP_LENGTH_RANGE,
                      check_range, to_si)
 from .data import (Engine, FullScale, HullModel, IdentificationNotes, MassProperties, ParameterCovariance, Particulars,
-                   Propeller, Rudder, RunSpread, Ship, SteeringGear, Wind)
+                   ModelForm, Propeller, Rudder, RunSpread, Ship, SteeringGear, Wind)
 from .yamlfile import ConfigError, field_path, one_line, read_yaml
 
 
@@ -214,6 +215,13 @@ class _RunSpread(_Strict):
     source: str = ""
 
 
+class _ModelForm(_Strict):
+    elapsed_froude: list[float]
+    heading_q90_deg: list[float]
+    records: int = 0
+    source: str = ""
+
+
 class _ShipFile(_Strict):
     name: str = Field(min_length=1)
     source: str = ""
@@ -230,6 +238,7 @@ class _ShipFile(_Strict):
     full_scale: Optional[_FullScale] = None
     identification: Optional[_Identification] = None
     run_spread: Optional[_RunSpread] = None
+    model_form: Optional[_ModelForm] = None
 
 
 _UNIT_HINT = {"L": "m", "B": "m", "T": "m", "S_wetted": "m^2", "x_G": "m", "rho": "kg/m^3", "D": "m", "P": "m",
@@ -474,7 +483,8 @@ def _build(f: _ShipFile, src: str) -> Ship:
     return Ship(name=f.name, particulars=particulars, mass=mass, hull=hull, propeller=propeller, rudder=rudder,
                 steering=steering, engine=engine, source=f.source, wind=wind, effects=effects, stated=stated,
                 covariance=_covariance(f, src), full_scale=_full_scale(f, src, particulars),
-                identification=_identification(f), run_spread=_run_spread(f, src))
+                identification=_identification(f), run_spread=_run_spread(f, src),
+                model_form=_model_form(f, src))
 
 
 def _full_scale(f: _ShipFile, src: str, pa: Particulars) -> FullScale | None:
@@ -510,6 +520,25 @@ def _run_spread(f: _ShipFile, src: str) -> RunSpread | None:
         if x < 0:
             raise InputError(src, f"run_spread.std.{i}", f"a negative standard deviation {x:g}")
     return RunSpread(tuple(c.names), tuple(c.units), tuple(float(x) for x in c.std), int(c.records), c.source)
+
+
+def _model_form(f: _ShipFile, src: str) -> ModelForm | None:
+    """model_form: as many finite errors as elapsed times, the times positive and increasing, the errors
+    non-negative and non-decreasing (an error that shrinks with time is not a growth curve)."""
+    c = f.model_form
+    if c is None:
+        return None
+    t, q = np.asarray(c.elapsed_froude, float), np.asarray(c.heading_q90_deg, float)
+    if len(q) != len(t) or not len(t):
+        raise InputError(src, "model_form.heading_q90_deg", f"{len(q)} entries for {len(t)} elapsed times (one or more)")
+    for key, x in (("elapsed_froude", t), ("heading_q90_deg", q)):
+        if not np.all(np.isfinite(x)):
+            raise InputError(src, f"model_form.{key}", "a value that is not a finite number")
+    if t[0] <= 0 or np.any(np.diff(t) <= 0):
+        raise InputError(src, "model_form.elapsed_froude", "elapsed times (in sqrt(L/g)) must be positive and increasing")
+    if q[0] < 0 or np.any(np.diff(q) < 0):
+        raise InputError(src, "model_form.heading_q90_deg", "must be non-negative and non-decreasing with elapsed time")
+    return ModelForm(tuple(float(x) for x in t), tuple(float(x) for x in q), int(c.records), c.source)
 
 
 def _covariance(f: _ShipFile, src: str) -> ParameterCovariance | None:

@@ -75,6 +75,10 @@ def _bands(args, ship, pred) -> list | None:
         return None
     from ..measured.bands import prediction_bands
 
+    if args.model_form == "off":
+        from dataclasses import replace
+
+        ship = replace(ship, model_form=None)
     out = []
     for i, r in enumerate(pred.runs):
         out.append(prediction_bands(ship, r.run, args.samples, seed=args.seed, support=args.support))
@@ -89,7 +93,8 @@ def _with_bands(doc: dict, bands, args) -> dict:
     for row, b in zip(doc["runs"], bands):
         row.update(b.to_json())
     notes = sorted({n for b in bands for n in b.notes})
-    doc["bands"] = {"samples": int(args.samples), "seed": int(args.seed), "support": args.support, "notes": notes}
+    doc["bands"] = {"samples": int(args.samples), "seed": int(args.seed), "support": args.support,
+                    "model_form": args.model_form, "notes": notes}
     return doc
 
 
@@ -124,6 +129,9 @@ def _add_band_arguments(p) -> None:
                    help="truncate the --samples ship draws: none (default), to the fit's hard bounds, or to those and "
                         "ships gaining no energy unpowered over the training states (rejected_draws; narrower bands "
                         "that cover less on held-out real records: docs/prediction_bands.md)")
+    p.add_argument("--model-form", choices=("on", "off"), default="on",
+                   help="add the YAML's model_form: term to each --samples draw's heading (on, default, where the YAML "
+                        "has one: the heading error a replay gains with elapsed time, written by mmg identify) or not")
 
 
 def _first_text(r, horizon) -> str:

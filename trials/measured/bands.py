@@ -333,6 +333,28 @@ def _one_replay(ship: Ship, run: MeasuredRun, names, row, mean, sp_names, sp_row
     return replay_record(s, r).pred[:, 3:6]
 
 
+Z90 = 1.6448536269514722
+"""The standard normal's 95 % quantile: a normal error of standard deviation s has a 90 % half-width Z90 s."""
+
+
+def _model_form_errors(ship: Ship, run: MeasuredRun, samples: int, seed: int, notes: list) -> np.ndarray | float:
+    """Each draw's model-form heading error [deg] (draws, N): a zero-mean normal, one per draw and whole along
+    the record, whose 90 % half-width is the ship's ``model_form:`` term at each sample's elapsed time
+    (:func:`trials.measured.modelform.heading_half_width`), from the third stream of ``seed``; 0 without one."""
+    mf = ship.model_form
+    if mf is None:
+        notes.append("no model-form term drawn (none in the ship config, or left out): the band is the "
+                     "parameters' and the run's doubt alone, narrower than a new record's error")
+        return 0.0
+    from .modelform import heading_half_width
+
+    hw = heading_half_width(mf, run.t - run.t[0], ship.particulars.L)
+    z = np.random.default_rng([int(seed), 2]).standard_normal(samples)
+    notes.append(f"model-form heading error added to each draw ({mf.source or 'model_form: section'}; "
+                 f"{hw[-1]:.1f} deg 90 % half-width at the record's end); the position band is the draws' alone")
+    return z[:, None] * (hw / Z90)[None, :]
+
+
 def _unwrapped_deg(psi: np.ndarray, first: float) -> np.ndarray:
     """Headings (..., N) [rad] unwrapped along the last axis, put on the turn of ``first`` [rad], in degrees."""
     u = np.unwrap(psi, axis=-1)
@@ -415,7 +437,7 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     P = np.stack(preds)                                              # (draws, N, 3): x, y, psi
     nominal = replay_record(ship, run)
     first = float(np.unwrap(run.meas[:, 5])[0])
-    lo, hi = _quantile_bounds(_unwrapped_deg(P[:, :, 2], first))
+    lo, hi = _quantile_bounds(_unwrapped_deg(P[:, :, 2], first) + _model_form_errors(ship, run, samples, seed, notes))
     xm, ym, radius = _position_band(P[:, :, :2])
     return Bands(nominal=nominal, t=np.asarray(run.t, float), heading_deg=np.degrees(np.unwrap(run.meas[:, 5])),
                  lo=lo, hi=hi, nominal_deg=_unwrapped_deg(nominal.pred[:, 5], first), x_median=xm, y_median=ym,

@@ -22,7 +22,7 @@ bare NaN.  :func:`select_candidate` is the inner step alone, on all the given re
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -32,7 +32,7 @@ from .predict import MeasuredRun, replay_record
 
 __all__ = ["BandSpec", "Candidate", "NestedCV", "Selection", "nested_cross_validate", "select_candidate", "choose",
            "replay_scores", "fit_model", "check_choosable", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES",
-           "band_scores", "band_sections", "band_summary"]
+           "band_scores", "band_sections", "band_summary", "band_ship", "MODEL_FORMS"]
 
 HULL_FORMS = {"kijima": "", "crossflow": "_crossflow"}
 """The hull forms ``mmg identify --hull`` knows, by the suffix of their bundled config's name after the
@@ -149,17 +149,19 @@ def band_sections(ident) -> tuple:
 
 
 def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None = None,
-                support: str = "none") -> dict:
+                support: str = "none", ship: Ship | None = None) -> dict:
     """The 90 % heading band of ``run`` predicted by the identified model ``ident`` (its ship drawn from the
     covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
     :func:`trials.measured.bands.prediction_bands`; ``sections``: :func:`band_sections` of ``ident``, made
     once for several runs): ``samples`` (the record's), ``inside`` (of them in the band), ``coverage90``,
     ``median_width_deg``, ``unbounded_share``, ``draws``, ``diverged_draws``, ``rejected_draws`` (candidate
-    ships outside the ``support``, not replayed: :func:`trials.measured.bands.prediction_bands`)."""
+    ships outside the ``support``, not replayed: :func:`trials.measured.bands.prediction_bands`); ``ship``:
+    ``ident.ship`` with the sections it carries (a model-form term: :func:`band_ship`), ``ident.ship`` by default."""
     from .bands import prediction_bands
 
     cov, spread = band_sections(ident) if sections is None else sections
-    b = prediction_bands(ident.ship, run, samples, seed, covariance=cov, run_spread=spread, jobs=1, support=support)
+    b = prediction_bands(ident.ship if ship is None else ship, run, samples, seed, covariance=cov, run_spread=spread,
+                         jobs=1, support=support)
     n = len(b.t)
     bounded = int(round((1.0 - b.unbounded_share) * n))
     inside_b = int(round(b.coverage90_where_bounded * bounded)) if bounded else 0
@@ -201,15 +203,28 @@ class BandSpec:
     support : {"none", "bounds", "physical"}
         Where the bands' ship draws are truncated (:data:`trials.measured.draws.SUPPORTS`,
         :func:`trials.measured.bands.prediction_bands`).
+    model_form : {"training", "kept-out", "none"}
+        The model-form term the fold's model carries (:func:`trials.measured.identify.model_form`), as
+        ``mmg identify`` writes it: from the fold's training replays (default, as without ``--cv``), from
+        the kept-out replays of a cross-validation inside the fold's training set (as with ``--cv``:
+        ``folds`` more fits per fold, dealt by ``folds_by``), or none.
+    folds : int
+        Folds of that inner cross-validation.
+    folds_by : str
+        How it deals the records (:func:`~trials.measured.identify.fold_of`).
 
     Raises
     ------
     ValueError
-        A negative ``samples`` or a ``support`` not in :data:`~trials.measured.draws.SUPPORTS`.
+        A negative ``samples``, a ``support`` not in :data:`~trials.measured.draws.SUPPORTS` or a
+        ``model_form`` not in :data:`MODEL_FORMS`.
     """
 
     samples: int = 0
     support: str = "none"
+    model_form: str = "training"
+    folds: int = 3
+    folds_by: str = "order"
 
     def __post_init__(self):
         from .draws import SUPPORTS
@@ -218,6 +233,33 @@ class BandSpec:
             raise ValueError(f"BandSpec.samples must be a whole number >= 0, got {self.samples!r}")
         if self.support not in SUPPORTS:
             raise ValueError(f"BandSpec.support must be one of {SUPPORTS}, got {self.support!r}")
+        if self.model_form not in MODEL_FORMS:
+            raise ValueError(f"BandSpec.model_form must be one of {MODEL_FORMS}, got {self.model_form!r}")
+
+
+MODEL_FORMS = ("training", "kept-out", "none")
+"""Where the bands' model-form term comes from (:class:`BandSpec`)."""
+
+
+def band_ship(ident, spec: BandSpec, initial: Ship | None = None, kw: dict | None = None) -> Ship:
+    """``ident``'s ship with the model-form term ``spec.model_form`` says (:class:`BandSpec`), as ``mmg
+    identify`` would write it into its ship.yaml; ``initial`` and ``kw`` (the fit's options) make the
+    inner cross-validation of ``"kept-out"``."""
+    from mmg.ship import ModelForm
+
+    from .identify import cross_validate, model_form
+
+    if spec.model_form == "none":
+        return replace(ident.ship, model_form=None)
+    cv = None
+    if spec.model_form == "kept-out":
+        kw = {**(kw or {}), "say": lambda m: None}
+        cv = cross_validate(ident.prior or ident.initial, ident.runs, folds=spec.folds, initial=initial,
+                            folds_by=spec.folds_by, **kw)
+    sec = model_form(ident, cv)
+    mf = None if sec is None else ModelForm(tuple(sec["elapsed_froude"]), tuple(sec["heading_q90_deg"]), sec["records"],
+                                            sec["source"])
+    return replace(ident.ship, model_form=mf)
 
 
 def _outer_task(task) -> list[dict]:
@@ -232,8 +274,10 @@ def _outer_task(task) -> list[dict]:
            for r in tests]
     if bands.samples:
         sections = band_sections(ident)                # one covariance and run spread per fold
+        ship = band_ship(ident, bands, initial, {**kw, **cand.options})
         for rec, r in zip(out, tests):
-            rec["band"] = band_scores(ident, r, bands.samples, seed=outer, sections=sections, support=bands.support)
+            rec["band"] = band_scores(ident, r, bands.samples, seed=outer, sections=sections, support=bands.support,
+                                      ship=ship)
     return out
 
 
@@ -365,6 +409,7 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
     """
     initial = _initial(candidates, initial)
     n_out, splits = _split(runs, folds, folds_by)
+    bands = replace(bands, folds=inner_folds, folds_by=folds_by)
     choices, tables, inner_rows = {}, {}, []
     if len(candidates) > 1:
         tasks = [t for k, (tr, _) in enumerate(splits)

@@ -208,3 +208,27 @@ def run_spread(ident: Identification) -> dict | None:
         return None
     return {"names": [names[i] for i in keep], "units": [units[i] for i in keep],
             "std": [float(f"{std[i]:.6g}") for i in keep], "records": n, "source": source}
+
+
+def model_form(ident: Identification, cv: list | None = None) -> dict | None:
+    """The ``model_form:`` section of ship.yaml (:func:`trials.measured.modelform.model_form_section`): the
+    heading error a replay gains with elapsed time.  With ``cv`` (:func:`~.fit.cross_validate`'s records,
+    each kept-out record with the ``ship`` and ``values`` of the fit that did not see it) from those
+    kept-out replays; otherwise from the fit's own training replays, in sample (a lower bound, said in the
+    section's ``source``).  None where too few records reach any elapsed time."""
+    from ..modelform import heading_error_curves, model_form_section
+    from .fit import replay_fitted
+
+    L = ident.ship.particulars.L
+    by_name = {r.name: r for r in ident.runs}
+    kept = [c for c in (cv or []) if c.get("ship") is not None and c.get("name") in by_name]
+    if kept:
+        reps = [replay_fitted(c["ship"], c["values"], by_name[c["name"]]) for c in kept]
+        folds = len({c.get("fold") for c in kept})
+        source = (f"heading errors of the {len(reps)} kept-out replays of a {folds}-fold cross-validation (each by "
+                  "the fit that did not see it), 90 % quantile per bin of elapsed time")
+    else:
+        reps = [ident.replay(r) for r in ident.runs]
+        source = (f"heading errors of the fit's own {len(reps)} training replays, in sample (a new record's are "
+                  "larger: identify with --cv for kept-out ones), 90 % quantile per bin of elapsed time")
+    return model_form_section(heading_error_curves(reps), L, source)

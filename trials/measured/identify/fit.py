@@ -217,7 +217,7 @@ class Identification:
         if hit is not None and hit[0] is run:
             return hit[1]
         if model == "identified":
-            rep = replay_record(self.ship, with_ship_effects(with_fitted_wind(run, self.fit.values()), self.ship))
+            rep = replay_fitted(self.ship, self.fit.values(), run)
         else:
             rep = replay_record(self.initial, run)
         self._replays[key] = (run, rep)
@@ -226,6 +226,13 @@ class Identification:
     @cached_property
     def _replays(self) -> dict:
         return {}
+
+
+def replay_fitted(ship: Ship, values: dict, run: MeasuredRun):
+    """:func:`trials.measured.predict.replay_record` of ``run`` with an identified ``ship`` and its fitted
+    ``values`` (:meth:`ekf.identify.IdentifyResult.values`): the record's wind loads scaled by the fitted
+    wind factors, the ship's own effects applied."""
+    return replay_record(ship, with_ship_effects(with_fitted_wind(run, values), ship))
 
 
 def with_ship_effects(run: MeasuredRun, ship: Ship) -> MeasuredRun:

@@ -12,7 +12,7 @@ import numpy as np
 from mmg.errors import InputError
 
 from ..predict import replay_record
-from .covariance import identification_covariance, run_spread
+from .covariance import identification_covariance, model_form, run_spread
 from .fit import Identification, _wind_keys, stage_description
 
 __all__ = ["write_identification", "ship_yaml", "fold_spread_json", "identification_summary", "free_parameter_text"]
@@ -57,14 +57,15 @@ def _change_text(pct: float) -> str:
 
 
 def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None = None,
-              identification: dict | None = None, spread: dict | None = None) -> str:
+              identification: dict | None = None, spread: dict | None = None, model_form: dict | None = None) -> str:
     """The ship YAML at ``ship_path`` with the fitted ``values`` written in (hull coefficients,
     ``w_P0`` constant term, ``Y_P_astern``, the rudder's ``epsilon``, ``kappa``, ``gamma_R_pos``,
     ``gamma_R_neg``, ``l_R_prime``, the added masses, a rudder offset and the wind factors) and ``note`` in its header and ``source``; with
     ``covariance`` (:func:`fit_covariance`) its ``covariance:`` section (else none: the initial
     ship's own section, if any, is about other values and is dropped); with ``identification``
     (:func:`identification_summary`) its ``identification:`` section and its warnings as header comments,
-    with ``spread`` (:func:`run_spread`) its ``run_spread:`` section (else none of either, as the covariance)."""
+    with ``spread`` (:func:`run_spread`) its ``run_spread:`` section (else none of either, as the covariance),
+    with ``model_form`` (:func:`trials.measured.identify.covariance.model_form`) its ``model_form:`` section."""
     import yaml
 
     from mmg.parameters import write_yaml_value
@@ -81,6 +82,9 @@ def ship_yaml(ship_path: Path, values: dict, note: str, covariance: dict | None 
     data.pop("run_spread", None)
     if spread is not None:
         data["run_spread"] = spread
+    data.pop("model_form", None)
+    if model_form is not None:
+        data["model_form"] = model_form
     data["name"] = f"{data['name']} (identified)"
     data["source"] = f"{data.get('source', '')}; identified by mmg identify: {note}"
     head = "".join(f"# {ln}\n" for ln in note.splitlines() + _warning_lines(identification))
@@ -410,7 +414,8 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
     cov, post, _ = identification_covariance(ident, parts=True)
     summary = identification_summary(ident, cov)
-    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, summary, spread=run_spread(ident)))
+    (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, summary, spread=run_spread(ident),
+                                                 model_form=model_form(ident, cv)))
     lines = _report_fit(ident, cov, summary["warnings"]) + _report_physical(ident.physical_check()) + _report_training(ident)
     if test_runs:
         lines += _report_test(ident, test_runs)

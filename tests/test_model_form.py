@@ -1,0 +1,174 @@
+"""The model-form term of the prediction bands (:mod:`trials.measured.modelform`, the ``model_form:`` section).
+
+The growth curve against quantiles counted by hand on made-up error curves (bins, the records a bin needs,
+made non-decreasing, a diverged sample as an infinite error); the same errors of a model and of its
+full-scale ship (times sqrt(lambda) apart) give the same section; the band of a ship with a term and
+nothing else drawn is the nominal replay plus or minus the term's half-width; a bad section is refused
+naming its field; ``mmg identify`` writes a section that loads back, from the training replays or, with
+``--cv``, the kept-out ones.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import yaml
+
+import mmg
+from mmg.errors import InputError
+from mmg.ship import ModelForm
+from trials.measured.bands import prediction_bands
+from trials.measured.modelform import (ELAPSED_EDGES, MIN_RECORDS, heading_error_growth, heading_half_width,
+                                       model_form_section)
+
+from .test_predict_bands import SHIP, _run
+
+L, G = 3.0, 9.80665
+UNIT = np.sqrt(L / G)                       # the Froude time unit of a 3 m model [s]
+
+
+def _curve(t_froude, err):
+    return np.asarray(t_froude, float) * UNIT, np.asarray(err, float)
+
+
+def test_growth_is_the_90_percent_quantile_per_bin_counted_by_hand():
+    """Three records sampled in the first two bins (0-10, 10-20 sqrt(L/g)); the third bin (20-40) reached by
+    two only: left out.  The quantile is numpy's 'higher' one of the absolute errors pooled in the bin."""
+    t1 = np.arange(0.0, 20.0, 0.5)
+    recs = [_curve(t1, 0.1 * (k + 1) * t1 * (-1) ** k) for k in range(3)]
+    recs += [_curve(np.arange(20.0, 30.0, 0.5), np.full(20, 50.0)), _curve(np.arange(20.0, 30.0, 0.5), np.full(20, 60.0))]
+    nodes, q, n = heading_error_growth(recs, L)
+    assert n == 5 and MIN_RECORDS == 3
+    np.testing.assert_allclose(nodes, [10.0, 20.0])
+    for j, (lo, hi) in enumerate([(0, 10), (10, 20)]):
+        pooled = np.concatenate([np.abs(e)[(t / UNIT >= lo) & (t / UNIT < hi)] for t, e in recs[:3]])
+        assert q[j] == pytest.approx(np.sort(pooled)[int(np.ceil(0.9 * (len(pooled) - 1)))])
+
+
+def test_growth_never_falls_and_a_diverged_sample_counts_as_infinite():
+    """Errors that shrink in the second bin keep the first bin's value; a NaN (diverged) in a bin where over a
+    tenth of the samples are NaN makes that bin's quantile infinite, and no section is written from it."""
+    t = np.arange(0.0, 20.0, 0.5)
+    shrink = [_curve(t, np.where(t < 10, 30.0, 1.0)) for _ in range(3)]
+    _, q, _ = heading_error_growth(shrink, L)
+    np.testing.assert_allclose(q, [30.0, 30.0])
+    bad = [_curve(t, np.where(t < 10, 1.0, np.nan)) for _ in range(3)]
+    _, q, _ = heading_error_growth(bad, L)
+    assert np.isinf(q[-1])
+    assert model_form_section(bad, L, "test") is None
+
+
+def test_model_and_full_scale_give_the_same_section():
+    """Froude similarity: the full-scale ship (lambda = 100) sees the same errors 10x later in seconds."""
+    t = np.arange(0.0, 200.0, 0.1)
+    recs = [(t, 0.2 * (k + 1) * t) for k in range(4)]
+    big = [(10.0 * tt, e) for tt, e in recs]
+    a, b = model_form_section(recs, L, "x"), model_form_section(big, 100 * L, "x")
+    assert a == b and a["elapsed_froude"][0] == ELAPSED_EDGES[1]
+
+
+def test_half_width_is_linear_from_zero_and_held_beyond_the_last_node():
+    mf = ModelForm((10.0, 20.0), (2.0, 6.0))
+    hw = heading_half_width(mf, np.array([0.0, 5.0, 10.0, 15.0, 20.0, 400.0]) * UNIT, L)
+    np.testing.assert_allclose(hw, [0.0, 1.0, 2.0, 4.0, 6.0, 6.0])
+
+
+def test_band_of_a_term_alone_is_the_nominal_plus_minus_its_half_width():
+    """No covariance, no run spread: every draw replays the nominal ship, so the band is the nominal heading
+    plus the term's normal error, whose 5 % and 95 % quantiles are -+ the half-width (within the sampling error
+    of 400 draws, about 7 %); without the term the band has no width."""
+    ship = mmg.load_ship(SHIP)
+    run = _run(ship, duration=30.0)
+    mf = ModelForm((10.0, 20.0, 40.0), (2.0, 5.0, 9.0))
+    ship = replace(ship, covariance=None, run_spread=None)
+    b = prediction_bands(replace(ship, model_form=mf), run, 400, seed=3, jobs=2)
+    hw = heading_half_width(mf, run.t - run.t[0], L)
+    late = hw > 1.0
+    np.testing.assert_allclose((b.hi - b.nominal_deg)[late] / hw[late], 1.0, atol=0.2)
+    np.testing.assert_allclose((b.nominal_deg - b.lo)[late] / hw[late], 1.0, atol=0.2)
+    assert any("model-form" in n for n in b.notes)
+    plain = prediction_bands(replace(ship, model_form=None), run, 50, seed=3, jobs=2)
+    assert plain.empty
+
+
+@pytest.mark.parametrize("section, field", [
+    ({"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [1.0]}, "model_form.heading_q90_deg"),
+    ({"elapsed_froude": [20.0, 10.0], "heading_q90_deg": [1.0, 2.0]}, "model_form.elapsed_froude"),
+    ({"elapsed_froude": [0.0, 10.0], "heading_q90_deg": [1.0, 2.0]}, "model_form.elapsed_froude"),
+    ({"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [3.0, 2.0]}, "model_form.heading_q90_deg"),
+    ({"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [-1.0, 2.0]}, "model_form.heading_q90_deg"),
+    ({"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [1.0, float("nan")]}, "model_form.heading_q90_deg"),
+])
+def test_a_bad_section_is_refused_naming_its_field(tmp_path, section, field):
+    data = yaml.safe_load(_ship_file().read_text())
+    data["model_form"] = section
+    p = tmp_path / "ship.yaml"
+    p.write_text(yaml.safe_dump(data))
+    with pytest.raises(InputError) as e:
+        mmg.load_ship(str(p))
+    assert field in str(e.value) and str(p) in str(e.value)
+
+
+def _ship_file():
+    from pathlib import Path
+
+    return Path(__file__).resolve().parents[1] / "configs" / "ships" / f"{SHIP}.yaml"
+
+
+def _binned_q90_by_hand(curves, L):
+    """The 90 % quantile ('higher') of |error| per bin of ELAPSED_EDGES reached by 3 or more records."""
+    out = []
+    for lo, hi in zip(ELAPSED_EDGES[:-1], ELAPSED_EDGES[1:]):
+        parts = [np.abs(e)[(t / np.sqrt(L / G) >= lo) & (t / np.sqrt(L / G) < hi)] for t, e in curves]
+        if sum(len(p) > 0 for p in parts) >= 3:
+            out.append(np.quantile(np.concatenate(parts), 0.9, method="higher"))
+    return np.maximum.accumulate(out)
+
+
+@pytest.fixture(scope="module")
+def three_slices(tmp_path_factory):
+    from .conftest import FRT
+
+    if not FRT.is_dir():
+        pytest.skip("FRT-DS-ESSO records not found")
+    from .test_identify_cli import _slice
+
+    d = tmp_path_factory.mktemp("mf")
+    return [_slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv", d / "zz.csv", 40.0),
+            _slice(FRT / "turning" / "turn_14-Sep-2020_13_51_45.csv", d / "turn.csv", 40.0),
+            _slice(FRT / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv", d / "zz2.csv", 40.0)]
+
+
+def test_identify_writes_the_training_replays_term_and_it_loads_back(three_slices, tmp_path):
+    """``mmg identify`` without ``--cv``: the section is the 90 % quantiles, binned here by hand, of the
+    identified ship's heading errors on its training records (replayed here from the written ship.yaml), and
+    says it is in sample; it loads back as the same :class:`mmg.ship.ModelForm`."""
+    from trials.cli import main
+    from trials.measured.identify import load_runs
+    from trials.measured.predict import replay_record
+
+    out = tmp_path / "out"
+    assert main(["identify", "--ship", SHIP, "--train", *map(str, three_slices), "--out", str(out),
+                 "--max-nfev", "8"]) == 0
+    sec = yaml.safe_load((out / "ship.yaml").read_text())["model_form"]
+    assert "in sample" in sec["source"] and sec["records"] == 3
+    ship = mmg.load_ship(str(out / "ship.yaml"))
+    assert ship.model_form == ModelForm(tuple(sec["elapsed_froude"]), tuple(sec["heading_q90_deg"]), 3, sec["source"])
+    curves = []
+    for r in load_runs(ship, three_slices):
+        p = replay_record(ship, r).pred
+        curves.append((r.t - r.t[0], np.degrees(np.unwrap(p[:, 5]) - np.unwrap(r.meas[:, 5]))))
+    np.testing.assert_allclose(sec["heading_q90_deg"], _binned_q90_by_hand(curves, ship.particulars.L), rtol=1e-4,
+                               atol=1e-4)
+
+
+def test_identify_with_cv_writes_the_kept_out_term(three_slices, tmp_path):
+    """With ``--cv 3`` the section is made of the three kept-out replays and says so."""
+    from trials.cli import main
+
+    out = tmp_path / "out"
+    assert main(["identify", "--ship", SHIP, "--train", *map(str, three_slices), "--out", str(out),
+                 "--max-nfev", "8", "--cv", "3"]) == 0
+    sec = yaml.safe_load((out / "ship.yaml").read_text())["model_form"]
+    assert "kept-out replays of a 3-fold cross-validation" in sec["source"] and sec["records"] == 3
