@@ -94,8 +94,8 @@ def _args(argv=None):
     ap.add_argument("--bands", type=int, default=0, metavar="N",
                     help="each kept-out record's 90 %% heading band from N draws of its fold's model (ship from the "
                          "written covariance, start from the run-to-run spread); pooled coverage and median width")
-    ap.add_argument("--band-support", choices=("none", "bounds", "physical"), default="none",
-                    help="truncate the bands' ship draws (mmg predict --support; default none)")
+    ap.add_argument("--band-support", choices=("none", "bounds", "physical"), default="physical",
+                    help="where the bands' ship draws are kept (mmg predict --support; default physical)")
     ap.add_argument("--band-model-form", choices=("training", "kept-out", "none"), default="training",
                     help="the model-form term of the bands: from each fold's training replays (as mmg identify "
                          "writes it; default), from the kept-out replays of a cross-validation inside the fold (as "

@@ -86,14 +86,19 @@ def test_a_draw_outside_the_fits_bounds_is_never_replayed(ship, monkeypatch):
     assert any("rejected" in x and "outside the support" in x for x in b.notes)
 
 
-def test_by_default_the_draws_are_not_truncated(ship, monkeypatch):
-    """Without ``support`` the ship is drawn from the covariance's normal as it is: kappa outside the fit's
-    bounds [0, 1] is replayed too, nothing is rejected, and the band is the first ``n`` draws' quantiles."""
+def test_support_none_does_not_truncate_and_physical_is_the_default(ship, monkeypatch):
+    """With ``support="none"`` the ship is drawn from the covariance's normal as it is: kappa outside the fit's
+    bounds [0, 1] is replayed too, nothing is rejected, and the band is the first ``n`` draws' quantiles.
+    Without ``support`` the draws are truncated as ``support="physical"`` truncates them."""
     run = _run(ship, duration=30.0)
     n, seed, k0 = 40, 5, ship.rudder.kappa
+    cov = {"names": ["kappa"], "matrix": [[0.25]]}
+    default = prediction_bands(ship, run, n, seed, covariance=cov, run_spread=SPREAD, jobs=1)
+    physical = prediction_bands(ship, run, n, seed, covariance=cov, run_spread=SPREAD, jobs=1, support="physical")
+    assert default.rejected == physical.rejected > 0
+    np.testing.assert_array_equal(default.lo, physical.lo)
     seen = _replayed_ships(monkeypatch)
-    b = prediction_bands(ship, run, n, seed, covariance={"names": ["kappa"], "matrix": [[0.25]]},
-                         run_spread=SPREAD, jobs=1)
+    b = prediction_bands(ship, run, n, seed, covariance=cov, run_spread=SPREAD, jobs=1, support="none")
     cand, offs = _candidates([k0], [[0.25]], SPREAD["std"], n, seed, batches=1)
     assert b.rejected == 0 and b.draws == n
     assert any(not 0.0 <= s.rudder.kappa <= 1.0 for s in seen)

@@ -84,7 +84,7 @@ def test_band_is_numpys_quantiles_of_draws_replayed_by_hand(ship):
 def test_zero_covariance_and_spread_give_the_nominal_replay(ship):
     run = _run(ship, amp_deg=15.0)
     b = prediction_bands(ship, run, 6, 0, covariance={"names": ["N_r"], "matrix": [[0.0]]},
-                         run_spread={"names": ["start.u", "start.psi"], "std": [0.0, 0.0]})
+                         run_spread={"names": ["start.u", "start.psi"], "std": [0.0, 0.0]}, support="none")
     nominal = np.degrees(replay_record(ship, run).pred[:, 5])
     np.testing.assert_allclose(b.lo, nominal, atol=1e-9)
     np.testing.assert_allclose(b.hi, nominal, atol=1e-9)
@@ -213,8 +213,9 @@ def test_cli_predict_samples_json_keys_and_plots(tmp_path, capsys):
     assert rc == 0, err
     doc = json.loads(js.read_text(), parse_constant=lambda c: pytest.fail(f"JSON holds {c}"))
     assert list(doc) == ["runs", "bands"]
-    assert doc["bands"] == {"samples": 20, "seed": 3, "support": "none", "model_form": "on",
-                            "notes": [n for n in doc["bands"]["notes"] if n.startswith("no model-form term")]}
+    assert doc["bands"] == {"samples": 20, "seed": 3, "support": "physical", "model_form": "on",
+                            "notes": [n for n in doc["bands"]["notes"]
+                                      if n.startswith(("no model-form term", "support 'physical' without"))]}
     run = doc["runs"][0]
     assert list(run)[-len(BAND_KEYS):] == ["draws", "diverged_draws", "rejected_draws", "heading_band_deg", "coverage90",
                                            "heading_band_median_width_deg", "heading_band_unbounded_share",

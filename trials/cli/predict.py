@@ -125,10 +125,11 @@ def _add_band_arguments(p) -> None:
                         "(JSON keys heading_band_deg, coverage90, position_band_m, ...; bands drawn in the plots)")
     p.add_argument("--seed", type=_whole(0, "--seed"), default=0, metavar="S",
                    help="seed of the --samples draws (default 0)")
-    p.add_argument("--support", choices=("none", "bounds", "physical"), default="none",
-                   help="truncate the --samples ship draws: none (default), to the fit's hard bounds, or to those and "
-                        "ships gaining no energy unpowered over the training states (rejected_draws; narrower bands "
-                        "that cover less on held-out real records: docs/prediction_bands.md)")
+    p.add_argument("--support", choices=("none", "bounds", "physical"), default="physical",
+                   help="where the --samples ship draws are kept: ships within the fit's hard bounds gaining no energy "
+                        "unpowered over the training states (physical, default; the others rejected_draws, never "
+                        "replayed), within the bounds alone, or anywhere (none: energy-gaining draws diverge and leave "
+                        "the band unbounded); docs/prediction_bands.md")
     p.add_argument("--model-form", choices=("on", "off"), default="on",
                    help="add the YAML's model_form: term to each --samples draw's heading (on, default, where the YAML "
                         "has one: the heading error a replay gains with elapsed time, written by mmg identify) or not")

@@ -6,7 +6,7 @@ times, each replay with
 * a ship drawn from the covariance of its identified parameters (the ship config's ``covariance:``
   section, :func:`trials.measured.draws.parameter_covariance`, written in by name with
   :func:`trials.measured.identify.ship_with_values`; a wind-load factor scales the record's measured
-  wind loads, relative to the covariance's own value), optionally (``support``) truncated to the ships
+  wind loads, relative to the covariance's own value), truncated (``support``, default) to the ships
   the estimator and the physics admit (:func:`trials.measured.draws.support_of`: within the fit's hard
   bounds, and not gaining energy unpowered over the training records' range of states): a candidate
   outside is never replayed but rejected and the next one drawn (:attr:`Bands.rejected`,
@@ -14,7 +14,11 @@ times, each replay with
 * the record's start state (and a per-record effect) offset by a zero-mean normal draw of the
   between-run spread of a run's own disturbance (the ``run_spread:`` section, :class:`mmg.ship.RunSpread`,
   written by ``mmg identify``: ``start.u``, ``start.v``, ``start.r``, ``start.psi`` added to the first
-  logged state; ``<effect>.<parameter>`` a per-record effect the run does not already have).
+  logged state; ``<effect>.<parameter>`` a per-record effect the run does not already have), and
+* on the heading, the model-form term of the ship's ``model_form:`` section (:class:`mmg.ship.ModelForm`,
+  :mod:`trials.measured.modelform`): a zero-mean normal error, one draw per replay from the third stream
+  of ``seed``, whose 90 % half-width grows with the elapsed time as the section says (the position band
+  is the draws' alone).
 
 At every sample of the record the band is the 5 % and 95 % quantiles over the draws (numpy's default
 linear interpolation) of
@@ -383,7 +387,7 @@ def _position_band(xy: np.ndarray):
 
 
 def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=None, run_spread=None,
-                     jobs: int | None = None, support: str = "none") -> Bands:
+                     jobs: int | None = None, support: str = "physical") -> Bands:
     """The 90 % heading and position bands of one record's prediction (module docstring).
 
     Parameters
@@ -404,12 +408,13 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
         neither is.
     jobs : int, optional
         Threads (default every core).
-    support : {"none", "bounds", "physical"}
-        Where the ship's draws are truncated (:data:`trials.measured.draws.SUPPORTS`): nowhere (default: the
-        covariance's normal, a diverging draw widening the band), to the fit's hard bounds, or to those and
-        no energy gained unpowered over the covariance's ``state_range`` (:func:`~trials.measured.draws.support_of`).
-        A truncated band is narrower and bounded more often, and on the held-out real records covers less
-        than 90 % (``docs/prediction_bands.md``).
+    support : {"physical", "bounds", "none"}
+        Where the ship's draws are truncated (:data:`trials.measured.draws.SUPPORTS`): to the fit's hard
+        bounds and no energy gained unpowered over the covariance's ``state_range`` (default,
+        :func:`~trials.measured.draws.support_of`), to the bounds alone, or nowhere (the covariance's normal:
+        a diverging draw widens the band, to unbounded).  The parameters' doubt alone under-covers new
+        records; the ship's ``model_form:`` term adds what a replay's heading strays beyond it
+        (``docs/prediction_bands.md``).
 
     Returns
     -------

@@ -149,7 +149,7 @@ def band_sections(ident) -> tuple:
 
 
 def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None = None,
-                support: str = "none", ship: Ship | None = None) -> dict:
+                support: str = "physical", ship: Ship | None = None) -> dict:
     """The 90 % heading band of ``run`` predicted by the identified model ``ident`` (its ship drawn from the
     covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
     :func:`trials.measured.bands.prediction_bands`; ``sections``: :func:`band_sections` of ``ident``, made
@@ -221,7 +221,7 @@ class BandSpec:
     """
 
     samples: int = 0
-    support: str = "none"
+    support: str = "physical"
     model_form: str = "training"
     folds: int = 3
     folds_by: str = "order"
