@@ -179,7 +179,7 @@ def main(argv=None) -> int:
     from trials.files.data import frt_folder
     from trials.files.sweep import run_sweep
     from trials.measured.identify import load_runs
-    from trials.measured.nested import _split
+    from trials.measured.nested import split_folds
 
     a = _args(argv)
     variants = list(dict.fromkeys(a.variants))
@@ -191,7 +191,7 @@ def main(argv=None) -> int:
     files = [p for s in ("turning", "zigzag", "random", "berthing") for p in sorted((d / s).glob("*.csv"))]
     initial = mmg.load_ship(INITIAL)
     runs = load_runs(initial, files, wind=True)
-    k, splits = _split(runs, a.folds, "manoeuvre")
+    k, splits = split_folds(runs, a.folds, "manoeuvre")
     print(f"hybrid nested CV: {len(runs)} records, {k} outer folds by manoeuvre, variants {', '.join(variants)}", flush=True)
     t0 = time.perf_counter()
     parts = run_sweep(one_fold, [(j, splits, a.folds_dir, initial, variants) for j in range(k)],

@@ -32,7 +32,7 @@ from .predict import MeasuredRun, replay_record
 
 __all__ = ["BandSpec", "Candidate", "NestedCV", "Selection", "nested_cross_validate", "select_candidate", "choose",
            "replay_scores", "fit_model", "check_choosable", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES",
-           "band_scores", "band_sections", "band_summary", "band_ship", "MODEL_FORMS"]
+           "band_scores", "band_sections", "band_summary", "band_ship", "MODEL_FORMS", "split_folds"]
 
 HULL_FORMS = {"kijima": "", "crossflow": "_crossflow"}
 """The hull forms ``mmg identify --hull`` knows, by the suffix of their bundled config's name after the
@@ -298,7 +298,9 @@ def choose(rows: list[dict], names) -> tuple[str, dict]:
     return best, table
 
 
-def _split(runs, folds: int, folds_by: str):
+def split_folds(runs, folds: int, folds_by: str) -> tuple[int, list]:
+    """(folds made, [(training records, kept-out records) per fold]): ``runs`` dealt into at most ``folds``
+    folds by ``folds_by`` (:func:`~trials.measured.identify.fold_of`; a record and its cut copies share one)."""
     from .identify import cv_folds, fold_of
 
     k = cv_folds(runs, folds)
@@ -308,7 +310,7 @@ def _split(runs, folds: int, folds_by: str):
 
 def _inner_tasks(outer, candidates, train, inner_folds, folds_by, initial, kw):
     try:
-        _, splits = _split(train, inner_folds, folds_by)
+        _, splits = split_folds(train, inner_folds, folds_by)
     except ValueError as e:
         where = "the records" if outer is None else f"outer fold {outer}'s training set"
         raise ValueError(f"no choice can be made on {where}: the inner {e}") from None
@@ -322,7 +324,7 @@ def check_choosable(candidates: dict, runs: list[MeasuredRun], inner_folds: int,
     an inner cross-validation needs 2 or more independent records."""
     _inner_tasks(None, candidates, runs, inner_folds, folds_by, None, {})
     if folds:
-        for k, (tr, _) in enumerate(_split(runs, folds, folds_by)[1]):
+        for k, (tr, _) in enumerate(split_folds(runs, folds, folds_by)[1]):
             _inner_tasks(k, candidates, tr, inner_folds, folds_by, None, {})
 
 
@@ -408,7 +410,7 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
         :func:`~trials.measured.identify.identify`'s options common to every candidate.
     """
     initial = _initial(candidates, initial)
-    n_out, splits = _split(runs, folds, folds_by)
+    n_out, splits = split_folds(runs, folds, folds_by)
     bands = replace(bands, folds=inner_folds, folds_by=folds_by)
     choices, tables, inner_rows = {}, {}, []
     if len(candidates) > 1:

@@ -20,7 +20,7 @@ import numpy as np
 
 from mmg.dissipation import PowerCheck, power_check, state_box
 
-__all__ = ["Divergence", "PhysicalCheck", "divergence_of", "physical_check", "MAX_STATES"]
+__all__ = ["Divergence", "PhysicalCheck", "divergence_of", "physical_check", "logged_states", "MAX_STATES"]
 
 MAX_STATES = 2000
 """The logged states checked (evenly subsampled over all the records)."""
@@ -117,7 +117,9 @@ class PhysicalCheck:
                 "divergences": [d.to_dict() for d in self.divergences]}
 
 
-def _logged_states(runs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def logged_states(runs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(u [m/s], v [m/s], r [rad/s]) of every finite logged state of the records ``runs``, evenly subsampled
+    to at most :data:`MAX_STATES`: the states the physical checks look at."""
     uvr = np.concatenate([r.meas[:, :3] for r in runs])
     uvr = uvr[np.isfinite(uvr).all(axis=1)]
     if len(uvr) > MAX_STATES:
@@ -129,7 +131,7 @@ def physical_check(ship, prior, runs, replays=()) -> PhysicalCheck:
     """:class:`PhysicalCheck` of the identified ``ship`` against its ``prior`` over the records
     ``runs`` (:class:`trials.measured.predict.MeasuredRun`); ``replays``: their open-loop replays with
     ``ship`` (:class:`trials.measured.predict.Replayed`) for the divergence check."""
-    states = _logged_states(runs)
+    states = logged_states(runs)
     box = state_box(*states)
     divs = [d for d in (divergence_of(r) for r in replays) if d is not None]
     return PhysicalCheck(power_check(ship, *states), power_check(ship, *box), power_check(prior, *states),

@@ -128,12 +128,12 @@ def training_state_range(runs) -> dict:
     the states the records ``runs`` log (those :func:`trials.measured.physical.physical_check` checks), over
     which a drawn ship is checked not to gain energy (:func:`trials.measured.draws.support_of`); {} without a
     finite logged state."""
-    from ..physical import _logged_states
+    from ..physical import logged_states
 
     if not any(np.isfinite(r.meas[:, :3]).all(axis=1).any() for r in runs):
         return {}
     return {k: [float(f"{np.min(a):.6g}"), float(f"{np.max(a):.6g}")]
-            for k, a in zip(("u_mps", "v_mps", "r_radps"), _logged_states(runs))}
+            for k, a in zip(("u_mps", "v_mps", "r_radps"), logged_states(runs))}
 
 
 START_UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "psi": "rad"}
