@@ -48,7 +48,8 @@ from frt_gap import KINDS, kind_of  # noqa: E402  (the record kinds, defined onc
 
 import mmg  # noqa: E402
 from trials.measured.identify import load_runs  # noqa: E402
-from trials.measured.nested import HULL_FORMS, SCORE_NAMES, BandSpec, hull_candidates, nested_cross_validate  # noqa: E402
+from trials.measured.nested import (HULL_FORMS, SCORE_NAMES, BandSpec, band_summary, hull_candidates,  # noqa: E402
+                                    nested_cross_validate)
 from trials.files.data import frt_folder  # noqa: E402
 
 SHIP = "esso_osaka_3m"
@@ -213,6 +214,9 @@ def kind_summary(records, keys=tuple(k for k, _ in KIND_KEYS)) -> list[dict]:
             pairs = np.array([p for p in pairs if None not in p and np.isfinite(p).all()], float).reshape(-1, 2)
             mean = [float(x) for x in pairs.mean(axis=0)] if len(pairs) else [None, None]
             row[key] = {"scaled": mean[0], "identified": mean[1], "n": len(pairs)}
+        band = band_summary(mine)
+        if band:
+            row["band"] = {"coverage90": band["band_coverage90"], "median_width_deg": band["band_median_width_deg"]}
         out.append(row)
     return out
 
@@ -220,14 +224,21 @@ def kind_summary(records, keys=tuple(k for k, _ in KIND_KEYS)) -> list[dict]:
 def kind_table(summary: list[dict], markdown: bool) -> list[str]:
     """:func:`kind_summary` as a table: per kind, scaled / identified mean heading RMS [deg] over the whole
     record and over the 60 s windows (with the records each is over when fewer than the kind's)."""
-    head = ["kind", "records"] + [f"{words}: heading RMS s / i [deg]" for _, words in KIND_KEYS]
+    bands = any("band" in r for r in summary)
+    head = (["kind", "records"] + [f"{words}: heading RMS s / i [deg]" for _, words in KIND_KEYS]
+            + (["90 % band: coverage, median width"] if bands else []))
 
     def cell(row, key):
         c = row[key]
         txt = f"{c['scaled']:.1f} / {c['identified']:.1f}" if c["n"] else "-"
         return txt + (f" ({c['n']} finite)" if c["n"] != row["n"] else "")
 
-    return _table(head, [[r["kind"], str(r["n"])] + [cell(r, k) for k, _ in KIND_KEYS] for r in summary], markdown)
+    def band(row):
+        b = row.get("band")
+        return [f"{100 * b['coverage90']:.1f} %, {b['median_width_deg']:.0f} deg" if b else "-"] if bands else []
+
+    return _table(head, [[r["kind"], str(r["n"])] + [cell(r, k) for k, _ in KIND_KEYS] + band(r) for r in summary],
+                  markdown)
 
 
 def _table(head, rows, markdown: bool) -> list[str]:
