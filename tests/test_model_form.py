@@ -161,6 +161,11 @@ def test_identify_writes_the_training_replays_term_and_it_loads_back(three_slice
         curves.append((r.t - r.t[0], np.degrees(np.unwrap(p[:, 5]) - np.unwrap(r.meas[:, 5]))))
     np.testing.assert_allclose(sec["heading_q90_deg"], _binned_q90_by_hand(curves, ship.particulars.L), rtol=1e-4,
                                atol=1e-4)
+    report = (out / "report.md").read_text().split("## Model-form term", 1)[1]
+    rows = [ln.split(" | ") for ln in report.splitlines() if ln.startswith("| ") and "[" not in ln]
+    assert len(rows) == len(sec["elapsed_froude"])
+    for (t_s, t_f, q), tf, qq in zip(rows, sec["elapsed_froude"], sec["heading_q90_deg"]):
+        assert float(t_s.strip("| ")) == pytest.approx(tf * UNIT, rel=1e-3) and float(q.strip("| ")) == pytest.approx(qq, rel=2e-3)
 
 
 def test_identify_with_cv_writes_the_kept_out_term(three_slices, tmp_path):

@@ -254,6 +254,21 @@ def _report_physical(chk) -> list:
     return lines
 
 
+def _report_model_form(form: dict | None, L: float) -> list:
+    """The report's model-form term (the ``model_form:`` section): its half-width per elapsed time, in
+    seconds of this ship and in sqrt(L/g), and where it came from."""
+    from mmg.model import G
+
+    if form is None:
+        return ["", "## Model-form term", "", "None written: fewer than three records reach any elapsed time."]
+    unit = float(np.sqrt(L / G))
+    lines = ["", "## Model-form term (`model_form:`, drawn by `mmg predict --samples`)", "",
+             f"Made from the {form['source']}.", "",
+             "| elapsed [s] | elapsed [sqrt(L/g)] | heading error, 90 % [deg] |", "|---|---|---|"]
+    return lines + [f"| {t * unit:.4g} | {t:.4g} | {q:.3g} |" for t, q in zip(form["elapsed_froude"],
+                                                                         form["heading_q90_deg"])]
+
+
 def _report_training(ident: Identification) -> list:
     """The report's training fits (heading and speed RMS) and manoeuvre metrics, measured and replayed."""
     a = ident.scores(model="initial")
@@ -414,9 +429,11 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
     cov, post, _ = identification_covariance(ident, parts=True)
     summary = identification_summary(ident, cov)
+    form = model_form(ident, cv)
     (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, summary, spread=run_spread(ident),
-                                                 model_form=model_form(ident, cv)))
-    lines = _report_fit(ident, cov, summary["warnings"]) + _report_physical(ident.physical_check()) + _report_training(ident)
+                                                 model_form=form))
+    lines = (_report_fit(ident, cov, summary["warnings"]) + _report_physical(ident.physical_check())
+             + _report_training(ident) + _report_model_form(form, ident.ship.particulars.L))
     if test_runs:
         lines += _report_test(ident, test_runs)
     written = {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
