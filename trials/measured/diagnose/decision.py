@@ -123,7 +123,7 @@ def mean_heading(psis) -> float:
 
 COMPONENT_FLOORS = {"zigzag": ("current_along", "current_across")}
 """Kinds of record on which a current's size is judged by its components along and across the mean
-heading, each against a floor of its own (the calibration's ``current_along``, ``current_across``).
+heading (in that order), each against a floor of its own (the calibration's ``current_along``, ``current_across``).
 On a zigzag the ship's own speed mismatch (resistance, thrust, wake) lends a current along the
 heading, hardly any across it (see ``bench/calibrate_diagnose.py``); a turn sweeps every heading and
 keeps the speed's floor."""
@@ -131,7 +131,7 @@ keeps the speed's floor."""
 SPEED_UNIT = "U"
 """The unit of a part floor that scales with the ship's speed: a fraction of the records'
 :func:`typical_speed` U (a part of 0.015 U is 0.116 m/s at U = 7.72 m/s, 15 kn)."""
-PART_UNITS = {"current_along": MAGNITUDE_UNITS["current"], "current_across": MAGNITUDE_UNITS["current"]}
+PART_UNITS = {part: MAGNITUDE_UNITS["current"] for parts in COMPONENT_FLOORS.values() for part in parts}
 """The units :mod:`.calibration` sets the part floors in by default: both over sqrt(g L), as the current's
 :func:`magnitude`.  :func:`speed_part_units` sets the part along the heading in :data:`SPEED_UNIT`
 instead (a resistance, thrust or wake mismatch errs the speed by a share of that speed).  A calibration
@@ -140,7 +140,8 @@ file says its own (its ``units``)."""
 
 def speed_part_units() -> dict:
     """:data:`PART_UNITS` with the part along the heading in :data:`SPEED_UNIT`."""
-    return {**PART_UNITS, "current_along": SPEED_UNIT}
+    along = [parts[0] for parts in COMPONENT_FLOORS.values()]           # the first part: along the heading
+    return {**PART_UNITS, **dict.fromkeys(along, SPEED_UNIT)}
 
 
 def typical_speed(meas) -> float:
