@@ -312,11 +312,15 @@ def test_the_band_spec_reaches_every_kept_out_records_band_and_none_by_default(m
     one = {"kijima": forms["kijima"]}
     N.nested_cross_validate(one, runs, folds=2)
     assert calls == [] and specs == []
-    res = N.nested_cross_validate(one, runs, folds=2, inner_folds=3, folds_by="manoeuvre",
+    res = N.nested_cross_validate(one, runs, folds=2, inner_folds=2, folds_by="manoeuvre",
                                   bands=N.BandSpec(samples=7, support="bounds", model_form="kept-out"))
     assert sorted(calls) == sorted((r["name"], 7, r["fold"], "bounds", "with its term") for r in res.records)
     assert len(calls) == 4 and all(r["band"] == {"samples": 1} for r in res.records)
-    assert [(s.model_form, s.folds, s.folds_by) for s in specs] == [("kept-out", 3, "manoeuvre")] * 2
+    assert [(s.model_form, s.folds, s.folds_by) for s in specs] == [("kept-out", 2, "manoeuvre")] * 2
+    specs.clear()
+    N.nested_cross_validate(one, runs, folds=2, inner_folds=2, folds_by="manoeuvre",
+                            bands=N.BandSpec(samples=7, model_form="kept-out", folds=4, folds_by="order"))
+    assert [(s.folds, s.folds_by) for s in specs] == [(4, "order")] * 2          # its own, where it says them
 
 
 @pytest.mark.parametrize("bad", [dict(samples=-1), dict(samples=2.5), dict(support="energy"), dict(model_form="cv")])

@@ -19,8 +19,8 @@ import mmg
 from mmg.errors import InputError
 from mmg.ship import ModelForm
 from trials.measured.bands import prediction_bands
-from trials.measured.modelform import (ELAPSED_EDGES, MIN_RECORDS, heading_error_growth, heading_half_width,
-                                       model_form_section)
+from trials.measured.modelform import (ELAPSED_EDGES, MIN_RECORDS, Z90, heading_error_curves, heading_error_growth,
+                                       heading_half_width, model_form_section)
 
 from .test_predict_bands import SHIP, _run
 
@@ -56,7 +56,47 @@ def test_growth_never_falls_and_a_diverged_sample_counts_as_infinite():
     bad = [_curve(t, np.where(t < 10, 1.0, np.nan)) for _ in range(3)]
     _, q, _ = heading_error_growth(bad, L)
     assert np.isinf(q[-1])
-    assert model_form_section(bad, L, "test") is None
+    sec, why = model_form_section(bad, L, "test")
+    assert sec["elapsed_froude"] == [10.0] and sec["heading_q90_deg"] == [1.0]      # the finite part kept
+    assert "diverged" in why and "diverged" in sec["source"]
+    assert model_form_section([_curve(t, np.full(len(t), np.nan)) for _ in range(3)], L, "x")[0] is None
+
+
+@pytest.mark.parametrize("ends", [20.0, 19.9999999])
+def test_records_ending_on_a_bin_edge_give_a_section_the_loader_takes(tmp_path, ends):
+    """Records whose last sample lies on (or within the kept digits of) a bin edge: the nodes still
+    increase, and the section loads back; records of one sample give none."""
+    t = np.r_[np.arange(0.0, 20.0, 0.5), ends]
+    recs = [_curve(t, 0.1 * t * (k + 1)) for k in range(3)]
+    sec, _ = model_form_section(recs, L, "x")
+    assert np.all(np.diff(sec["elapsed_froude"]) > 0)
+    data = yaml.safe_load(_ship_file().read_text())
+    data["model_form"] = sec
+    p = tmp_path / "ship.yaml"
+    p.write_text(yaml.safe_dump(data))
+    assert mmg.load_ship(str(p)).model_form.elapsed_froude == tuple(sec["elapsed_froude"])
+    one = [_curve([0.0], [0.0]) for _ in range(3)]
+    assert model_form_section(one, L, "x")[0] is None
+
+
+def test_heading_error_curves_unwrap_align_and_keep_a_divergence():
+    """A record logged in (-180, 180] crossing 180 deg and its replay 2 deg ahead, the replay starting a whole
+    turn away: the error is +2 deg throughout; a replay that diverges gives NaN from there on."""
+    from types import SimpleNamespace
+
+    t = np.arange(0.0, 10.0, 1.0)
+    true = np.radians(170.0 + 3.0 * t)
+    logged = np.angle(np.exp(1j * true))
+    pred = np.zeros((len(t), 6))
+    pred[:, 5] = true + np.radians(2.0) + 2 * np.pi
+    run = SimpleNamespace(t=t + 100.0, meas=np.column_stack([np.zeros((len(t), 5)), logged]))
+    (el, e), = heading_error_curves([SimpleNamespace(run=run, pred=pred)])
+    np.testing.assert_allclose(el, t)
+    np.testing.assert_allclose(e, 2.0, atol=1e-9)
+    pred[6:, 5] = np.nan
+    (_, e), = heading_error_curves([SimpleNamespace(run=run, pred=pred)])
+    np.testing.assert_allclose(e[:6], 2.0, atol=1e-9)
+    assert np.isnan(e[6:]).all()
 
 
 def test_model_and_full_scale_give_the_same_section():
@@ -64,7 +104,7 @@ def test_model_and_full_scale_give_the_same_section():
     t = np.arange(0.0, 200.0, 0.1)
     recs = [(t, 0.2 * (k + 1) * t) for k in range(4)]
     big = [(10.0 * tt, e) for tt, e in recs]
-    a, b = model_form_section(recs, L, "x"), model_form_section(big, 100 * L, "x")
+    a, b = model_form_section(recs, L, "x")[0], model_form_section(big, 100 * L, "x")[0]
     assert a == b and a["elapsed_froude"][0] == ELAPSED_EDGES[1]
 
 
@@ -88,6 +128,9 @@ def test_band_of_a_term_alone_is_the_nominal_plus_minus_its_half_width():
     np.testing.assert_allclose((b.hi - b.nominal_deg)[late] / hw[late], 1.0, atol=0.2)
     np.testing.assert_allclose((b.nominal_deg - b.lo)[late] / hw[late], 1.0, atol=0.2)
     assert any("model-form" in n for n in b.notes)
+    z = np.sort(np.random.default_rng([3, 2]).standard_normal(400))      # the documented third stream of the seed
+    np.testing.assert_allclose(b.hi - b.nominal_deg, np.quantile(z, 0.95) * hw / Z90, atol=1e-9)
+    assert any("held at its last value" in n for n in b.notes)          # a 30 s record, the term to 40 sqrt(L/g) = 22 s
     plain = prediction_bands(replace(ship, model_form=None), run, 50, seed=3, jobs=2)
     assert plain.empty
 
@@ -177,3 +220,31 @@ def test_identify_with_cv_writes_the_kept_out_term(three_slices, tmp_path):
                  "--max-nfev", "8", "--cv", "3"]) == 0
     sec = yaml.safe_load((out / "ship.yaml").read_text())["model_form"]
     assert "kept-out replays of a 3-fold cross-validation" in sec["source"] and sec["records"] == 3
+
+
+def test_predict_model_form_on_and_off(tmp_path, capsys):
+    """``mmg predict --samples`` on a ship with a ``model_form:`` section: on (default) the JSON says so and
+    the band is wider than with ``--model-form off``, whose JSON and notes say no term was drawn."""
+    import json
+
+    from .test_predict import FRT, ZIGZAG, _run_cli, _slice
+
+    if not FRT.is_dir():
+        pytest.skip("FRT-DS-ESSO records not found")
+    from .test_predict_bands import _ship_with_sections
+
+    p = _ship_with_sections(tmp_path)
+    data = yaml.safe_load(p.read_text())
+    data["model_form"] = {"elapsed_froude": [10.0, 40.0], "heading_q90_deg": [3.0, 12.0], "records": 5, "source": "t"}
+    p.write_text(yaml.safe_dump(data, sort_keys=False))
+    rec = _slice(FRT / ZIGZAG, tmp_path / "zz.csv", rows=300)
+    docs = {}
+    for form in ("on", "off"):
+        js = tmp_path / f"{form}.json"
+        rc, out, err = _run_cli(["predict", "--ship", p, rec, "--json", js, "--samples", "40", "--model-form", form], capsys)
+        assert rc == 0, err
+        docs[form] = json.loads(js.read_text())
+    assert docs["on"]["bands"]["model_form"] == "on" and docs["off"]["bands"]["model_form"] == "off"
+    assert any(n.startswith("no model-form term") for n in docs["off"]["bands"]["notes"])
+    w = {k: d["runs"][0]["heading_band_median_width_deg"] for k, d in docs.items()}
+    assert w["on"] > w["off"] + 5.0

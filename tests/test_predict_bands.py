@@ -213,7 +213,7 @@ def test_cli_predict_samples_json_keys_and_plots(tmp_path, capsys):
     assert rc == 0, err
     doc = json.loads(js.read_text(), parse_constant=lambda c: pytest.fail(f"JSON holds {c}"))
     assert list(doc) == ["runs", "bands"]
-    assert doc["bands"] == {"samples": 20, "seed": 3, "support": "physical", "model_form": "on",
+    assert doc["bands"] == {"samples": 20, "seed": 3, "support": "physical", "model_form": "none in the ship config",
                             "notes": [n for n in doc["bands"]["notes"]
                                       if n.startswith(("no model-form term", "support 'physical' without"))]}
     run = doc["runs"][0]

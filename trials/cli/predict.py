@@ -93,8 +93,11 @@ def _with_bands(doc: dict, bands, args) -> dict:
     for row, b in zip(doc["runs"], bands):
         row.update(b.to_json())
     notes = sorted({n for b in bands for n in b.notes})
+    drawn = [b.notes for b in bands]
+    form = ("off" if args.model_form == "off" else "on" if any(n.startswith("model-form heading error") for ns in drawn
+                                                               for n in ns) else "none in the ship config")
     doc["bands"] = {"samples": int(args.samples), "seed": int(args.seed), "support": args.support,
-                    "model_form": args.model_form, "notes": notes}
+                    "model_form": form, "notes": notes}
     return doc
 
 

@@ -278,7 +278,7 @@ def _fit_doubts(ship: Ship, names, covariance) -> list:
             "the uncertainty of a finished fit"] if why else []
 
 
-def _candidates(ship: Ship, covariance, notes: list, support: str = "none"):
+def _candidates(ship: Ship, covariance, notes: list, support: str):
     """(names, mean, matrix, support) of the ship's draws; no support with ``support`` "none" or without a
     covariance (no names then)."""
     cov = ship.covariance if covariance is None else covariance
@@ -293,7 +293,7 @@ def _candidates(ship: Ship, covariance, notes: list, support: str = "none"):
     return names, mean, matrix, sup
 
 
-def _draws(ship: Ship, covariance, std, samples: int, seed: int, notes: list, support: str = "none"):
+def _draws(ship: Ship, covariance, std, samples: int, seed: int, notes: list, support: str):
     """(names, ship rows (k, n), mean, run rows (k, len(std)), rejected): ``samples`` draws of the ship inside
     its support (:func:`_candidates`) each with its run draw, batches of ``samples`` candidates from the
     two streams of ``seed``, at most :data:`MAX_CANDIDATES` times ``samples`` candidates."""
@@ -337,10 +337,6 @@ def _one_replay(ship: Ship, run: MeasuredRun, names, row, mean, sp_names, sp_row
     return replay_record(s, r).pred[:, 3:6]
 
 
-Z90 = 1.6448536269514722
-"""The standard normal's 95 % quantile: a normal error of standard deviation s has a 90 % half-width Z90 s."""
-
-
 def _model_form_errors(ship: Ship, run: MeasuredRun, samples: int, seed: int, notes: list) -> np.ndarray | float:
     """Each draw's model-form heading error [deg] (draws, N): a zero-mean normal, one per draw and whole along
     the record, whose 90 % half-width is the ship's ``model_form:`` term at each sample's elapsed time
@@ -350,12 +346,16 @@ def _model_form_errors(ship: Ship, run: MeasuredRun, samples: int, seed: int, no
         notes.append("no model-form term drawn (none in the ship config, or left out): the band is the "
                      "parameters' and the run's doubt alone, narrower than a new record's error")
         return 0.0
-    from .modelform import heading_half_width
+    from .modelform import Z90, heading_half_width, measured_until
 
-    hw = heading_half_width(mf, run.t - run.t[0], ship.particulars.L)
+    L = ship.particulars.L
+    hw = heading_half_width(mf, run.t - run.t[0], L)
     z = np.random.default_rng([int(seed), 2]).standard_normal(samples)
     notes.append(f"model-form heading error added to each draw ({mf.source or 'model_form: section'}; "
                  f"{hw[-1]:.1f} deg 90 % half-width at the record's end); the position band is the draws' alone")
+    if run.t[-1] - run.t[0] > measured_until(mf, L):
+        notes.append(f"the model-form term was measured up to {measured_until(mf, L):.4g} s of elapsed time and is "
+                     "held at its last value beyond (a longer record's error may grow further)")
     return z[:, None] * (hw / Z90)[None, :]
 
 

@@ -21,13 +21,15 @@ fit's own training replays are in sample: their errors are smaller, a lower boun
 """
 from __future__ import annotations
 
+from statistics import NormalDist
+
 import numpy as np
 
 from mmg.model import G
 from mmg.ship import ModelForm
 
-__all__ = ["ELAPSED_EDGES", "MIN_RECORDS", "QUANTILE", "heading_error_curves", "heading_error_growth",
-           "heading_half_width", "model_form_section"]
+__all__ = ["ELAPSED_EDGES", "MIN_RECORDS", "QUANTILE", "Z90", "heading_error_curves", "heading_error_growth",
+           "heading_half_width", "model_form_section", "model_form_of", "measured_until"]
 
 ELAPSED_EDGES = (0.0, 10.0, 20.0, 40.0, 80.0, 160.0, 320.0, 640.0, 1280.0, 2560.0, 5120.0)
 """Bin edges of elapsed time in sqrt(L/g) (a 3 m model: 0.55 s; a 320 m ship: 5.7 s)."""
@@ -35,6 +37,9 @@ MIN_RECORDS = 3
 """A bin counts only where at least this many records reach it (fewer: the previous node is held)."""
 QUANTILE = 0.9
 """The quantile of the absolute heading error given at each node (the band's half-width)."""
+Z90 = NormalDist().inv_cdf(0.5 + QUANTILE / 2)
+"""The normal quantile of :data:`QUANTILE`'s central interval (1.645): a normal error of standard deviation s
+has a :data:`QUANTILE` half-width Z90 s."""
 
 
 def heading_error_curves(replays) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -63,6 +68,9 @@ def heading_error_curves(replays) -> list[tuple[np.ndarray, np.ndarray]]:
 def heading_error_growth(curves, L: float, g: float = G) -> tuple[np.ndarray, np.ndarray, int]:
     """The :data:`QUANTILE` quantile of the absolute heading error per bin of elapsed Froude time.
 
+    The samples of a bin are pooled over the records (a longer record counts more, as in the share of
+    samples the bands are judged by); a bin counts where :data:`MIN_RECORDS` records reach it.
+
     Parameters
     ----------
     curves : list of (ndarray, ndarray)
@@ -75,7 +83,8 @@ def heading_error_growth(curves, L: float, g: float = G) -> tuple[np.ndarray, np
     Returns
     -------
     elapsed : ndarray
-        Each kept bin's end (the last elapsed time reached, for the last bin) [sqrt(L/g)].
+        Each kept bin's node: its end, or the last elapsed time any record reaches where that is earlier
+        [sqrt(L/g)], to 6 significant figures; a bin whose node would not lie after the previous one is left out.
     q90 : ndarray
         The quantile of the absolute error in the bin [deg] (a diverged sample counts as an infinite
         error), made non-decreasing with time.
@@ -85,29 +94,49 @@ def heading_error_growth(curves, L: float, g: float = G) -> tuple[np.ndarray, np
     unit = np.sqrt(L / g)
     ts = [np.asarray(t, float) / unit for t, _ in curves]
     es = [np.where(np.isfinite(e), np.abs(e), np.inf) for _, e in curves]
-    reach = max((t[-1] for t in ts if len(t)), default=0.0)
+    reach = max((float(t[-1]) for t in ts if len(t)), default=0.0)
     nodes, q = [], []
     for lo, hi in zip(ELAPSED_EDGES[:-1], ELAPSED_EDGES[1:]):
         sel = [(t >= lo) & (t < hi) for t in ts]
         if sum(bool(s.any()) for s in sel) < MIN_RECORDS:
             continue
-        v = np.concatenate([e[s] for e, s in zip(es, sel)])
-        nodes.append(min(hi, reach))
-        q.append(float(np.quantile(v, QUANTILE, method="higher")))
+        node = float(f"{min(hi, reach):.6g}")
+        if node <= (nodes[-1] if nodes else 0.0):
+            continue
+        nodes.append(node)
+        q.append(float(np.quantile(np.concatenate([e[s] for e, s in zip(es, sel)]), QUANTILE, method="higher")))
     q = np.maximum.accumulate(np.array(q)) if q else np.zeros(0)
     return np.array(nodes), q, len(curves)
 
 
-def model_form_section(curves, L: float, source: str) -> dict | None:
-    """The ``model_form:`` section of the ship YAML (:class:`mmg.ship.ModelForm`) from the error ``curves``
-    (:func:`heading_error_growth`), with ``source`` saying which replays they are; None where no bin is
-    reached by :data:`MIN_RECORDS` records or an error is not finite (a replay that diverged early)."""
+def model_form_section(curves, L: float, source: str) -> tuple[dict | None, str]:
+    """(the ``model_form:`` section of the ship YAML, :class:`mmg.ship.ModelForm`, or None; what limits it)
+    from the error ``curves`` (:func:`heading_error_growth`), with ``source`` saying which replays they are.
+
+    Where replays diverged, the section ends before the first bin whose quantile they make infinite (and
+    says so in its ``source``); None where no bin is left, the second item saying why."""
     nodes, q, n = heading_error_growth(curves, L)
-    if not len(nodes) or not np.all(np.isfinite(q)):
-        return None
+    if not len(nodes):
+        return None, f"fewer than {MIN_RECORDS} records reach any elapsed time"
+    keep = np.isfinite(q)
+    why = ""
+    if not keep.all():
+        why = (f"replays diverged: the heading error is unbounded from {nodes[~keep][0]:.6g} sqrt(L/g) on "
+               "(held at the last finite value there)")
+        if not keep.any():
+            return None, why
+        nodes, q = nodes[keep], q[keep]
     six = lambda a: [float(f"{x:.6g}") for x in a]          # noqa: E731
-    return {"elapsed_froude": six(nodes), "heading_q90_deg": six(q),
-            "records": int(n), "source": source}
+    return {"elapsed_froude": six(nodes), "heading_q90_deg": six(q), "records": int(n),
+            "source": source + (f"; {why}" if why else "")}, why
+
+
+def model_form_of(section: dict | None) -> ModelForm | None:
+    """A ``model_form:`` section (:func:`model_form_section`) as the :class:`mmg.ship.ModelForm` a ship carries."""
+    if section is None:
+        return None
+    return ModelForm(tuple(section["elapsed_froude"]), tuple(section["heading_q90_deg"]), int(section["records"]),
+                     section["source"])
 
 
 def heading_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G) -> np.ndarray:
@@ -115,3 +144,8 @@ def heading_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G)
     ``L`` [m]: linear in elapsed Froude time between zero at the start and the nodes, held beyond the last."""
     t = np.asarray(elapsed_s, float) / np.sqrt(L / g)
     return np.interp(t, np.r_[0.0, model_form.elapsed_froude], np.r_[0.0, model_form.heading_q90_deg])
+
+
+def measured_until(model_form: ModelForm, L: float, g: float = G) -> float:
+    """The elapsed time [s] of a ship of length ``L`` [m] up to which the term was measured (its last node)."""
+    return float(model_form.elapsed_froude[-1] * np.sqrt(L / g))

@@ -208,10 +208,11 @@ class BandSpec:
         ``mmg identify`` writes it: from the fold's training replays (default, as without ``--cv``), from
         the kept-out replays of a cross-validation inside the fold's training set (as with ``--cv``:
         ``folds`` more fits per fold, dealt by ``folds_by``), or none.
-    folds : int
-        Folds of that inner cross-validation.
-    folds_by : str
-        How it deals the records (:func:`~trials.measured.identify.fold_of`).
+    folds : int, optional
+        Folds of that inner cross-validation (:func:`nested_cross_validate`'s ``inner_folds`` when None).
+    folds_by : str, optional
+        How it deals the records (:func:`~trials.measured.identify.fold_of`; the nested cross-validation's
+        ``folds_by`` when None).
 
     Raises
     ------
@@ -223,8 +224,8 @@ class BandSpec:
     samples: int = 0
     support: str = "physical"
     model_form: str = "training"
-    folds: int = 3
-    folds_by: str = "order"
+    folds: int | None = None
+    folds_by: str | None = None
 
     def __post_init__(self):
         from .draws import SUPPORTS
@@ -245,21 +246,17 @@ def band_ship(ident, spec: BandSpec, initial: Ship | None = None, kw: dict | Non
     """``ident``'s ship with the model-form term ``spec.model_form`` says (:class:`BandSpec`), as ``mmg
     identify`` would write it into its ship.yaml; ``initial`` and ``kw`` (the fit's options) make the
     inner cross-validation of ``"kept-out"``."""
-    from mmg.ship import ModelForm
-
     from .identify import cross_validate, model_form
+    from .modelform import model_form_of
 
     if spec.model_form == "none":
         return replace(ident.ship, model_form=None)
     cv = None
     if spec.model_form == "kept-out":
         kw = {**(kw or {}), "say": lambda m: None}
-        cv = cross_validate(ident.prior or ident.initial, ident.runs, folds=spec.folds, initial=initial,
-                            folds_by=spec.folds_by, **kw)
-    sec = model_form(ident, cv)
-    mf = None if sec is None else ModelForm(tuple(sec["elapsed_froude"]), tuple(sec["heading_q90_deg"]), sec["records"],
-                                            sec["source"])
-    return replace(ident.ship, model_form=mf)
+        cv = cross_validate(ident.prior or ident.initial, ident.runs, folds=spec.folds or 3, initial=initial,
+                            folds_by=spec.folds_by or "order", **kw)
+    return replace(ident.ship, model_form=model_form_of(model_form(ident, cv)[0]))
 
 
 def _outer_task(task) -> list[dict]:
@@ -411,7 +408,8 @@ def nested_cross_validate(candidates: dict, runs: list[MeasuredRun], folds: int 
     """
     initial = _initial(candidates, initial)
     n_out, splits = split_folds(runs, folds, folds_by)
-    bands = replace(bands, folds=inner_folds, folds_by=folds_by)
+    bands = replace(bands, folds=inner_folds if bands.folds is None else bands.folds,
+                    folds_by=folds_by if bands.folds_by is None else bands.folds_by)
     choices, tables, inner_rows = {}, {}, []
     if len(candidates) > 1:
         tasks = [t for k, (tr, _) in enumerate(splits)

@@ -210,12 +210,12 @@ def run_spread(ident: Identification) -> dict | None:
             "std": [float(f"{std[i]:.6g}") for i in keep], "records": n, "source": source}
 
 
-def model_form(ident: Identification, cv: list | None = None) -> dict | None:
-    """The ``model_form:`` section of ship.yaml (:func:`trials.measured.modelform.model_form_section`): the
-    heading error a replay gains with elapsed time.  With ``cv`` (:func:`~.fit.cross_validate`'s records,
-    each kept-out record with the ``ship`` and ``values`` of the fit that did not see it) from those
-    kept-out replays; otherwise from the fit's own training replays, in sample (a lower bound, said in the
-    section's ``source``).  None where too few records reach any elapsed time."""
+def model_form(ident: Identification, cv: list | None = None) -> tuple[dict | None, str]:
+    """(the ``model_form:`` section of ship.yaml or None, what limits it):
+    :func:`trials.measured.modelform.model_form_section`, the heading error a replay gains with elapsed
+    time.  With ``cv`` (:func:`~.fit.cross_validate`'s records, each kept-out record with the ``ship`` and
+    ``values`` of the fit that did not see it) from those kept-out replays; otherwise from the fit's own
+    training replays, in sample (a lower bound, said in the section's ``source``)."""
     from ..modelform import heading_error_curves, model_form_section
     from .fit import replay_fitted
 

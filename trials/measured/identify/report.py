@@ -254,13 +254,13 @@ def _report_physical(chk) -> list:
     return lines
 
 
-def _report_model_form(form: dict | None, L: float) -> list:
+def _report_model_form(form: dict | None, why: str, L: float) -> list:
     """The report's model-form term (the ``model_form:`` section): its half-width per elapsed time, in
-    seconds of this ship and in sqrt(L/g), and where it came from."""
+    seconds of this ship and in sqrt(L/g), and where it came from; ``why``: what limits it."""
     from mmg.model import G
 
     if form is None:
-        return ["", "## Model-form term", "", "None written: fewer than three records reach any elapsed time."]
+        return ["", "## Model-form term", "", f"None written: {why}."]
     unit = float(np.sqrt(L / G))
     lines = ["", "## Model-form term (`model_form:`, drawn by `mmg predict --samples`)", "",
              f"Made from the {form['source']}.", "",
@@ -429,11 +429,11 @@ def write_identification(ident: Identification, ship_path, out_dir, cv: list | N
             f"({', '.join(r.name for r in ident.runs)}); cost {fit.cost_initial:.4g} -> {fit.cost_final:.4g}")
     cov, post, _ = identification_covariance(ident, parts=True)
     summary = identification_summary(ident, cov)
-    form = model_form(ident, cv)
+    form, why = model_form(ident, cv)
     (out_dir / "ship.yaml").write_text(ship_yaml(ship_path, fit.values(), note, cov, summary, spread=run_spread(ident),
                                                  model_form=form))
     lines = (_report_fit(ident, cov, summary["warnings"]) + _report_physical(ident.physical_check())
-             + _report_training(ident) + _report_model_form(form, ident.ship.particulars.L))
+             + _report_training(ident) + _report_model_form(form, why, ident.ship.particulars.L))
     if test_runs:
         lines += _report_test(ident, test_runs)
     written = {"ship": out_dir / "ship.yaml", "report": out_dir / "report.md"}
