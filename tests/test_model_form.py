@@ -248,3 +248,26 @@ def test_predict_model_form_on_and_off(tmp_path, capsys):
     assert any(n.startswith("no model-form term") for n in docs["off"]["bands"]["notes"])
     w = {k: d["runs"][0]["heading_band_median_width_deg"] for k, d in docs.items()}
     assert w["on"] > w["off"] + 5.0
+
+
+def test_the_kept_out_term_replays_each_record_with_its_folds_ship(three_slices):
+    """``model_form(ident, cv)`` takes each kept-out record's replay by the ship of the fit that did not see it:
+    with a made-up cross-validation whose every fold ship is the unfitted config (not the identified ship),
+    the section is the quantiles, binned here by hand, of the config's replays, and says kept-out."""
+    from trials.measured.identify import identify, load_runs, model_form
+    from trials.measured.predict import replay_record
+
+    ship = mmg.load_ship(SHIP)
+    runs = load_runs(ship, three_slices)
+    ident = identify(ship, runs, max_nfev=2, say=lambda m: None)
+    cv = [{"name": r.name, "fold": k, "ship": ship, "values": {}} for k, r in enumerate(runs)]
+    sec, _ = model_form(ident, cv)
+    curves = []
+    for r in runs:
+        p = replay_record(ship, r).pred
+        curves.append((r.t - r.t[0], np.degrees(np.unwrap(p[:, 5]) - np.unwrap(r.meas[:, 5]))))
+    np.testing.assert_allclose(sec["heading_q90_deg"], _binned_q90_by_hand(curves, ship.particulars.L), rtol=1e-4,
+                               atol=1e-4)
+    assert "kept-out replays of a 3-fold" in sec["source"]
+    own, _ = model_form(ident)
+    assert own["heading_q90_deg"] != sec["heading_q90_deg"]               # the identified ship's differ
