@@ -10,6 +10,7 @@ import numpy as np
 
 from ._jit import njit
 from .model import DELTA_, ENGINE_CONSTANT_RPM, N_, P_ENGINE, PSI_, R_, U_, V_, rhs_of
+from .rk4 import rk4_step
 from .rudder import switch_side
 
 __all__ = ["simulate_kernel", "rk4_step", "SCHEDULE", "HEADING_SWITCH"]
@@ -41,27 +42,6 @@ def _axpy(a, c, b):
     """a + c b of two 8-tuples (the state and a stage derivative) as a tuple: stays in registers."""
     return (a[0] + c * b[0], a[1] + c * b[1], a[2] + c * b[2], a[3] + c * b[3],
             a[4] + c * b[4], a[5] + c * b[5], a[6] + c * b[6], a[7] + c * b[7])
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def rk4_step(f, axpy, zero, xs, dt, args):
-    """One classical RK4 step of length ``dt`` from the state ``xs`` (a tuple of floats): the one
-    integrator step of the simulator (:func:`simulate_kernel`, 8 states) and the replay
-    (:mod:`mmg.replay`, 6).
-
-    ``f(y, tau, args)`` is the right-hand side at the stage state ``y`` and the stage's fraction
-    ``tau`` of the step (0, 1/2, 1/2, 1: where inputs that vary within the step are taken), as a
-    tuple like ``xs``; ``args`` its other arguments (a tuple); ``axpy(a, c, b)`` = a + c b of two
-    such tuples and ``zero`` the zero one (the state's length: each caller keeps only its own states
-    in scalars, i.e. registers).  The stage derivatives are summed with the RK4 weights as they come."""
-    k = zero
-    acc = k
-    for s in range(4):
-        tau = 0.0 if s == 0 else (0.5 if s < 3 else 1.0)
-        y = axpy(xs, tau * dt, k)
-        k = f(y, tau, args)
-        acc = axpy(acc, 1.0 if (s == 0 or s == 3) else 2.0, k)
-    return axpy(xs, dt / 6.0, acc)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -16,6 +16,7 @@ import numpy as np
 from ._jit import njit
 
 from .model import steering_rate
+from .rk4 import rk4_step
 
 
 @njit(cache=True, error_model="numpy")
@@ -46,7 +47,7 @@ def switch_levels(kind: str, manoeuvre: dict) -> tuple[float, float, float]:
 
 @njit(cache=True)
 def _steer(t, psi, law, amp, hi, lo, first, delta0, p, out_order, out_delta):
-    """Rudder order by the trial's law and the rudder through the steering gear (RK4 per sample)."""
+    """Rudder order by the trial's law and the rudder through the steering gear (:func:`mmg.rk4.rk4_step` per sample)."""
     side = first
     d = delta0
     psi0 = psi[0]
@@ -59,12 +60,23 @@ def _steer(t, psi, law, amp, hi, lo, first, delta0, p, out_order, out_delta):
         out_order[k] = cmd
         out_delta[k] = d
         if k + 1 < t.shape[0]:
-            h = t[k + 1] - t[k]
-            k1 = steering_rate(cmd, d, p)
-            k2 = steering_rate(cmd, d + 0.5 * h * k1, p)
-            k3 = steering_rate(cmd, d + 0.5 * h * k2, p)
-            k4 = steering_rate(cmd, d + h * k3, p)
-            d = d + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            d = rk4_step(_gear_rhs, _axpy1, _ZERO1, (d,), t[k + 1] - t[k], (cmd, p))[0]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _gear_rhs(y, tau, args):
+    """The steering gear's right-hand side for :func:`mmg.rk4.rk4_step`: the rudder rate at the order held
+    over the step (``args`` = (order, p))."""
+    return (steering_rate(args[0], y[0], args[1]),)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _axpy1(a, c, b):
+    """a + c b of two 1-tuples (the rudder angle and its rate)."""
+    return (a[0] + c * b[0],)
+
+
+_ZERO1 = (0.0,)
 
 
 def reconstruct_rudder(t, psi, kind: str, manoeuvre: dict, p: np.ndarray, delta0: float = 0.0):
