@@ -263,6 +263,10 @@ def summary_lines(res) -> list[str]:
                    f"{100 * s['band_coverage90_where_bounded']:.1f} % of the others; median width "
                    f"{s['band_median_width_deg']:.3g} deg (median over the records); "
                    f"{100 * s.get('band_rejected_share', 0.0):.1f} % of the candidate ships rejected outside the support")
+        if "band_position_coverage90" in s:
+            out.append(f"90 % position bands (a disc about the draws' median track; no model-form term): "
+                       f"{100 * s['band_position_coverage90']:.1f} % of the samples inside, median radius "
+                       f"{s['band_median_radius_m']:.3g} m (median over the records)")
     for key, words in (("heading_rms_deg", "heading RMS [deg]"), ("yaw_rate_rms_degps", "yaw-rate RMS [deg/s]"),
                        ("speed_rms_mps", "speed RMS [m/s]"), ("final_position_error_L", "final position error [L]")):
         spans = ((key, "whole record"), (key + tag, f"first {res.horizon_s:g} s"), ("window_" + key, "60 s windows"))

@@ -128,6 +128,11 @@ def test_kept_out_bands_pool_samples_inside_over_all_samples():
     assert s["band_coverage90_where_bounded"] == pytest.approx(140 / 300)
     assert s["band_records"] == 3 and band_summary([{"name": "x"}]) == {}
     assert s["band_rejected_share"] == pytest.approx(100 / 500)
+    assert "band_position_coverage90" not in s                              # not every record carries it
+    for r, (k, rad) in zip(recs[:3], [(80, 3.0), (270, 5.0), (10, 1.0)]):
+        r["band"].update(position_inside=k, median_radius_m=rad)
+    s = band_summary(recs)
+    assert s["band_position_coverage90"] == pytest.approx(360 / 450) and s["band_median_radius_m"] == 3.0
 
 
 def test_a_folds_band_of_a_kept_out_record_draws_from_its_fit():
@@ -143,3 +148,4 @@ def test_a_folds_band_of_a_kept_out_record_draws_from_its_fit():
     assert b["median_width_deg"] > 0.0 and 0.0 <= b["coverage90"] <= 1.0
     assert b["inside"] == round(b["coverage90"] * b["samples"])
     assert b["bounded"] == round((1 - b["unbounded_share"]) * b["samples"]) and b["inside_bounded"] <= b["bounded"]
+    assert 0 <= b["position_inside"] <= b["samples"] and b["median_radius_m"] > 0.0

@@ -155,7 +155,8 @@ def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None 
     :func:`trials.measured.bands.prediction_bands`; ``sections``: :func:`band_sections` of ``ident``, made
     once for several runs): ``samples`` (the record's), ``inside`` (of them in the band), ``coverage90``,
     ``median_width_deg``, ``unbounded_share``, ``draws``, ``diverged_draws``, ``rejected_draws`` (candidate
-    ships outside the ``support``, not replayed: :func:`trials.measured.bands.prediction_bands`); ``ship``:
+    ships outside the ``support``, not replayed: :func:`trials.measured.bands.prediction_bands`), and of the
+    position band ``position_inside`` (samples whose logged position lies in it) and ``median_radius_m``; ``ship``:
     ``ident.ship`` with the sections it carries (a model-form term: :func:`band_ship`), ``ident.ship`` by default."""
     from .bands import prediction_bands
 
@@ -168,7 +169,8 @@ def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None 
     return {"samples": n, "inside": int(round(b.coverage90 * n)), "coverage90": b.coverage90,
             "bounded": bounded, "inside_bounded": inside_b, "median_width_deg": b.median_width_deg,
             "unbounded_share": b.unbounded_share, "draws": b.draws, "diverged_draws": b.diverged,
-            "rejected_draws": b.rejected}
+            "rejected_draws": b.rejected, "position_inside": int(round(b.position_coverage90 * n)),
+            "median_radius_m": b.median_radius_m}
 
 
 def band_summary(records: list[dict]) -> dict:
@@ -177,7 +179,10 @@ def band_summary(records: list[dict]) -> dict:
     inside), ``band_unbounded_share`` (samples where it is, over all), ``band_coverage90_where_bounded``
     (inside over the bounded samples), ``band_median_width_deg`` (the median over the records of each
     record's median width), ``band_records``, ``band_rejected_share`` (candidate ships rejected outside the
-    support over all candidates, pooled over the records); {} where none carries a band."""
+    support over all candidates, pooled over the records); where every record carries them also
+    ``band_position_coverage90`` (samples inside the position band over all samples) and
+    ``band_median_radius_m`` (the median over the records of each one's median radius [m]); {} where none
+    carries a band."""
     b = [r["band"] for r in records if r.get("band")]
     if not b:
         return {}
@@ -189,7 +194,10 @@ def band_summary(records: list[dict]) -> dict:
             "band_coverage90_where_bounded": (sum(x.get("inside_bounded", x["inside"]) for x in b) / nb) if nb else
             float("nan"),
             "band_rejected_share": sum(x.get("rejected_draws", 0) for x in b)
-            / max(sum(x.get("draws", 0) + x.get("rejected_draws", 0) for x in b), 1)}
+            / max(sum(x.get("draws", 0) + x.get("rejected_draws", 0) for x in b), 1),
+            **({"band_position_coverage90": sum(x["position_inside"] for x in b) / n,
+                "band_median_radius_m": float(np.median([x["median_radius_m"] for x in b]))}
+               if all("position_inside" in x for x in b) else {})}
 
 
 @dataclass(frozen=True)
