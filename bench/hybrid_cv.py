@@ -160,26 +160,13 @@ def table(summary: list[dict], models: list[str]) -> list[str]:
     return out
 
 
-def _clean(v):
-    """JSON-ready: NaN as None, numpy scalars as Python ones."""
-    if isinstance(v, dict):
-        return {str(k): _clean(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [_clean(x) for x in v]
-    if isinstance(v, (float, np.floating)):
-        return float(v) if np.isfinite(v) else None
-    if isinstance(v, np.integer):
-        return int(v)
-    return v
-
-
 def main(argv=None) -> int:
     import mmg
     from identify_cv import INITIAL
     from trials.files.data import frt_folder
     from trials.files.sweep import run_sweep
     from trials.measured.identify import load_runs
-    from trials.measured.nested import split_folds
+    from trials.measured.nested import json_ready, split_folds
 
     a = _args(argv)
     variants = list(dict.fromkeys(a.variants))
@@ -206,7 +193,7 @@ def main(argv=None) -> int:
                                                  f"fit {x['fit_s']:.0f} s" for v, x in p["fits"].items()))
     print("\n".join(table(summary, models)))
     if a.json:
-        a.json.write_text(json.dumps(_clean({"variants": variants, "folds": parts, "summary": summary}), indent=1) + "\n")
+        a.json.write_text(json.dumps(json_ready({"variants": variants, "folds": parts, "summary": summary}), indent=1) + "\n")
         print(f"wrote {a.json}")
     return 0
 

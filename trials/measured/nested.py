@@ -32,7 +32,7 @@ from .predict import MeasuredRun, replay_record
 
 __all__ = ["BandSpec", "Candidate", "NestedCV", "Selection", "nested_cross_validate", "select_candidate", "choose",
            "replay_scores", "fit_model", "check_choosable", "HULL_FORMS", "hull_candidates", "HORIZON_S", "SCORE_NAMES",
-           "band_scores", "band_sections", "band_summary", "band_ship", "MODEL_FORMS", "split_folds"]
+           "band_scores", "band_sections", "band_summary", "band_ship", "MODEL_FORMS", "split_folds", "json_ready"]
 
 HULL_FORMS = {"kijima": "", "crossflow": "_crossflow"}
 """The hull forms ``mmg identify --hull`` knows, by the suffix of their bundled config's name after the
@@ -303,6 +303,20 @@ def choose(rows: list[dict], names) -> tuple[str, dict]:
     return best, table
 
 
+def json_ready(v, drop=()):
+    """``v`` (dicts, lists, tuples, numbers) as JSON takes it: keys as text, a non-finite float as None, numpy
+    scalars as Python ones; a dict's keys in ``drop`` left out at every depth."""
+    if isinstance(v, dict):
+        return {str(k): json_ready(x, drop) for k, x in v.items() if k not in drop}
+    if isinstance(v, (list, tuple)):
+        return [json_ready(x, drop) for x in v]
+    if isinstance(v, (float, np.floating)):
+        return float(v) if np.isfinite(v) else None
+    if isinstance(v, np.integer):
+        return int(v)
+    return v
+
+
 def split_folds(runs, folds: int, folds_by: str) -> tuple[int, list]:
     """(folds made, [(training records, kept-out records) per fold]): ``runs`` dealt into at most ``folds``
     folds by ``folds_by`` (:func:`~trials.measured.identify.fold_of`; a record and its cut copies share one)."""
@@ -500,17 +514,6 @@ class NestedCV:
         return pd.DataFrame(rows).set_index("name")
 
     def to_json(self) -> dict:
-        """Everything but the identified ships, JSON-ready (NaN as None)."""
-        def clean(v):
-            if isinstance(v, dict):
-                return {k: clean(x) for k, x in v.items() if k != "ship"}
-            if isinstance(v, (list, tuple)):
-                return [clean(x) for x in v]
-            if isinstance(v, (float, np.floating)):
-                return float(v) if np.isfinite(v) else None
-            if isinstance(v, np.integer):
-                return int(v)
-            return v
-
-        return clean({"candidates": self.candidates, "horizon_s": self.horizon_s, "folds": self.folds,
-                      "records": self.records, "inner": self.inner, "summary": self.summary()})
+        """Everything but the identified ships, JSON-ready (NaN as None: :func:`json_ready`)."""
+        return json_ready({"candidates": self.candidates, "horizon_s": self.horizon_s, "folds": self.folds,
+                           "records": self.records, "inner": self.inner, "summary": self.summary()}, drop=("ship",))
