@@ -1,6 +1,7 @@
 """Measured records against the model.  Replay of a record against its own rudder and revolutions
 (:mod:`.predict`, ``mmg predict``; its 90 % bands from the identified ship's uncertainty, :mod:`.bands`, the
-ship drawn from its covariance by :mod:`.draws`), identification of a ship model from records and its
+ship drawn from its covariance by :mod:`.draws`, the heading error of the model's form by :mod:`.modelform`;
+a learned correction of the residual forces, :mod:`.hybrid`), identification of a ship model from records and its
 cross-validation (:mod:`.identify`, ``mmg identify``; whether its stated uncertainty holds from one group
 of records to the next, :mod:`.foldspread`), the discrepancy workflow that names the
 effect the model is missing (the package :mod:`.diagnose`, ``mmg diagnose``; the effects themselves, and
