@@ -135,7 +135,49 @@ def test_band_of_a_term_alone_is_the_nominal_plus_minus_its_half_width():
     assert plain.empty
 
 
+def test_position_band_of_a_term_alone_is_a_disc_of_its_radius():
+    """No covariance, no run spread: every draw replays the nominal track and adds the term's circular normal
+    offset, so the band's radius is the term's (the Rayleigh 90 % quantile, scipy's, of 400 draws: within
+    about 10 %) about the nominal track; a section without ``position_q90_L`` leaves the radius at zero and
+    says the position band is the draws' alone."""
+    from scipy.stats import rayleigh
+
+    from trials.measured.modelform import R90, position_half_width
+
+    assert R90 == pytest.approx(rayleigh.ppf(0.9))
+    ship = replace(mmg.load_ship(SHIP), covariance=None, run_spread=None)
+    run = _run(ship, duration=30.0)
+    mf = ModelForm((10.0, 20.0, 40.0), (2.0, 5.0, 9.0), position_q90_L=(0.1, 0.3, 0.5))
+    b = prediction_bands(replace(ship, model_form=mf), run, 400, seed=3, jobs=2)
+    r = position_half_width(mf, run.t - run.t[0], L)
+    np.testing.assert_allclose(r, L * np.interp((run.t - run.t[0]) / UNIT, [0, 10, 20, 40], [0, 0.1, 0.3, 0.5]))
+    late = r > 0.3
+    np.testing.assert_allclose(b.radius[late] / r[late], 1.0, atol=0.15)
+    np.testing.assert_allclose(b.x_median[late], b.nominal.pred[late, 3], atol=0.1 * r[late].max())
+    assert any("model-form position offset" in n for n in b.notes)
+    heading_only = prediction_bands(replace(ship, model_form=ModelForm((10.0, 20.0), (2.0, 5.0))), run, 50, seed=3, jobs=2)
+    assert np.all(heading_only.radius <= 1e-9) and any("position band is the draws' alone" in n for n in heading_only.notes)
+
+
+def test_position_growth_and_a_position_divergence_end_the_section():
+    """Position errors binned as the heading's (in ship lengths); a bin where the position diverged ends the
+    section for both terms, even where the heading stayed finite."""
+    t = np.arange(0.0, 40.0, 0.5)
+    head = [_curve(t, 0.1 * t) for _ in range(3)]
+    pos = [_curve(t, 0.01 * (k + 1) * t) for k in range(3)]
+    sec, _ = model_form_section(head, L, "x", pos)
+    np.testing.assert_allclose(sec["position_q90_L"], _binned_q90_by_hand(pos, L))
+    pos[0] = _curve(t, np.where(t < 20, 0.01 * t, np.nan))
+    pos[1] = _curve(t, np.where(t < 20, 0.01 * t, np.nan))
+    sec, why = model_form_section(head, L, "x", pos)
+    assert sec["elapsed_froude"] == [10.0, 20.0] and len(sec["position_q90_L"]) == 2 and "diverged" in why
+
+
 @pytest.mark.parametrize("section, field", [
+    ({"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [1.0, 2.0], "position_q90_L": [0.1]}, "model_form.position_q90_L"),
+    ({"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [1.0, 2.0], "position_q90_L": [0.2, 0.1]}, "model_form.position_q90_L"),
+    ({"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [1.0, 2.0], "position_q90_L": [0.1, float("inf")]},
+     "model_form.position_q90_L"),
     ({"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [1.0]}, "model_form.heading_q90_deg"),
     ({"elapsed_froude": [20.0, 10.0], "heading_q90_deg": [1.0, 2.0]}, "model_form.elapsed_froude"),
     ({"elapsed_froude": [0.0, 10.0], "heading_q90_deg": [1.0, 2.0]}, "model_form.elapsed_froude"),
@@ -197,18 +239,23 @@ def test_identify_writes_the_training_replays_term_and_it_loads_back(three_slice
     sec = yaml.safe_load((out / "ship.yaml").read_text())["model_form"]
     assert "in sample" in sec["source"] and sec["records"] == 3
     ship = mmg.load_ship(str(out / "ship.yaml"))
-    assert ship.model_form == ModelForm(tuple(sec["elapsed_froude"]), tuple(sec["heading_q90_deg"]), 3, sec["source"])
-    curves = []
+    assert ship.model_form == ModelForm(tuple(sec["elapsed_froude"]), tuple(sec["heading_q90_deg"]), 3, sec["source"],
+                                        tuple(sec["position_q90_L"]))
+    curves, dist = [], []
     for r in load_runs(ship, three_slices):
         p = replay_record(ship, r).pred
         curves.append((r.t - r.t[0], np.degrees(np.unwrap(p[:, 5]) - np.unwrap(r.meas[:, 5]))))
+        dist.append((r.t - r.t[0], np.sqrt((p[:, 3] - r.meas[:, 3]) ** 2 + (p[:, 4] - r.meas[:, 4]) ** 2) / L))
     np.testing.assert_allclose(sec["heading_q90_deg"], _binned_q90_by_hand(curves, ship.particulars.L), rtol=1e-4,
                                atol=1e-4)
+    np.testing.assert_allclose(sec["position_q90_L"], _binned_q90_by_hand(dist, ship.particulars.L), rtol=1e-4,
+                               atol=1e-6)
     report = (out / "report.md").read_text().split("## Model-form term", 1)[1]
     rows = [ln.split(" | ") for ln in report.splitlines() if ln.startswith("| ") and "[" not in ln]
     assert len(rows) == len(sec["elapsed_froude"])
-    for (t_s, t_f, q), tf, qq in zip(rows, sec["elapsed_froude"], sec["heading_q90_deg"]):
+    for (t_s, t_f, q, d), tf, qq, dd in zip(rows, sec["elapsed_froude"], sec["heading_q90_deg"], sec["position_q90_L"]):
         assert float(t_s.strip("| ")) == pytest.approx(tf * UNIT, rel=1e-3) and float(q.strip("| ")) == pytest.approx(qq, rel=2e-3)
+        assert float(d.strip("| ")) == pytest.approx(dd * L, rel=5e-3)      # 3 significant figures
 
 
 def test_identify_with_cv_writes_the_kept_out_term(three_slices, tmp_path):

@@ -305,7 +305,8 @@ class ModelForm:
 
     ``mmg identify`` writes it (:func:`trials.measured.modelform.heading_error_growth`) from the heading
     errors of replays of records; ``mmg predict --samples`` adds to each drawn replay's heading a
-    zero-mean normal error whose 90 % half-width grows as ``heading_q90_deg`` over ``elapsed_froude``.
+    zero-mean normal error whose 90 % half-width grows as ``heading_q90_deg`` over ``elapsed_froude``, and
+    to its position a circular normal offset whose 90 % radius grows as ``position_q90_L`` ship lengths.
 
     Attributes
     ----------
@@ -319,12 +320,16 @@ class ModelForm:
         The records the errors came from.
     source : str
         How it was made (which replays: kept out of the fit, or its own training records).
+    position_q90_L : tuple of float or None
+        At each elapsed time, the 90 % quantile of the distance between the replayed and the logged
+        position, in ship lengths L, non-decreasing; None where the section gives no position term.
     """
 
     elapsed_froude: tuple
     heading_q90_deg: tuple
     records: int = 0
     source: str = ""
+    position_q90_L: tuple | None = None
 
 
 @dataclass(frozen=True)

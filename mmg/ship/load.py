@@ -218,6 +218,7 @@ class _RunSpread(_Strict):
 class _ModelForm(_Strict):
     elapsed_froude: list[float]
     heading_q90_deg: list[float]
+    position_q90_L: Optional[list[float]] = None
     records: int = 0
     source: str = ""
 
@@ -524,21 +525,28 @@ def _run_spread(f: _ShipFile, src: str) -> RunSpread | None:
 
 def _model_form(f: _ShipFile, src: str) -> ModelForm | None:
     """model_form: as many finite errors as elapsed times, the times positive and increasing, the errors
-    non-negative and non-decreasing (an error that shrinks with time is not a growth curve)."""
+    (heading, and position where given) non-negative and non-decreasing (an error that shrinks with time is
+    not a growth curve)."""
     c = f.model_form
     if c is None:
         return None
-    t, q = np.asarray(c.elapsed_froude, float), np.asarray(c.heading_q90_deg, float)
-    if len(q) != len(t) or not len(t):
-        raise InputError(src, "model_form.heading_q90_deg", f"{len(q)} entries for {len(t)} elapsed times (one or more)")
-    for key, x in (("elapsed_froude", t), ("heading_q90_deg", q)):
+    t = np.asarray(c.elapsed_froude, float)
+    errors = {"heading_q90_deg": np.asarray(c.heading_q90_deg, float)}
+    if c.position_q90_L is not None:
+        errors["position_q90_L"] = np.asarray(c.position_q90_L, float)
+    for key, x in (("elapsed_froude", t), *errors.items()):
+        if len(x) != len(t) or not len(t):
+            raise InputError(src, f"model_form.{key}", f"{len(x)} entries for {len(t)} elapsed times (one or more)")
         if not np.all(np.isfinite(x)):
             raise InputError(src, f"model_form.{key}", "a value that is not a finite number")
     if t[0] <= 0 or np.any(np.diff(t) <= 0):
         raise InputError(src, "model_form.elapsed_froude", "elapsed times (in sqrt(L/g)) must be positive and increasing")
-    if q[0] < 0 or np.any(np.diff(q) < 0):
-        raise InputError(src, "model_form.heading_q90_deg", "must be non-negative and non-decreasing with elapsed time")
-    return ModelForm(tuple(float(x) for x in t), tuple(float(x) for x in q), int(c.records), c.source)
+    for key, x in errors.items():
+        if x[0] < 0 or np.any(np.diff(x) < 0):
+            raise InputError(src, f"model_form.{key}", "must be non-negative and non-decreasing with elapsed time")
+    pos = errors.get("position_q90_L")
+    return ModelForm(tuple(float(x) for x in t), tuple(float(x) for x in errors["heading_q90_deg"]), int(c.records),
+                     c.source, None if pos is None else tuple(float(x) for x in pos))
 
 
 def _covariance(f: _ShipFile, src: str) -> ParameterCovariance | None:

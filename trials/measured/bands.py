@@ -15,10 +15,11 @@ times, each replay with
   between-run spread of a run's own disturbance (the ``run_spread:`` section, :class:`mmg.ship.RunSpread`,
   written by ``mmg identify``: ``start.u``, ``start.v``, ``start.r``, ``start.psi`` added to the first
   logged state; ``<effect>.<parameter>`` a per-record effect the run does not already have), and
-* on the heading, the model-form term of the ship's ``model_form:`` section (:class:`mmg.ship.ModelForm`,
-  :mod:`trials.measured.modelform`): a zero-mean normal error, one draw per replay from the third stream
-  of ``seed``, whose 90 % half-width grows with the elapsed time as the section says (the position band
-  is the draws' alone).
+* the model-form term of the ship's ``model_form:`` section (:class:`mmg.ship.ModelForm`,
+  :mod:`trials.measured.modelform`): on the heading a zero-mean normal error, one draw per replay from the
+  third stream of ``seed``, whose 90 % half-width grows with the elapsed time as the section says; on the
+  position (where the section has ``position_q90_L``) a circular normal offset, one draw per replay from
+  the fourth stream, whose 90 % radius grows so.
 
 At every sample of the record the band is the 5 % and 95 % quantiles over the draws (numpy's default
 linear interpolation) of
@@ -352,11 +353,30 @@ def _model_form_errors(ship: Ship, run: MeasuredRun, samples: int, seed: int, no
     hw = heading_half_width(mf, run.t - run.t[0], L)
     z = np.random.default_rng([int(seed), 2]).standard_normal(samples)
     notes.append(f"model-form heading error added to each draw ({mf.source or 'model_form: section'}; "
-                 f"{hw[-1]:.1f} deg 90 % half-width at the record's end); the position band is the draws' alone")
+                 f"{hw[-1]:.1f} deg 90 % half-width at the record's end)")
     if run.t[-1] - run.t[0] > measured_until(mf, L):
         notes.append(f"the model-form term was measured up to {measured_until(mf, L):.4g} s of elapsed time and is "
                      "held at its last value beyond (a longer record's error may grow further)")
     return z[:, None] * (hw / Z90)[None, :]
+
+
+def _model_form_offsets(ship: Ship, run: MeasuredRun, samples: int, seed: int, notes: list) -> np.ndarray | float:
+    """Each draw's model-form position offset [m] (draws, N, 2): a circular normal, one per draw and whole
+    along the record, whose 90 % radius is the ship's ``model_form:`` position term at each sample's elapsed
+    time (:func:`trials.measured.modelform.position_half_width`), from the fourth stream of ``seed``; 0
+    without one."""
+    from .modelform import R90, position_half_width
+
+    mf = ship.model_form
+    hw = None if mf is None else position_half_width(mf, run.t - run.t[0], ship.particulars.L)
+    if hw is None:
+        if mf is not None:
+            notes.append("no model-form position term (the model_form: section has no position_q90_L): the "
+                         "position band is the draws' alone, narrower than a new record's error")
+        return 0.0
+    z = np.random.default_rng([int(seed), 3]).standard_normal((samples, 2))
+    notes.append(f"model-form position offset added to each draw ({hw[-1]:.3g} m 90 % radius at the record's end)")
+    return z[:, None, :] * (hw / R90)[None, :, None]
 
 
 def _unwrapped_deg(psi: np.ndarray, first: float) -> np.ndarray:
@@ -443,7 +463,7 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     nominal = replay_record(ship, run)
     first = float(np.unwrap(run.meas[:, 5])[0])
     lo, hi = _quantile_bounds(_unwrapped_deg(P[:, :, 2], first) + _model_form_errors(ship, run, samples, seed, notes))
-    xm, ym, radius = _position_band(P[:, :, :2])
+    xm, ym, radius = _position_band(P[:, :, :2] + _model_form_offsets(ship, run, samples, seed, notes))
     return Bands(nominal=nominal, t=np.asarray(run.t, float), heading_deg=np.degrees(np.unwrap(run.meas[:, 5])),
                  lo=lo, hi=hi, nominal_deg=_unwrapped_deg(nominal.pred[:, 5], first), x_median=xm, y_median=ym,
                  radius=radius, tracks=P[:SAMPLE_TRACKS, :, :2].copy(), draws=samples,

@@ -1,4 +1,4 @@
-"""The model-form term of a prediction band: the heading error a replay gains with elapsed time.
+"""The model-form term of a prediction band: the heading and position error a replay gains with elapsed time.
 
 A band drawn from the identified parameters' covariance and the run spread alone carries the doubt of
 the fit, not the error of the model's form: on real records a replay strays from the record further than
@@ -11,8 +11,10 @@ function of the time elapsed since the replay's start:
   :data:`ELAPSED_EDGES`) and gives, per bin that at least :data:`MIN_RECORDS` records reach, the
   :data:`QUANTILE` quantile of the absolute error, made non-decreasing with time: the ``model_form:``
   section of the ship YAML (:class:`mmg.ship.ModelForm`);
-* :func:`heading_half_width` evaluates it at the elapsed times of another record (linear between the
-  nodes, from zero at the start, held beyond the last node).
+* :func:`position_error_curves` and the same binning give the distance between the predicted and the
+  logged position, in ship lengths (``position_q90_L``);
+* :func:`heading_half_width` and :func:`position_half_width` evaluate them at the elapsed times of another
+  record (linear between the nodes, from zero at the start, held beyond the last node).
 
 Which replays are measured sets what the term means.  The kept-out replays of a cross-validation
 (``mmg identify --cv K``) are errors on records the fit did not see: what a new record will meet.  The
@@ -28,8 +30,9 @@ import numpy as np
 from mmg.model import G
 from mmg.ship import ModelForm
 
-__all__ = ["ELAPSED_EDGES", "MIN_RECORDS", "QUANTILE", "Z90", "heading_error_curves", "heading_error_growth",
-           "heading_half_width", "model_form_section", "model_form_of", "measured_until"]
+__all__ = ["ELAPSED_EDGES", "MIN_RECORDS", "QUANTILE", "Z90", "R90", "heading_error_curves", "heading_error_growth",
+           "position_error_curves", "heading_half_width", "position_half_width", "model_form_section",
+           "model_form_of", "measured_until"]
 
 ELAPSED_EDGES = (0.0, 10.0, 20.0, 40.0, 80.0, 160.0, 320.0, 640.0, 1280.0, 2560.0, 5120.0)
 """Bin edges of elapsed time in sqrt(L/g) (a 3 m model: 0.55 s; a 320 m ship: 5.7 s)."""
@@ -40,6 +43,9 @@ QUANTILE = 0.9
 Z90 = NormalDist().inv_cdf(0.5 + QUANTILE / 2)
 """The normal quantile of :data:`QUANTILE`'s central interval (1.645): a normal error of standard deviation s
 has a :data:`QUANTILE` half-width Z90 s."""
+R90 = float(np.sqrt(-2.0 * np.log(1.0 - QUANTILE)))
+"""The :data:`QUANTILE` quantile of the distance from the centre of a circular two-dimensional normal of
+standard deviation 1 per axis (2.146; the Rayleigh distribution's)."""
 
 
 def heading_error_curves(replays) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -65,8 +71,32 @@ def heading_error_curves(replays) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def position_error_curves(replays, L: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per replay, (elapsed time from its first sample [s], distance between the predicted and the logged
+    position in ship lengths ``L`` [m]); NaN where the replay diverged.
+
+    Parameters
+    ----------
+    replays : iterable of Replayed
+        :class:`trials.measured.predict.Replayed` (``run.t``, ``run.meas``, ``pred``; x, y in columns 3, 4).
+    L : float
+        Ship length [m].
+
+    Returns
+    -------
+    list of (ndarray, ndarray)
+    """
+    out = []
+    for rep in replays:
+        t = np.asarray(rep.run.t, float)
+        d = np.hypot(rep.pred[:, 3] - rep.run.meas[:, 3], rep.pred[:, 4] - rep.run.meas[:, 4]) / L
+        out.append((t - t[0], d))
+    return out
+
+
 def heading_error_growth(curves, L: float, g: float = G) -> tuple[np.ndarray, np.ndarray, int]:
-    """The :data:`QUANTILE` quantile of the absolute heading error per bin of elapsed Froude time.
+    """The :data:`QUANTILE` quantile of the absolute error per bin of elapsed Froude time: of the heading
+    [deg] for :func:`heading_error_curves`, of the position [ship lengths] for :func:`position_error_curves`.
 
     The samples of a bin are pooled over the records (a longer record counts more, as in the share of
     samples the bands are judged by); a bin counts where :data:`MIN_RECORDS` records reach it.
@@ -109,34 +139,39 @@ def heading_error_growth(curves, L: float, g: float = G) -> tuple[np.ndarray, np
     return np.array(nodes), q, len(curves)
 
 
-def model_form_section(curves, L: float, source: str) -> tuple[dict | None, str]:
+def model_form_section(curves, L: float, source: str, position_curves=None) -> tuple[dict | None, str]:
     """(the ``model_form:`` section of the ship YAML, :class:`mmg.ship.ModelForm`, or None; what limits it)
-    from the error ``curves`` (:func:`heading_error_growth`), with ``source`` saying which replays they are.
+    from the heading error ``curves`` and, where given, the ``position_curves`` of the same replays
+    (:func:`heading_error_growth`), with ``source`` saying which replays they are.
 
     Where replays diverged, the section ends before the first bin whose quantile they make infinite (and
     says so in its ``source``); None where no bin is left, the second item saying why."""
     nodes, q, n = heading_error_growth(curves, L)
     if not len(nodes):
         return None, f"fewer than {MIN_RECORDS} records reach any elapsed time"
-    keep = np.isfinite(q)
+    qp = heading_error_growth(position_curves, L)[1] if position_curves is not None else None
+    keep = np.isfinite(q) & (np.isfinite(qp) if qp is not None else True)
     why = ""
     if not keep.all():
-        why = (f"replays diverged: the heading error is unbounded from {nodes[~keep][0]:.6g} sqrt(L/g) on "
+        why = (f"replays diverged: the error is unbounded from {nodes[~keep][0]:.6g} sqrt(L/g) on "
                "(held at the last finite value there)")
+        keep = np.cumsum(~keep) == 0
         if not keep.any():
             return None, why
-        nodes, q = nodes[keep], q[keep]
     six = lambda a: [float(f"{x:.6g}") for x in a]          # noqa: E731
-    return {"elapsed_froude": six(nodes), "heading_q90_deg": six(q), "records": int(n),
-            "source": source + (f"; {why}" if why else "")}, why
+    out = {"elapsed_froude": six(nodes[keep]), "heading_q90_deg": six(q[keep])}
+    if qp is not None:
+        out["position_q90_L"] = six(qp[keep])
+    return out | {"records": int(n), "source": source + (f"; {why}" if why else "")}, why
 
 
 def model_form_of(section: dict | None) -> ModelForm | None:
     """A ``model_form:`` section (:func:`model_form_section`) as the :class:`mmg.ship.ModelForm` a ship carries."""
     if section is None:
         return None
+    pos = section.get("position_q90_L")
     return ModelForm(tuple(section["elapsed_froude"]), tuple(section["heading_q90_deg"]), int(section["records"]),
-                     section["source"])
+                     section["source"], None if pos is None else tuple(pos))
 
 
 def heading_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G) -> np.ndarray:
@@ -144,6 +179,15 @@ def heading_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G)
     ``L`` [m]: linear in elapsed Froude time between zero at the start and the nodes, held beyond the last."""
     t = np.asarray(elapsed_s, float) / np.sqrt(L / g)
     return np.interp(t, np.r_[0.0, model_form.elapsed_froude], np.r_[0.0, model_form.heading_q90_deg])
+
+
+def position_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G) -> np.ndarray | None:
+    """The model-form term's 90 % position radius [m] at elapsed times ``elapsed_s`` [s] of a ship of length
+    ``L`` [m] (as :func:`heading_half_width`); None where the section has no ``position_q90_L``."""
+    if model_form.position_q90_L is None:
+        return None
+    t = np.asarray(elapsed_s, float) / np.sqrt(L / g)
+    return L * np.interp(t, np.r_[0.0, model_form.elapsed_froude], np.r_[0.0, model_form.position_q90_L])
 
 
 def measured_until(model_form: ModelForm, L: float, g: float = G) -> float:

@@ -212,11 +212,11 @@ def run_spread(ident: Identification) -> dict | None:
 
 def model_form(ident: Identification, cv: list | None = None) -> tuple[dict | None, str]:
     """(the ``model_form:`` section of ship.yaml or None, what limits it):
-    :func:`trials.measured.modelform.model_form_section`, the heading error a replay gains with elapsed
-    time.  With ``cv`` (:func:`~.fit.cross_validate`'s records, each kept-out record with the ``ship`` and
+    :func:`trials.measured.modelform.model_form_section`, the heading and position error a replay gains
+    with elapsed time.  With ``cv`` (:func:`~.fit.cross_validate`'s records, each kept-out record with the ``ship`` and
     ``values`` of the fit that did not see it) from those kept-out replays; otherwise from the fit's own
     training replays, in sample (a lower bound, said in the section's ``source``)."""
-    from ..modelform import heading_error_curves, model_form_section
+    from ..modelform import heading_error_curves, model_form_section, position_error_curves
     from .fit import replay_fitted
 
     L = ident.ship.particulars.L
@@ -225,10 +225,10 @@ def model_form(ident: Identification, cv: list | None = None) -> tuple[dict | No
     if kept:
         reps = [replay_fitted(c["ship"], c["values"], by_name[c["name"]]) for c in kept]
         folds = len({c.get("fold") for c in kept})
-        source = (f"heading errors of the {len(reps)} kept-out replays of a {folds}-fold cross-validation (each by "
+        source = (f"heading and position errors of the {len(reps)} kept-out replays of a {folds}-fold cross-validation (each by "
                   "the fit that did not see it), 90 % quantile per bin of elapsed time")
     else:
         reps = [ident.replay(r) for r in ident.runs]
-        source = (f"heading errors of the fit's own {len(reps)} training replays, in sample (a new record's are "
+        source = (f"heading and position errors of the fit's own {len(reps)} training replays, in sample (a new record's are "
                   "larger: identify with --cv for kept-out ones), 90 % quantile per bin of elapsed time")
-    return model_form_section(heading_error_curves(reps), L, source)
+    return model_form_section(heading_error_curves(reps), L, source, position_error_curves(reps, L))
