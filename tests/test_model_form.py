@@ -318,3 +318,22 @@ def test_the_kept_out_term_replays_each_record_with_its_folds_ship(three_slices)
     assert "kept-out replays of a 3-fold" in sec["source"]
     own, _ = model_form(ident)
     assert own["heading_q90_deg"] != sec["heading_q90_deg"]               # the identified ship's differ
+
+
+def test_a_ship_identified_from_an_identified_ship_does_not_carry_its_priors_uncertainty(three_slices, tmp_path):
+    """The prior carries a ``covariance:``, ``run_spread:`` and ``model_form:`` of its own fit; the ship
+    identified from it has none of them (a band drawn from ``ident.ship`` would otherwise draw the prior's doubt
+    as the new fit's); ``mmg identify`` writes the new fit's."""
+    from trials.measured.identify import identify
+
+    from .test_predict_bands import _ship_with_sections
+
+    p = _ship_with_sections(tmp_path)
+    data = yaml.safe_load(p.read_text())
+    data["model_form"] = {"elapsed_froude": [10.0], "heading_q90_deg": [99.0], "records": 9, "source": "prior"}
+    p.write_text(yaml.safe_dump(data, sort_keys=False))
+    prior = mmg.load_ship(str(p))
+    assert prior.covariance is not None and prior.run_spread is not None and prior.model_form is not None
+    ident = identify(prior, three_slices, free=["N_r", "kappa"], max_nfev=2)
+    assert ident.ship.covariance is None and ident.ship.run_spread is None and ident.ship.model_form is None
+    assert ident.ship.hull.value("N_r") == pytest.approx(ident.fit.values()["N_r"])

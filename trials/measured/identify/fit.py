@@ -286,6 +286,13 @@ def _wind_keys() -> dict:
 _ship_with = ship_with_values
 
 
+def without_fit_sections(ship: Ship) -> Ship:
+    """``ship`` without the sections an identification writes about its own fit (``covariance:``,
+    ``run_spread:``, ``model_form:``, ``identification:``): a ship identified again from an identified
+    ship.yaml does not carry its prior's uncertainty as its own."""
+    return replace(ship, covariance=None, run_spread=None, model_form=None, identification=None)
+
+
 def stage_description(segment_s: float) -> str:
     """What a fit stage with segments of ``segment_s`` [s] fits, in words (an infinite length: the
     whole record, not cut)."""
@@ -548,7 +555,7 @@ def identify(ship: Ship, paths_or_runs, free=DEFAULT_FREE, options: IdentifyOpti
                      "max_nfev": int(o.max_nfev), "cost_initial": fit.cost_initial, "cost_final": fit.cost_final,
                      "status": fit.status, "message": fit.message})
     tau = _residual_tau((ship, packed, runs, fp, nuisance), fit, o)
-    return Identification(ship=_ship_with(ship, fit.values()), initial=ship if o.initial is None else o.initial,
+    return Identification(ship=_ship_with(without_fit_sections(ship), fit.values()), initial=ship if o.initial is None else o.initial,
                           fit=fit, runs=runs, segment_s=seg, prior=None if o.initial is None else ship,
                           record_weighting=o.record_weighting, velocity_weight=float(o.velocity_weight),
                           stages=tuple(done), tau=tau, initial_state=o.initial_state,
