@@ -216,7 +216,9 @@ def kind_summary(records, keys=tuple(k for k, _ in KIND_KEYS)) -> list[dict]:
             row[key] = {"scaled": mean[0], "identified": mean[1], "n": len(pairs)}
         band = band_summary(mine)
         if band:
-            row["band"] = {"coverage90": band["band_coverage90"], "median_width_deg": band["band_median_width_deg"]}
+            row["band"] = {"coverage90": band["band_coverage90"], "median_width_deg": band["band_median_width_deg"],
+                           "position_coverage90": band.get("band_position_coverage90"),
+                           "median_radius_m": band.get("band_median_radius_m")}
         out.append(row)
     return out
 
@@ -226,7 +228,8 @@ def kind_table(summary: list[dict], markdown: bool) -> list[str]:
     record and over the 60 s windows (with the records each is over when fewer than the kind's)."""
     bands = any("band" in r for r in summary)
     head = (["kind", "records"] + [f"{words}: heading RMS s / i [deg]" for _, words in KIND_KEYS]
-            + (["90 % band: coverage, median width"] if bands else []))
+            + (["90 % heading band: coverage, median width", "90 % position band: coverage, median radius"]
+               if bands else []))
 
     def cell(row, key):
         c = row[key]
@@ -235,7 +238,13 @@ def kind_table(summary: list[dict], markdown: bool) -> list[str]:
 
     def band(row):
         b = row.get("band")
-        return [f"{100 * b['coverage90']:.1f} %, {b['median_width_deg']:.0f} deg" if b else "-"] if bands else []
+        if not bands:
+            return []
+        if not b:
+            return ["-", "-"]
+        pos = (f"{100 * b['position_coverage90']:.1f} %, {b['median_radius_m']:.3g} m"
+               if b.get("position_coverage90") is not None else "-")
+        return [f"{100 * b['coverage90']:.1f} %, {b['median_width_deg']:.0f} deg", pos]
 
     return _table(head, [[r["kind"], str(r["n"])] + [cell(r, k) for k, _ in KIND_KEYS] + band(r) for r in summary],
                   markdown)
@@ -264,7 +273,8 @@ def summary_lines(res) -> list[str]:
                    f"{s['band_median_width_deg']:.3g} deg (median over the records); "
                    f"{100 * s.get('band_rejected_share', 0.0):.1f} % of the candidate ships rejected outside the support")
         if "band_position_coverage90" in s:
-            out.append(f"90 % position bands (a disc about the draws' median track; no model-form term): "
+            out.append(f"90 % position bands (a disc about the draws' median track, with the model-form term's "
+                       "position part where the ship carries one): "
                        f"{100 * s['band_position_coverage90']:.1f} % of the samples inside, median radius "
                        f"{s['band_median_radius_m']:.3g} m (median over the records)")
     for key, words in (("heading_rms_deg", "heading RMS [deg]"), ("yaw_rate_rms_degps", "yaw-rate RMS [deg/s]"),
