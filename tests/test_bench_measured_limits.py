@@ -239,13 +239,17 @@ def test_kind_summary_whole_record_and_window_means_by_hand():
     assert none[0]["heading_rms_deg"] == {"scaled": None, "identified": None, "n": 0}
     assert cv.kind_table(none, markdown=True)[2] == "| zigzag | 1 | - (0 finite) | - (0 finite) |"
     # bands pooled per kind: turns 90 of 100 and 30 of 50 samples inside (120 of 150: 80 %), median width
-    # of the records' medians 40 and 60 deg: 50 deg; the random runs carry none
-    band = lambda n, k, w: {"samples": n, "inside": k, "median_width_deg": w}    # noqa: E731
-    recs[0]["band"], recs[1]["band"] = band(100, 90, 40.0), band(50, 30, 60.0)
+    # of the records' medians 40 and 60 deg: 50 deg; positions 80 and 45 inside (125 of 150: 83.3 %), median
+    # radius of 3 and 5 m: 4 m; the random runs carry none
+    band = lambda n, k, w, p, r: {"samples": n, "inside": k, "median_width_deg": w,     # noqa: E731
+                                  "position_inside": p, "median_radius_m": r}
+    recs[0]["band"], recs[1]["band"] = band(100, 90, 40.0, 80, 3.0), band(50, 30, 60.0, 45, 5.0)
     rows = cv.kind_summary(recs)
-    assert rows[0]["band"] == {"coverage90": pytest.approx(0.8), "median_width_deg": 50.0} and "band" not in rows[1]
+    assert rows[0]["band"] == {"coverage90": pytest.approx(0.8), "median_width_deg": 50.0,
+                               "position_coverage90": pytest.approx(125 / 150), "median_radius_m": 4.0}
+    assert "band" not in rows[1]
     md = cv.kind_table(rows, markdown=True)
-    assert md[2].endswith("| 80.0 %, 50 deg |") and md[3].endswith("| - |")
+    assert md[2].endswith("| 80.0 %, 50 deg | 83.3 %, 4 m |") and md[3].endswith("| - | - |")
 
 
 def test_the_identified_models_window_scores_carry_its_fitted_wind_scale():
