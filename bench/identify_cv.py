@@ -93,8 +93,9 @@ def _args(argv=None):
                          "'fit'; docs/benchmark_frt.md's figures: 'sample')")
     ap.add_argument("--horizon", type=float, default=60.0, help="the short-horizon window [s] (default 60)")
     ap.add_argument("--bands", type=int, default=0, metavar="N",
-                    help="each kept-out record's 90 %% heading band from N draws of its fold's model (ship from the "
-                         "written covariance, start from the run-to-run spread); pooled coverage and median width")
+                    help="each kept-out record's 90 %% heading and position bands from N draws of its fold's model "
+                         "(ship from the written covariance, start from the run-to-run spread, the model-form term); "
+                         "pooled coverage, median width and radius")
     ap.add_argument("--band-support", choices=("none", "bounds", "physical"), default="physical",
                     help="where the bands' ship draws are kept (mmg predict --support; default physical)")
     ap.add_argument("--band-model-form", choices=("training", "kept-out", "none"), default="training",

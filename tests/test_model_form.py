@@ -20,7 +20,7 @@ from mmg.errors import InputError
 from mmg.ship import ModelForm
 from trials.measured.bands import prediction_bands
 from trials.measured.modelform import (ELAPSED_EDGES, MIN_RECORDS, Z90, heading_error_curves, heading_error_growth,
-                                       heading_half_width, model_form_section)
+                                       heading_half_width, model_form_of, model_form_section)
 
 from .test_predict_bands import SHIP, _run
 
@@ -149,8 +149,9 @@ def test_position_band_of_a_term_alone_is_a_disc_of_its_radius():
     run = _run(ship, duration=30.0)
     mf = ModelForm((10.0, 20.0, 40.0), (2.0, 5.0, 9.0), position_q90_L=(0.1, 0.3, 0.5))
     b = prediction_bands(replace(ship, model_form=mf), run, 400, seed=3, jobs=2)
+    np.testing.assert_allclose(position_half_width(mf, np.array([0.0, 5.0, 10.0, 15.0, 40.0, 99.0]) * UNIT, L),
+                               [0.0, 0.15, 0.3, 0.6, 1.5, 1.5])            # ship lengths to metres, linear, held
     r = position_half_width(mf, run.t - run.t[0], L)
-    np.testing.assert_allclose(r, L * np.interp((run.t - run.t[0]) / UNIT, [0, 10, 20, 40], [0, 0.1, 0.3, 0.5]))
     late = r > 0.3
     np.testing.assert_allclose(b.radius[late] / r[late], 1.0, atol=0.15)
     np.testing.assert_allclose(b.x_median[late], b.nominal.pred[late, 3], atol=0.1 * r[late].max())
@@ -171,6 +172,12 @@ def test_position_growth_and_a_position_divergence_end_the_section():
     pos[1] = _curve(t, np.where(t < 20, 0.01 * t, np.nan))
     sec, why = model_form_section(head, L, "x", pos)
     assert sec["elapsed_froude"] == [10.0, 20.0] and len(sec["position_q90_L"]) == 2 and "diverged" in why
+    assert len(sec["heading_q90_deg"]) == 2 and "position error" in why and "heading" not in why
+    mf = model_form_of(sec)                  # the section as the ship carries it (the bench's band_ship path)
+    assert mf.position_q90_L == tuple(sec["position_q90_L"]) and mf.heading_q90_deg == tuple(sec["heading_q90_deg"])
+    assert model_form_of({k: v for k, v in sec.items() if k != "position_q90_L"}).position_q90_L is None
+    with pytest.raises(ValueError):          # position curves of other replays: nodes that do not line up
+        model_form_section(head, L, "x", [_curve(t[:20], 0.01 * t[:20]) for _ in range(3)])
 
 
 @pytest.mark.parametrize("section, field", [
@@ -245,7 +252,8 @@ def test_identify_writes_the_training_replays_term_and_it_loads_back(three_slice
     for r in load_runs(ship, three_slices):
         p = replay_record(ship, r).pred
         curves.append((r.t - r.t[0], np.degrees(np.unwrap(p[:, 5]) - np.unwrap(r.meas[:, 5]))))
-        dist.append((r.t - r.t[0], np.sqrt((p[:, 3] - r.meas[:, 3]) ** 2 + (p[:, 4] - r.meas[:, 4]) ** 2) / L))
+        dist.append((r.t - r.t[0], np.sqrt((p[:, 3] - r.meas[:, 3]) ** 2 + (p[:, 4] - r.meas[:, 4]) ** 2)
+                     / ship.particulars.L))
     np.testing.assert_allclose(sec["heading_q90_deg"], _binned_q90_by_hand(curves, ship.particulars.L), rtol=1e-4,
                                atol=1e-4)
     np.testing.assert_allclose(sec["position_q90_L"], _binned_q90_by_hand(dist, ship.particulars.L), rtol=1e-4,
@@ -331,9 +339,12 @@ def test_a_ship_identified_from_an_identified_ship_does_not_carry_its_priors_unc
     p = _ship_with_sections(tmp_path)
     data = yaml.safe_load(p.read_text())
     data["model_form"] = {"elapsed_froude": [10.0], "heading_q90_deg": [99.0], "records": 9, "source": "prior"}
+    data["identification"] = {"converged": False, "warnings": ["the prior's own fit did not converge"]}
     p.write_text(yaml.safe_dump(data, sort_keys=False))
     prior = mmg.load_ship(str(p))
     assert prior.covariance is not None and prior.run_spread is not None and prior.model_form is not None
+    assert prior.identification is not None
     ident = identify(prior, three_slices, free=["N_r", "kappa"], max_nfev=2)
     assert ident.ship.covariance is None and ident.ship.run_spread is None and ident.ship.model_form is None
+    assert ident.ship.identification is None
     assert ident.ship.hull.value("N_r") == pytest.approx(ident.fit.values()["N_r"])

@@ -1,9 +1,10 @@
 """bench/wind_offset_alias.py: what a wind-curve departure takes up of a rudder offset's signature on a zigzag.
 
-Physics, not the bench's own numbers: in a head wind the published side force and yaw moment vanish
-(C_Y(0) = C_N(0) = 0, and ``yaw_sin`` multiplies sin(0)), so no shape term can act and nothing of the
-offset is taken up; in a beam wind the yaw moment acts on the whole record, and a shape departure within
-two prior standard deviations takes up most of a 10/10 zigzag's offset signature."""
+Physics, not the bench's own numbers: in a head wind the zigzag swings the relative wind to either side
+of the bow alike, and the side force and yaw moment are odd in that angle, so any change of their shape
+acts to both sides alike and cannot make the one-sided moment of an offset: nothing is taken up; in a beam
+wind the yaw moment keeps one sign over the whole record, and a shape departure within two prior standard
+deviations takes up most of a 10/10 zigzag's offset signature."""
 from __future__ import annotations
 
 import numpy as np

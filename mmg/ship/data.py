@@ -300,11 +300,11 @@ class RunSpread:
 
 @dataclass(frozen=True)
 class ModelForm:
-    """How far a replay's heading strays from a record's with elapsed time, beyond what the parameters'
-    covariance and the run spread carry: the ``model_form:`` section, the model-form term of a prediction band.
+    """How far a replay's heading and position stray from a record's with elapsed time, beyond what the
+    parameters' covariance and the run spread carry: the ``model_form:`` section, the model-form term of a prediction band.
 
     ``mmg identify`` writes it (:func:`trials.measured.modelform.heading_error_growth`) from the heading
-    errors of replays of records; ``mmg predict --samples`` adds to each drawn replay's heading a
+    and position errors of replays of records; ``mmg predict --samples`` adds to each drawn replay's heading a
     zero-mean normal error whose 90 % half-width grows as ``heading_q90_deg`` over ``elapsed_froude``, and
     to its position a circular normal offset whose 90 % radius grows as ``position_q90_L`` ship lengths.
 
@@ -369,8 +369,8 @@ class Ship:
     run_spread: RunSpread | None = field(default=None, compare=False, repr=False)
     """The spread of a run's own disturbance between runs (the ``run_spread:`` section), or None."""
     model_form: ModelForm | None = field(default=None, compare=False, repr=False)
-    """The heading error a replay gains with elapsed time beyond its parameters' doubt (the ``model_form:``
-    section), or None."""
+    """The heading and position error a replay gains with elapsed time beyond its parameters' doubt (the
+    ``model_form:`` section), or None."""
 
     def effect_set(self):
         """:attr:`effects` as an :class:`mmg.effects.EffectSet` (an empty one when None)."""

@@ -134,8 +134,9 @@ def _add_band_arguments(p) -> None:
                         "replayed), within the bounds alone, or anywhere (none: energy-gaining draws diverge and leave "
                         "the band unbounded); docs/prediction_bands.md")
     p.add_argument("--model-form", choices=("on", "off"), default="on",
-                   help="add the YAML's model_form: term to each --samples draw's heading (on, default, where the YAML "
-                        "has one: the heading error a replay gains with elapsed time, written by mmg identify) or not")
+                   help="add the YAML's model_form: term to each --samples draw's heading and position (on, default, "
+                        "where the YAML has one: the error a replay gains with elapsed time, written by mmg identify) "
+                        "or not")
 
 
 def _first_text(r, horizon) -> str:

@@ -94,7 +94,8 @@ class Bands:
     radius : ndarray (N,)
         The 90 % quantile of the draws' distance from the median track [m].
     tracks : ndarray (k, N, 2)
-        The first :data:`SAMPLE_TRACKS` drawn tracks, x and y [m] (for the figure).
+        The first :data:`SAMPLE_TRACKS` drawn tracks, x and y [m] (for the figure; the replays themselves,
+        without the model-form position offset the band's radius carries).
     draws, diverged : int
         Replays made, and how many of them diverged somewhere in the record.
     notes : tuple of str
@@ -433,7 +434,7 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
         bounds and no energy gained unpowered over the covariance's ``state_range`` (default,
         :func:`~trials.measured.draws.support_of`), to the bounds alone, or nowhere (the covariance's normal:
         a diverging draw widens the band, to unbounded).  The parameters' doubt alone under-covers new
-        records; the ship's ``model_form:`` term adds what a replay's heading strays beyond it
+        records; the ship's ``model_form:`` term adds what a replay's heading and position stray beyond it
         (``docs/prediction_bands.md``).
 
     Returns

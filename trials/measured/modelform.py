@@ -149,15 +149,21 @@ def model_form_section(curves, L: float, source: str, position_curves=None) -> t
     nodes, q, n = heading_error_growth(curves, L)
     if not len(nodes):
         return None, f"fewer than {MIN_RECORDS} records reach any elapsed time"
-    qp = heading_error_growth(position_curves, L)[1] if position_curves is not None else None
-    keep = np.isfinite(q) & (np.isfinite(qp) if qp is not None else True)
+    qp = None
+    if position_curves is not None:
+        pnodes, qp, _ = heading_error_growth(position_curves, L)
+        if not np.array_equal(pnodes, nodes):
+            raise ValueError("model_form_section: the position curves do not reach the heading curves' elapsed "
+                             "times (they must be of the same replays)")
+    bad = ~np.isfinite(q) | (~np.isfinite(qp) if qp is not None else False)
     why = ""
-    if not keep.all():
-        why = (f"replays diverged: the error is unbounded from {nodes[~keep][0]:.6g} sqrt(L/g) on "
+    if bad.any():
+        which = " and ".join(n for n, x in (("heading", q), ("position", qp)) if x is not None and not np.isfinite(x).all())
+        why = (f"replays diverged: the {which} error is unbounded from {nodes[bad][0]:.6g} sqrt(L/g) on "
                "(held at the last finite value there)")
-        keep = np.cumsum(~keep) == 0
-        if not keep.any():
-            return None, why
+    keep = np.cumsum(bad) == 0
+    if not keep.any():
+        return None, why
     six = lambda a: [float(f"{x:.6g}") for x in a]          # noqa: E731
     out = {"elapsed_froude": six(nodes[keep]), "heading_q90_deg": six(q[keep])}
     if qp is not None:

@@ -266,8 +266,8 @@ def _report_model_form(form: dict | None, why: str, L: float) -> list:
              f"Made from the {form['source']}.", "",
              "| elapsed [s] | elapsed [sqrt(L/g)] | heading error, 90 % [deg] | position error, 90 % [m] |",
              "|---|---|---|---|"]
-    pos = form.get("position_q90_L") or [float("nan")] * len(form["elapsed_froude"])
-    return lines + [f"| {t * unit:.4g} | {t:.4g} | {q:.3g} | {p * L:.3g} |"
+    pos = form.get("position_q90_L") or [None] * len(form["elapsed_froude"])
+    return lines + [f"| {t * unit:.4g} | {t:.4g} | {q:.3g} | {'-' if p is None else f'{p * L:.3g}'} |"
                     for t, q, p in zip(form["elapsed_froude"], form["heading_q90_deg"], pos)]
 
 
