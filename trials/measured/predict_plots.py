@@ -46,17 +46,10 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
     -------
     matplotlib.figure.Figure
     """
-    run, p, L, B = rep.run, rep.pred, rep.L, rep.B
-    m, t = run.meas, run.t
-    title = title or run.name
+    m, p, L = rep.run.meas, rep.pred, rep.L
+    title = title or rep.run.name
     t_div = rep.diverged_at
     div = "" if t_div is None else f"\nreplay diverged at t = {t_div:.1f} s"
-
-    def keep_measured_range(x):
-        lo, hi = float(np.nanmin(x)), float(np.nanmax(x))
-        pad = max(hi - lo, 1e-6 * max(abs(lo), abs(hi), 1.0))
-        return lo - pad, hi + pad
-
     shown = m if t_div is not None else np.vstack([m, p[np.all(np.isfinite(p[:, 3:5]), axis=1)]])
     view, wide, track_h = replay_layout(shown[:, 3] / L, shown[:, 4] / L)      # the track as drawn
     if wide:                     # a long track across the top, turned so its long side runs across
@@ -69,6 +62,22 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
         gs = fig.add_gridspec(5, 2, width_ratios=[1.0, 1.2])
         ax = fig.add_subplot(gs[:, 0])
         cell = lambda k: gs[k, 1]                                         # noqa: E731
+    _replay_track(ax, view, rep, bands, shown, wide, f"{title}: track (L = {L:g} m, wind {rep.run.wind}){div}")
+    _replay_histories(fig, cell, rep, bands, f"{title}: time histories{div}")
+    fig.set_layout_engine("constrained", h_pad=0.02, hspace=0.0)
+    return fig
+
+
+def _measured_range(x) -> tuple:
+    """The range of ``x`` with its span again on each side (a panel's limits where the replay diverged)."""
+    lo, hi = float(np.nanmin(x)), float(np.nanmax(x))
+    pad = max(hi - lo, 1e-6 * max(abs(lo), abs(hi), 1.0))
+    return lo - pad, hi + pad
+
+
+def _replay_track(ax, view, rep, bands, shown, wide: bool, title: str) -> None:
+    """:func:`replay_figure`'s track: measured and predicted, the start, outlines to scale, the bands."""
+    m, p, t, L, B = rep.run.meas, rep.pred, rep.run.t, rep.L, rep.B
     ax.plot(*view.hv(m[:, 3] / L, m[:, 4] / L), "k-", lw=1.2, label="measured")
     ax.plot(*view.hv(p[:, 3] / L, p[:, 4] / L), "r--", lw=1.2, label="predicted")
     ax.plot(*view.hv(m[:1, 3] / L, m[:1, 4] / L), "o", color="g", ms=6, zorder=3, label="start")
@@ -84,15 +93,21 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
         first = False
     if bands is not None:
         _track_bands(ax, view, bands, L, t, every, shown[:, 3:5])
-    if t_div is not None:
-        hlim, vlim = view.hv(keep_measured_range(m[:, 3] / L), keep_measured_range(m[:, 4] / L))
+    if rep.diverged_at is not None:
+        hlim, vlim = view.hv(_measured_range(m[:, 3] / L), _measured_range(m[:, 4] / L))
         ax.set_xlim(*hlim)
         ax.set_ylim(*vlim)
     view.finish(ax)
-    ax.set_title(f"{title}: track (L = {L:g} m, wind {run.wind}){div}")
+    ax.set_title(title)
     # the legend below the track, 4.5 font sizes under it: clear of the ticks and the axis label
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.5, ncol=3 if wide else 2, fontsize=8,
               frameon=False)
+
+
+def _replay_histories(fig, cell, rep, bands, title: str) -> None:
+    """:func:`replay_figure`'s time histories in the cells ``cell(0..4)``: heading (with the band), yaw rate,
+    speed, sway, and the inputs."""
+    m, p, t, t_div = rep.run.meas, rep.pred, rep.run.t, rep.diverged_at
     rows = [("heading (deg)", np.degrees(m[:, 5]), np.degrees(p[:, 5])) if bands is None else
             ("heading (deg)\nunwrapped", bands.heading_deg, bands.nominal_deg),
             ("yaw rate (deg/s)", np.degrees(m[:, 2]), np.degrees(p[:, 2])),
@@ -107,7 +122,7 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
         a_.plot(t, b, "r--", lw=1, label="predicted" if bands is None else "predicted, nominal ship and start")
         if t_div is not None:
             a_.axvline(t_div, color="r", ls=":", lw=1.2, label=f"replay diverged (t = {t_div:.1f} s)")
-            a_.set_ylim(*keep_measured_range(a))
+            a_.set_ylim(*_measured_range(a))
         a_.set_ylabel(lab)
         a_.grid(True, alpha=0.3)
         axs.append(a_)
@@ -117,18 +132,16 @@ def replay_figure(rep, title: str | None = None, pyplot: bool = True, bands=None
         axs[0].legend(loc="upper left", fontsize=7, ncol=2)
     else:
         axs[0].legend(loc="best", fontsize=8)
-    axs[0].set_title(f"{title}: time histories{div}")
+    axs[0].set_title(title)
     a_ = fig.add_subplot(cell(4), sharex=axs[0])
-    a_.plot(t, np.degrees(run.inputs.delta), "b-", lw=1, label="rudder (deg)")
-    a_.plot(t, run.inputs.n, "g-", lw=1, label="revolutions (rps)")
+    a_.plot(t, np.degrees(rep.run.inputs.delta), "b-", lw=1, label="rudder (deg)")
+    a_.plot(t, rep.run.inputs.n, "g-", lw=1, label="revolutions (rps)")
     a_.set_ylabel("inputs")
     a_.set_xlabel("t (s)")
     a_.grid(True, alpha=0.3)
     a_.legend(loc="best", fontsize=8)
     for a in axs:
         a.tick_params(labelbottom=False)
-    fig.set_layout_engine("constrained", h_pad=0.02, hspace=0.0)
-    return fig
 
 
 def _track_bands(ax, view, bands, L: float, t, every: float, shown) -> None:
