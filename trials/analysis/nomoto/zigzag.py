@@ -277,6 +277,37 @@ def _zero_crossings(s, psi, s_os) -> tuple:
     return tuple(s_z)
 
 
+def _zigzag_input(record: TrialRecord, L: float) -> tuple:
+    """(the record's name for messages, its times) after the checks :func:`zigzag_data` needs: a positive
+    length, heading and rudder channels, finite values, at least 10 strictly increasing times."""
+    src = record.source or record.name or "record"
+    if not (np.isfinite(L) and L > 0):
+        raise InputError("--length", "", f"ship length must be positive, got {L}")
+    for c in ("psi", "delta"):
+        if getattr(record, c) is None:
+            from trials.files.logio import missing_channel
+
+            raise missing_channel(record, c, "a zigzag analysis needs heading and rudder")
+    _check_finite(record, ("t", "psi", "delta", "r"))
+    t = np.asarray(record.t, float)
+    if len(t) < 10 or np.any(np.diff(t) <= 0):
+        raise InputError(src, "t", "need at least 10 samples with strictly increasing time")
+    return src, t
+
+
+def _zigzag_speed(record: TrialRecord, t_e: float, U: Optional[float], src: str) -> float:
+    """The speed for s' [m/s]: ``U`` where given, else the approach speed at the execute ``t_e``; positive."""
+    given = U is not None
+    if not given:
+        try:
+            U = approach_speed(record, t_e)
+        except ValueError:
+            raise InputError(src, "U", "no speed channel; give --speed") from None
+    if not (np.isfinite(U) and U > 0):
+        raise InputError("--speed" if given else src, "U", f"speed must be positive, got {U}")
+    return U
+
+
 def zigzag_data(record: TrialRecord, L: float, U: Optional[float] = None, per_knot: Optional[int] = None) -> ZigzagData:
     """Find the zigzag in a record and convert it to dimensionless variables.
 
@@ -314,18 +345,7 @@ def zigzag_data(record: TrialRecord, L: float, U: Optional[float] = None, per_kn
     InputError
         Missing channels, NaN, no zigzag (no counter-rudder), bad L or U.
     """
-    src = record.source or record.name or "record"
-    if not (np.isfinite(L) and L > 0):
-        raise InputError("--length", "", f"ship length must be positive, got {L}")
-    for c in ("psi", "delta"):
-        if getattr(record, c) is None:
-            from trials.files.logio import missing_channel
-
-            raise missing_channel(record, c, "a zigzag analysis needs heading and rudder")
-    _check_finite(record, ("t", "psi", "delta", "r"))
-    t = np.asarray(record.t, float)
-    if len(t) < 10 or np.any(np.diff(t) <= 0):
-        raise InputError(src, "t", "need at least 10 samples with strictly increasing time")
+    src, t = _zigzag_input(record, L)
     delta_raw = np.asarray(record.delta, float)
     plats, d0 = _plateaus(delta_raw)
     if len(plats) < 2:
@@ -338,13 +358,7 @@ def zigzag_data(record: TrialRecord, L: float, U: Optional[float] = None, per_kn
     while ie > 0 and delta[ie] - delta[ie - 1] > 1e-4 * d0:
         ie -= 1
     t_e = t[ie]
-    if U is None:
-        try:
-            U = approach_speed(record, t_e)
-        except ValueError:
-            raise InputError(src, "U", "no speed channel; give --speed") from None
-    if not (np.isfinite(U) and U > 0):
-        raise InputError(src if U is None else "--speed", "U", f"speed must be positive, got {U}")
+    U = _zigzag_speed(record, t_e, U, src)
     end = plats[-1][1]
     sl = slice(ie, end + 1)
     s = (t[sl] - t_e) * U / L
