@@ -48,50 +48,28 @@ R90 = float(np.sqrt(-2.0 * np.log(1.0 - QUANTILE)))
 standard deviation 1 per axis (2.146; the Rayleigh distribution's)."""
 
 
+def _elapsed_curves(replays, error) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per replay, (elapsed time from its first sample [s], ``error(replay)``)."""
+    return [(np.asarray(rep.run.t, float) - float(rep.run.t[0]), error(rep)) for rep in replays]
+
+
 def heading_error_curves(replays) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Per replay, (elapsed time from its first sample [s], predicted minus logged heading [deg]); both
-    headings unwrapped, NaN where the replay diverged.
-
-    Parameters
-    ----------
-    replays : iterable of Replayed
-        :class:`trials.measured.predict.Replayed` (``run.t``, ``run.meas``, ``pred``).
-
-    Returns
-    -------
-    list of (ndarray, ndarray)
-    """
-    out = []
-    for rep in replays:
-        t = np.asarray(rep.run.t, float)
+    """Per replay (:class:`trials.measured.predict.Replayed`: ``run.t``, ``run.meas``, ``pred``), (elapsed
+    time from its first sample [s], predicted minus logged heading [deg]); both headings unwrapped, put on
+    the same turn at the start, NaN where the replay diverged."""
+    def error(rep):
         with np.errstate(invalid="ignore"):
             e = np.degrees(np.unwrap(rep.pred[:, 5]) - np.unwrap(rep.run.meas[:, 5]))
-        e = e - 360.0 * np.round((e[0] if np.isfinite(e[0]) else 0.0) / 360.0)     # the same turn at the start
-        out.append((t - t[0], e))
-    return out
+        return e - 360.0 * np.round((e[0] if np.isfinite(e[0]) else 0.0) / 360.0)
+
+    return _elapsed_curves(replays, error)
 
 
 def position_error_curves(replays, L: float) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Per replay, (elapsed time from its first sample [s], distance between the predicted and the logged
-    position in ship lengths ``L`` [m]); NaN where the replay diverged.
-
-    Parameters
-    ----------
-    replays : iterable of Replayed
-        :class:`trials.measured.predict.Replayed` (``run.t``, ``run.meas``, ``pred``; x, y in columns 3, 4).
-    L : float
-        Ship length [m].
-
-    Returns
-    -------
-    list of (ndarray, ndarray)
-    """
-    out = []
-    for rep in replays:
-        t = np.asarray(rep.run.t, float)
-        d = np.hypot(rep.pred[:, 3] - rep.run.meas[:, 3], rep.pred[:, 4] - rep.run.meas[:, 4]) / L
-        out.append((t - t[0], d))
-    return out
+    """Per replay (as :func:`heading_error_curves`), (elapsed time from its first sample [s], distance
+    between the predicted and the logged position [ship lengths ``L`` in m]); NaN where it diverged."""
+    return _elapsed_curves(replays, lambda rep: np.hypot(rep.pred[:, 3] - rep.run.meas[:, 3],
+                                                         rep.pred[:, 4] - rep.run.meas[:, 4]) / L)
 
 
 def heading_error_growth(curves, L: float, g: float = G) -> tuple[np.ndarray, np.ndarray, int]:
