@@ -58,6 +58,8 @@ def test_growth_never_falls_and_a_diverged_sample_counts_as_infinite():
     assert np.isinf(q[-1])
     sec, why = model_form_section(bad, L, "test")
     assert sec["elapsed_froude"] == [10.0] and sec["heading_q90_deg"] == [1.0]      # the finite part kept
+    assert sec["unbounded_from_froude"] == 10.0 and "unbounded" in why               # and unbounded beyond it
+    assert "unbounded_from_froude" not in model_form_section(shrink, L, "test")[0]
     assert "diverged" in why and "diverged" in sec["source"]
     assert model_form_section([_curve(t, np.full(len(t), np.nan)) for _ in range(3)], L, "x")[0] is None
 
@@ -178,6 +180,37 @@ def test_position_growth_and_a_position_divergence_end_the_section():
     assert model_form_of({k: v for k, v in sec.items() if k != "position_q90_L"}).position_q90_L is None
     with pytest.raises(ValueError):          # position curves of other replays: nodes that do not line up
         model_form_section(head, L, "x", [_curve(t[:20], 0.01 * t[:20]) for _ in range(3)])
+
+
+def test_a_term_whose_replays_diverged_makes_the_bands_unbounded_beyond():
+    """A section unbounded from 20 sqrt(L/g) (11 s of a 3 m model) on a 30 s record: the heading band and the
+    position radius are finite up to 11 s and unbounded after (counted inside, as a diverged draw's), and the
+    notes say why; the same section without it is held at its last value and bounded throughout."""
+    ship = replace(mmg.load_ship(SHIP), covariance=None, run_spread=None)
+    run = _run(ship, duration=30.0)
+    mf = ModelForm((10.0, 20.0), (2.0, 5.0), position_q90_L=(0.1, 0.3), unbounded_from_froude=20.0)
+    b = prediction_bands(replace(ship, model_form=mf), run, 50, seed=3, jobs=2)
+    out = (run.t - run.t[0]) / UNIT > 20.0
+    assert out.any() and (~out).any()
+    assert np.all(np.isinf(b.lo[out])) and np.all(np.isinf(b.hi[out])) and np.all(np.isinf(b.radius[out]))
+    assert np.all(np.isfinite(b.lo[~out])) and np.all(np.isfinite(b.radius[~out]))
+    assert b.unbounded_share == pytest.approx(out.mean()) and any("unbounded from" in n for n in b.notes)
+    held = prediction_bands(replace(ship, model_form=replace(mf, unbounded_from_froude=None)), run, 50, seed=3, jobs=2)
+    assert np.all(np.isfinite(held.hi)) and any("held at its last value" in n for n in held.notes)
+
+
+def test_unbounded_from_round_trips_and_a_bad_one_is_refused(tmp_path):
+    data = yaml.safe_load(_ship_file().read_text())
+    data["model_form"] = {"elapsed_froude": [10.0, 20.0], "heading_q90_deg": [1.0, 2.0], "unbounded_from_froude": 20.0}
+    p = tmp_path / "ship.yaml"
+    p.write_text(yaml.safe_dump(data))
+    assert mmg.load_ship(str(p)).model_form.unbounded_from_froude == 20.0
+    for bad in (10.0, float("nan")):                 # before the last node; not a number
+        data["model_form"]["unbounded_from_froude"] = bad
+        p.write_text(yaml.safe_dump(data))
+        with pytest.raises(InputError) as e:
+            mmg.load_ship(str(p))
+        assert "model_form.unbounded_from_froude" in str(e.value) and str(p) in str(e.value)
 
 
 @pytest.mark.parametrize("section, field", [

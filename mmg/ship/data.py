@@ -323,6 +323,9 @@ class ModelForm:
     position_q90_L : tuple of float or None
         At each elapsed time, the 90 % quantile of the distance between the replayed and the logged
         position, in ship lengths L, non-decreasing; None where the section gives no position term.
+    unbounded_from_froude : float or None
+        Elapsed time [sqrt(L/g)] from which the error is unbounded (replays that made the section diverged
+        there: a band drawn with the term is unbounded beyond it); None: bounded, held beyond the last node.
     """
 
     elapsed_froude: tuple
@@ -330,6 +333,7 @@ class ModelForm:
     records: int = 0
     source: str = ""
     position_q90_L: tuple | None = None
+    unbounded_from_froude: float | None = None
 
 
 @dataclass(frozen=True)

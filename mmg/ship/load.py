@@ -219,6 +219,7 @@ class _ModelForm(_Strict):
     elapsed_froude: list[float]
     heading_q90_deg: list[float]
     position_q90_L: Optional[list[float]] = None
+    unbounded_from_froude: Optional[float] = None
     records: int = 0
     source: str = ""
 
@@ -544,9 +545,13 @@ def _model_form(f: _ShipFile, src: str) -> ModelForm | None:
     for key, x in errors.items():
         if x[0] < 0 or np.any(np.diff(x) < 0):
             raise InputError(src, f"model_form.{key}", "must be non-negative and non-decreasing with elapsed time")
+    u = c.unbounded_from_froude
+    if u is not None and not (np.isfinite(u) and u >= t[-1]):
+        raise InputError(src, "model_form.unbounded_from_froude",
+                         f"{u} must be a finite elapsed time (in sqrt(L/g)) at or after the last of elapsed_froude")
     pos = errors.get("position_q90_L")
     return ModelForm(tuple(float(x) for x in t), tuple(float(x) for x in errors["heading_q90_deg"]), int(c.records),
-                     c.source, None if pos is None else tuple(float(x) for x in pos))
+                     c.source, None if pos is None else tuple(float(x) for x in pos), None if u is None else float(u))
 
 
 def _covariance(f: _ShipFile, src: str) -> ParameterCovariance | None:

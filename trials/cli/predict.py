@@ -105,7 +105,8 @@ def _print_bands(bands) -> None:
     """One console line per run's bands, then what was not drawn."""
     import numpy as np
 
-    num = lambda x, unit: f"{x:.3g} {unit}" if np.isfinite(x) else "unbounded (diverged draws)"   # noqa: E731
+    num = lambda x, unit: (f"{x:.3g} {unit}" if np.isfinite(x)                                     # noqa: E731
+                           else "unbounded (diverged draws, or the model-form term unbounded)")
     for b in bands or ():
         if b.empty:
             print(f"{b.nominal.run.name}: no band: the {b.draws} draws all replay the nominal ship and start "

@@ -355,7 +355,11 @@ def _model_form_errors(ship: Ship, run: MeasuredRun, samples: int, seed: int, no
     z = np.random.default_rng([int(seed), 2]).standard_normal(samples)
     notes.append(f"model-form heading error added to each draw ({mf.source or 'model_form: section'}; "
                  f"{hw[-1]:.1f} deg 90 % half-width at the record's end)")
-    if run.t[-1] - run.t[0] > measured_until(mf, L):
+    if mf.unbounded_from_froude is not None:
+        if run.t[-1] - run.t[0] > measured_until(mf, L):
+            notes.append(f"the model-form term is unbounded from {measured_until(mf, L):.4g} s of elapsed time (replays "
+                         "that made it diverged there): the bands are unbounded beyond")
+    elif run.t[-1] - run.t[0] > measured_until(mf, L):
         notes.append(f"the model-form term was measured up to {measured_until(mf, L):.4g} s of elapsed time and is "
                      "held at its last value beyond (a longer record's error may grow further)")
     return z[:, None] * (hw / Z90)[None, :]
@@ -465,6 +469,11 @@ def prediction_bands(ship: Ship, run, samples: int, seed: int = 0, covariance=No
     first = float(np.unwrap(run.meas[:, 5])[0])
     lo, hi = _quantile_bounds(_unwrapped_deg(P[:, :, 2], first) + _model_form_errors(ship, run, samples, seed, notes))
     xm, ym, radius = _position_band(P[:, :, :2] + _model_form_offsets(ship, run, samples, seed, notes))
+    if ship.model_form is not None:                   # beyond where the term's own replays diverged
+        from .modelform import unbounded_after
+
+        out = unbounded_after(ship.model_form, run.t - run.t[0], ship.particulars.L)
+        lo, hi, radius = np.where(out, -np.inf, lo), np.where(out, np.inf, hi), np.where(out, np.inf, radius)
     return Bands(nominal=nominal, t=np.asarray(run.t, float), heading_deg=np.degrees(np.unwrap(run.meas[:, 5])),
                  lo=lo, hi=hi, nominal_deg=_unwrapped_deg(nominal.pred[:, 5], first), x_median=xm, y_median=ym,
                  radius=radius, tracks=P[:SAMPLE_TRACKS, :, :2].copy(), draws=samples,

@@ -14,7 +14,8 @@ function of the time elapsed since the replay's start:
 * :func:`position_error_curves` and the same binning give the distance between the predicted and the
   logged position, in ship lengths (``position_q90_L``);
 * :func:`heading_half_width` and :func:`position_half_width` evaluate them at the elapsed times of another
-  record (linear between the nodes, from zero at the start, held beyond the last node).
+  record (linear between the nodes, from zero at the start, held beyond the last node, or unbounded beyond
+  it where the replays that made it diverged: :func:`unbounded_after`).
 
 Which replays are measured sets what the term means.  The kept-out replays of a cross-validation
 (``mmg identify --cv K``) are errors on records the fit did not see: what a new record will meet.  The
@@ -32,7 +33,7 @@ from mmg.ship import ModelForm
 
 __all__ = ["ELAPSED_EDGES", "MIN_RECORDS", "QUANTILE", "Z90", "R90", "heading_error_curves", "heading_error_growth",
            "position_error_curves", "heading_half_width", "position_half_width", "model_form_section",
-           "model_form_of", "measured_until"]
+           "model_form_of", "measured_until", "unbounded_after"]
 
 ELAPSED_EDGES = (0.0, 10.0, 20.0, 40.0, 80.0, 160.0, 320.0, 640.0, 1280.0, 2560.0, 5120.0)
 """Bin edges of elapsed time in sqrt(L/g) (a 3 m model: 0.55 s; a 320 m ship: 5.7 s)."""
@@ -122,8 +123,9 @@ def model_form_section(curves, L: float, source: str, position_curves=None) -> t
     from the heading error ``curves`` and, where given, the ``position_curves`` of the same replays
     (:func:`heading_error_growth`), with ``source`` saying which replays they are.
 
-    Where replays diverged, the section ends before the first bin whose quantile they make infinite (and
-    says so in its ``source``); None where no bin is left, the second item saying why."""
+    Where replays diverged, the section ends before the first bin whose quantile they make infinite, and is
+    unbounded from its last node on (``unbounded_from_froude``; its ``source`` says why); None where no bin
+    is left, the second item saying why."""
     nodes, q, n = heading_error_growth(curves, L)
     if not len(nodes):
         return None, f"fewer than {MIN_RECORDS} records reach any elapsed time"
@@ -137,8 +139,8 @@ def model_form_section(curves, L: float, source: str, position_curves=None) -> t
     why = ""
     if bad.any():
         which = " and ".join(n for n, x in (("heading", q), ("position", qp)) if x is not None and not np.isfinite(x).all())
-        why = (f"replays diverged: the {which} error is unbounded from {nodes[bad][0]:.6g} sqrt(L/g) on "
-               "(held at the last finite value there)")
+        why = (f"replays diverged: the {which} error is unbounded in the bin ending at {nodes[bad][0]:.6g} "
+               "sqrt(L/g), so the term is unbounded from the last finite node on (unbounded_from_froude)")
     keep = np.cumsum(bad) == 0
     if not keep.any():
         return None, why
@@ -146,6 +148,8 @@ def model_form_section(curves, L: float, source: str, position_curves=None) -> t
     out = {"elapsed_froude": six(nodes[keep]), "heading_q90_deg": six(q[keep])}
     if qp is not None:
         out["position_q90_L"] = six(qp[keep])
+    if bad.any():
+        out["unbounded_from_froude"] = out["elapsed_froude"][-1]
     return out | {"records": int(n), "source": source + (f"; {why}" if why else "")}, why
 
 
@@ -155,7 +159,7 @@ def model_form_of(section: dict | None) -> ModelForm | None:
         return None
     pos = section.get("position_q90_L")
     return ModelForm(tuple(section["elapsed_froude"]), tuple(section["heading_q90_deg"]), int(section["records"]),
-                     section["source"], None if pos is None else tuple(pos))
+                     section["source"], None if pos is None else tuple(pos), section.get("unbounded_from_froude"))
 
 
 def heading_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G) -> np.ndarray:
@@ -172,6 +176,15 @@ def position_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G
         return None
     t = np.asarray(elapsed_s, float) / np.sqrt(L / g)
     return L * np.interp(t, np.r_[0.0, model_form.elapsed_froude], np.r_[0.0, model_form.position_q90_L])
+
+
+def unbounded_after(model_form: ModelForm, elapsed_s, L: float, g: float = G) -> np.ndarray:
+    """Where (bool per elapsed time [s] of a ship of length ``L`` [m]) the term is unbounded: beyond its
+    ``unbounded_from_froude``; nowhere where it has none."""
+    t = np.asarray(elapsed_s, float)
+    if model_form.unbounded_from_froude is None:
+        return np.zeros(t.shape, bool)
+    return t / np.sqrt(L / g) > model_form.unbounded_from_froude
 
 
 def measured_until(model_form: ModelForm, L: float, g: float = G) -> float:

@@ -267,8 +267,13 @@ def _report_model_form(form: dict | None, why: str, L: float) -> list:
              "| elapsed [s] | elapsed [sqrt(L/g)] | heading error, 90 % [deg] | position error, 90 % [m] |",
              "|---|---|---|---|"]
     pos = form.get("position_q90_L") or [None] * len(form["elapsed_froude"])
-    return lines + [f"| {t * unit:.4g} | {t:.4g} | {q:.3g} | {'-' if p is None else f'{p * L:.3g}'} |"
-                    for t, q, p in zip(form["elapsed_froude"], form["heading_q90_deg"], pos)]
+    lines += [f"| {t * unit:.4g} | {t:.4g} | {q:.3g} | {'-' if p is None else f'{p * L:.3g}'} |"
+              for t, q, p in zip(form["elapsed_froude"], form["heading_q90_deg"], pos)]
+    u = form.get("unbounded_from_froude")
+    if u is not None:
+        lines += ["", f"Unbounded from {u * unit:.4g} s ({u:.4g} sqrt(L/g)) of elapsed time on: replays diverged "
+                      "there, and `mmg predict --samples` draws unbounded bands beyond."]
+    return lines
 
 
 def _report_training(ident: Identification) -> list:
