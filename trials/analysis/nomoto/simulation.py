@@ -245,61 +245,86 @@ def simulate_zigzag(model: NomotoModel, delta0_deg: float = 10.0, psi0_deg: Opti
     d0, p0 = np.radians(delta0_deg), np.radians(psi0_deg)
     s_R = delta0_deg / rudder_rate_deg_per_L
     rate = d0 / s_R
-    f = _rhs(model)
+    run = _Pieces(_rhs(model), s_max, {"rtol": rtol, "atol": atol})
     y = np.zeros(2 if model.order == 1 else 3)
     s0, dstart, side = 0.0, 0.0, 1.0
-    pieces, s_cr, s_os = [], [], []
-    # ramp 0 -> +delta0 then hold; the loop alternates (ramp, hold)
-    ramp_to = d0
+    s_cr, s_os = [], []
+    ramp_to = d0                 # ramp 0 -> +delta0 then hold; the loop alternates (ramp, hold)
     while s0 < s_max:
-        # ramp from dstart to ramp_to
-        L_ramp = abs(ramp_to - dstart) / rate
-        dd = np.sign(ramp_to - dstart) * rate
-        fun = (lambda dst, ddd, st: (lambda s, yy: f(s, yy, dst + ddd * (s - st), ddd)))(dstart, dd, s0)
-        s1 = min(s0 + L_ramp, s_max)
-        ev_os = lambda s, yy: yy[1]  # overshoot: omega' changes sign towards the new side
-        ev_os.terminal, ev_os.direction = False, side
-        sol = solve_ivp(fun, (s0, s1), y, method="DOP853", rtol=rtol, atol=atol, dense_output=True,
-                        events=ev_os)
-        if s_cr and len(s_os) < len(s_cr) and len(sol.t_events[0]):
-            s_os.append(float(sol.t_events[0][0]))
-        pieces.append((s0, s1, sol.sol, dstart, dd))
-        y, s0 = sol.y[:, -1], s1
+        y, s0, os_at = run.ramp(y, s0, dstart, ramp_to, rate, side)
+        if s_cr and len(s_os) < len(s_cr) and os_at is not None:
+            s_os.append(os_at)
         if s0 >= s_max:
             break
-        # hold at ramp_to until the heading reaches side*psi0 (the overshoot is omega'=0 on the way)
-        hold = ramp_to
-        target = side * p0
-        ev_cr = (lambda tg: (lambda s, yy: yy[0] - tg))(target)
-        ev_cr.terminal, ev_cr.direction = True, side
-        ev_os = lambda s, yy: yy[1]
-        ev_os.terminal, ev_os.direction = False, side
-        fun = (lambda dh: (lambda s, yy: f(s, yy, dh, 0.0)))(hold)
-        sol = solve_ivp(fun, (s0, s_max), y, method="DOP853", rtol=rtol, atol=atol,
-                        dense_output=True, events=(ev_cr, ev_os))
-        pieces.append((s0, sol.t[-1], sol.sol, hold, 0.0))
-        if s_cr and len(s_os) < len(s_cr) and len(sol.t_events[1]):
-            s_os.append(float(sol.t_events[1][0]))
-        y, s0 = sol.y[:, -1], sol.t[-1]
-        if len(sol.t_events[0]) == 0 or len(s_cr) >= n_cr:
+        y, s0, cr_at, os_at = run.hold(y, s0, ramp_to, side * p0, side)
+        if s_cr and len(s_os) < len(s_cr) and os_at is not None:
+            s_os.append(os_at)
+        if cr_at is None or len(s_cr) >= n_cr:
             break
-        s_cr.append(float(sol.t_events[0][0]))
-        dstart, ramp_to, side = hold, -hold, -side
-    s = np.arange(0.0, s0 + 0.5 * ds, ds)
-    s = s[s <= s0 + 1e-12]
-    out = np.zeros((len(y), len(s)))
-    dl = np.zeros(len(s))
-    for (a, b, sol, dst, ddd) in pieces:
-        m = (s >= a) & (s <= b)
-        if m.any():
-            out[:, m] = sol(s[m])
-            dl[m] = dst + ddd * (s[m] - a)
+        s_cr.append(cr_at)
+        dstart, ramp_to, side = ramp_to, -ramp_to, -side
+    pieces = run.pieces
+    s, out, dl = _sampled(pieces, s0, ds, len(y))
     eps = _eps_of(model, out, dl)
     delta, Delta = trapezoid_rudder(s, d0, s_R, s_cr)
     sim = ZigzagSimulation(model=model, s=s, psi=out[0], omega=out[1], eps=eps, delta=delta, Delta=Delta,
                            s_cr=tuple(s_cr), s_os=tuple(s_os), delta0=d0, psi0=p0, s_R=s_R)
     object.__setattr__(sim, "_pieces", pieces)
     return sim
+
+
+def _overshoot_event(side: float):
+    """The overshoot event of a zigzag piece: omega' changes sign towards the new ``side``."""
+    ev = lambda s, yy: yy[1]                                              # noqa: E731
+    ev.terminal, ev.direction = False, side
+    return ev
+
+
+class _Pieces:
+    """The pieces of a zigzag integrated so far (``pieces``: (start, end, dense output, rudder at the start,
+    rudder rate)), each by ``solve_ivp`` (DOP853, tolerances ``tol``) of the right-hand side ``f`` up to ``s_max``."""
+
+    def __init__(self, f, s_max: float, tol: dict):
+        self.f, self.s_max, self.tol, self.pieces = f, s_max, tol, []
+
+    def ramp(self, y, s0: float, dstart: float, ramp_to: float, rate: float, side: float):
+        """The rudder's ramp from ``dstart`` to ``ramp_to`` at ``rate``: (state, end abscissa, the overshoot's
+        abscissa in it or None)."""
+        f, dd = self.f, np.sign(ramp_to - dstart) * rate
+        fun = (lambda dst, ddd, st: (lambda s, yy: f(s, yy, dst + ddd * (s - st), ddd)))(dstart, dd, s0)
+        s1 = min(s0 + abs(ramp_to - dstart) / rate, self.s_max)
+        sol = solve_ivp(fun, (s0, s1), y, method="DOP853", dense_output=True, events=_overshoot_event(side),
+                        **self.tol)
+        self.pieces.append((s0, s1, sol.sol, dstart, dd))
+        return sol.y[:, -1], s1, float(sol.t_events[0][0]) if len(sol.t_events[0]) else None
+
+    def hold(self, y, s0: float, hold: float, target: float, side: float):
+        """The rudder held at ``hold`` until the heading reaches ``target`` (the counter-rudder; the overshoot
+        is omega' = 0 on the way): (state, end abscissa, the counter-rudder's abscissa or None, the
+        overshoot's or None)."""
+        f = self.f
+        ev_cr = (lambda tg: (lambda s, yy: yy[0] - tg))(target)
+        ev_cr.terminal, ev_cr.direction = True, side
+        fun = (lambda dh: (lambda s, yy: f(s, yy, dh, 0.0)))(hold)
+        sol = solve_ivp(fun, (s0, self.s_max), y, method="DOP853", dense_output=True,
+                        events=(ev_cr, _overshoot_event(side)), **self.tol)
+        self.pieces.append((s0, sol.t[-1], sol.sol, hold, 0.0))
+        first = lambda k: float(sol.t_events[k][0]) if len(sol.t_events[k]) else None     # noqa: E731
+        return sol.y[:, -1], sol.t[-1], first(0), first(1)
+
+
+def _sampled(pieces, s_end: float, ds: float, n_states: int):
+    """(s every ``ds`` up to ``s_end``, the states there from the pieces' dense output, the rudder there)."""
+    s = np.arange(0.0, s_end + 0.5 * ds, ds)
+    s = s[s <= s_end + 1e-12]
+    out = np.zeros((n_states, len(s)))
+    dl = np.zeros(len(s))
+    for (a, b, sol, dst, ddd) in pieces:
+        m = (s >= a) & (s <= b)
+        if m.any():
+            out[:, m] = sol(s[m])
+            dl[m] = dst + ddd * (s[m] - a)
+    return s, out, dl
 
 
 def _exact_states(sim: ZigzagSimulation, ss) -> list:
