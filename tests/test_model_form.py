@@ -197,6 +197,12 @@ def test_a_term_whose_replays_diverged_makes_the_bands_unbounded_beyond():
     assert b.unbounded_share == pytest.approx(out.mean()) and any("unbounded from" in n for n in b.notes)
     held = prediction_bands(replace(ship, model_form=replace(mf, unbounded_from_froude=None)), run, 50, seed=3, jobs=2)
     assert np.all(np.isfinite(held.hi)) and any("held at its last value" in n for n in held.notes)
+    # unbounded from 40 sqrt(L/g) (22 s) with the last node at 20 (11 s): held between, unbounded after, said so
+    later = prediction_bands(replace(ship, model_form=replace(mf, unbounded_from_froude=40.0)), run, 50, seed=3, jobs=2)
+    out = (run.t - run.t[0]) / UNIT > 40.0
+    assert np.all(np.isinf(later.hi[out])) and np.all(np.isfinite(later.hi[~out]))
+    assert any(f"unbounded from {40 * UNIT:.4g} s" in n for n in later.notes)
+    assert any(f"held at its last value beyond up to {40 * UNIT:.4g} s" in n for n in later.notes)
 
 
 def test_unbounded_from_round_trips_and_a_bad_one_is_refused(tmp_path):

@@ -24,7 +24,7 @@ def test_head_wind_shape_takes_up_nothing(alias):
     assert abs(r["taken_up"]) < 0.05
 
 
-def test_beam_wind_shape_within_the_prior_takes_up_most_of_it(alias):
+def test_beam_wind_shape_about_two_prior_sd_off_takes_up_most_of_it(alias):
     r = alias.alias_case("esso_osaka", 10.0, 10.0, 20.0, 90.0, 1.0, "rudder_offset")
     assert r["taken_up"] > 0.5 and r["left_heading_rms_deg"] < 0.5 * r["signature_heading_rms_deg"]
     assert np.all(np.abs(list(r["shape_prior_sd"].values())) < 2.5)      # the starts' grid reaches 2 sd
@@ -36,6 +36,22 @@ def test_a_heading_bias_is_a_measurement_no_wind_curve_takes_up(alias):
     r = alias.alias_case("esso_osaka", 10.0, 10.0, 20.0, 90.0, 1.0, "heading_bias")
     assert r["signature_heading_rms_deg"] == pytest.approx(1.0, abs=1e-6) and r["signature_position_rms_m"] < 1e-6
     assert r["taken_up"] < 0.2
+
+
+def test_the_fit_starts_from_a_grid_within_two_prior_sd_clipped_to_the_bounds():
+    """The residual of a zigzag jumps where a reversal moves, so a local fit stays at its start: the starts are
+    every combination of -2..2 prior sd per shape term (125), clipped to the terms' hard bounds."""
+    from mmg.effects import Wind
+
+    from .conftest import load_bench
+
+    alias = load_bench("wind_alias")
+    p = {q.name: q for q in Wind.fit_parameters()}
+    mu, sd = (np.array([getattr(p[n], k) for n in alias.SHAPES]) for k in ("default", "sigma"))
+    lo, hi = (np.array([getattr(p[n], k) for n in alias.SHAPES]) for k in ("lower", "upper"))
+    g = np.array(alias._grid(mu, sd, lo, hi))
+    assert g.shape == (125, 3) and np.all(g >= lo) and np.all(g <= hi)
+    assert np.allclose(sorted(set(np.round(g[:, 2], 12))), mu[2] + sd[2] * np.array([-2, -1, 0, 1, 2]))
 
 
 def test_the_current_sets_downwind():

@@ -324,8 +324,9 @@ class ModelForm:
         At each elapsed time, the 90 % quantile of the distance between the replayed and the logged
         position, in ship lengths L, non-decreasing; None where the section gives no position term.
     unbounded_from_froude : float or None
-        Elapsed time [sqrt(L/g)] from which the error is unbounded (replays that made the section diverged
-        there: a band drawn with the term is unbounded beyond it); None: bounded, held beyond the last node.
+        Elapsed time [sqrt(L/g)] from which the error is unbounded (replays that made the section diverged in
+        the bin after its last node: a band drawn with the term is unbounded beyond it); None: bounded, held
+        beyond the last node.
     """
 
     elapsed_froude: tuple

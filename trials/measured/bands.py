@@ -42,6 +42,7 @@ number of threads.
 """
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -50,6 +51,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mmg.errors import InputError
+from mmg.model import G
 from mmg.replay import STATE
 from mmg.ship import RunSpread, Ship
 
@@ -86,7 +88,7 @@ class Bands:
         The record's logged heading, unwrapped [deg].
     lo, hi : ndarray (N,)
         The band's 5 % and 95 % quantiles of the predicted heading [deg] (``-inf``/``inf`` where
-        diverged draws leave it unbounded), on the record's turn.
+        diverged draws leave it unbounded, or the model-form term is), on the record's turn.
     nominal_deg : ndarray (N,)
         The nominal replay's heading on the record's turn [deg].
     x_median, y_median : ndarray (N,)
@@ -136,8 +138,8 @@ class Bands:
 
     @property
     def unbounded_share(self) -> float:
-        """The share of the record's samples where diverged draws leave the heading band unbounded (inside
-        it, whatever the record does: read :attr:`coverage90` with this)."""
+        """The share of the record's samples where the heading band is unbounded (diverged draws, or the
+        model-form term unbounded there; inside it, whatever the record does: read :attr:`coverage90` with this)."""
         return float(np.mean(~(np.isfinite(self.lo) & np.isfinite(self.hi))))
 
     @property
@@ -353,15 +355,18 @@ def _model_form_errors(ship: Ship, run: MeasuredRun, samples: int, seed: int, no
     L = ship.particulars.L
     hw = heading_half_width(mf, run.t - run.t[0], L)
     z = np.random.default_rng([int(seed), 2]).standard_normal(samples)
+    span, last = run.t[-1] - run.t[0], measured_until(mf, L)
+    cut = math.inf if mf.unbounded_from_froude is None else mf.unbounded_from_froude * math.sqrt(L / G)
     notes.append(f"model-form heading error added to each draw ({mf.source or 'model_form: section'}; "
-                 f"{hw[-1]:.1f} deg 90 % half-width at the record's end)")
-    if mf.unbounded_from_froude is not None:
-        if run.t[-1] - run.t[0] > measured_until(mf, L):
-            notes.append(f"the model-form term is unbounded from {measured_until(mf, L):.4g} s of elapsed time (replays "
-                         "that made it diverged there): the bands are unbounded beyond")
-    elif run.t[-1] - run.t[0] > measured_until(mf, L):
-        notes.append(f"the model-form term was measured up to {measured_until(mf, L):.4g} s of elapsed time and is "
-                     "held at its last value beyond (a longer record's error may grow further)")
+                 f"{hw[-1]:.1f} deg 90 % half-width at the record's end" + (", where the term is unbounded)"
+                                                                        if span > cut else ")"))
+    if span > last and cut > last:
+        notes.append(f"the model-form term was measured up to {last:.4g} s of elapsed time and is held at its last "
+                     f"value beyond{'' if span <= cut else f' up to {cut:.4g} s'} (a longer record's error may grow "
+                     "further)")
+    if span > cut:
+        notes.append(f"the model-form term is unbounded from {cut:.4g} s of elapsed time (replays that made it "
+                     "diverged in the bin after its last node): the bands are unbounded beyond")
     return z[:, None] * (hw / Z90)[None, :]
 
 
