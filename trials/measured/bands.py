@@ -42,7 +42,6 @@ number of threads.
 """
 from __future__ import annotations
 
-import math
 import os
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -51,7 +50,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mmg.errors import InputError
-from mmg.model import G
 from mmg.replay import STATE
 from mmg.ship import RunSpread, Ship
 
@@ -350,13 +348,13 @@ def _model_form_errors(ship: Ship, run: MeasuredRun, samples: int, seed: int, no
         notes.append("no model-form term drawn (none in the ship config, or left out): the band is the "
                      "parameters' and the run's doubt alone, narrower than a new record's error")
         return 0.0
-    from .modelform import Z90, heading_half_width, measured_until
+    from .modelform import Z90, heading_half_width, measured_until, unbounded_from
 
     L = ship.particulars.L
     hw = heading_half_width(mf, run.t - run.t[0], L)
     z = np.random.default_rng([int(seed), 2]).standard_normal(samples)
     span, last = run.t[-1] - run.t[0], measured_until(mf, L)
-    cut = math.inf if mf.unbounded_from_froude is None else mf.unbounded_from_froude * math.sqrt(L / G)
+    cut = unbounded_from(mf, L)
     notes.append(f"model-form heading error added to each draw ({mf.source or 'model_form: section'}; "
                  f"{hw[-1]:.1f} deg 90 % half-width at the record's end" + (", where the term is unbounded)"
                                                                         if span > cut else ")"))

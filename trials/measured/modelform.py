@@ -33,7 +33,7 @@ from mmg.ship import ModelForm
 
 __all__ = ["ELAPSED_EDGES", "MIN_RECORDS", "QUANTILE", "Z90", "R90", "heading_error_curves", "heading_error_growth",
            "position_error_curves", "heading_half_width", "position_half_width", "model_form_section",
-           "model_form_of", "measured_until", "unbounded_after"]
+           "model_form_of", "measured_until", "unbounded_from", "unbounded_after"]
 
 ELAPSED_EDGES = (0.0, 10.0, 20.0, 40.0, 80.0, 160.0, 320.0, 640.0, 1280.0, 2560.0, 5120.0)
 """Bin edges of elapsed time in sqrt(L/g) (a 3 m model: 0.55 s; a 320 m ship: 5.7 s)."""
@@ -138,7 +138,8 @@ def model_form_section(curves, L: float, source: str, position_curves=None) -> t
     bad = ~np.isfinite(q) | (~np.isfinite(qp) if qp is not None else False)
     why = ""
     if bad.any():
-        which = " and ".join(n for n, x in (("heading", q), ("position", qp)) if x is not None and not np.isfinite(x).all())
+        which = " and ".join(name for name, x in (("heading", q), ("position", qp))
+                             if x is not None and not np.isfinite(x).all())
         why = (f"replays diverged: the {which} error is unbounded in the bin ending at {nodes[bad][0]:.6g} "
                "sqrt(L/g), so the term is unbounded from the last finite node on (unbounded_from_froude)")
     keep = np.cumsum(bad) == 0
@@ -162,11 +163,17 @@ def model_form_of(section: dict | None) -> ModelForm | None:
                      section["source"], None if pos is None else tuple(pos), section.get("unbounded_from_froude"))
 
 
+def _along(model_form: ModelForm, values, elapsed_s, L: float, g: float) -> np.ndarray:
+    """``values`` (one per node) at elapsed times ``elapsed_s`` [s] of a ship of length ``L`` [m]: linear in
+    elapsed Froude time between zero at the start and the nodes, held beyond the last."""
+    t = np.asarray(elapsed_s, float) / np.sqrt(L / g)
+    return np.interp(t, np.r_[0.0, model_form.elapsed_froude], np.r_[0.0, values])
+
+
 def heading_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G) -> np.ndarray:
     """The model-form term's 90 % half-width [deg] at elapsed times ``elapsed_s`` [s] of a ship of length
     ``L`` [m]: linear in elapsed Froude time between zero at the start and the nodes, held beyond the last."""
-    t = np.asarray(elapsed_s, float) / np.sqrt(L / g)
-    return np.interp(t, np.r_[0.0, model_form.elapsed_froude], np.r_[0.0, model_form.heading_q90_deg])
+    return _along(model_form, model_form.heading_q90_deg, elapsed_s, L, g)
 
 
 def position_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G) -> np.ndarray | None:
@@ -174,17 +181,20 @@ def position_half_width(model_form: ModelForm, elapsed_s, L: float, g: float = G
     ``L`` [m] (as :func:`heading_half_width`); None where the section has no ``position_q90_L``."""
     if model_form.position_q90_L is None:
         return None
-    t = np.asarray(elapsed_s, float) / np.sqrt(L / g)
-    return L * np.interp(t, np.r_[0.0, model_form.elapsed_froude], np.r_[0.0, model_form.position_q90_L])
+    return L * _along(model_form, model_form.position_q90_L, elapsed_s, L, g)
+
+
+def unbounded_from(model_form: ModelForm, L: float, g: float = G) -> float:
+    """The elapsed time [s] of a ship of length ``L`` [m] from which the term is unbounded
+    (``unbounded_from_froude``); infinite where it has none."""
+    u = model_form.unbounded_from_froude
+    return float("inf") if u is None else float(u * np.sqrt(L / g))
 
 
 def unbounded_after(model_form: ModelForm, elapsed_s, L: float, g: float = G) -> np.ndarray:
-    """Where (bool per elapsed time [s] of a ship of length ``L`` [m]) the term is unbounded: beyond its
-    ``unbounded_from_froude``; nowhere where it has none."""
-    t = np.asarray(elapsed_s, float)
-    if model_form.unbounded_from_froude is None:
-        return np.zeros(t.shape, bool)
-    return t / np.sqrt(L / g) > model_form.unbounded_from_froude
+    """Where (bool per elapsed time [s] of a ship of length ``L`` [m]) the term is unbounded: beyond
+    :func:`unbounded_from`."""
+    return np.asarray(elapsed_s, float) > unbounded_from(model_form, L, g)
 
 
 def measured_until(model_form: ModelForm, L: float, g: float = G) -> float:

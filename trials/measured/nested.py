@@ -304,17 +304,16 @@ def choose(rows: list[dict], names) -> tuple[str, dict]:
 
 
 def json_ready(v, drop=()):
-    """``v`` (dicts, lists, tuples, numbers) as JSON takes it: keys as text, a non-finite float as None, numpy
-    scalars as Python ones; a dict's keys in ``drop`` left out at every depth."""
+    """``v`` (dicts, lists, tuples, numbers) as JSON takes it: keys as text, a dict's keys in ``drop`` left
+    out at every depth, the values as :func:`trials.files.output.json_safe` makes them (a non-finite float as
+    None, numpy scalars and arrays as Python numbers and lists)."""
+    from ..files.output import json_safe
+
     if isinstance(v, dict):
         return {str(k): json_ready(x, drop) for k, x in v.items() if k not in drop}
     if isinstance(v, (list, tuple)):
         return [json_ready(x, drop) for x in v]
-    if isinstance(v, (float, np.floating)):
-        return float(v) if np.isfinite(v) else None
-    if isinstance(v, np.integer):
-        return int(v)
-    return v
+    return json_safe(v)
 
 
 def split_folds(runs, folds: int, folds_by: str) -> tuple[int, list]:
