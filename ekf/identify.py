@@ -597,6 +597,7 @@ class _SegmentFit:
         self.straight = [k for k, r in enumerate(records) if r.straight is not None]   # one row each, after the blocks
         self.longest_first = sorted(range(n), key=lambda k: -len(records[k].meas))   # the pool's order (see resid)
         self.count = 0
+        self._last = None                                     # (theta's bytes, its residuals): see resid
 
     def record_rows(self) -> list[np.ndarray]:
         """Each record's data rows in the residual vector: its block, then its straight-run row if any."""
@@ -617,7 +618,18 @@ class _SegmentFit:
         return o.straight_weight * self.wts[k] * straight_run_residual(self.records[k], o.effects, self.free, theta, k)
 
     def resid(self, theta, parallel=True):
-        """Every record's residuals, then their straight runs', then the prior's."""
+        """Every record's residuals, then their straight runs', then the prior's.  The last vector made on
+        the main thread (``parallel``) is kept: the Jacobian at a point the solver has just evaluated
+        starts from it instead of replaying the records again."""
+        key = np.asarray(theta, float).tobytes()
+        if parallel and self._last is not None and self._last[0] == key:
+            return self._last[1].copy()
+        r = self._resid(theta, parallel)
+        if parallel:
+            self._last = (key, r.copy())
+        return r
+
+    def _resid(self, theta, parallel):
         pk = apply_parameters(self.packed, self.free, theta)
         one = lambda k: self.block(theta, k, pk)  # noqa: E731
         if parallel:       # longest records first, so no long one is left to run alone at the end
