@@ -1,6 +1,8 @@
-"""`mmg diagnose` on the development set of an independent simulator.
+"""`mmg diagnose` on the development sets of an independent simulator.
 
-Diagnoses every log of ``../shared/data/diagnose-dev/`` alone, with the bundled full-scale ship
+Diagnoses every log of ``../shared/data/diagnose-dev/`` (or another set with the same layout, ``--set``:
+``diagnose-dev2``, port-first manoeuvres and strong winds beside other effects, of a third ship) alone, with
+the bundled full-scale ship
 (``esso_osaka``), as a user would (``mmg diagnose --ship esso_osaka LOG``), and scores the named
 effects against the set's ``manifest.json``:
 
@@ -15,7 +17,10 @@ Conventions: the manifest's current ``set_towards_deg`` is the direction it sets
 minus true, its ``rudder_offset.offset_deg`` actual minus logged (the set's README), as in
 :mod:`mmg.effects`.
 
-    python bench/diagnose_devset.py [--jobs 2] [--only dev_01 dev_07] [--json bench/out/diagnose_devset.json]
+    python bench/diagnose_devset.py [--set diagnose-dev2] [--jobs 2] [--only dev_01 dev_07] [--json J]
+
+Beside the totals it prints them per class: the hand of the first rudder (a trial name ending in ``p``:
+port first) and whether a wind blows beside another effect.
 
 The data are read from the shared folder and never copied; the script stops with a message where
 the folder is absent.
@@ -31,7 +36,7 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
-DEV = REPO.parent / "shared" / "data" / "diagnose-dev"
+DATA = REPO.parent / "shared" / "data"
 
 TOL = {("current", "speed_mps"): 0.05, ("current", "direction_deg"): 15.0,
        ("rudder_offset", "offset_deg"): 0.3, ("heading_bias", "bias_deg"): 0.3}
@@ -82,22 +87,46 @@ def score(entry: dict, res: dict) -> dict:
             "false_alarm": not true and bool(named), "values_ok": ok_vals, "errors": errs}
 
 
+def log_class(r: dict) -> tuple[str, str]:
+    """(hand of the first rudder: ``port`` for a trial name ending in ``p``, else ``starboard``; ``wind beside``
+    for a wind with another effect, ``wind alone``, ``other`` for effects without wind, ``clean``)."""
+    true = {e for e in r["true"] if e != "none"}
+    hand = "port" if r["trial"].endswith("p") else "starboard"
+    kind = ("clean" if not true else "wind beside" if "wind" in true and len(true) > 1
+            else "wind alone" if "wind" in true else "other")
+    return hand, kind
+
+
+def class_lines(results: list) -> list[str]:
+    """One line per (hand, kind) of :func:`log_class`: exact, exact or not_identifiable, false alarms."""
+    groups = {}
+    for r in results:
+        groups.setdefault(log_class(r), []).append(r)
+    out = ["class (hand, effects): exact / exact or not_identifiable / false alarms, of n logs"]
+    for (hand, kind), rs in sorted(groups.items()):
+        out.append(f"  {hand:9s} {kind:11s} {sum(r['exact'] for r in rs)} / {sum(r['exact_or_not_identifiable'] for r in rs)}"
+                   f" / {sum(r['false_alarm'] for r in rs)} of {len(rs)}")
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--set", default="diagnose-dev", help="the set's folder under ../shared/data (or a path)")
     ap.add_argument("--ship", default="esso_osaka")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--only", nargs="*", help="file stems to run (default all)")
     ap.add_argument("--json", default=str(REPO / "bench" / "out" / "diagnose_devset.json"))
     a = ap.parse_args(argv)
-    if not (DEV / "manifest.json").is_file():
-        print(f"development set absent: {DEV}", file=sys.stderr)
+    dev = Path(a.set) if Path(a.set).is_absolute() else DATA / a.set
+    if not (dev / "manifest.json").is_file():
+        print(f"development set absent: {dev}", file=sys.stderr)
         return 2
-    files = json.loads((DEV / "manifest.json").read_text())["files"]
+    files = json.loads((dev / "manifest.json").read_text())["files"]
     if a.only:
         files = [f for f in files if Path(f["file"]).stem in a.only]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=max(1, a.jobs)) as ex:
-        futs = [ex.submit(_one, str(DEV / f["file"]), a.ship) for f in files]
+        futs = [ex.submit(_one, str(dev / f["file"]), a.ship) for f in files]
         results = []
         for i, (f, fu) in enumerate(zip(files, futs)):
             r = fu.result()
@@ -128,9 +157,11 @@ def main(argv=None) -> int:
     print(f"exact naming {exact} of {len(results)} (with values in tolerance {exact_vals}); false alarms {fa} of "
           f"{len(clean)} clean logs; exact or the missing effect reported not_identifiable {honest} of {len(results)}; {time.perf_counter() - t0:.0f} s wall, median "
           f"{sorted(r['seconds'] for r in results)[len(results) // 2]:.1f} s per log")
+    for line in class_lines(results):
+        print(line)
     out = Path(a.json)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"ship": a.ship, "exact": exact, "exact_with_values": exact_vals, "false_alarms": fa, "exact_or_not_identifiable": honest,
+    out.write_text(json.dumps({"set": str(dev), "ship": a.ship, "exact": exact, "exact_with_values": exact_vals, "false_alarms": fa, "exact_or_not_identifiable": honest,
                                "clean": len(clean), "logs": results}, indent=1, default=float))
     return 0
 
