@@ -136,6 +136,10 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=2, help="--mismatch: parallel processes")
     ap.add_argument("--only", nargs="+", default=None, metavar="ID",
                     help="--mismatch: only these records (ids as printed, e.g. wind_10_0 clean_20) of the full draw")
+    ap.add_argument("--mirror", action="store_true",
+                    help="--mismatch: each record's port <-> starboard twin instead (the other hand first, wind and "
+                         "current directions mirrored about the approach course, offset and bias signs flipped; the "
+                         "same member and noise): diagnose_mismatch.mirrored")
     ap.add_argument("--candidate-start", choices=("config", "current"), default="config",
                     help="--mismatch: where candidates' fits start the ship (DiagnoseOptions.candidate_start)")
     ap.add_argument("--max-nfev", type=int, default=None,

@@ -176,6 +176,29 @@ def wide_jobs(nclean: int, seeds: int, effects, seed0: int) -> list[dict]:
     return mixed + eff_jobs[len(mixed) - len(clean):]
 
 
+def mirrored(job: dict) -> dict:
+    """The port <-> starboard twin of a job: the trial of the other hand (``zz10`` <-> ``zz10p``), the true
+    wind's and the current's directions mirrored about the approach course (north: d -> -d), the offset's
+    and the bias's signs flipped; the same member, speed and noise seed, id ``<id>_mirror``.  The member's
+    own asymmetries (gamma_R of either sign, the cross-flow hull) are not mirrored: a twin is the same ship
+    run the other way in the mirrored sea."""
+    import copy
+
+    m = copy.deepcopy(job)
+    t = job["trial"]
+    m["trial"] = t if t in PAIRS else t[:-1] if t.endswith("p") else t + "p"       # a pair holds both hands
+    m["id"] = f"{job['id']}_mirror"
+    spec = m["spec"]
+    if "current" in spec:
+        spec["current"]["direction_deg"] = (-float(spec["current"]["direction_deg"])) % 360.0
+    for eff, key in (("heading_bias", "bias_deg"), ("rudder_offset", "offset_deg")):
+        if eff in spec:
+            spec[eff][key] = -float(spec[eff][key])
+    speed, frm = job["true_wind"]
+    m["true_wind"] = (speed, (-frm) % (2.0 * math.pi) if speed else frm)
+    return m
+
+
 def true_effects(r: dict) -> set:
     """The effects a record was made with (``"wind+current"``: both)."""
     return set(r["effect"].split("+")) if r["effect"] else set()
@@ -483,6 +506,8 @@ def main_mismatch(a) -> None:
             else jobs(nclean, seeds, effects, a.seed0, a.trials))
     if a.only:                                   # the same records as a full run of these options, by id
         todo = [j for j in todo if j["id"] in set(a.only)]
+    if getattr(a, "mirror", False):
+        todo = [mirrored(j) for j in todo]
     curve = getattr(a, "wind_curve", "fujiwara")
     todo = [{**j, "candidate_start": a.candidate_start, "max_nfev": a.max_nfev, "ship": a.ship, "wind_curve": curve}
             for j in todo]

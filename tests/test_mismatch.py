@@ -226,3 +226,49 @@ def test_class_figures_read_a_model_scale_truth_at_full_scale():
     assert dm.true_sizes(rows[0])["current"] == pytest.approx(0.03 * lam ** 0.5)
     f = dm.class_figures(rows)
     assert f["current"] == [1, 1] and f["heading_bias"] == [0, 1]
+
+
+def test_mirrored_job_is_the_other_hand_in_the_mirrored_sea():
+    import sys
+
+    sys.path.insert(0, str(REPO / "bench"))
+    import diagnose_mismatch as dm
+
+    job = {"id": "wind+current_20_1", "trial": "zz10", "member": 3, "speed_kn": 9.0, "seed": 11,
+           "spec": {"wind": {}, "current": {"speed_mps": 0.15, "direction_deg": 30.0},
+                    "heading_bias": {"bias_deg": 1.0}, "rudder_offset": {"offset_deg": -1.5}},
+           "true_wind": (20.0, math.radians(100.0))}
+    m = dm.mirrored(job)
+    assert m["trial"] == "zz10p" and m["id"] == "wind+current_20_1_mirror"
+    assert m["member"] == 3 and m["seed"] == 11 and m["speed_kn"] == 9.0
+    assert math.isclose(m["spec"]["current"]["direction_deg"], 330.0)
+    assert m["spec"]["heading_bias"]["bias_deg"] == -1.0 and m["spec"]["rudder_offset"]["offset_deg"] == 1.5
+    assert math.isclose(m["true_wind"][0], 20.0) and math.isclose(math.degrees(m["true_wind"][1]), 260.0)
+    assert job["spec"]["current"]["direction_deg"] == 30.0                      # the job itself untouched
+    back = dm.mirrored(m)
+    assert back["trial"] == "zz10" and back["spec"] == job["spec"]
+    assert math.isclose(back["true_wind"][1], job["true_wind"][1])
+    assert dm.mirrored({**job, "trial": "turn_pair"})["trial"] == "turn_pair"   # a pair holds both hands
+
+
+def test_mirrored_record_swings_the_other_way_by_as_much(config):
+    # the config as its own truth, a current setting 30 deg off the course: the twin's heading is the
+    # original's mirror image, up to the config's own asymmetry and the noise (the same draw, unmirrored)
+    import sys
+
+    sys.path.insert(0, str(REPO / "bench"))
+    import diagnose_mismatch as dm
+
+    job = {"id": "current_0.25_0", "trial": "zz20", "spec": {"current": {"speed_mps": 0.25, "direction_deg": 30.0}},
+           "true_wind": (0.0, 0.0)}
+    recs = []
+    for j in (job, dm.mirrored(job)):
+        sea = TrialConditions(j["spec"], j["true_wind"], 10.0)
+        recs.append(trial_records(config, config, j["trial"], sea, seed=5))
+    a, b = recs
+    n = min(len(a.psi), len(b.psi))
+    swing = float(np.max(np.abs(np.degrees(a.psi[:n]))))
+    assert swing > 20.0
+    assert float(np.max(np.abs(np.degrees(a.psi[:n] + b.psi[:n])))) < 0.1 * swing
+    ya, yb = a.y[:n], b.y[:n]
+    assert float(np.max(np.abs(ya + yb))) < 0.2 * float(np.max(np.abs(ya)))   # the asymmetry adds up over the run
