@@ -261,26 +261,7 @@ def turning_metrics(t, x, y, psi, U, L, t_execute=None, delta=None, order=None, 
     change they need.
     """
     t, x, y, psi, U = (np.asarray(a, dtype=float) for a in (t, x, y, psi, U))
-    iend = len(t) - 1
-    rudder_deg = None
-    if t_execute is not None:
-        te = float(t_execute)
-    else:
-        rudder, measured = (order, False) if order is not None else (delta, True)
-        h = _turn_hold(t, rudder, measured) if rudder is not None else None
-        if h is None:
-            te = float(t[0])
-        else:
-            te = _execute_time(t, h, measured)
-            iend = h.last if h.last < len(t) - 1 else iend
-            rudder_deg = h.level / DEG
-    i0 = min(int(np.searchsorted(t, te)), len(t) - 1)
-    if n is not None:
-        n = np.asarray(n, dtype=float)
-        n0 = float(np.interp(te, t, n))
-        stop = np.flatnonzero(np.abs(n[i0:iend + 1]) < 0.5 * abs(n0)) if abs(n0) > 0 else np.array([], int)
-        if stop.size:
-            iend = i0 + int(stop[0]) - 1 if stop[0] > 0 else i0
+    te, iend, rudder_deg = _turn_span(t, t_execute, delta, order, n)
     psi0, x0, y0, U0 = (float(np.interp(te, t, a)) for a in (psi, x, y, U))
     # the turn: from the execute (values interpolated there) to its end
     k = np.arange(iend + 1)
@@ -303,8 +284,44 @@ def turning_metrics(t, x, y, psi, U, L, t_execute=None, delta=None, order=None, 
     out["tactical_diameter_L"] = float(_at(across, w180) / L) if w180 is not None else None
     out["time_to_90_s"] = None if t90 is None else float(t90 - te)
     out["time_to_180_s"] = None if t180 is None else float(t180 - te)
-    # steady part: after 360 deg of turn if reached, else after 180 deg with at least 90 deg more
-    steady, out["steady_from_deg"] = None, None
+    out.update(_steady_turn(turn, xx, yy, UU, U0, L))
+    return out
+
+
+def _turn_span(t, t_execute, delta, order, n) -> tuple:
+    """(execute time [s], index of the turn's last sample, held rudder [deg] or None) of
+    :func:`turning_metrics`: the execute given, or read from the order or the measured rudder (the turn
+    then ends where the rudder leaves its hold); the turn ends earlier where the propeller revolutions
+    ``n`` fall below half their value at the execute."""
+    iend = len(t) - 1
+    rudder_deg = None
+    if t_execute is not None:
+        te = float(t_execute)
+    else:
+        rudder, measured = (order, False) if order is not None else (delta, True)
+        h = _turn_hold(t, rudder, measured) if rudder is not None else None
+        if h is None:
+            te = float(t[0])
+        else:
+            te = _execute_time(t, h, measured)
+            iend = h.last if h.last < len(t) - 1 else iend
+            rudder_deg = h.level / DEG
+    i0 = min(int(np.searchsorted(t, te)), len(t) - 1)
+    if n is not None:
+        n = np.asarray(n, dtype=float)
+        n0 = float(np.interp(te, t, n))
+        stop = np.flatnonzero(np.abs(n[i0:iend + 1]) < 0.5 * abs(n0)) if abs(n0) > 0 else np.array([], int)
+        if stop.size:
+            iend = i0 + int(stop[0]) - 1 if stop[0] > 0 else i0
+    return te, iend, rudder_deg
+
+
+def _steady_turn(turn, xx, yy, UU, U0: float, L: float) -> dict:
+    """The steady part of a turn (after 360 deg of turn if reached, else after 180 deg with at least 90 deg
+    more): ``steady_from_deg``, ``steady_diameter_L`` (a circle fitted to its track), ``steady_speed_ratio``
+    and ``speed_loss`` (its mean speed against the approach speed ``U0``); None where there is none."""
+    out = {"steady_from_deg": None}
+    steady = None
     for start in (2 * np.pi, np.pi):
         m = turn >= start
         if m.sum() > 10 and turn[-1] - start >= np.pi / 2:
@@ -493,12 +510,9 @@ def zigzag_metrics(t, psi, order=None, angle=None, first=None, U=None, L=None, *
     distance_to_second_execute_L when U (and L) are given.
     """
     t, psi = np.asarray(t, dtype=float), np.asarray(psi, dtype=float)
-    dense = _median_dt(t) <= 0.25
     if order is not None:
         o = np.asarray(order, dtype=float)
-        if measured is None:
-            measured = len(np.unique(o)) > 8
-        sw = _rudder_switches(t, psi, o, measured)
+        sw = _rudder_switches(t, psi, o, len(np.unique(o)) > 8 if measured is None else measured)
     else:
         if levels is None:
             if angle is None:
@@ -511,6 +525,16 @@ def zigzag_metrics(t, psi, order=None, angle=None, first=None, U=None, L=None, *
            "switching_headings_deg": [float((h - sw.headings[0]) / DEG) for h in sw.headings[1:]],
            "reversal_sides": [int(s) for s in sw.sides[:-1]][:max(len(sw.times) - 1, 0)],
            "rudder_deg": None if sw.amplitude is None else float(sw.amplitude / DEG)}
+    out["heading_steps_removed"], out["overshoots_deg"] = _overshoots(t, psi, r, sw)
+    out.update(_zigzag_times(t, sw.times, U, L))
+    return out
+
+
+def _overshoots(t, psi, r, sw) -> tuple[list, list]:
+    """(heading-sensor steps taken out, overshoots [deg] in order) of the zigzag whose reversals are
+    ``sw``: each hold's heading extreme beyond the heading at its reversal, while the heading turns back
+    within the hold (:func:`zigzag_metrics`)."""
+    dense = _median_dt(t) <= 0.25
     psi_c, steps = corrected_heading(t, psi, r)
     margin = (0.5 if dense else 0.2) * DEG     # a peak: the heading comes back by this much within the hold
     overs, used = [], []
@@ -525,10 +549,14 @@ def zigzag_metrics(t, psi, order=None, angle=None, first=None, U=None, L=None, *
             break                              # the hold (record) ends before the heading turns back
         overs.append(float(dirn * (ext[1] - sw.heading_at(t, psi_c, k)) / DEG))
         used += [st for st in steps if sw.times[k] < st[0] <= ext[0]]
-    out["heading_steps_removed"] = used
-    out["overshoots_deg"] = overs
-    ts = sw.times
-    out["initial_turning_time_s"] = float(ts[1] - ts[0]) if len(ts) > 1 else None
+    return used, overs
+
+
+def _zigzag_times(t, ts, U, L) -> dict:
+    """The zigzag's ``initial_turning_time_s``, ``period_s`` (mean full cycle), and with the speed ``U``
+    (and the length ``L``) ``approach_speed_mps`` and ``distance_to_second_execute_L``, from its execute
+    times ``ts`` [s]."""
+    out = {"initial_turning_time_s": float(ts[1] - ts[0]) if len(ts) > 1 else None}
     odd = ts[1::2]
     if len(ts) > 3:
         out["period_s"] = float(np.mean(np.diff(odd))) if len(odd) > 1 else float(ts[3] - ts[1])
