@@ -111,7 +111,7 @@ def class_lines(results: list) -> list[str]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--set", default="diagnose-dev", help="the set's folder under ../shared/data (or a path)")
+    ap.add_argument("--set", default="diagnose-dev", help="the set's folder under ../shared/data (or an absolute path)")
     ap.add_argument("--ship", default="esso_osaka")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--only", nargs="*", help="file stems to run (default all)")

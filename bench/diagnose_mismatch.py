@@ -305,6 +305,10 @@ def summarise(rows: list) -> dict:
     allr = _rate(rows, lambda r: set(r["named"]) == true_effects(r))
     print(f"\nexact (named set == true set) over all records: {_pct(*allr)}")
     table["exact"] = list(allr)
+    table["exact_by_hand"] = exact_by_hand(rows)
+    print("exact by hand of the first rudder, records with an effect (with a wind beside another) / clean: "
+          + "; ".join(f"{h} {_pct(*v['effect'])} ({_pct(*v['wind_beside'])}) / {_pct(*v['clean'])}"
+                      for h, v in table["exact_by_hand"].items()))
     table["model_form"] = model_form_lines(rows)
     table["per_trial"] = _per_trial(rows)
     table["reasons"] = _reason_counts(rows)
@@ -324,6 +328,21 @@ def model_form_lines(rows: list) -> dict:
     for r in mf:
         print(f"  {r['id']} {r['trial']}: named {r['named']}, model_form_mismatch {sorted(r['model_form'])}")
     return {"records": len(mf), "clean": len(clean), "true_effect": len(true), "ids": [r["id"] for r in mf]}
+
+
+def exact_by_hand(rows: list) -> dict:
+    """``{hand: {"effect": (k, n), "wind_beside": (k, n), "clean": (k, n)}}``: records named exactly, per hand of
+    the first rudder (:func:`record_class`), counted once each: those with an effect, those with a wind
+    beside another effect, the clean ones."""
+    out = {}
+    for r in rows:
+        d = out.setdefault(record_class(r)[0], {"effect": [0, 0], "wind_beside": [0, 0], "clean": [0, 0]})
+        true = true_effects(r)
+        keys = ["effect", "wind_beside"] if "wind" in true and len(true) > 1 else ["effect"] if true else ["clean"]
+        for k in keys:
+            d[k][0] += set(r["named"]) == true
+            d[k][1] += 1
+    return {h: {k: tuple(v) for k, v in d.items()} for h, d in sorted(out.items())}
 
 
 def record_class(r: dict) -> tuple[str, str, str]:
@@ -511,11 +530,12 @@ def main_mismatch(a) -> None:
     curve = getattr(a, "wind_curve", "fujiwara")
     todo = [{**j, "candidate_start": a.candidate_start, "max_nfev": a.max_nfev, "ship": a.ship, "wind_curve": curve}
             for j in todo]
-    path = out / f"diagnose_mismatch{a.tag}.json"
+    tag = a.tag + ("_mirror" if getattr(a, "mirror", False) else "")      # twins never overwrite their draw
+    path = out / f"diagnose_mismatch{tag}.json"
     wide = getattr(a, "wide", False)
     head = {"ship": a.ship, "family_seed": a.seed0, "family_size": FAMILY_SIZE, "clean": nclean, "seeds": seeds,
             "effects": effects, "sizes": {e: (WIDE_SIZES if wide else SIZES)[e] for e in effects}, "wide": wide,
-            "wind_curve": curve}
+            "wind_curve": curve, "mirror": bool(getattr(a, "mirror", False))}
     save = lambda rows: path.write_text(json.dumps({**head, "records": rows}, indent=1, default=float))  # noqa: E731
     t0 = time.perf_counter()
     nc = sum(j["effect"] is None for j in todo)
@@ -525,6 +545,6 @@ def main_mismatch(a) -> None:
     table = summarise(rows)
     save(rows)
     path.write_text(json.dumps({**head, "summary": table, "records": rows}, indent=1, default=float))
-    png = out / f"diagnose_detection_mismatch{a.tag}.png"
+    png = out / f"diagnose_detection_mismatch{tag}.png"
     plot(table, png, f"mmg diagnose on the {a.ship} mismatch family (seed {a.seed0}, {seeds} seed(s)/size)")
     print(f"wrote {path} and {png}; {time.perf_counter() - t0:.0f} s wall")

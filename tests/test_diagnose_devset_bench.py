@@ -1,11 +1,7 @@
 """bench/diagnose_devset.py's scoring and its classes, on hand-made manifest entries and diagnoses."""
-import importlib.util
-from pathlib import Path
+from .conftest import load_bench
 
-_spec = importlib.util.spec_from_file_location(
-    "diagnose_devset", Path(__file__).resolve().parents[1] / "bench" / "diagnose_devset.py")
-dev = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(dev)
+dev = load_bench("diagnose_devset")
 
 
 def _entry(effects, **parameters):

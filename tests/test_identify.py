@@ -568,3 +568,32 @@ def test_cv_report_sets_the_written_std_against_the_folds_jackknife(tmp_path):
     other = cross_validate(ship, runs, folds=3, **{**kw, "free": ["N_r"]})
     rep2 = write_identification(ident, mmg.config_path("ships", f"{SHIP}.yaml"), tmp_path, other)["report"].read_text()
     assert "no fold spread" in rep2 and "## The written standard errors" not in rep2
+
+
+def test_jacobian_reuses_the_residuals_just_evaluated_and_not_a_stale_copy(monkeypatch):
+    # every Jacobian starts at a point the solver has just evaluated: counted replays show one saved per
+    # Jacobian, and the fit is the same as when every residual vector is made afresh
+    import ekf.identify as I
+
+    ship = mmg.load_ship(SHIP)
+    true = {"N_r": ship.hull.value("N_r") * 1.3, "N_beta": ship.hull.value("N_beta") * 0.8}
+    runs = _synthetic_runs(ship.with_hull(true), seeds=(0,), duration=60.0)
+    pk = pack(ship)
+    free = free_parameters(pk, ship.hull.names, list(true))
+    segs = [Segmented(r.name, r.meas, r.inputs, segment_resets(r.t, 30.0)) for r in runs]
+    sc = Scales(0.005, 0.005, 0.001, np.radians(0.5))
+    calls = []
+    one = I._residual_one
+    monkeypatch.setattr(I, "_residual_one", lambda *a, **k: calls.append(1) or one(*a, **k))
+    cached = identify_segments(pk, segs, free, sc, n_jobs=1, max_nfev=6)
+    n_cached = len(calls)
+    monkeypatch.setattr(I._SegmentFit, "resid", lambda self, theta, parallel=True: self._resid(theta, parallel))
+    calls.clear()
+    fresh = identify_segments(pk, segs, free, sc, n_jobs=1, max_nfev=6)
+    assert np.array_equal(cached.theta, fresh.theta) and cached.cost_final == fresh.cost_final
+    assert np.array_equal(cached.std, fresh.std)
+    # fresh: 1 initial + nfev evaluations + (1 + n columns) per Jacobian; cached: one fewer per Jacobian,
+    # and the solver's first evaluation at the start (the priors) is the initial one
+    n_jac = (len(calls) - 1 - fresh.iterations) // (1 + len(free))
+    assert n_jac >= 2
+    assert n_cached <= len(calls) - n_jac

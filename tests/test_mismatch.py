@@ -272,3 +272,20 @@ def test_mirrored_record_swings_the_other_way_by_as_much(config):
     assert float(np.max(np.abs(np.degrees(a.psi[:n] + b.psi[:n])))) < 0.1 * swing
     ya, yb = a.y[:n], b.y[:n]
     assert float(np.max(np.abs(ya + yb))) < 0.2 * float(np.max(np.abs(ya)))   # the asymmetry adds up over the run
+
+
+def test_exact_by_hand_counts_each_record_once_per_class():
+    import sys
+
+    sys.path.insert(0, str(REPO / "bench"))
+    import diagnose_mismatch as dm
+
+    rows = [{"trial": "zz10p", "effect": "wind+current", "named": ["wind", "current"]},
+            {"trial": "zz10p", "effect": "current", "named": ["current", "heading_bias"]},
+            {"trial": "turn25", "effect": "wind+heading_bias", "named": ["wind"]},
+            {"trial": "zz20", "effect": None, "named": []},
+            {"trial": "zz20", "effect": None, "named": ["current"]},
+            {"trial": "turn35p", "effect": None, "named": []}]
+    got = dm.exact_by_hand(rows)
+    assert got["port"] == {"effect": (1, 2), "wind_beside": (1, 1), "clean": (1, 1)}
+    assert got["starboard"] == {"effect": (0, 1), "wind_beside": (0, 1), "clean": (1, 2)}
