@@ -19,7 +19,7 @@ minus true, its ``rudder_offset.offset_deg`` actual minus logged (the set's READ
 
     python bench/diagnose_devset.py [--set diagnose-dev2] [--jobs 2] [--only dev_01 dev_07] [--json J]
 
-Beside the totals it prints them per class: the hand of the first rudder (a trial name ending in ``p``:
+Beside the totals it prints them per class: the hand of the first rudder (``zz10p``, ``turn25p``:
 port first) and whether a wind blows beside another effect.
 
 The data are read from the shared folder and never copied; the script stops with a message where
@@ -88,10 +88,12 @@ def score(entry: dict, res: dict) -> dict:
 
 
 def log_class(r: dict) -> tuple[str, str]:
-    """(hand of the first rudder: ``port`` for a trial name ending in ``p``, else ``starboard``; ``wind beside``
-    for a wind with another effect, ``wind alone``, ``other`` for effects without wind, ``clean``)."""
+    """(hand of the first rudder, :func:`trials.measured.mismatch.trial_hand` of the trial's name; ``wind
+    beside`` for a wind with another effect, ``wind alone``, ``other`` for effects without wind, ``clean``)."""
+    from trials.measured.mismatch import trial_hand
+
     true = {e for e in r["true"] if e != "none"}
-    hand = "port" if r["trial"].endswith("p") else "starboard"
+    hand = trial_hand(r["trial"])
     kind = ("clean" if not true else "wind beside" if "wind" in true and len(true) > 1
             else "wind alone" if "wind" in true else "other")
     return hand, kind

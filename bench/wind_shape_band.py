@@ -63,7 +63,11 @@ def band_fit(curve, particulars, centre_deg: float, half_width_deg: float = 20.0
         c = candidate(g, particulars, th, extra)
         return np.concatenate([(arm[k] * c[k] - target[k]) / scale[k] for k in range(3)])
 
-    lo, hi, x0 = [0.0, 0.2, 0.2, -0.3], [10.0, 3.0, 3.0, 0.3], [1.0, 1.0, 1.0, 0.0]
+    from mmg.effects import Wind
+
+    params = Wind.fit_parameters()                         # the candidate's own bounds and starts
+    lo, hi = [q.lower for q in params], [q.upper for q in params]
+    x0 = [q.default if q.start is None else q.start for q in params]
     if extra is not None:
         lo, hi, x0 = lo + [-0.5], hi + [0.5], x0 + [0.0]
     sol = least_squares(res, np.array(x0), bounds=(lo, hi))

@@ -623,13 +623,12 @@ class _SegmentFit:
         """Every record's residuals, then their straight runs', then the prior's.  The last vector made on
         the main thread (``parallel``) is kept: the Jacobian at a point the solver has just evaluated
         starts from it instead of replaying the records again."""
+        if not parallel:                                  # a Jacobian column on a pool thread
+            return self._resid(theta, False)
         key = np.asarray(theta, float).tobytes()
-        if parallel and self._last is not None and self._last[0] == key:
-            return self._last[1].copy()
-        r = self._resid(theta, parallel)
-        if parallel:
-            self._last = (key, r.copy())
-        return r
+        if self._last is None or self._last[0] != key:
+            self._last = (key, self._resid(theta, True))
+        return self._last[1].copy()
 
     def _resid(self, theta, parallel):
         pk = apply_parameters(self.packed, self.free, theta)
