@@ -9,7 +9,7 @@ estimated hull derivatives sit in their state z:
   ``[X_, Y_, PSI_, N_, U_, V_, R_]``, derivatives from z[8] (tau, the rudder-timing offset, is
   held like the derivatives and enters through the rudder angle, see :func:`jacobian_step`).
 
-So one RK4 step (:func:`rk4_step`), one exact Jacobian of it (:func:`jacobian_step`: the
+So one RK4 step (:func:`rk4_step`, the step :func:`mmg.rk4.rk4_step` of every integrator), one exact Jacobian of it (:func:`jacobian_step`: the
 tangent-linear RK4, state columns by complex step of each stage, derivative columns analytic), one
 covariance propagation (:func:`fpft`) and one measurement update (:func:`joseph_update_ws`) serve
 both; the only physics is :func:`mmg.model` (:func:`~mmg.model.rhs` and the parts it is made of).
@@ -20,15 +20,40 @@ from __future__ import annotations
 
 import numpy as np
 from mmg._jit import njit
-
-from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_, dynamics, inverse_mass, rhs, rhs_hull_jacobian, track
+from mmg.kernel import axpy8
+from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_, dynamics, inverse_mass, rhs_hull_jacobian, rhs_of, track
+from mmg.rk4 import NODES, WEIGHTS
+from mmg.rk4 import rk4_step as rk4
 
 CSTEP = 1e-30               # complex-step size: F = Im(step(z + i h e_j)) / h, exact to rounding
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _at(z, slots, j, zero):
+    """z[i] where slots[i] == j (the mmg state j as the filter holds it), else ``zero``."""
+    for i in range(slots.shape[0]):
+        if slots[i] == j:
+            return z[i] + zero
+    return zero
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _filter_rhs(y, tau, args):
+    """The filters' right-hand side for :func:`mmg.rk4.rk4_step`: :func:`mmg.model.rhs_of` at the stage
+    state ``y`` (an 8-tuple of mmg states) with the rudder d0 (tau 0), its mean (1/2) or d1 (1), the
+    derivatives of the states the filter does not propagate (bit j of ``mask`` clear) held at 0."""
+    d0, d1, mask, p, poly, hull_axis, hull_term, coef = args
+    d = d0 if tau == 0.0 else (d1 if tau == 1.0 else 0.5 * (d0 + d1))
+    k = rhs_of(y[U_], y[V_], y[R_], y[PSI_], d, y[N_], d.real, p, poly, hull_axis, hull_term, coef)
+    z = 0j
+    return (k[0] if mask & 1 else z, k[1] if (mask >> 1) & 1 else z, k[2] if (mask >> 2) & 1 else z,
+            k[3] if (mask >> 3) & 1 else z, k[4] if (mask >> 4) & 1 else z, k[5] if (mask >> 5) & 1 else z,
+            k[6] if (mask >> 6) & 1 else z, k[7] if (mask >> 7) & 1 else z)
+
+
 @njit(cache=True)
 def rk4_step(z, d0, d1, dt, layout, ship, ws):
-    """One RK4 step of the dynamic states of z over ``dt`` [s]; real or complex z.
+    """One RK4 step (:func:`mmg.rk4.rk4_step`) of the dynamic states of z over ``dt`` [s]; real or complex z.
 
     z[i] (i < len(slots)) is the mmg state ``slots[i]`` (SI units: m/s, rad/s, m, rad, rps);
     z[c0 + j] is the hull derivative written into ``coef[idx[j]]`` (``coef`` a complex copy of
@@ -37,52 +62,40 @@ def rk4_step(z, d0, d1, dt, layout, ship, ws):
     complex-step perturbation), linear over the step: it enters as the DELTA_ state (d0 for
     stage 1, the mid value for stages 2-3, d1 for stage 4) and its real part as the command.
     layout = (slots, c0, idx, itau) (itau not used: the rudder d0, d1 comes whole), ship = (p, poly,
-    hull_axis, hull_term); ws from :func:`make_workspace`: its complex work arrays coef = ws[1],
-    xs, k1..k4 = ws[2:7] and out = ws[7]: out[:len(slots)] <- z_next of the dynamic states.
+    hull_axis, hull_term); ws from :func:`make_workspace`: its complex work arrays coef = ws[1]
+    and out = ws[7]: out[:len(slots)] <- z_next of the dynamic states.
     """
     slots, c0, idx, _ = layout
     p, poly, hull_axis, hull_term = ship
-    coef, xs, k1, k2, k3, k4, out = ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
-    ns = slots.shape[0]
+    coef, out = ws[1], ws[7]
     for j in range(idx.shape[0]):
         coef[idx[j]] = z[c0 + j]
-    zero = 0.0 * z[0]
-    for j in range(xs.shape[0]):
-        xs[j] = zero
-    dm = 0.5 * (d0 + d1)
-    for i in range(ns):
-        xs[slots[i]] = z[i]
-    xs[DELTA_] = d0 + zero
-    rhs(xs, d0.real, p, poly, hull_axis, hull_term, coef, k1)
-    for i in range(ns):
-        xs[slots[i]] = z[i] + 0.5 * dt * k1[slots[i]]
-    xs[DELTA_] = dm + zero
-    rhs(xs, dm.real, p, poly, hull_axis, hull_term, coef, k2)
-    for i in range(ns):
-        xs[slots[i]] = z[i] + 0.5 * dt * k2[slots[i]]
-    rhs(xs, dm.real, p, poly, hull_axis, hull_term, coef, k3)
-    for i in range(ns):
-        xs[slots[i]] = z[i] + dt * k3[slots[i]]
-    xs[DELTA_] = d1 + zero
-    rhs(xs, d1.real, p, poly, hull_axis, hull_term, coef, k4)
-    c6 = dt / 6.0
-    for i in range(ns):
-        s = slots[i]
-        out[i] = z[i] + c6 * (k1[s] + 2.0 * k2[s] + 2.0 * k3[s] + k4[s])
+    zero = 0j
+    mask = 0
+    for i in range(slots.shape[0]):
+        mask |= 1 << slots[i]
+    y = (_at(z, slots, 0, zero), _at(z, slots, 1, zero), _at(z, slots, 2, zero), _at(z, slots, 3, zero),
+         _at(z, slots, 4, zero), _at(z, slots, 5, zero), _at(z, slots, 6, zero), _at(z, slots, 7, zero))
+    zeros = (zero, zero, zero, zero, zero, zero, zero, zero)
+    y = rk4(_filter_rhs, axpy8, zeros, y, dt, (d0, d1, mask, p, poly, hull_axis, hull_term, coef))
+    for i in range(slots.shape[0]):
+        out[i] = y[slots[i]]
 
 
 @njit(cache=True)
 def make_workspace(nz, ns, hull_coef):
     """Work arrays of :func:`jacobian_step` (and :func:`jacobian_step_reference`) for nz states of
-    which ns are propagated: (zc, coef, xs, k1, k2, k3, k4, out, z_next, F, hc, xr, kc, kr, ks, A, dK,
-    dKn, B, w); coef a complex and hc a real copy of ``hull_coef``.  ws[0:8] are the complex work
-    arrays of :func:`rk4_step`, z_next = ws[8], F = ws[9]; ws[10:] those of the tangent-linear RK4."""
+    which ns are propagated: (zc, coef, -, -, -, -, -, out, z_next, F, hc, xr, kc, kr, ks, A, dK,
+    dKn, B, w); coef a complex and hc a real copy of ``hull_coef``.  zc, coef and out are the complex
+    work arrays of :func:`rk4_step` and :func:`jacobian_step_reference`, z_next = ws[8], F = ws[9];
+    ws[10:] those of the tangent-linear RK4; ws[2:7] are empty (the filters' step keeps its stages in
+    registers, :func:`mmg.rk4.rk4_step`)."""
     coef = np.empty(hull_coef.shape[0], dtype=np.complex128)
     for i in range(hull_coef.shape[0]):
         coef[i] = hull_coef[i]
-    return (np.empty(nz, dtype=np.complex128), coef, np.zeros(8, dtype=np.complex128),
-            np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128), np.empty(8, dtype=np.complex128),
-            np.empty(8, dtype=np.complex128), np.empty(ns, dtype=np.complex128), np.empty(nz), np.empty((nz, nz)),
+    none = np.empty(0, dtype=np.complex128)
+    return (np.empty(nz, dtype=np.complex128), coef, none, none, none, none, none, np.empty(ns, dtype=np.complex128),
+            np.empty(nz), np.empty((nz, nz)),
             hull_coef.copy(), np.zeros(8), np.zeros(8, dtype=np.complex128), np.empty(ns), np.empty(ns),
             np.zeros((ns, ns + 1)), np.zeros((ns, nz)), np.zeros((ns, nz)), np.empty((3, max(nz - ns, 0))),
             np.empty(8))
@@ -169,12 +182,15 @@ def _slot_roles(slots):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _stage(st, dt, e0, e1, g0, g1):
-    """(a_s dt, RK4 weight, rudder [rad], its d / d tau [rad/s]) of RK4 stage st (0..3)."""
-    if st == 0:
-        return 0.0, 1.0, e0, g0
-    if st == 3:
-        return dt, 1.0, e1, g1
-    return 0.5 * dt, 2.0, 0.5 * (e0 + e1), 0.5 * (g0 + g1)
+    """(a_s dt, RK4 weight, rudder [rad], its d / d tau [rad/s]) of RK4 stage st (0..3): the node and
+    weight of :func:`mmg.rk4.rk4_step` (:data:`mmg.rk4.NODES`, :data:`mmg.rk4.WEIGHTS`), the rudder linear
+    over the step."""
+    tau = NODES[st]
+    if tau == 0.0:
+        return tau * dt, WEIGHTS[st], e0, g0
+    if tau == 1.0:
+        return tau * dt, WEIGHTS[st], e1, g1
+    return tau * dt, WEIGHTS[st], 0.5 * (e0 + e1), 0.5 * (g0 + g1)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -13,7 +13,7 @@ from .model import DELTA_, ENGINE_CONSTANT_RPM, N_, P_ENGINE, PSI_, R_, U_, V_, 
 from .rk4 import rk4_step
 from .rudder import switch_side
 
-__all__ = ["simulate_kernel", "rk4_step", "SCHEDULE", "HEADING_SWITCH"]
+__all__ = ["simulate_kernel", "rk4_step", "axpy8", "ZERO8", "SCHEDULE", "HEADING_SWITCH"]
 
 SCHEDULE, HEADING_SWITCH = 0, 1
 
@@ -38,7 +38,7 @@ def _interp(tq, ts, vs, k):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _axpy(a, c, b):
+def axpy8(a, c, b):
     """a + c b of two 8-tuples (the state and a stage derivative) as a tuple: stays in registers."""
     return (a[0] + c * b[0], a[1] + c * b[1], a[2] + c * b[2], a[3] + c * b[3],
             a[4] + c * b[4], a[5] + c * b[5], a[6] + c * b[6], a[7] + c * b[7])
@@ -93,7 +93,7 @@ def simulate_kernel(x0, dt, nsteps, p, poly, hull_axis, hull_term, hull_coef,
         if i == nsteps:
             break
         # the four RK4 stages through one inlined copy of the right-hand side (rk4_step)
-        xs = rk4_step(_simulator_rhs, _axpy, ZERO8, xs, dt, (dcmd, p, poly, hull_axis, hull_term, hull_coef))
+        xs = rk4_step(_simulator_rhs, axpy8, ZERO8, xs, dt, (dcmd, p, poly, hull_axis, hull_term, hull_coef))
     return nsteps + 1
 
 
