@@ -201,13 +201,9 @@ def imo(ship, speed: str | None = None, samples: int = 0, cov=None, seed: int | 
         scale_to=None):
     """Check the IMO manoeuvring standards on ``ship``, with their uncertainty when ``samples`` > 0.
 
-    Criteria of IMO Resolution MSC.137(76) (2002), Annex 5.3, with the explanatory notes MSC/Circ.1053:
-    advance <= 4.5 L and tactical diameter <= 5 L of the 35 deg (or maximum-rudder) turning circles,
-    the track reach <= 2.5 L by 10 deg of heading change with 10 deg rudder (from the 10/10 zigzag),
-    the 10/10 first and second overshoots (limits in L/V) and the 20/20 first overshoot <= 25 deg, each
-    to starboard and to port, and the full-astern stopping test's track reach (<= 15 L; the
-    Administration may accept up to 20 L for large ships), the engine ordered astern along
-    :class:`mmg.engine_order.AsternOrder`.  See :mod:`trials.imo.standard`.
+    The criteria of IMO Resolution MSC.137(76) (2002) with MSC/Circ.1053 (turning, initial turning, the
+    10/10 and 20/20 zigzags to either side and the stopping test, the engine ordered astern along
+    :class:`mmg.engine_order.AsternOrder`), their limits as :mod:`trials.imo.standard` states them.
 
     Parameters
     ----------
