@@ -28,7 +28,7 @@ from .terms import is_resistance
 __all__ = ["ShipParameter", "CONSTANTS", "PRIOR_REL_STD", "DIAGNOSIS_PRIOR_REL_STD",
            "hull_parameter", "parameter", "ship_value", "with_value", "write_yaml_value", "unit_of", "is_resistance",
            "EffectPrior", "WIND_COLUMNS", "config_values", "MASS_NAMES", "to_slot", "to_hull", "to_wake",
-           "not_packed", "to_load_factor", "rule_of_kind", "LINEAR_TERMS"]
+           "not_packed", "through_effect", "to_load_factor", "rule_of_kind", "LINEAR_TERMS"]
 
 PRIOR_REL_STD = {"hull": 0.5, "epsilon": 0.5, "kappa": 0.5, "rudder": 0.5, "mass": 0.5}
 """Prior std of a freed ship coefficient relative to its config value, per family (identification's: the
@@ -121,6 +121,30 @@ def not_packed(packed: PackedShip, index: int, value: float) -> None:
     """
 
 
+def through_effect(prior: "EffectPrior") -> Callable:
+    """Apply rule of an effect's parameter that acts through the packed ship (the rudder offset): the value,
+    in the fit's unit, back in the effect's (``prior.factor``) and written by the effect's own
+    :meth:`mmg.effects.Effect.slots`, the one way the effect enters the model in a simulation, a
+    diagnosis and an identification.
+
+    Parameters
+    ----------
+    prior : EffectPrior
+        The effect, its parameter and the factor from its unit to the fit's.
+
+    Returns
+    -------
+    callable
+        ``apply(packed, index, value)`` (``index`` not used: the effect knows its slots).
+    """
+    def apply(packed: PackedShip, index: int, value: float) -> None:
+        import mmg.effects as E
+
+        for slot, v in E.get(prior.effect).slots({prior.parameter: value / prior.factor}).items():
+            packed.p[slot] = v
+    return apply
+
+
 def to_load_factor(factors: np.ndarray, index: int, value: float) -> None:
     """Load rule of a wind value: ``value`` as the wind effect's fit parameter ``index`` (scale, sway and yaw
     factor, :meth:`mmg.effects.Wind.fit_parameters`) in ``factors``, which :meth:`mmg.effects.Wind.load_factors`
@@ -163,7 +187,8 @@ class ShipParameter:
         std (``abs_std``) or an effect's own prior (``effect``).
     kind : str
         Its kind (:attr:`ekf.identify.FreeParameter.kind`), a label a caller can select by: ``"hull"``,
-        ``"w_P0"``, ``"epsilon"``, ``"kappa"``, ``"rudder"``, ``"propeller"``, ``"mass"``, ``"wind_scale"``.
+        ``"w_P0"``, ``"epsilon"``, ``"kappa"``, ``"rudder"``, ``"propeller"``, ``"mass"``, ``"wind_scale"``,
+        ``"rudder_offset"``.
     slot : int
         Its index in :attr:`mmg.model.PackedShip.p` (a hull coefficient's in ``hull_coef``; the wind's: the
         loads' column, :data:`WIND_COLUMNS`), the ``index`` its rules are given.
@@ -375,6 +400,9 @@ def _wind(name: str) -> ShipParameter:
                          apply=not_packed, loads=to_load_factor, multiplies=lambda s: float(getattr(s.wind, key)))
 
 
+_OFFSET = EffectPrior("rudder_offset", "offset_deg", np.pi / 180.0)
+
+
 def _constants() -> dict:
     def set_yaml(section, key, index=None):
         def w(d, v, path):
@@ -392,9 +420,9 @@ def _constants() -> dict:
         _rudder("epsilon", P_EPS, "epsilon", 0.3, 3.0),
         _rudder("kappa", P_KAPPA, "kappa", 0.0, 1.0),
         _wind("wind_scale"), _wind("wind_sway_factor"), _wind("wind_yaw_factor"),
-        ShipParameter("rudder_offset", "rad", "", "rudder", P_RUDDER_OFFSET, "effects.rudder_offset.offset_deg",
+        ShipParameter("rudder_offset", "rad", "", "rudder_offset", P_RUDDER_OFFSET, "effects.rudder_offset.offset_deg",
                       read=_offset_of, write=_with_offset, write_yaml=_offset_yaml,
-                      packed=lambda p: p.p[P_RUDDER_OFFSET], effect=EffectPrior("rudder_offset", "offset_deg", np.pi / 180.0)),
+                      packed=lambda p: p.p[P_RUDDER_OFFSET], effect=_OFFSET, apply=through_effect(_OFFSET)),
         ShipParameter("Y_P_astern", "1", "", "propeller", P_YP_ASTERN, "propeller.Y_P_astern",
                       read=lambda s: s.propeller.Y_P_astern,
                       write=lambda s, v: replace(s, propeller=replace(s.propeller, Y_P_astern=float(v))),

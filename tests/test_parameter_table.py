@@ -187,6 +187,21 @@ def test_the_identifications_rudder_offset_is_the_effects_slot_to_round_off():
         assert mine == pytest.approx(effect, rel=4e-16) and mine == pytest.approx(deg * np.pi / 180.0, rel=1e-15)
 
 
+def test_the_identifications_rudder_offset_goes_through_the_effect(monkeypatch):
+    """One path for the offset: ``--free rudder_offset`` enters the packed ship by the effect's own
+    :meth:`~mmg.effects.RudderOffset.slots` (a changed effect changes the fit's model too), not by a
+    write of its own into the slot."""
+    import mmg.effects as E
+    from mmg.model import P_RUDDER_OFFSET
+
+    ship = mmg.load_ship("esso_osaka_3m")
+    pk = pack(ship)
+    (f,) = free_parameters(pk, ship.hull.names, ["rudder_offset"])
+    monkeypatch.setattr(E.RudderOffset, "slots",
+                        classmethod(lambda cls, v: {P_RUDDER_OFFSET: 3.0 * np.radians(v["offset_deg"])}))
+    assert apply_parameters(pk, [f], [np.radians(1.5)]).p[P_RUDDER_OFFSET] == pytest.approx(np.radians(4.5), rel=1e-12)
+
+
 def test_an_unknown_name_is_refused_by_the_fit_and_the_sampler_and_left_out_by_the_writers():
     ship = mmg.load_ship("esso_osaka_3m")
     with pytest.raises(KeyError, match="unknown parameter"):
