@@ -9,9 +9,9 @@ estimated hull derivatives sit in their state z:
   ``[X_, Y_, PSI_, N_, U_, V_, R_]``, derivatives from z[8] (tau, the rudder-timing offset, is
   held like the derivatives and enters through the rudder angle, see :func:`jacobian_step`).
 
-So one RK4 step (:func:`rk4_step`, the step :func:`mmg.rk4.rk4_step` of every integrator), one exact Jacobian of it (:func:`jacobian_step`: the
-tangent-linear RK4, state columns by complex step of each stage, derivative columns analytic), one
-covariance propagation (:func:`fpft`) and one measurement update (:func:`joseph_update_ws`) serve
+So one RK4 step (:func:`rk4_step`, the step :func:`mmg.rk4.rk4_step` of every integrator), one
+exact Jacobian of it (:func:`jacobian_step`: the tangent-linear RK4, state columns by complex step
+of each stage, derivative columns analytic), one covariance propagation (:func:`fpft`) and one measurement update (:func:`joseph_update_ws`) serve
 both; the only physics is :func:`mmg.model` (:func:`~mmg.model.rhs` and the parts it is made of).
 :func:`jacobian_step_reference` keeps the brute-force complex step (one complex RK4 step per
 column of F, ~5 x slower for the paper filter) as the reference for tests and ``bench/bench_ekf.py``.
@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from mmg._jit import njit
 from mmg.kernel import axpy8
-from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_, dynamics, inverse_mass, rhs_hull_jacobian, rhs_of, track
+from mmg.model import DELTA_, N_, P_WIND_V, PSI_, R_, U_, V_, X_, Y_, dynamics, inverse_mass, rhs_hull_jacobian, rhs_of, track
 from mmg.rk4 import NODES, WEIGHTS
 from mmg.rk4 import rk4_step as rk4
 
@@ -183,8 +183,8 @@ def _slot_roles(slots):
 @njit(cache=True, error_model="numpy", inline="always")
 def _stage(st, dt, e0, e1, g0, g1):
     """(a_s dt, RK4 weight, rudder [rad], its d / d tau [rad/s]) of RK4 stage st (0..3): the node and
-    weight of :func:`mmg.rk4.rk4_step` (:data:`mmg.rk4.NODES`, :data:`mmg.rk4.WEIGHTS`), the rudder linear
-    over the step."""
+    weight of :func:`mmg.rk4.rk4_step` (:data:`mmg.rk4.NODES`, :data:`mmg.rk4.WEIGHTS`); the rudder is
+    linear over the step, so at the nodes 0 and 1 its ends and at the middle nodes their mean."""
     tau = NODES[st]
     if tau == 0.0:
         return tau * dt, WEIGHTS[st], e0, g0
@@ -294,7 +294,9 @@ def jacobian_step(z, rudder, layout, dt, ship, ws):
       (:func:`mmg.model.rhs_hull_jacobian`; the hull forces are linear in them).
 
     Paper filter: 16 complex evaluations of the dynamics a step instead of 64 of rhs; raw-log
-    filter 20 (and 16 cheap ones of the track) instead of 80.
+    filter 20 (and 16 cheap ones of the track) instead of 80.  With a steady true wind in the packed
+    ship (its loads depend on the heading, which :func:`mmg.model.dynamics` does not take) the step is
+    :func:`jacobian_step_reference`'s, which carries the wind through :func:`mmg.model.rhs_of`.
     Arguments and outputs as :func:`jacobian_step_reference`: rudder = (d0, d1, g0, g1), layout =
     (slots, c0, idx, itau), ship = (p, poly, hull_axis, hull_term); ws from
     :func:`make_workspace`: z_next = ws[8], F = ws[9].
@@ -302,6 +304,9 @@ def jacobian_step(z, rudder, layout, dt, ship, ws):
     d0, d1, g0, g1 = rudder
     slots, c0, idx, itau = layout
     p, _, hull_axis, hull_term = ship
+    if p[P_WIND_V] != 0.0:          # a steady wind's loads turn with psi: the whole model's complex step
+        jacobian_step_reference(z, rudder, layout, dt, ship, ws)
+        return
     z_next, F, hc, xr, kr, ks, dK, dKn, B, w = ws[8], ws[9], ws[10], ws[11], ws[13], ws[14], ws[16], ws[17], \
         ws[18], ws[19]
     nz = z.shape[0]

@@ -13,7 +13,7 @@ from .model import DELTA_, ENGINE_CONSTANT_RPM, N_, P_ENGINE, PSI_, R_, U_, V_, 
 from .rk4 import rk4_step
 from .rudder import switch_side
 
-__all__ = ["simulate_kernel", "rk4_step", "axpy8", "ZERO8", "SCHEDULE", "HEADING_SWITCH"]
+__all__ = ["simulate_kernel", "rk4_step", "axpy8", "SCHEDULE", "HEADING_SWITCH"]
 
 SCHEDULE, HEADING_SWITCH = 0, 1
 

@@ -10,8 +10,9 @@ the ship's own (:func:`hull_parameter`, one entry per name of its hull model); t
 of :data:`CONSTANTS`.  Estimators, the writers of ship configs and the samplers loop over this table.
 
 The wind's scale and shape factors and the rudder offset are :mod:`mmg.effects` parameters: their priors
-and bounds are the effects' own (:func:`effect_prior_of`); a fitted wind value is a factor on the loads
-the ship's wind section gives.
+and bounds are the effects' own (:func:`ekf.identify.effect_prior`); a fitted wind value is a factor on the
+loads the ship's wind section gives (:meth:`mmg.effects.Wind.load_factors`), a fitted rudder offset enters
+through the effect's slots (:func:`through_effect`).
 """
 from __future__ import annotations
 
@@ -205,6 +206,7 @@ class ShipParameter:
     apply : callable
         ``apply(packed, slot, value)``: writes a fitted value into a packed ship (a copy: the caller's arrays
         ``p``, ``poly`` and ``hull_coef`` are copies, written in place); :func:`to_slot` by default,
+        :func:`through_effect` for an effect's parameter that the effect writes into the packed ship,
         :func:`not_packed` for a value that acts elsewhere.
     loads : callable or None
         ``loads(factors, slot, value)``: where the value acts on the records' external loads instead

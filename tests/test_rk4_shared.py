@@ -1,7 +1,9 @@
-"""One RK4 step for every integrator: the filters' step (:func:`ekf.kernels.rk4_step`) and the
-simulator's (:func:`mmg.kernel.simulate_kernel`) both take :func:`mmg.rk4.rk4_step`.  Checked here
-against the textbook tableau written out in the test (k1 at t, k2 and k3 at t + dt/2, k4 at t + dt,
-weights 1, 2, 2, 1 over 6) on the model's own right-hand side :func:`mmg.model.rhs`."""
+"""The filters' RK4 step (:func:`ekf.kernels.rk4_step`, which takes the integrators' shared
+:func:`mmg.rk4.rk4_step`) against the textbook tableau written out in the test (k1 at t, k2 and k3 at
+t + dt/2, k4 at t + dt, weights 1, 2, 2, 1 over 6) on the model's own right-hand side
+:func:`mmg.model.rhs`, the states the filter does not propagate held at 0; with and without a steady
+wind, whose loads depend on the heading (which the paper filter holds at 0).  With the wind, the fast
+transition Jacobian (:func:`ekf.kernels.jacobian_step`) must still be the complex-step reference's."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -9,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ekf.kernels import make_workspace, rk4_step
+import mmg.effects as E
+from ekf.kernels import jacobian_step, jacobian_step_reference, make_workspace, rk4_step
 from mmg._jit import readonly
 from mmg.model import DELTA_, N_, PSI_, R_, U_, V_, X_, Y_, rhs
 from mmg.simulation import prepare
@@ -41,10 +44,12 @@ def _textbook_step(x, d0, d1, dt, pk, slots):
     return x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-@pytest.fixture(scope="module")
-def packed():
+@pytest.fixture(scope="module", params=["calm", "steady wind"])
+def packed(request):
     tr = load_trial(REPO / "configs" / "trials" / "zz20.yaml")
     pk, eq = prepare(tr.ship, tr.u0, tr.n0, tr.trim)
+    if request.param == "steady wind":
+        pk = E.Wind.pack(pk, {"scale": 1.0, "true_speed_mps": 25.0, "true_from_deg": 60.0}, tr.ship)
     return pk, eq.state()
 
 
@@ -68,3 +73,22 @@ def test_filter_step_is_the_textbook_rk4(packed, slots):
         np.testing.assert_allclose(ws[7][:c0].real, want.real, rtol=1e-13, atol=1e-15)
         np.testing.assert_allclose(ws[7][:c0].imag, want.imag, rtol=1e-10, atol=1e-45)
         assert np.any(ws[7][:c0].imag != 0)                        # the perturbation was carried
+
+
+def test_the_fast_jacobian_carries_a_steady_wind(packed):
+    pk, x0 = packed
+    rng = np.random.default_rng(8)
+    idx = np.array([0, 3, 5], dtype=np.int64)
+    c0 = len(LOG) + 1                                # x, y, psi, n, u, v, r, then the timing offset
+    nz = c0 + len(idx)
+    ws, wr = make_workspace(np.int64(nz), np.int64(len(LOG)), pk.hull_coef), \
+        make_workspace(np.int64(nz), np.int64(len(LOG)), pk.hull_coef)
+    for _ in range(5):
+        z = np.r_[0.0, 0.0, rng.uniform(-3, 3), x0[N_], x0[U_], x0[U_] * rng.uniform(-0.1, 0.1),
+                  rng.uniform(-0.005, 0.005), 0.1, pk.hull_coef[idx]]
+        rudder = (*rng.uniform(-0.5, 0.5, 2), *rng.uniform(-0.05, 0.05, 2))
+        layout = (LOG, np.int64(c0), idx, np.int64(len(LOG)))
+        jacobian_step(z, rudder, layout, 0.5, pk.args()[:4], ws)
+        jacobian_step_reference(z, rudder, layout, 0.5, pk.args()[:4], wr)
+        np.testing.assert_allclose(ws[8], wr[8], rtol=1e-13, atol=1e-12)
+        np.testing.assert_allclose(ws[9], wr[9], rtol=1e-9, atol=1e-12)
