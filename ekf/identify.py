@@ -14,7 +14,7 @@ cores (threads; the compiled replay releases the GIL).
 The free parameters (:class:`FreeParameter`) are hull coefficients by name and, optionally,
 the ship constants ``"w_P0"`` (the constant term of the wake polynomial: the model-scale wake),
 ``"epsilon"`` (rudder inflow ratio), ``"kappa"`` (the share of the propeller slipstream's speed-up
-that reaches the rudder, Yasukawa & Yoshimura 2015) and ``"X_uu"`` is simply a hull name.  The standard errors
+that reaches the rudder, Yasukawa & Yoshimura 2015) and the others of :mod:`mmg.parameters`.  The standard errors
 are from the Gauss-Newton covariance at the optimum, scaled by the residual variance per
 degree of freedom; correlated residuals (10 Hz samples are not independent) make them optimistic.
 
@@ -199,6 +199,14 @@ def effect_prior(effect, name: str, nm: str | None = None, kind: str = "effect",
                          factor * q.lower, factor * q.upper, sub=j, start=start)
 
 
+def _packed_terms(packed: PackedShip) -> list[str]:
+    """The term expression of each of the packed ship's hull coefficients (:data:`mmg.terms.TERMS`)."""
+    from mmg.terms import TERMS
+
+    name = {i: k for k, i in TERMS.items()}
+    return [name[int(t)] for t in packed.hull_term]
+
+
 def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float | None = None,
                     priors: dict | None = None, hull_terms=()) -> list[FreeParameter]:
     """The :class:`FreeParameter` list for ``names`` (hull coefficient names or :data:`SHIP_CONSTANTS`), from
@@ -209,13 +217,13 @@ def free_parameters(packed: PackedShip, hull_names, names, prior_rel_std: float 
     given, is one relative std for every family instead.  Effect parameters (``"rudder_offset"``,
     ``"wind_scale"`` and the wind's shape factors) take the effects' priors (:func:`effect_prior`).
     ``hull_terms`` (the hull model's term of each name) marks the straight-ahead resistance, bounded to
-    stay negative; without them a coefficient named ``X_uu`` is taken as it."""
+    stay negative; without them the packed ship's own terms tell it."""
     import mmg.effects as E
 
     rel = dict(priors or PRIOR_REL_STD)
     if prior_rel_std is not None:
         rel = {k: float(prior_rel_std) for k in rel}
-    terms = list(hull_terms) or ["cos(beta)^2" if n == "X_uu" else "" for n in hull_names]
+    terms = list(hull_terms) or _packed_terms(packed)
     out = []
     for nm in names:
         spec = parameter(nm, hull_names, terms)

@@ -253,3 +253,12 @@ def test_fitted_values_under_the_configs_keys_prime_the_added_masses():
     assert got["m_x_prime"] == pytest.approx(20.0 / (0.5 * pa.rho * pa.L ** 2 * pa.T), rel=1e-12)
     assert got["J_z_prime"] == pytest.approx(90.0 / (0.5 * pa.rho * pa.L ** 4 * pa.T), rel=1e-12)
     assert got["N_r"] == -0.05 and got["start.u[a]"] == 0.1 and "m_x" not in got
+
+
+def test_without_hull_terms_the_packed_ship_tells_the_resistance():
+    """free_parameters called without ``hull_terms`` bounds the resistance the packed ship's own terms name
+    (X_uu of the Kijima form, X_0 of the KVLCC2's), not a coefficient picked by its name."""
+    for name, res in (("esso_osaka_3m", "X_uu"), ("kvlcc2_l7", "X_0")):
+        ship = mmg.load_ship(name)
+        free = free_parameters(pack(ship), ship.hull.names, list(ship.hull.names))
+        assert [f.name for f in free if f.upper == 0.0] == [res], name
