@@ -327,3 +327,33 @@ def test_the_band_spec_reaches_every_kept_out_records_band_and_none_by_default(m
 def test_a_band_spec_outside_its_range_is_refused(bad):
     with pytest.raises(ValueError, match="BandSpec"):
         N.BandSpec(**bad)
+
+
+class _WindFit:
+    def values(self):
+        return {"wind_scale": 0.5}
+
+
+def test_a_kept_out_records_band_varies_about_the_identified_replay(monkeypatch, forms):
+    """The band of a kept-out record is drawn about the record as the fold's fit replays it: its wind loads
+    (made with the initial ship's wind section) times the fitted wind scale, as its score's replay has them."""
+    ship = forms["kijima"].ship
+    runs = []
+    for r in _runs(ship, n=4)[:4]:
+        ext = np.tile([100.0, 50.0, 1e3], (len(r.inputs.t), 1))
+        runs.append(replace(r, inputs=replace(r.inputs, ext=ext)))
+
+    def fit(ship, train, **kw):
+        return Identification(ship=ship, initial=kw.get("initial") or ship, fit=_WindFit(), runs=list(train),
+                              segment_s=np.inf)
+
+    seen = {}
+    monkeypatch.setattr(N, "fit_model", fit)
+    monkeypatch.setattr(N, "band_sections", lambda ident: (None, None))
+    monkeypatch.setattr(N, "band_ship", lambda ident, spec, initial=None, kw=None: ident.ship)
+    monkeypatch.setattr(N, "band_scores", lambda ident, run, samples, seed=0, sections=None, support="none", ship=None:
+                        seen.setdefault(run.name, run) and {"samples": 1})
+    N.nested_cross_validate({"kijima": forms["kijima"]}, runs, folds=2, bands=N.BandSpec(samples=3))
+    assert sorted(seen) == sorted(r.name for r in runs)
+    for r in runs:
+        np.testing.assert_allclose(seen[r.name].inputs.ext, 0.5 * r.inputs.ext)

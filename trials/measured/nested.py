@@ -150,7 +150,8 @@ def band_sections(ident) -> tuple:
 
 def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None = None,
                 support: str = "physical", ship: Ship | None = None) -> dict:
-    """The 90 % heading band of ``run`` predicted by the identified model ``ident`` (its ship drawn from the
+    """The 90 % heading band of ``run`` (the record as ``ident`` replays it, with its fitted wind factors:
+    :func:`trials.measured.identify.fitted_run`) predicted by the identified model ``ident`` (its ship drawn from the
     covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
     :func:`trials.measured.bands.prediction_bands`; ``sections``: :func:`band_sections` of ``ident``, made
     once for several runs): ``samples`` (the record's), ``inside`` (of them in the band), ``coverage90``,
@@ -280,9 +281,11 @@ def _outer_task(task) -> list[dict]:
     if bands.samples:
         sections = band_sections(ident)                # one covariance and run spread per fold
         ship = band_ship(ident, bands, initial, {**kw, **cand.options})
-        for rec, r in zip(out, tests):
-            rec["band"] = band_scores(ident, r, bands.samples, seed=outer, sections=sections, support=bands.support,
-                                      ship=ship)
+        from .identify import fitted_run
+
+        for rec, r in zip(out, tests):          # the record as the identified model replays it (its wind scale)
+            rec["band"] = band_scores(ident, fitted_run(ident.ship, values, r), bands.samples, seed=outer,
+                                      sections=sections, support=bands.support, ship=ship)
     return out
 
 

@@ -10,7 +10,7 @@ from .fit import (identify, IdentifyOptions, cross_validate, cv_folds, load_runs
                   DEFAULT_FREE, DEFAULT_WEIGHTING, DEFAULT_MAX_NFEV, stage_description, start_noise,
                   DEFAULT_INITIAL_STATE, INITIAL_STATES, fold_of, manoeuvre_class, goes_astern, ASTERN_SHARE,
                   FOLD_ASSIGNMENTS, _bounded_wind, _free_names, same_run_groups, with_fitted_wind, with_ship_effects,
-                  replay_fitted, without_fit_sections)
+                  replay_fitted, fitted_run, without_fit_sections)
 from .covariance import (fit_covariance, identification_covariance, run_covariance, COVARIANCE_METHOD, run_spread,
                          START_UNITS, model_form)
 from .report import write_identification, ship_yaml, fold_spread_json, identification_summary, free_parameter_text
@@ -21,5 +21,5 @@ __all__ = ["identify", "IdentifyOptions",
            "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV",
            "stage_description", "identification_covariance", "run_covariance", "fold_spread_json",
            "COVARIANCE_METHOD", "identification_summary", "start_noise", "DEFAULT_INITIAL_STATE", "run_spread",
-           "START_UNITS", "free_parameter_text", "model_form", "replay_fitted", "without_fit_sections",
+           "START_UNITS", "free_parameter_text", "model_form", "replay_fitted", "fitted_run", "without_fit_sections",
            "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern", "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]

@@ -80,7 +80,7 @@ from ..predict import MeasuredRun, measured_run, replay_record
 __all__ = ["identify", "IdentifyOptions", "cross_validate", "cv_folds", "load_runs", "Identification",
            "ship_with_values", "DEFAULT_FREE", "DEFAULT_WEIGHTING", "DEFAULT_MAX_NFEV", "stage_description",
            "start_noise", "DEFAULT_INITIAL_STATE", "INITIAL_STATES", "fold_of", "manoeuvre_class", "goes_astern",
-           "ASTERN_SHARE", "FOLD_ASSIGNMENTS"]
+           "ASTERN_SHARE", "FOLD_ASSIGNMENTS", "fitted_run"]
 
 
 DEFAULT_FREE = ("hull", "w_P0", "epsilon", "kappa", "gamma_R_pos", "gamma_R_neg", "wind_scale", "Y_P_astern")
@@ -232,7 +232,14 @@ def replay_fitted(ship: Ship, values: dict, run: MeasuredRun):
     """:func:`trials.measured.predict.replay_record` of ``run`` with an identified ``ship`` and its fitted
     ``values`` (:meth:`ekf.identify.IdentifyResult.values`): the record's wind loads scaled by the fitted
     wind factors, the ship's own effects applied."""
-    return replay_record(ship, with_ship_effects(with_fitted_wind(run, values), ship))
+    return replay_record(ship, fitted_run(ship, values, run))
+
+
+def fitted_run(ship: Ship, values: dict, run: MeasuredRun) -> MeasuredRun:
+    """``run`` as the identified ``ship`` with its fitted ``values`` replays it: its wind loads (made with
+    another ship's wind section, e.g. the initial one) scaled by the fitted wind factors, the ship's own
+    effects applied.  What :func:`replay_fitted` replays, and what a band of that fit varies about."""
+    return with_ship_effects(with_fitted_wind(run, values), ship)
 
 
 def with_ship_effects(run: MeasuredRun, ship: Ship) -> MeasuredRun:
