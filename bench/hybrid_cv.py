@@ -89,7 +89,7 @@ def one_fold(task) -> dict:
     from mmg.model import pack
     from trials.measured.hybrid import (CorrectionForm, CorrectionSelection, fit_correction, fit_output_correction,
                                         hybrid_window_scores, replay_hybrid)
-    from trials.measured.identify import with_fitted_wind, with_ship_effects
+    from trials.measured.identify import fitted_run
     from trials.measured.predict import replay_record
     from trials.measured.window import window_scores
 
@@ -98,7 +98,7 @@ def one_fold(task) -> dict:
     tr, te = splits[k]
     ship, values = ident.ship, ident.fit.values()
     packed = pack(ship)
-    prep = lambda r: with_ship_effects(with_fitted_wind(r, values), ship)  # noqa: E731  (as ident.replay has it)
+    prep = lambda r: fitted_run(ship, values, r)  # noqa: E731  (as ident.replay has it)
     corr, fits = {}, {}
     for v in variants:
         t0 = time.perf_counter()

@@ -336,24 +336,38 @@ class _WindFit:
 
 def test_a_kept_out_records_band_varies_about_the_identified_replay(monkeypatch, forms):
     """The band of a kept-out record is drawn about the record as the fold's fit replays it: its wind loads
-    (made with the initial ship's wind section) times the fitted wind scale, as its score's replay has them."""
+    (made with the initial ship's wind section) times the fitted wind scale, so that the band's nominal
+    replay is the replay its score is made of."""
+    from types import SimpleNamespace
+
+    import trials.measured.bands as B
+
     ship = forms["kijima"].ship
     runs = []
     for r in _runs(ship, n=4)[:4]:
         ext = np.tile([100.0, 50.0, 1e3], (len(r.inputs.t), 1))
         runs.append(replace(r, inputs=replace(r.inputs, ext=ext)))
+    idents, seen = [], {}
 
     def fit(ship, train, **kw):
-        return Identification(ship=ship, initial=kw.get("initial") or ship, fit=_WindFit(), runs=list(train),
-                              segment_s=np.inf)
+        idents.append(Identification(ship=ship, initial=kw.get("initial") or ship, fit=_WindFit(),
+                                     runs=list(train), segment_s=np.inf))
+        return idents[-1]
 
-    seen = {}
+    def bands(ship, run, samples, seed=0, **kw):
+        seen[run.name] = (ship, run)
+        t = run.t
+        return SimpleNamespace(t=t, unbounded_share=0.0, coverage90_where_bounded=1.0, coverage90=1.0,
+                               median_width_deg=1.0, draws=samples, diverged=0, rejected=0,
+                               position_coverage90=1.0, median_radius_m=1.0)
+
     monkeypatch.setattr(N, "fit_model", fit)
     monkeypatch.setattr(N, "band_sections", lambda ident: (None, None))
     monkeypatch.setattr(N, "band_ship", lambda ident, spec, initial=None, kw=None: ident.ship)
-    monkeypatch.setattr(N, "band_scores", lambda ident, run, samples, seed=0, sections=None, support="none", ship=None:
-                        seen.setdefault(run.name, run) and {"samples": 1})
+    monkeypatch.setattr(B, "prediction_bands", bands)
     N.nested_cross_validate({"kijima": forms["kijima"]}, runs, folds=2, bands=N.BandSpec(samples=3))
     assert sorted(seen) == sorted(r.name for r in runs)
     for r in runs:
-        np.testing.assert_allclose(seen[r.name].inputs.ext, 0.5 * r.inputs.ext)
+        band_ship, band_run = seen[r.name]
+        np.testing.assert_allclose(band_run.inputs.ext, 0.5 * r.inputs.ext)
+        np.testing.assert_array_equal(replay_record(band_ship, band_run).pred, idents[0].replay(r).pred)

@@ -150,8 +150,9 @@ def band_sections(ident) -> tuple:
 
 def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None = None,
                 support: str = "physical", ship: Ship | None = None) -> dict:
-    """The 90 % heading band of ``run`` (the record as ``ident`` replays it, with its fitted wind factors:
-    :func:`trials.measured.identify.fitted_run`) predicted by the identified model ``ident`` (its ship drawn from the
+    """The 90 % heading band of ``run`` (a record as loaded for the initial ship; the band varies about it as
+    ``ident`` replays it, with its fitted wind factors and effects: :func:`trials.measured.identify.fitted_run`)
+    predicted by the identified model ``ident`` (its ship drawn from the
     covariance ``mmg identify`` would write, each start from the training records' run-to-run spread:
     :func:`trials.measured.bands.prediction_bands`; ``sections``: :func:`band_sections` of ``ident``, made
     once for several runs): ``samples`` (the record's), ``inside`` (of them in the band), ``coverage90``,
@@ -160,8 +161,10 @@ def band_scores(ident, run, samples: int, seed: int = 0, sections: tuple | None 
     position band ``position_inside`` (samples whose logged position lies in it) and ``median_radius_m``; ``ship``:
     ``ident.ship`` with the sections it carries (a model-form term: :func:`band_ship`), ``ident.ship`` by default."""
     from .bands import prediction_bands
+    from .identify import fitted_run
 
     cov, spread = band_sections(ident) if sections is None else sections
+    run = fitted_run(ident.ship, ident.fit.values(), run)
     b = prediction_bands(ident.ship if ship is None else ship, run, samples, seed, covariance=cov, run_spread=spread,
                          jobs=1, support=support)
     n = len(b.t)
@@ -281,11 +284,9 @@ def _outer_task(task) -> list[dict]:
     if bands.samples:
         sections = band_sections(ident)                # one covariance and run spread per fold
         ship = band_ship(ident, bands, initial, {**kw, **cand.options})
-        from .identify import fitted_run
-
-        for rec, r in zip(out, tests):          # the record as the identified model replays it (its wind scale)
-            rec["band"] = band_scores(ident, fitted_run(ident.ship, values, r), bands.samples, seed=outer,
-                                      sections=sections, support=bands.support, ship=ship)
+        for rec, r in zip(out, tests):
+            rec["band"] = band_scores(ident, r, bands.samples, seed=outer, sections=sections, support=bands.support,
+                                      ship=ship)
     return out
 
 
