@@ -21,3 +21,7 @@ class InputError(Exception):
         self.message = str(message)
         where = f"{self.source}: {self.field}" if self.field else self.source
         super().__init__(f"{where}: {self.message}")
+
+    def __reduce__(self):
+        """Pickled by its three fields, so an error raised in a worker process reaches the caller whole."""
+        return (type(self), (self.source, self.field, self.message))

@@ -42,3 +42,18 @@ def test_serial_equals_dask(serial):
 def test_unknown_backend():
     with pytest.raises(ValueError, match="unknown sweep backend"):
         run_sweep(abs, [1], backend="mpi")
+
+
+def _refuse(name):
+    from mmg.errors import InputError
+
+    raise InputError(f"{name}.csv", "u", "looks like knots")
+
+
+def test_an_input_error_in_a_worker_reaches_the_caller_whole():
+    """Raised in a loky worker, the error crosses back by pickle with its file, field and message."""
+    from mmg.errors import InputError
+
+    with pytest.raises(InputError) as e:
+        run_sweep(_refuse, ["run7", "run8"], backend="loky", n_jobs=2, progress=False)
+    assert (e.value.source, e.value.field, e.value.message) in {("run7.csv", "u", "looks like knots"), ("run8.csv", "u", "looks like knots")}
