@@ -110,7 +110,7 @@ def crossflow_N(a, b):
     -------
     float or complex
     """
-    if sabs(a).real >= 0.5 * sabs(b).real:
+    if sabs(a).real >= 0.5 * sabs(b).real or b.real * b.real == 0.0:     # b^2 underflowing: G ~ 0 either way
         s = 1.0 if a.real >= 0.0 else -1.0
         return s * a * b / 6.0
     wp = a + 0.5 * b

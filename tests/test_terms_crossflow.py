@@ -31,6 +31,13 @@ def test_closed_forms_equal_the_quadrature_of_the_strip_integrals(a, b):
     assert crossflow_N(a, b) == pytest.approx(_strip(a, b, True), rel=1e-10, abs=1e-14)
 
 
+@pytest.mark.parametrize("a,b", [(0.0, 5e-217), (1e-200, -3e-190), (0.0, -1e-170), (2e-170, 1e-163)])
+def test_tiny_yaw_rates_give_finite_integrals(a, b):
+    """b^2 underflows to 0 here; the integrals are then 0 to double precision, not 0/0."""
+    assert crossflow_Y(a, b) == pytest.approx(0.0, abs=1e-300)
+    assert crossflow_N(a, b) == pytest.approx(0.0, abs=1e-300)
+
+
 def test_random_states_against_quadrature():
     rng = np.random.default_rng(7)
     for a, b in zip(rng.uniform(-1.5, 1.5, 200), rng.uniform(-3.0, 3.0, 200)):
