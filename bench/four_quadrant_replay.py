@@ -9,7 +9,8 @@ samples with the propeller astern (n < 0) and the ship moving astern (u < 0).  M
 the propeller astern only after 40-250 s, so a second replay starts from the measured state at the
 first astern order (n < 0) and is scored over the 60 s after it ("60 s from n<0").
 
-    python bench/four_quadrant_replay.py [--ship esso_osaka_3m] [--json out.json] [--compare before.json]
+    python bench/four_quadrant_replay.py [--ship esso_osaka_3m] [--hull-astern end_for_end] [--json out.json]
+        [--compare before.json]
 
 ``--compare`` prints the figures of an earlier run (e.g. of the code before a change) beside these.
 """
@@ -65,8 +66,14 @@ def main(argv=None) -> int:
     ap.add_argument("--ship", default="esso_osaka_3m")
     ap.add_argument("--json", help="write the figures to this file")
     ap.add_argument("--compare", help="figures of an earlier run (--json) printed beside these")
+    ap.add_argument("--hull-astern", choices=("as_ahead", "end_for_end"),
+                    help="how the hull acts astern, over the config's hull.astern (mmg.model.astern_factor)")
     a = ap.parse_args(argv)
     ship = load_ship(a.ship)
+    if a.hull_astern:
+        from dataclasses import replace
+
+        ship = replace(ship, hull=replace(ship.hull, astern=a.hull_astern))
     files = sorted(_data().glob("random/*.csv")) + sorted(_data().glob("berthing/*.csv"))
     if not files:
         print(f"no records in {_data()}")

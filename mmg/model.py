@@ -31,7 +31,7 @@ from ._jit import njit
 from ._inlining import hot_loops_only
 from .nondim import force_scale, inertia_scale, mass_scale, moment_scale, r_prime
 from .fourquadrant import N_HARMONICS, atan2_of, b4_70_coefficients, ct_from_kt, fourier_ct, pitch_angle
-from .terms import AXES, TERMS, sabs, term_value
+from .terms import AXES, TERMS, V_PARITY, sabs, term_value
 from .wind import apparent_air_velocity, fujiwara_series
 
 _fujiwara_series = njit(cache=True, error_model="numpy", inline="always")(fujiwara_series)
@@ -64,7 +64,10 @@ P_FQ_A = P_FQ_BLEND + 1
 P_YP_ASTERN = P_FQ_A + 2 * N_HARMONICS
 """Lateral force coefficient of the propeller running astern, Y_P / (rho n^2 D^4) for n < 0
 (:func:`propeller_lateral`; the config's ``propeller.Y_P_astern``)."""
-N_PARAMS = P_YP_ASTERN + 1
+P_HULL_ASTERN = P_YP_ASTERN + 1
+"""1 where the hull's terms act astern as the ship moving ahead turned end for end, 0 where each acts as
+written for ahead (the config's ``hull.astern``; :func:`astern_factor`)."""
+N_PARAMS = P_HULL_ASTERN + 1
 
 LOW_SPEED_FROUDE = 0.01
 """Froude number below which the hull's speed scale is floored (:func:`kinematics`): U_low =
@@ -141,6 +144,7 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0) -> PackedShip:
     p[P_ULOW] = LOW_SPEED_FROUDE * np.sqrt(G * pa.L)
     p[P_FQ_SCALE], p[P_FQ_BLEND], p[P_FQ_A:P_YP_ASTERN] = four_quadrant_slots(pr.K_T, pr.P_D)
     p[P_YP_ASTERN] = pr.Y_P_astern
+    p[P_HULL_ASTERN] = 1.0 if ship.hull.astern == "end_for_end" else 0.0
     poly = _poly_table([pr.K_T, pr.K_Q, pr.t_P, pr.w_P0])
     h = ship.hull
     return PackedShip(
@@ -193,9 +197,11 @@ def kinematics(u, v, r, p):
     meaning (every measured record starts at rest), the speed scale is floored smoothly,
     U_h = (U^2 + U_low^2) / (2 U_low) (equal to U, with equal slope, at U_low; U_low/2 at rest),
     and v' = v/U_h, r' = r L/U_h, beta = atan(-v / sqrt(U_h^2 - v^2)), all bounded at U = 0.
-    Going astern (u < 0, outside the Kijima polynomials' range) beta is atan(-v/|u|), so the sway
-    and yaw damping keep their sign, and :func:`forces_of` turns the surge force with the motion
-    (factor clip(u / U_low, -1, 1)).  The
+    Going astern (u < 0, outside the Kijima polynomials' range) beta is atan(-v/|u|), the flow
+    along the hull as if ahead; with the config's ``hull.astern: end_for_end`` :func:`astern_factor` then
+    turns the terms that change sign with the direction of motion (the Munk moment, the sway force of
+    yawing), and in either case :func:`forces_of` turns the
+    surge force with the motion (factor clip(u / U_low, -1, 1)).  The
     hull forces are the primed forces times 1/2 rho L T U U_h (:func:`hull_scales`), so they fall
     to zero at rest, the quadratic resistance turning linear in U below U_low (a laminar-like
     floor), and the manoeuvring derivatives act as linear damping there, Y = 1/2 rho L T Y_v' v U_h.
@@ -213,7 +219,8 @@ def kinematics(u, v, r, p):
 
 @njit(cache=True, error_model="numpy", inline=hot_loops_only)
 def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
-    """Primed hull forces (X_H', Y_H', N_H') = sum of coefficient x term per axis."""
+    """Primed hull forces (X_H', Y_H', N_H') = sum of coefficient x term per axis, each term as written
+    (ahead; astern with ``hull.astern: as_ahead``; :func:`hull_primed_at` chooses)."""
     X = 0.0 * beta
     Y = 0.0 * beta
     N = 0.0 * beta
@@ -227,6 +234,65 @@ def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
         else:
             N += val
     return X, Y, N
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def hull_primed_at(beta, vp, rp, u, p, hull_axis, hull_term, hull_coef):
+    """Primed hull forces at the surge velocity u [m/s]: :func:`hull_primed`, or moving astern with the
+    config's ``hull.astern: end_for_end`` (``p[P_HULL_ASTERN]``) :func:`hull_primed_astern`."""
+    if p[P_HULL_ASTERN] != 0.0 and u.real < 0.0:
+        return hull_primed_astern(beta, vp, rp, u, p, hull_axis, hull_term, hull_coef)
+    return hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef)
+
+
+@njit(cache=True, error_model="numpy")
+def hull_primed_astern(beta, vp, rp, u, p, hull_axis, hull_term, hull_coef):
+    """:func:`hull_primed` moving astern (u < 0 [m/s]) with ``hull.astern: end_for_end``: each term times
+    its :func:`astern_factor`."""
+    X = 0.0 * beta
+    Y = 0.0 * beta
+    N = 0.0 * beta
+    for i in range(hull_coef.shape[0]):
+        a = hull_axis[i]
+        val = hull_coef[i] * term_value(hull_term[i], beta, vp, rp) * astern_factor(a, hull_term[i], u, p)
+        if a == 0:
+            X += val
+        elif a == 1:
+            Y += val
+        else:
+            N += val
+    return X, Y, N
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def astern_factor(axis, tid, u, p):
+    """Factor on hull term ``tid`` of axis ``axis`` (0 X, 1 Y, 2 N) at the surge velocity u [m/s].
+
+    The hull's terms are written for the ship moving ahead.  Moving astern with sway v and yaw rate r,
+    the flow about the hull is that of the ship moving ahead with sway -v and the same r, turned end
+    for end: (X, Y, N)(u, v, r) = (-X, -Y, N)(|u|, -v, r) for a hull alike at both ends.
+    :func:`kinematics` gives beta and v' of the motion as if ahead (the flow along the hull), so a term
+    even in v (:data:`mmg.terms.V_PARITY`) changes sign astern on Y, an odd one on N: the Munk
+    moment N_v v' and the lift Y_r r' take the sign of u, the damping Y_v and N_r keep theirs.  This
+    is the low-speed hull model of Yoshimura (Y_v v|u| + Y_r r u, N_v v u + N_r r|u|), which the Osaka
+    group fits to this 3 m model.  X's even terms turn with the motion through :func:`surge_sign`
+    (the resistance opposes it); its odd terms (X_vr v r) keep their sign, so this factor turns them back.
+
+    Where the config's ``hull.astern`` is ``as_ahead`` (``p[P_HULL_ASTERN]`` 0, the default) the factor
+    is 1 everywhere: each term acts astern as written for ahead in the flow along the hull.  With
+    ``end_for_end`` it is 1 for u >= 0, so nothing changes ahead.  On Y's even and N's odd terms it runs
+    from 1 at u = 0 linearly to -1 at u = -U_low (``p[P_ULOW]``) and stays there: continuous in u.  On
+    X's odd terms it is -1 for u < 0 (their product with :func:`surge_sign` is continuous, 0 at u = 0).
+    """
+    if u.real >= 0.0 or p[P_HULL_ASTERN] == 0.0:
+        return 1.0 + 0.0 * u
+    par = V_PARITY[tid]
+    if axis == 0:
+        return (-1.0 if par == -1 else 1.0) + 0.0 * u
+    if (axis == 1 and par == 1) or (axis == 2 and par == -1):
+        ul = p[P_ULOW]
+        return (-1.0 + 0.0 * u) if u.real <= -ul else 1.0 + 2.0 * u / ul
+    return 1.0 + 0.0 * u
 
 
 @njit(cache=True, error_model="numpy", inline=hot_loops_only)
@@ -446,7 +512,7 @@ def forces_of(u, v, r, delta, n, p, poly, hull_axis, hull_term, hull_coef):
     """:func:`forces` of the states u, v [m/s], r [rad/s], delta [rad], n [rps] as scalars, each
     real or complex (a complex step in one of them leaves the parts that do not depend on it real)."""
     U, Uh, beta, vp, rp = kinematics(u, v, r, p)
-    XHp, YHp, NHp = hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef)
+    XHp, YHp, NHp = hull_primed_at(beta, vp, rp, u, p, hull_axis, hull_term, hull_coef)
     sX, sY, sN = hull_scales(U, Uh, p)
     owp = one_minus_wake(u, beta, rp, p, poly)
     J, XP, TL = propeller(u, n, owp, p, poly)
@@ -607,8 +673,8 @@ def hull_regressors(x, p, hull_axis, hull_term, idx, out):
     sX = sX * surge_sign(x[U_], p)
     for j in range(idx.shape[0]):
         i = idx[j]
-        val = term_value(hull_term[i], beta, vp, rp)
         a = hull_axis[i]
+        val = term_value(hull_term[i], beta, vp, rp) * astern_factor(a, hull_term[i], x[U_], p)
         out[0, j] = val * sX if a == 0 else 0.0
         out[1, j] = val * sY if a == 1 else 0.0
         out[2, j] = val * sN if a == 2 else 0.0

@@ -17,6 +17,7 @@ any drift angle (``mmg.fourquadrant``, ``mmg.model.propeller`` / ``rudder`` / ``
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -198,9 +199,11 @@ def test_reversed_inflow_reverses_the_rudder_force():
 # ----------------------------------------------------------------------------- hull at any drift angle
 
 
+@pytest.mark.parametrize("astern", ["as_ahead", "end_for_end"])
 @pytest.mark.parametrize("name", ["esso_osaka_3m", "esso_osaka_3m_crossflow"])
-def test_hull_forces_continuous_over_all_drift_angles(name):
-    pk = M.pack(load_ship(name))
+def test_hull_forces_continuous_over_all_drift_angles(name, astern):
+    ship = load_ship(name)
+    pk = M.pack(replace(ship, hull=replace(ship.hull, astern=astern)))
     p, L = pk.p, pk.p[M.P_L]
     U = 0.3
     betas = np.radians(np.arange(0.0, 360.0, 0.05))
@@ -209,7 +212,7 @@ def test_hull_forces_continuous_over_all_drift_angles(name):
         for b in betas:
             u, v = U * math.cos(b), -U * math.sin(b)
             Uk, Uh, beta, vp, rp = M.kinematics(u, v, r, p)
-            X, Y, N = M.hull_primed(beta, vp, rp, pk.hull_axis, pk.hull_term, pk.hull_coef)
+            X, Y, N = M.hull_primed_at(beta, vp, rp, u, p, pk.hull_axis, pk.hull_term, pk.hull_coef)
             sX, sY, sN = M.hull_scales(Uk, Uh, p)
             F.append((X * sX * M.surge_sign(u, p), Y * sY, N * sN / L))
         F = np.array(F)

@@ -52,6 +52,10 @@ class HullModel:
     axes: tuple[str, ...]
     terms: tuple[str, ...]
     values: tuple[float, ...]
+    astern: str = "as_ahead"
+    """How the terms act with the ship moving astern (the config's ``hull.astern``): ``"as_ahead"``, each
+    term of the flow along the hull as written for ahead; ``"end_for_end"``, the ship moving ahead turned
+    end for end (:func:`mmg.model.astern_factor`)."""
 
     def value(self, name: str) -> float:
         """Value of one coefficient."""

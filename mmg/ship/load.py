@@ -118,6 +118,7 @@ class _Coefficient(_Strict):
 class _Hull(_Strict):
     form: str = ""
     coefficients: dict[str, _Coefficient]
+    astern: Literal["as_ahead", "end_for_end"] = "as_ahead"
 
 
 class _Wake(_Strict):
@@ -348,7 +349,7 @@ def _hull(f: _ShipFile, src: str) -> HullModel:
         if axis not in axes:
             raise InputError(src, "hull.coefficients", f"no {axis}_ coefficient: the hull model needs at least one "
                                                        "force term on each of X, Y and N")
-    return HullModel(tuple(names), tuple(axes), tuple(terms), tuple(values))
+    return HullModel(tuple(names), tuple(axes), tuple(terms), tuple(values), f.hull.astern)
 
 
 def _propeller(f: _ShipFile, src: str, pa: Particulars) -> Propeller:
