@@ -130,3 +130,16 @@ def test_the_estimators_hull_jacobian_astern_is_the_complex_step_of_rhs(name):
             M.rhs(x.astype(complex), x[6], p, poly, ha, ht, c, out)
             d = out.imag / 1e-30
             np.testing.assert_allclose(B[:, j], d[[M.U_, M.V_, M.R_]], rtol=1e-12, atol=1e-12 * np.abs(d).max())
+
+
+def test_the_parity_table_is_the_terms_own():
+    """Each registered term evaluated at (-beta, -v', r') against (beta, v', r') at two generic points:
+    the ratio is the table's parity, so a term added without its right parity fails here."""
+    from mmg.terms import TERMS, V_PARITY, term_value
+
+    assert len(V_PARITY) == len(TERMS)
+    for key, tid in TERMS.items():
+        for b, v, r in ((0.31, -0.27, 0.43), (-0.12, 0.4, -0.77)):
+            a, m = term_value(tid, b, v, r), term_value(tid, -b, -v, r)
+            assert a != 0.0, key
+            assert m == pytest.approx(V_PARITY[tid] * a, rel=1e-12), key
