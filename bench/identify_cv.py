@@ -278,6 +278,9 @@ def summary_lines(res) -> list[str]:
                        "position part where the ship carries one): "
                        f"{100 * s['band_position_coverage90']:.1f} % of the samples inside, median radius "
                        f"{s['band_median_radius_m']:.3g} m (median over the records)")
+    if s.get("band_refused_records"):
+        out.append(f"bands refused on {s['band_refused_records']} kept-out records (their fold's covariance admits "
+                   "no ship in the support, as mmg predict --samples would say) and left out of the band figures")
     for key, words in (("heading_rms_deg", "heading RMS [deg]"), ("yaw_rate_rms_degps", "yaw-rate RMS [deg/s]"),
                        ("speed_rms_mps", "speed RMS [m/s]"), ("final_position_error_L", "final position error [L]")):
         spans = ((key, "whole record"), (key + tag, f"first {res.horizon_s:g} s"), ("window_" + key, "60 s windows"))

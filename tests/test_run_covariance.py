@@ -135,6 +135,19 @@ def test_kept_out_bands_pool_samples_inside_over_all_samples():
     assert s["band_position_coverage90"] == pytest.approx(360 / 450) and s["band_median_radius_m"] == 3.0
 
 
+def test_refused_bands_are_counted_and_left_out_of_the_pooled_figures():
+    """A kept-out record whose fold's covariance admits no ship (``band_refused``) is counted apart and does
+    not enter the coverage, so a pooled figure never silently covers fewer records than it names."""
+    from trials.measured.nested import band_summary
+
+    ok = {"band": {"samples": 100, "inside": 80, "bounded": 100, "inside_bounded": 80, "median_width_deg": 6.0}}
+    s = band_summary([ok, {"name": "r", "band_refused": "covariance.matrix: none of 10000 ships drawn"}])
+    assert s["band_refused_records"] == 1 and s["band_records"] == 1
+    assert s["band_coverage90"] == pytest.approx(0.8)
+    assert band_summary([{"band_refused": "x"}, {"band_refused": "y"}]) == {"band_refused_records": 2}
+    assert band_summary([ok])["band_refused_records"] == 0
+
+
 def test_a_folds_band_of_a_kept_out_record_draws_from_its_fit():
     """band_scores of a record the fit did not see: the ship drawn from the fit's written covariance and the
     start from its run-to-run spread, so the band has width; its inside count is its coverage times its samples."""

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from mmg.ship import Ship
+from mmg.errors import InputError
 
 from .predict import MeasuredRun, replay_record
 
@@ -186,13 +187,15 @@ def band_summary(records: list[dict]) -> dict:
     support over all candidates, pooled over the records); where every record carries them also
     ``band_position_coverage90`` (samples inside the position band over all samples) and
     ``band_median_radius_m`` (the median over the records of each one's median radius [m]); {} where none
-    carries a band."""
+    carries a band; ``band_refused_records`` counts the records whose band ``mmg predict --samples`` would
+    refuse (their fold's covariance admits no ship in the support: ``band_refused``), left out of the rest."""
+    refused = sum(1 for r in records if r.get("band_refused"))
     b = [r["band"] for r in records if r.get("band")]
     if not b:
-        return {}
+        return {"band_refused_records": refused} if refused else {}
     n = sum(x["samples"] for x in b)
     nb = sum(x.get("bounded", x["samples"]) for x in b)
-    return {"band_coverage90": sum(x["inside"] for x in b) / n,
+    return {"band_coverage90": sum(x["inside"] for x in b) / n, "band_refused_records": refused,
             "band_median_width_deg": float(np.median([x["median_width_deg"] for x in b])), "band_records": len(b),
             "band_unbounded_share": 1.0 - nb / n,
             "band_coverage90_where_bounded": (sum(x.get("inside_bounded", x["inside"]) for x in b) / nb) if nb else
@@ -285,8 +288,11 @@ def _outer_task(task) -> list[dict]:
         sections = band_sections(ident)                # one covariance and run spread per fold
         ship = band_ship(ident, bands, initial, {**kw, **cand.options})
         for rec, r in zip(out, tests):
-            rec["band"] = band_scores(ident, r, bands.samples, seed=outer, sections=sections, support=bands.support,
-                                      ship=ship)
+            try:
+                rec["band"] = band_scores(ident, r, bands.samples, seed=outer, sections=sections,
+                                          support=bands.support, ship=ship)
+            except InputError as e:                # the fold's covariance admits no ship to draw
+                rec["band_refused"] = str(e)
     return out
 
 
