@@ -67,6 +67,9 @@ def _args(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--hull", choices=("auto", *HULL_FORMS), default="auto",
                     help="the hull form: chosen in each fold by the inner CV (auto, default) or fixed")
+    ap.add_argument("--hull-astern", choices=("as_ahead", "end_for_end"),
+                    help="how the hull acts astern in every ship of the run, the scaled one included, over the "
+                         "configs' hull.astern (mmg.model.astern_factor)")
     ap.add_argument("--folds", type=int, default=4, help="outer folds (default 4)")
     ap.add_argument("--inner-folds", type=int, default=2, help="inner folds of the choice (default 2)")
     ap.add_argument("--records", nargs="+", choices=SUBSETS, default=list(SUBSETS),
@@ -321,6 +324,12 @@ def main(argv=None) -> None:
     forms = tuple(HULL_FORMS) if a.hull == "auto" else (a.hull,)
     cands = candidates(forms, a.prior, a.initial_state or (None,))
     initial = mmg.load_ship(INITIAL)
+    if a.hull_astern:
+        from dataclasses import replace
+
+        astern = lambda s: replace(s, hull=replace(s.hull, astern=a.hull_astern))  # noqa: E731
+        cands = {k: replace(c, ship=astern(c.ship)) for k, c in cands.items()}
+        initial = astern(initial)
     opts = _options(a)
     runs = load_runs(initial, files, wind=opts["wind"])
     if a.offset_spread_of is not None:
@@ -328,7 +337,7 @@ def main(argv=None) -> None:
         return
     print(f"nested cross-validation: {len(runs)} records ({', '.join(a.records)}), {a.folds} outer folds, "
           f"hull {a.hull} ({' / '.join(c.ship.name for c in cands.values())}), inner folds {a.inner_folds}, "
-          f"scored against {initial.name}; wind {a.wind}; free {a.free or 'default'}; "
+          f"scored against {initial.name}; hull astern {initial.hull.astern}; wind {a.wind}; free {a.free or 'default'}; "
           f"prior {' / '.join(f'{p:g}' for p in a.prior)}; "
           f"weighting {a.weighting or 'default'}; folds by {a.folds_by}; backend {a.backend} ({a.jobs} jobs)", flush=True)
     t0 = time.perf_counter()
