@@ -42,6 +42,8 @@ def check_ship(ship, packed) -> None:
         raise ValueError("kernel is specialised to Kijima wake, constant power and x_G = 0")
     if p[M.P_YP_ASTERN] != 0.0:
         raise ValueError("kernel has no propeller walk astern (propeller.Y_P_astern must be 0)")
+    if p[M.P_HULL_ASTERN] != 0.0:
+        raise ValueError("kernel takes the hull astern as ahead (hull.astern must be as_ahead)")
 
 
 @njit(cache=True, error_model="numpy", nogil=True)

@@ -144,6 +144,8 @@ def pack(ship: "mmg.ship.Ship", engine_power_W: float = 0.0) -> PackedShip:
     p[P_ULOW] = LOW_SPEED_FROUDE * np.sqrt(G * pa.L)
     p[P_FQ_SCALE], p[P_FQ_BLEND], p[P_FQ_A:P_YP_ASTERN] = four_quadrant_slots(pr.K_T, pr.P_D)
     p[P_YP_ASTERN] = pr.Y_P_astern
+    if ship.hull.astern not in ("as_ahead", "end_for_end"):
+        raise ValueError(f"hull.astern {ship.hull.astern!r}: expected as_ahead or end_for_end")
     p[P_HULL_ASTERN] = 1.0 if ship.hull.astern == "end_for_end" else 0.0
     poly = _poly_table([pr.K_T, pr.K_Q, pr.t_P, pr.w_P0])
     h = ship.hull

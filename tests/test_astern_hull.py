@@ -139,7 +139,17 @@ def test_the_parity_table_is_the_terms_own():
 
     assert len(V_PARITY) == len(TERMS)
     for key, tid in TERMS.items():
-        for b, v, r in ((0.31, -0.27, 0.43), (-0.12, 0.4, -0.77)):
+        for b, v, r in ((0.31, -0.27, 0.43), (-0.12, 0.4, -0.77), (0.05, 0.05, 0.6)):   # the last: |v'| < |r'|/2
             a, m = term_value(tid, b, v, r), term_value(tid, -b, -v, r)
             assert a != 0.0, key
             assert m == pytest.approx(V_PARITY[tid] * a, rel=1e-12), key
+
+
+def test_a_mismatch_ship_keeps_its_hulls_astern_rule():
+    """The mismatch family perturbs the coefficients, not how the hull acts astern."""
+    from trials.measured.mismatch import mismatch_ship
+
+    ship = _end_for_end("esso_osaka_3m")
+    assert mismatch_ship(ship, np.random.default_rng(3)).hull.astern == "end_for_end"
+    with pytest.raises(ValueError, match="hull.astern"):
+        M.pack(replace(ship, hull=replace(ship.hull, astern="mirrored")))

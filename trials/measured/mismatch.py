@@ -194,7 +194,7 @@ def _hull(ship: Ship, rng, spec: MismatchSpec, crossflow: bool):
         if term != "1" or linear:
             factors[name] = _factor(rng, spec.hull_linear if linear else spec.hull_nonlinear)
     hull = HullModel(names=tuple(r[0] for r in rows), axes=tuple(r[1] for r in rows), terms=tuple(r[2] for r in rows),
-                     values=tuple(r[3] * factors.get(r[0], 1.0) for r in rows))
+                     values=tuple(r[3] * factors.get(r[0], 1.0) for r in rows), astern=h.astern)
     return hull, factors
 
 
