@@ -227,15 +227,18 @@ def hull_primed(beta, vp, rp, hull_axis, hull_term, hull_coef):
     Y = 0.0 * beta
     N = 0.0 * beta
     for i in range(hull_coef.shape[0]):
-        val = hull_coef[i] * term_value(hull_term[i], beta, vp, rp)
-        a = hull_axis[i]
-        if a == 0:
-            X += val
-        elif a == 1:
-            Y += val
-        else:
-            N += val
+        X, Y, N = _on_axis(hull_axis[i], hull_coef[i] * term_value(hull_term[i], beta, vp, rp), X, Y, N)
     return X, Y, N
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _on_axis(a, val, X, Y, N):
+    """(X, Y, N) with ``val`` added to axis ``a`` (0 X, 1 Y, 2 N)."""
+    if a == 0:
+        return X + val, Y, N
+    if a == 1:
+        return X, Y + val, N
+    return X, Y, N + val
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -257,12 +260,7 @@ def hull_primed_astern(beta, vp, rp, u, p, hull_axis, hull_term, hull_coef):
     for i in range(hull_coef.shape[0]):
         a = hull_axis[i]
         val = hull_coef[i] * term_value(hull_term[i], beta, vp, rp) * astern_factor(a, hull_term[i], u, p)
-        if a == 0:
-            X += val
-        elif a == 1:
-            Y += val
-        else:
-            N += val
+        X, Y, N = _on_axis(a, val, X, Y, N)
     return X, Y, N
 
 
