@@ -71,9 +71,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     ship = load_ship(a.ship)
     if a.hull_astern:
-        from dataclasses import replace
-
-        ship = replace(ship, hull=replace(ship.hull, astern=a.hull_astern))
+        ship = ship.with_hull_astern(a.hull_astern)
     files = sorted(_data().glob("random/*.csv")) + sorted(_data().glob("berthing/*.csv"))
     if not files:
         print(f"no records in {_data()}")

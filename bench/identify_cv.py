@@ -327,9 +327,8 @@ def main(argv=None) -> None:
     if a.hull_astern:
         from dataclasses import replace
 
-        astern = lambda s: replace(s, hull=replace(s.hull, astern=a.hull_astern))  # noqa: E731
-        cands = {k: replace(c, ship=astern(c.ship)) for k, c in cands.items()}
-        initial = astern(initial)
+        cands = {k: replace(c, ship=c.ship.with_hull_astern(a.hull_astern)) for k, c in cands.items()}
+        initial = initial.with_hull_astern(a.hull_astern)
     opts = _options(a)
     runs = load_runs(initial, files, wind=opts["wind"])
     if a.offset_spread_of is not None:

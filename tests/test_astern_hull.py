@@ -29,8 +29,7 @@ from .conftest import CONFIGS
 
 
 def _end_for_end(name):
-    ship = load_ship(name)
-    return replace(ship, hull=replace(ship.hull, astern="end_for_end"))
+    return load_ship(name).with_hull_astern("end_for_end")
 
 
 def _hull_forces(pk, u, v, r):

@@ -17,7 +17,6 @@ any drift angle (``mmg.fourquadrant``, ``mmg.model.propeller`` / ``rudder`` / ``
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -202,8 +201,7 @@ def test_reversed_inflow_reverses_the_rudder_force():
 @pytest.mark.parametrize("astern", ["as_ahead", "end_for_end"])
 @pytest.mark.parametrize("name", ["esso_osaka_3m", "esso_osaka_3m_crossflow"])
 def test_hull_forces_continuous_over_all_drift_angles(name, astern):
-    ship = load_ship(name)
-    pk = M.pack(replace(ship, hull=replace(ship.hull, astern=astern)))
+    pk = M.pack(load_ship(name).with_hull_astern(astern))
     p, L = pk.p, pk.p[M.P_L]
     U = 0.3
     betas = np.radians(np.arange(0.0, 360.0, 0.05))

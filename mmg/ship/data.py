@@ -392,3 +392,9 @@ class Ship:
     def with_hull(self, changes: dict[str, float]) -> "Ship":
         """A copy with some hull coefficients changed (e.g. for sensitivity)."""
         return replace(self, hull=self.hull.with_values(changes))
+
+    def with_hull_astern(self, rule: str) -> "Ship":
+        """A copy whose hull acts astern by ``rule``, ``"as_ahead"`` or ``"end_for_end"`` (:attr:`HullModel.astern`)."""
+        if rule not in ("as_ahead", "end_for_end"):
+            raise ValueError(f"hull.astern {rule!r}: expected as_ahead or end_for_end")
+        return replace(self, hull=replace(self.hull, astern=rule))
