@@ -8,10 +8,11 @@ import numpy as np
 
 from .decision import MAGNITUDE_UNITS, evidence_short, over_floor
 from .options import DiagnoseOptions
+from .report import format_values
 from .rules import rule
 from .statistics import _effect_index, _taus
 
-__all__ = ["verdicts", "to_demote", "withheld", "rivals_withheld", "weak_evidence", "within_mismatch"]
+__all__ = ["verdicts", "to_demote", "withheld", "rivals_withheld", "absorbed", "weak_evidence", "within_mismatch"]
 
 
 def to_demote(table) -> list:
@@ -60,7 +61,7 @@ def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()
         {"effect": k, "confused_with": ["the ship's own coefficients"], "correlation": None,
          "what_would_separate": "a longer record, or one where the effect is larger", "reason": why,
          "reason_kind": "evidence"}
-        for k, why in weak.items()] + rivals_withheld(rounds)   # those assess could not assess (a singular information)
+        for k, why in weak.items()] + rivals_withheld(rounds) + absorbed(rounds)   # those assess could not assess
     out = list(entries)
     have |= set(named)
     for e in extra:
@@ -87,10 +88,52 @@ def rivals_withheld(rounds) -> list:
             for rnd in rounds for w in rnd.get("withheld", [])]
 
 
-def _rival_entry(effect: str, other: str, reason: str) -> dict:
-    return {"effect": effect, "confused_with": [other], "correlation": None,
-            "what_would_separate": "a record where they act differently: the mirror turn or a zigzag, or a longer "
-                                   "straight run", "reason": reason, "reason_kind": "rival"}
+def absorbed(rounds) -> list:
+    """``not_identifiable`` entries (kind "rival") of the candidates that another effect, one with shape
+    terms (:func:`has_shape_terms`: the wind's), took the evidence of: a candidate that cleared every
+    naming test in the round the shaped effect was named, at a size of at least its detection size
+    (:attr:`mmg.effects.Effect.detection_size`), and no longer cleared them in the last round it was
+    tried, beside it.  The shape terms are free within their priors to follow a load curve that is not
+    the regression's, so they can take the candidate's signature (a strong wind's shape takes a rudder
+    offset's): the candidate's value beside the shaped effect is that fit's, with its signature already
+    inside it, and the records do not say whether it is there as well.  Between effects without shape
+    terms (a current and a heading bias) the joint fit separates them by their physics, and its value
+    stands."""
+    import mmg.effects as E
+
+    out = {}
+    for i, rnd in enumerate(rounds[:-1]):
+        taken = [e for e in rounds[i + 1].get("model", []) if e not in rnd.get("model", [])]
+        shaped = [e for e in taken if has_shape_terms(E.get(e))]
+        for c in rnd["candidates"] if shaped else ():
+            eff = c["effect"]
+            if (not c["clears_threshold"] or eff in taken or eff in out
+                    or abs(c["magnitude"]) < E.get(eff).detection_size[0]):
+                continue
+            last = next((x for r in reversed(rounds[i + 1:]) for x in r["candidates"] if x["effect"] == eff), None)
+            if last is None or last["clears_threshold"]:
+                continue
+            out[eff] = _rival_entry(eff, shaped[0], (
+                f"on its own it cleared every test ({format_values(eff, c['parameters'])}, dBIC "
+                f"{c['delta_bic']:.3g}, z {c['z']:.3g}); beside {shaped[0]}, whose shape terms can take its signature, "
+                f"it falls to dBIC {last['delta_bic']:.3g}, z {last['z']:.3g} ({format_values(eff, last['parameters'])}): "
+                f"these records do not say whether {eff} is there as well"),
+                "a record where they act differently: the same manoeuvre on another heading to the wind, "
+                "or the mirror manoeuvre")
+    return list(out.values())
+
+
+def has_shape_terms(cls) -> bool:
+    """Whether an effect fits parameters beyond its presence ones (:meth:`mmg.effects.Effect.presence_parameters`):
+    shape terms that only shape an effect that is there (the wind's ``sway_factor``, ``yaw_factor``, ``yaw_sin``)."""
+    return bool({p.name for p in cls.fit_parameters()} - set(cls.presence_parameters()))
+
+
+def _rival_entry(effect: str, other: str, reason: str,
+                 what: str = "a record where they act differently: the mirror turn or a zigzag, or a longer "
+                             "straight run") -> dict:
+    return {"effect": effect, "confused_with": [other], "correlation": None, "what_would_separate": what,
+            "reason": reason, "reason_kind": "rival"}
 
 
 def weak_evidence(rounds) -> dict:
