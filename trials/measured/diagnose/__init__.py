@@ -100,7 +100,7 @@ from .result import (CHANNELS, Diagnosis, absent_table, model_form_mismatch, shi
                      straight_run_table, _describe)
 from .search import _covered, _rival, straight_contradicts  # noqa: F401
 from .statistics import _delta_bic, _effect_report, _tau  # noqa: F401
-from .verdicts import _demote, rivals_withheld, to_demote, weak_evidence, withheld, within_mismatch  # noqa: F401
+from .verdicts import _demote, absorbed, rivals_withheld, to_demote, weak_evidence, withheld, within_mismatch  # noqa: F401
 
 __all__ = ["diagnose", "DiagnoseOptions", "Diagnosis", "straight_run_table", "straight_contradicts",
            "prepare", "synthetic_record", "Manoeuvre", "RecordNoise", "write_frt_csv",

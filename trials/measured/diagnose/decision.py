@@ -63,7 +63,8 @@ STATISTICAL_REASON = "its standard error and correlation"
 not have shown the size to detect: :func:`trials.measured.diagnose.identifiability.verdict`), as against its
 calibrated floor, its evidence or too little information."""
 
-REASON_KINDS = ("statistics", "floor", "evidence", "information", "rival", "straight_run", "coefficients")
+REASON_KINDS = ("statistics", "floor", "evidence", "information", "rival", "straight_run", "coefficients",
+                "absorbed")
 """The kinds of ``not_identifiable`` reasons, each entry's ``reason_kind``: its standard error and
 confounding (:data:`STATISTICAL_REASON`), the calibrated floor (the ship's own mismatch lends it as much),
 evidence short of a name, too little information (:func:`trials.measured.diagnose.identifiability.verdict`,
@@ -71,7 +72,9 @@ evidence short of a name, too little information (:func:`trials.measured.diagnos
 name withheld because another candidate with as much evidence takes its evidence away
 (:func:`trials.measured.diagnose.withheld`), or whose fit the record's straight run contradicts
 (:func:`trials.measured.diagnose.straight_contradicts`), or a coefficient effect not fitted because the fit
-frees every coefficient it changes (:func:`trials.measured.diagnose._covered`)."""
+frees every coefficient it changes (:func:`trials.measured.diagnose._covered`), or one that cleared every
+test in the round the wind was named and lost its evidence to the wind's shape terms
+(:func:`trials.measured.diagnose.verdicts.absorbed`)."""
 
 MAGNITUDE_UNITS = {n: c.magnitude_unit for n, c in E.REGISTRY.items()}
 """The unit of each effect's :func:`magnitude` (:attr:`mmg.effects.Effect.magnitude_unit`)."""

@@ -61,7 +61,7 @@ def _identifiability(fitter, current, named, cand, o: DiagnoseOptions, rounds=()
         {"effect": k, "confused_with": ["the ship's own coefficients"], "correlation": None,
          "what_would_separate": "a longer record, or one where the effect is larger", "reason": why,
          "reason_kind": "evidence"}
-        for k, why in weak.items()] + rivals_withheld(rounds) + absorbed(rounds)   # those assess could not assess
+        for k, why in weak.items()] + rivals_withheld(rounds) + absorbed(rounds, named)   # those assess could not assess
     out = list(entries)
     have |= set(named)
     for e in extra:
@@ -88,38 +88,39 @@ def rivals_withheld(rounds) -> list:
             for rnd in rounds for w in rnd.get("withheld", [])]
 
 
-def absorbed(rounds) -> list:
-    """``not_identifiable`` entries (kind "rival") of the candidates that another effect, one with shape
-    terms (:func:`has_shape_terms`: the wind's), took the evidence of: a candidate that cleared every
-    naming test in the round the shaped effect was named, at a size of at least its detection size
-    (:attr:`mmg.effects.Effect.detection_size`), and no longer cleared them in the last round it was
-    tried, beside it.  The shape terms are free within their priors to follow a load curve that is not
-    the regression's, so they can take the candidate's signature (a strong wind's shape takes a rudder
-    offset's): the candidate's value beside the shaped effect is that fit's, with its signature already
-    inside it, and the records do not say whether it is there as well.  Between effects without shape
-    terms (a current and a heading bias) the joint fit separates them by their physics, and its value
-    stands."""
+def absorbed(rounds, named) -> list:
+    """``not_identifiable`` entries (kind "absorbed") of the candidates whose evidence the wind took: an
+    effect with shape terms (:func:`has_shape_terms`: the wind's) named in some round and still named at
+    the end (``named``), and a candidate that cleared every naming test in that round, at a size of at
+    least its detection size (:attr:`mmg.effects.Effect.detection_size`), and no longer cleared them in the
+    next round, beside it and the effects named before it.  The shape terms are free within their priors
+    to follow a load curve that is not the regression's, so they can take part of the candidate's signature
+    (of a rudder offset's most, ``bench/wind_alias.py``): its value in that fit is no evidence that it is
+    absent, and the records do not say whether it is there as well.  Between effects without shape terms (a
+    current and a heading bias) the joint fit separates them by their physics, and its value stands."""
     import mmg.effects as E
 
     out = {}
     for i, rnd in enumerate(rounds[:-1]):
-        taken = [e for e in rounds[i + 1].get("model", []) if e not in rnd.get("model", [])]
-        shaped = [e for e in taken if has_shape_terms(E.get(e))]
-        for c in rnd["candidates"] if shaped else ():
-            eff = c["effect"]
-            if (not c["clears_threshold"] or eff in taken or eff in out
-                    or abs(c["magnitude"]) < E.get(eff).detection_size[0]):
+        nxt = rounds[i + 1]
+        taken = [e for e in nxt.get("model", []) if e not in rnd.get("model", [])]
+        shaped = [e for e in taken if e in named and has_shape_terms(E.get(e))]
+        beside = {x["effect"]: x for x in nxt["candidates"]} if shaped else {}
+        for c in rnd["candidates"]:
+            eff, after = c["effect"], beside.get(c["effect"])
+            if (after is None or after["clears_threshold"] or not c["clears_threshold"] or eff in named
+                    or eff in out or abs(c["magnitude"]) < E.get(eff).detection_size[0]):
                 continue
-            last = next((x for r in reversed(rounds[i + 1:]) for x in r["candidates"] if x["effect"] == eff), None)
-            if last is None or last["clears_threshold"]:
-                continue
-            out[eff] = _rival_entry(eff, shaped[0], (
-                f"on its own it cleared every test ({format_values(eff, c['parameters'])}, dBIC "
-                f"{c['delta_bic']:.3g}, z {c['z']:.3g}); beside {shaped[0]}, whose shape terms can take its signature, "
-                f"it falls to dBIC {last['delta_bic']:.3g}, z {last['z']:.3g} ({format_values(eff, last['parameters'])}): "
-                f"these records do not say whether {eff} is there as well"),
-                "a record where they act differently: the same manoeuvre on another heading to the wind, "
-                "or the mirror manoeuvre")
+            before = f" beside {', '.join(rnd['model'])}" if rnd.get("model") else ""
+            out[eff] = {"effect": eff, "confused_with": [shaped[0]], "correlation": None,
+                        "what_would_separate": "a record where they act differently: the same manoeuvre on another "
+                                               "heading to the wind, or the mirror manoeuvre",
+                        "reason": (f"in round {rnd.get('round', i + 1)}{before} it cleared every test "
+                                   f"({format_values(eff, c['parameters'])}, dBIC {c['delta_bic']:.3g}, z {c['z']:.3g}); "
+                                   f"once {shaped[0]} was named, it fell to dBIC {after['delta_bic']:.3g}, z "
+                                   f"{after['z']:.3g} ({format_values(eff, after['parameters'])}): {shaped[0]}'s shape "
+                                   f"terms took its evidence, so these records do not say whether {eff} is there too"),
+                        "reason_kind": "absorbed"}
     return list(out.values())
 
 
@@ -129,11 +130,10 @@ def has_shape_terms(cls) -> bool:
     return bool({p.name for p in cls.fit_parameters()} - set(cls.presence_parameters()))
 
 
-def _rival_entry(effect: str, other: str, reason: str,
-                 what: str = "a record where they act differently: the mirror turn or a zigzag, or a longer "
-                             "straight run") -> dict:
-    return {"effect": effect, "confused_with": [other], "correlation": None, "what_would_separate": what,
-            "reason": reason, "reason_kind": "rival"}
+def _rival_entry(effect: str, other: str, reason: str) -> dict:
+    return {"effect": effect, "confused_with": [other], "correlation": None,
+            "what_would_separate": "a record where they act differently: the mirror turn or a zigzag, or a longer "
+                                   "straight run", "reason": reason, "reason_kind": "rival"}
 
 
 def weak_evidence(rounds) -> dict:
