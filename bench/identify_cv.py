@@ -86,6 +86,9 @@ def _args(argv=None):
                          "or by manoeuvre (trials.measured.identify.manoeuvre_class)")
     ap.add_argument("--max-nfev", type=int, default=None,
                     help="evaluation limit of each fit stage (default: trials.measured.identify.DEFAULT_MAX_NFEV)")
+    ap.add_argument("--segment-s", type=float, nargs="+", default=None, metavar="S",
+                    help="segment length [s] of each fit stage, inf for the whole record (identify(segment_s=); "
+                         "default trials.measured.identify.DEFAULT_SEGMENTS_L: 52 sqrt(L/g), then the whole record)")
     ap.add_argument("--velocity-weight", type=float, default=1.0,
                     help="weight of the u, v, r residuals beside the heading's (identify(velocity_weight=))")
     ap.add_argument("--nuisance", nargs="+", default=(), metavar="EFFECT",
@@ -130,6 +133,8 @@ def _options(a) -> dict:
         extra["velocity_weight"] = a.velocity_weight
     if a.max_nfev:
         extra["max_nfev"] = a.max_nfev
+    if a.segment_s:
+        extra["segment_s"] = tuple(a.segment_s)
     if a.initial_state and len(a.initial_state) == 1:
         extra["initial_state"] = a.initial_state[0]
     return extra
@@ -337,7 +342,7 @@ def main(argv=None) -> None:
     print(f"nested cross-validation: {len(runs)} records ({', '.join(a.records)}), {a.folds} outer folds, "
           f"hull {a.hull} ({' / '.join(c.ship.name for c in cands.values())}), inner folds {a.inner_folds}, "
           f"scored against {initial.name}; hull astern {initial.hull.astern}; wind {a.wind}; free {a.free or 'default'}; "
-          f"prior {' / '.join(f'{p:g}' for p in a.prior)}; "
+          f"segments {a.segment_s or 'default'} s; prior {' / '.join(f'{p:g}' for p in a.prior)}; "
           f"weighting {a.weighting or 'default'}; folds by {a.folds_by}; backend {a.backend} ({a.jobs} jobs)", flush=True)
     t0 = time.perf_counter()
     res = nested_cross_validate(cands, runs, folds=a.folds, inner_folds=a.inner_folds, initial=initial,
