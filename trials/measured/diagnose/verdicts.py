@@ -97,7 +97,21 @@ def absorbed(rounds, named) -> list:
     to follow a load curve that is not the regression's, so they can take part of the candidate's signature
     (of a rudder offset's most, ``bench/wind_alias.py``): its value in that fit is no evidence that it is
     absent, and the records do not say whether it is there as well.  Between effects without shape terms (a
-    current and a heading bias) the joint fit separates them by their physics, and its value stands."""
+    current and a heading bias) the joint fit separates them by their physics, and its value stands.
+
+    Parameters
+    ----------
+    rounds : list of dict
+        The search's rounds (:func:`~.search.search`): ``round``, ``model`` (the effects named before it),
+        ``candidates`` (``effect``, ``delta_bic``, ``z``, ``magnitude``, ``clears_threshold``, ``parameters``).
+    named : sequence of str
+        The effects named at the end.
+
+    Returns
+    -------
+    list of dict
+        One ``not_identifiable`` entry per such candidate (``effect``, ``confused_with``, ``correlation``
+        None, ``what_would_separate``, ``reason``, ``reason_kind`` ``"absorbed"``)."""
     import mmg.effects as E
 
     out = {}
@@ -126,7 +140,17 @@ def absorbed(rounds, named) -> list:
 
 def has_shape_terms(cls) -> bool:
     """Whether an effect fits parameters beyond its presence ones (:meth:`mmg.effects.Effect.presence_parameters`):
-    shape terms that only shape an effect that is there (the wind's ``sway_factor``, ``yaw_factor``, ``yaw_sin``)."""
+    shape terms that only shape an effect that is there (the wind's ``sway_factor``, ``yaw_factor``, ``yaw_sin``).
+
+    Parameters
+    ----------
+    cls : type
+        An effect class (:class:`mmg.effects.Effect`).
+
+    Returns
+    -------
+    bool
+    """
     return bool({p.name for p in cls.fit_parameters()} - set(cls.presence_parameters()))
 
 
