@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .decision import MAGNITUDE_UNITS, evidence_short, over_floor
+from .identifiability import _size_of
 from .options import DiagnoseOptions
 from .report import format_values
 from .rules import rule
@@ -92,7 +93,7 @@ def absorbed(rounds, named) -> list:
     """``not_identifiable`` entries (kind "absorbed") of the candidates whose evidence the wind took: an
     effect with shape terms (:func:`has_shape_terms`: the wind's) named in some round and still named at
     the end (``named``), and a candidate that cleared every naming test in that round, at a size of at
-    least its detection size (:attr:`mmg.effects.Effect.detection_size`), and no longer cleared them in the
+    least its detection size (:func:`~.identifiability._size_of`, in its magnitude's unit), and no longer cleared them in the
     next round, beside it and the effects named before it.  The shape terms are free within their priors
     to follow a load curve that is not the regression's, so they can take part of the candidate's signature
     (of a rudder offset's most, ``bench/wind_alias.py``): its value in that fit is no evidence that it is
@@ -123,7 +124,7 @@ def absorbed(rounds, named) -> list:
         for c in rnd["candidates"]:
             eff, after = c["effect"], beside.get(c["effect"])
             if (after is None or after["clears_threshold"] or not c["clears_threshold"] or eff in named
-                    or eff in out or abs(c["magnitude"]) < E.get(eff).detection_size[0]):
+                    or eff in out or abs(c["magnitude"]) < _size_of(eff)[0]):
                 continue
             before = f" beside {', '.join(rnd['model'])}" if rnd.get("model") else ""
             out[eff] = {"effect": eff, "confused_with": [shaped[0]], "correlation": None,
